@@ -1,0 +1,47 @@
+"""Checks of user-given arguments, raised as ValueError before any solver work.
+
+Each message names the argument, what was given and what is allowed.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+
+def as_vector(name: str, value, size: int, unit: str) -> np.ndarray:
+    """value as a finite float array of shape (size,), else ValueError."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be an array of {size} numbers ({unit}), got {value!r}") from None
+    if array.shape != (size,):
+        raise ValueError(f"{name} must have shape ({size},) ({unit}), got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite ({unit}), got {array.tolist()}")
+    return array
+
+
+def as_positive(name: str, value, unit: str) -> float:
+    """value as a finite float > 0, else ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value) or value <= 0:
+        raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}")
+    return float(value)
+
+
+def as_optional_positive(name: str, value, unit: str) -> float | None:
+    return None if value is None else as_positive(name, value, unit)
+
+
+def as_matrix(name: str, value, shape: tuple[int, ...], unit: str) -> np.ndarray:
+    """value as a finite float array of the given shape, else ValueError."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a numeric array of shape {shape} ({unit}), got {value!r}") from None
+    if array.shape != shape:
+        raise ValueError(f"{name} must have shape {shape} ({unit}), got shape {array.shape}")
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite ({unit}); it holds NaN or inf")
+    return array

@@ -1,0 +1,106 @@
+"""The body interface every layer above speaks: inertia, damping, kinematics, one discrete step.
+
+Notation (shared with the rest of comanip): joint (or Cartesian) position q (n,), velocity qdot (n,),
+state s = [q; qdot] (2n,), control tau (n,) in N·m or N, end-effector position x = x_ee(q) (d,) in m,
+Jacobian J(q) = dx_ee/dq (d, n), step h in s.
+
+A body is written once as CasADi expressions. The belief layer linearises `discrete_step` with CasADi, so
+a nonlinear body (the Panda) plugs in by overriding the few methods below; nothing above changes.
+"""
+
+from __future__ import annotations
+
+from abc import ABC, abstractmethod
+from functools import cached_property
+
+import casadi as ca
+import numpy as np
+
+
+class Body(ABC):
+    """A rigid body model: ``M(q) qddot + D qdot + G(q) = tau``.
+
+    Subclasses set ``n`` (degrees of freedom), ``d`` (task-space dimension) and ``name``, and implement
+    :meth:`mass_matrix`, :meth:`end_effector`. Everything else has a default that holds for any body.
+    """
+
+    n: int
+    d: int
+    name: str
+
+    #: Damping D (n, n), N·m·s/rad or N·s/m.
+    damping: np.ndarray
+
+    @abstractmethod
+    def mass_matrix(self, q: ca.SX) -> ca.SX:
+        """Inertia M(q) (n, n), kg·m² or kg, as a CasADi expression of q (n,)."""
+
+    @abstractmethod
+    def end_effector(self, q: ca.SX) -> ca.SX:
+        """End-effector position x_ee(q) (d,), m, as a CasADi expression of q (n,)."""
+
+    def gravity(self, q: ca.SX) -> ca.SX:
+        """Gravity torque G(q) (n,). Zero by default: point masses, and arms whose controller compensates it."""
+        return ca.SX.zeros(self.n)
+
+    def jacobian(self, q: ca.SX) -> ca.SX:
+        """Translational Jacobian J(q) = dx_ee/dq (d, n)."""
+        return ca.jacobian(self.end_effector(q), q)
+
+    def discrete_step(self, s: ca.SX, tau: ca.SX, h: float) -> ca.SX:
+        """Mean state after one forward-Euler step of length h (s): s (2n,), tau (n,) -> (2n,).
+
+        qddot = M(q)^-1 (tau - D qdot - G(q)); q+ = q + h qdot; qdot+ = qdot + h qddot.
+        """
+        q, qdot = s[: self.n], s[self.n :]
+        qddot = ca.solve(self.mass_matrix(q), tau - ca.mtimes(self.damping, qdot) - self.gravity(q))
+        return ca.vertcat(q + h * qdot, qdot + h * qddot)
+
+    @property
+    def is_linear(self) -> bool:
+        """True when M is constant and x_ee is linear, so the belief dynamics are exactly LTI."""
+        return False
+
+    @cached_property
+    def kinematics_function(self) -> ca.Function:
+        """Numeric ``(q (n,)) -> (x_ee (d,), J (d, n))``."""
+        q = ca.SX.sym("q", self.n)
+        return ca.Function("kinematics", [q], [self.end_effector(q), self.jacobian(q)], ["q"], ["x", "J"])
+
+    @cached_property
+    def mass_matrix_function(self) -> ca.Function:
+        """Numeric ``(q (n,)) -> M (n, n)``."""
+        q = ca.SX.sym("q", self.n)
+        return ca.Function("M", [q], [self.mass_matrix(q)], ["q"], ["M"])
+
+    @cached_property
+    def gravity_function(self) -> ca.Function:
+        """Numeric ``(q (n,)) -> G (n,)``."""
+        q = ca.SX.sym("q", self.n)
+        return ca.Function("G", [q], [self.gravity(q)], ["q"], ["G"])
+
+    def inverse_dynamics(self, q: np.ndarray, qdot: np.ndarray, qddot: np.ndarray) -> np.ndarray:
+        """Torque (n,) that produces acceleration qddot at (q, qdot): M(q) qddot + D qdot + G(q)."""
+        M = np.asarray(self.mass_matrix_function(q))
+        G = np.asarray(self.gravity_function(q)).ravel()
+        return M @ qddot + self.damping @ qdot + G
+
+    def inverse_kinematics(self, x: np.ndarray, q_init: np.ndarray, iterations: int = 100) -> np.ndarray:
+        """Joint position (n,) whose end effector is nearest x (d,), m, by damped least squares from q_init."""
+        q = np.array(q_init, dtype=float)
+        for _ in range(iterations):
+            x_q, J = (np.asarray(v) for v in self.kinematics_function(q))
+            error = np.asarray(x, dtype=float) - x_q.ravel()
+            if np.linalg.norm(error) < 1e-9:
+                break
+            q = q + J.T @ np.linalg.solve(J @ J.T + 1e-6 * np.eye(self.d), error)
+            q = self.clip_to_limits(q)
+        return q
+
+    def clip_to_limits(self, q: np.ndarray) -> np.ndarray:
+        """q (n,) clipped to the joint limits; unchanged for a body without limits."""
+        return q
+
+    @abstractmethod
+    def config(self) -> dict:
+        """The body's parameters as plain data with a ``type`` key (for YAML); see :func:`comanip.bodies.body_from_config`."""

@@ -1,0 +1,47 @@
+"""``comanip plan``: plan one reach and write it as JSON and CSV (and a PNG figure on request)."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.planning.planner import Planner
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser("plan", help="plan one reach", description=__doc__)
+    add_model_arguments(parser)
+    parser.add_argument("--start", type=vector, help="start state [q; qdot], comma-separated (default: at rest at the origin)")
+    parser.add_argument("--goal", type=vector, help="goal position (m), comma-separated (default: 0.3 m along x from the start)")
+    parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
+    parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
+    parser.add_argument("--out", default="out/plan", help="output folder (default: %(default)s)")
+    parser.add_argument("--png", action="store_true", help="also save a figure")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    model = load_model(args)
+    planner = Planner(model)
+    start = np.zeros(2 * model.n) if args.start is None else args.start
+    if args.goal is None:
+        start_x = np.asarray(model.body.kinematics_function(planner.check_inputs(start, np.zeros(model.d), None)[0][: model.n])[0]).ravel()
+        goal = start_x + 0.3 * np.eye(model.d)[0]
+    else:
+        goal = args.goal
+    plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)
+    out = output_dir(args.out)
+    plan.save_json(out / "plan.json")
+    plan.save_csv(out / "plan.csv")
+    written = [out / "plan.json", out / "plan.csv"]
+    if args.png:
+        from comanip.plots.plan_figure import plot_plan
+
+        written.append(plot_plan(plan, out / "plan.png"))
+    print(json.dumps({"model": model.name, "goal": np.asarray(plan.goal).tolist(), "width": plan.width,
+                      "success": plan.success, "status": plan.status, "objective": plan.objective,
+                      "solve_time_s": plan.solve_time, "iterations": plan.iterations,
+                      "final_error_m": plan.final_error, "files": [str(p) for p in written]}, indent=1))
+    return 0 if plan.success else 1

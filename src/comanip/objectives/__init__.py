@@ -1,0 +1,14 @@
+"""Objectives: expected reward of hitting the goal, its discounting over time, and effort."""
+
+from comanip.objectives.discounting import DISCOUNT_FORMS, discount_weights
+from comanip.objectives.reach_objective import reach_objective
+from comanip.objectives.reward import GOAL_COVARIANCE_FORMS, expected_reward, goal_covariance
+
+__all__ = [
+    "DISCOUNT_FORMS",
+    "GOAL_COVARIANCE_FORMS",
+    "discount_weights",
+    "expected_reward",
+    "goal_covariance",
+    "reach_objective",
+]

@@ -1,0 +1,47 @@
+"""Initial guesses: minimum-jerk reaches (Flash & Hogan 1985) turned into torques by inverse dynamics.
+
+The zero-torque guess is a trap: far from a narrow goal the expected reward underflows, its gradient is
+~0, and a solver stops at once with the arm at rest (SPEC §9). A smooth reach of a chosen duration starts
+the solver where the reward is felt; the duration selects among the local optima.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from comanip.bodies.body import Body
+
+
+def minimum_jerk(x0, v0, x1, duration: float, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Quintic from x0 (k,) at velocity v0 (k,), zero acceleration, to rest at x1 (k,) after duration (s).
+
+    Returns position, velocity, acceleration, each (len(t), k); held at x1 after the duration.
+    With v0 = 0 this is the Flash–Hogan minimum-jerk profile (peak speed at mid-movement).
+    """
+    x0, v0, x1 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (x0, v0, x1))
+    T = float(duration)
+    lhs = np.array([[T**3, T**4, T**5], [3 * T**2, 4 * T**3, 5 * T**4], [6 * T, 12 * T**2, 20 * T**3]])
+    rhs = np.stack([x1 - x0 - v0 * T, -v0, np.zeros_like(v0)])
+    a3, a4, a5 = np.linalg.solve(lhs, rhs)
+    tc = np.clip(np.asarray(t, dtype=float), 0.0, T)[:, None]
+    pos = x0 + v0 * tc + a3 * tc**3 + a4 * tc**4 + a5 * tc**5
+    vel = v0 + 3 * a3 * tc**2 + 4 * a4 * tc**3 + 5 * a5 * tc**4
+    acc = 6 * a3 * tc + 12 * a4 * tc**2 + 20 * a5 * tc**3
+    after = np.asarray(t, dtype=float) > T
+    vel[after] = 0.0
+    acc[after] = 0.0
+    return pos, vel, acc
+
+
+def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration: float) -> np.ndarray:
+    """Torques (H, n) that make the mean follow a joint-space minimum-jerk reach from start (2n,) to goal_q (n,)."""
+    t = h * np.arange(H)
+    q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n :], goal_q, duration, t)
+    return np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(H)])
+
+
+def guess_durations(horizon_s: float, count: int) -> np.ndarray:
+    """Reach durations (s) to try as initial guesses: spread over 25 %–75 % of the horizon."""
+    if count == 1:
+        return np.array([0.5 * horizon_s])
+    return np.linspace(0.25, 0.75, count) * horizon_s

@@ -1,0 +1,103 @@
+"""The result of a planning solve, in the shape of scipy's OptimizeResult: status first, then the plan."""
+
+from __future__ import annotations
+
+import csv
+import json
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+
+@dataclass
+class Plan:
+    """A planned reach and how the solve went.
+
+    Shapes: H steps, n degrees of freedom, d task dimensions. Units: s, m, m/s, N·m (or N for point masses).
+    """
+
+    success: bool
+    """True when the solver converged (to its tolerance or an acceptable level) to a finite plan."""
+    status: str
+    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'unreachable', 'failed'."""
+    message: str
+    """What the solver said, in words."""
+    objective: float
+    """SPEC §4 objective J at the returned torques (lower is better)."""
+    solve_time: float
+    """Wall time of the solve (s), initial guesses included."""
+    iterations: int
+    """Solver iterations (summed over starts)."""
+    t: np.ndarray
+    """Times (H+1,), s."""
+    mean: np.ndarray
+    """Mean state mu_i = [q; qdot] (H+1, 2n)."""
+    cov: np.ndarray
+    """State covariance Sigma_i (H+1, 2n, 2n)."""
+    torque: np.ndarray
+    """Planned command tau_i (H, n); tau_i acts from t_i to t_{i+1}."""
+    ee_mean: np.ndarray
+    """End-effector mean mu_x,i (H+1, d), m."""
+    ee_cov: np.ndarray
+    """End-effector covariance Sigma_x,i (H+1, d, d), m²."""
+    ee_velocity: np.ndarray
+    """End-effector mean velocity J(mu_q) mu_qdot (H+1, d), m/s."""
+    start: np.ndarray
+    """Start state s_0 (2n,)."""
+    goal: np.ndarray
+    """Goal position (d,), m."""
+    width: float
+    """Goal width w (m)."""
+    model_name: str = ""
+    extras: dict = field(default_factory=dict)
+    """Application-specific results (e.g. an estimated goal)."""
+
+    @property
+    def ee_speed(self) -> np.ndarray:
+        """Speed of the mean end effector ||d mu_x/dt|| (H+1,), m/s."""
+        return np.linalg.norm(self.ee_velocity, axis=1)
+
+    @property
+    def ee_std(self) -> np.ndarray:
+        """Per-axis standard deviation of the end effector (H+1, d), m."""
+        return np.sqrt(np.maximum(np.diagonal(self.ee_cov, axis1=1, axis2=2), 0.0))
+
+    @property
+    def final_error(self) -> float:
+        """Distance of the final mean end effector from the goal (m)."""
+        return float(np.linalg.norm(self.ee_mean[-1] - self.goal))
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (arrays as nested lists)."""
+        out = {}
+        for name in self.__dataclass_fields__:
+            value = getattr(self, name)
+            out[name] = value.tolist() if isinstance(value, np.ndarray) else value
+        out["extras"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.extras.items()}
+        return out
+
+    def save_json(self, path: str | Path) -> Path:
+        path = Path(path)
+        path.write_text(json.dumps(self.to_dict(), indent=1))
+        return path
+
+    def save_csv(self, path: str | Path) -> Path:
+        """One row per step: t, q, qdot, x, x velocity, x std, tau (empty on the last row)."""
+        path = Path(path)
+        n, d = self.torque.shape[1], self.ee_mean.shape[1]
+        axes = "xyz"[:d] if d <= 3 else [str(k) for k in range(d)]
+        header = (["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
+                  + [f"x_{a}_m" for a in axes] + [f"v_{a}_m_per_s" for a in axes] + [f"std_{a}_m" for a in axes]
+                  + [f"tau{k}" for k in range(n)])
+        with open(path, "w", newline="") as f:
+            writer = csv.writer(f)
+            writer.writerow(header)
+            for i, t in enumerate(self.t):
+                tau = self.torque[i].tolist() if i < len(self.torque) else [""] * n
+                writer.writerow([t, *self.mean[i], *self.ee_mean[i], *self.ee_velocity[i], *self.ee_std[i], *tau])
+        return path
+
+    def summary(self) -> str:
+        return (f"{self.status} ({'success' if self.success else 'no success'}) objective {self.objective:.4g}, "
+                f"{self.iterations} iterations in {1e3 * self.solve_time:.1f} ms; final error {1e3 * self.final_error:.1f} mm")
