@@ -18,13 +18,10 @@ import casadi as ca
 import numpy as np
 
 from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
-from comanip.belief.propagation import belief_step_function, end_effector_belief_function
 from comanip.model import ReachingModel
-from comanip.objectives.discounting import discount_weights
-from comanip.objectives.reach_objective import reach_objective
-from comanip.objectives.reward import goal_covariance
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques
 from comanip.planning.plan import Plan
+from comanip.planning.reach_problem import ReachProblem
 
 _IPOPT_STATUS = {
     "Solve_Succeeded": ("solved", True),
@@ -67,44 +64,15 @@ class Planner:
         self._build()
 
     def _build(self) -> None:
-        model, body = self.model, self.model.body
-        n, d, H = model.n, model.d, model.H
-        tau = ca.SX.sym("tau", n, H)
-        s0 = ca.SX.sym("s0", 2 * n)
-        goal = ca.SX.sym("goal", d)
-        width = ca.SX.sym("width")
-
-        step = belief_step_function(body, model.h, model.kappa, model.noise)
-        ee = end_effector_belief_function(body)
-        means, covs = [s0], [ca.SX.zeros(2 * n, 2 * n)]
-        for i in range(H):
-            mu, Sigma = step(means[-1], covs[-1], tau[:, i])
-            means.append(mu)
-            covs.append(Sigma)
-        ee_beliefs = [ee(m, S) for m, S in zip(means, covs)]
-        weights = discount_weights(model.gamma, H, model.discount)
-        W = goal_covariance(width, d, model.goal_covariance)
-        J = reach_objective([x for x, _ in ee_beliefs], [S for _, S in ee_beliefs],
-                            [tau[:, i] for i in range(H)], goal, W, weights, model.nu)
-        # Normalise by the best reward attainable (hand on the goal with no noise at every step), so the
-        # solver's tolerances mean the same thing for every width; the minimiser is unchanged.
-        peak = float(np.sum(weights)) / ca.sqrt(ca.det(2 * ca.pi * W))
-        params = ca.vertcat(s0, goal, width)
-        self._n_params = params.shape[0]
-
+        problem = self.problem = ReachProblem(self.model)
+        params = ca.vertcat(problem.s0, problem.goal, problem.width)
         ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations,
                  "tol": self.options.tolerance, **self.options.ipopt}
-        self._deadline = _Deadline(H * n, params.shape[0])
-        self._solver = ca.nlpsol("planner", "ipopt", {"x": ca.vec(tau), "p": params, "f": J / peak},
+        self._deadline = _Deadline(problem.tau.numel(), params.shape[0])
+        self._solver = ca.nlpsol("planner", "ipopt",
+                                 {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
                                  {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
                                   "iteration_callback": self._deadline})
-        self._trajectory = ca.Function(
-            "trajectory", [ca.vec(tau), params],
-            [ca.horzcat(*means), ca.horzcat(*covs), ca.horzcat(*[x for x, _ in ee_beliefs]),
-             ca.horzcat(*[S for _, S in ee_beliefs]), J],
-            ["tau", "p"], ["mean", "cov", "ee_mean", "ee_cov", "J"])
-        q, qdot = ca.SX.sym("q", n), ca.SX.sym("qdot", n)
-        self._ee_velocity = ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1)
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (2n,), goal (d,), width) or ValueError naming the argument."""
@@ -131,8 +99,7 @@ class Planner:
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         guesses = self._initial_guesses(start, goal, warm_start)
-        params = np.concatenate([start, goal, [width]])
-        return self._solve_from(guesses, params, start, goal, width, max_wall_time)
+        return self._solve_from(guesses, start, goal, width, max_wall_time)
 
     def _initial_guesses(self, start, goal, warm_start) -> list[np.ndarray]:
         model = self.model
@@ -143,48 +110,39 @@ class Planner:
         return [minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, T)
                 for T in guess_durations(model.duration, self.options.n_starts)]
 
-    def _solve_from(self, guesses, params, start, goal, width, max_wall_time) -> Plan:
+    def _solve_from(self, guesses, start, goal, width, max_wall_time) -> Plan:
         t_begin = time.perf_counter()
+        params = np.concatenate([start, goal, [width]])
         best = None
         iterations = 0
         for guess in guesses:
             remaining = None if max_wall_time is None else max_wall_time - (time.perf_counter() - t_begin)
             if remaining is not None and remaining <= 0 and best is not None:
                 break
-            x, status, success, message, nit = self._run_solver(guess, params, remaining)
+            torque, status, success, message, nit = self._run_solver(guess, params, remaining)
             iterations += nit
-            objective = float(self._trajectory(x, params)[4])
-            if not np.isfinite(objective):
-                x, objective, status, success = ca.vec(guess.T), float(self._trajectory(ca.vec(guess.T), params)[4]), "failed", False
+            objective = self.problem.objective_value(torque, start, goal, width)
+            if not np.all(np.isfinite(torque)) or not np.isfinite(objective):
+                torque, status, success = guess, "failed", False
+                objective = self.problem.objective_value(guess, start, goal, width)
                 message = "solver returned a non-finite plan; returning the initial guess"
-            candidate = (not success, objective, x, status, success, message)
+            candidate = (not success, objective, torque, status, success, message)
             if best is None or candidate[:2] < best[:2]:
                 best = candidate
-        _, objective, x, status, success, message = best
-        return self._make_plan(np.asarray(x).ravel(), params, start, goal, width, status, success, message,
-                               time.perf_counter() - t_begin, iterations)
+        _, _, torque, status, success, message = best
+        return self.problem.make_plan(torque, start, goal, width, status=status, success=success, message=message,
+                                      solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
     def _run_solver(self, guess: np.ndarray, params: np.ndarray, budget: float | None):
+        """One IPOPT run from torques guess (H, n); returns (torques (H, n), status, success, message, iterations)."""
         self._deadline.time = np.inf if budget is None else time.perf_counter() + budget
-        result = self._solver(x0=ca.vec(ca.DM(guess).T), p=params)
+        result = self._solver(x0=np.ravel(guess), p=params)
         stats = self._solver.stats()
         status, success = _IPOPT_STATUS.get(stats["return_status"], ("failed", False))
         if stats["return_status"] == "User_Requested_Stop" and self._deadline.expired:
             status = "max_wall_time"
-        return result["x"], status, success, stats["return_status"], int(stats.get("iter_count", 0))
-
-    def _make_plan(self, x, params, start, goal, width, status, success, message, solve_time, iterations) -> Plan:
-        model = self.model
-        mean, cov, ee_mean, ee_cov, J = (np.asarray(v) for v in self._trajectory(x, params))
-        n2, d, H = 2 * model.n, model.d, model.H
-        mean = mean.T
-        ee_velocity = np.asarray(self._ee_velocity(mean[:, : model.n].T, mean[:, model.n :].T)).T
-        return Plan(
-            success=bool(success), status=status, message=message, objective=float(J.item()),
-            solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),
-            mean=mean, cov=cov.reshape(n2, H + 1, n2).transpose(1, 0, 2),
-            torque=x.reshape(H, model.n), ee_mean=ee_mean.T, ee_cov=ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2),
-            ee_velocity=ee_velocity, start=start, goal=goal, width=width, model_name=model.name)
+        torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
+        return torque, status, success, stats["return_status"], int(stats.get("iter_count", 0))
 
 
 class _Deadline(ca.Callback):

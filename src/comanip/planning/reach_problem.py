@@ -1,0 +1,78 @@
+"""The reaching problem as CasADi expressions, shared by the planner and the goal estimator.
+
+Symbols: tau (n, H) torques, s0 (2n,) start state, goal (d,) m, width (scalar) m. From them, by single
+shooting through the belief dynamics: means[i] (2n,), covs[i] (2n, 2n), ee_means[i] (d,),
+ee_covs[i] (d, d) for i = 0..H, and the SPEC §4 objective J. Which symbols are decision variables and
+which are parameters is the caller's choice (the estimator makes the goal a decision variable).
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from comanip.belief.propagation import belief_step_function, end_effector_belief_function
+from comanip.model import ReachingModel
+from comanip.objectives.discounting import discount_weights
+from comanip.objectives.reach_objective import reach_objective
+from comanip.objectives.reward import goal_covariance
+from comanip.planning.plan import Plan
+
+
+class ReachProblem:
+    """Single-shooting expressions of one model's reaching problem (built once, in SX)."""
+
+    def __init__(self, model: ReachingModel):
+        self.model = model
+        body, n, d, H = model.body, model.n, model.d, model.H
+        self.tau = ca.SX.sym("tau", n, H)
+        self.s0 = ca.SX.sym("s0", 2 * n)
+        self.goal = ca.SX.sym("goal", d)
+        self.width = ca.SX.sym("width")
+
+        step = belief_step_function(body, model.h, model.kappa, model.noise)
+        ee = end_effector_belief_function(body)
+        self.means, self.covs = [self.s0], [ca.SX.zeros(2 * n, 2 * n)]
+        for i in range(H):
+            mu, Sigma = step(self.means[-1], self.covs[-1], self.tau[:, i])
+            self.means.append(mu)
+            self.covs.append(Sigma)
+        ee_beliefs = [ee(m, S) for m, S in zip(self.means, self.covs)]
+        self.ee_means = [x for x, _ in ee_beliefs]
+        self.ee_covs = [S for _, S in ee_beliefs]
+        weights = discount_weights(model.gamma, H, model.discount)
+        self.W = goal_covariance(self.width, d, model.goal_covariance)
+        self.objective = reach_objective(self.ee_means, self.ee_covs, [self.tau[:, i] for i in range(H)],
+                                         self.goal, self.W, weights, model.nu)
+        # The best objective attainable (hand on the goal with no noise at every step, no effort), used to
+        # normalise J for the solver so its tolerances mean the same for every width; the minimiser is unchanged.
+        self.best_objective = -float(np.sum(weights)) / ca.sqrt(ca.det(2 * ca.pi * self.W))
+
+        self.trajectory = ca.Function(
+            "trajectory", [ca.vec(self.tau), self.s0, self.goal, self.width],
+            [ca.horzcat(*self.means), ca.horzcat(*self.covs), ca.horzcat(*self.ee_means),
+             ca.horzcat(*self.ee_covs), self.objective],
+            ["tau", "s0", "goal", "width"], ["mean", "cov", "ee_mean", "ee_cov", "J"])
+        q, qdot = ca.SX.sym("q", n), ca.SX.sym("qdot", n)
+        self._ee_velocity = ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1)
+
+    def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
+        """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
+        return float(np.asarray(self.trajectory(np.ravel(torque), start, goal, width)[4]).item())
+
+    def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
+                  solve_time: float, iterations: int, extras: dict | None = None) -> Plan:
+        """A :class:`Plan` for torques (H, n): rolls the belief out and fills every field."""
+        model = self.model
+        n2, d, H = 2 * model.n, model.d, model.H
+        torque = np.asarray(torque, dtype=float).reshape(H, model.n)
+        mean, cov, ee_mean, ee_cov, J = (np.asarray(v) for v in self.trajectory(torque.ravel(), start, goal, width))
+        mean = mean.T
+        ee_velocity = np.asarray(self._ee_velocity(mean[:, : model.n].T, mean[:, model.n :].T)).T
+        return Plan(
+            success=bool(success), status=status, message=message, objective=float(J.item()),
+            solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),
+            mean=mean, cov=cov.reshape(n2, H + 1, n2).transpose(1, 0, 2), torque=torque,
+            ee_mean=ee_mean.T, ee_cov=ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2), ee_velocity=ee_velocity,
+            start=np.asarray(start, dtype=float), goal=np.asarray(goal, dtype=float), width=float(width),
+            model_name=model.name, extras=extras or {})
