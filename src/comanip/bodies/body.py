@@ -97,9 +97,34 @@ class Body(ABC):
             q = self.clip_to_limits(q)
         return q
 
+    @property
+    def q_min(self) -> np.ndarray:
+        """Lower position limits (n,), rad or m; -inf (no limit) unless the body has joint limits."""
+        return np.full(self.n, -np.inf)
+
+    @property
+    def q_max(self) -> np.ndarray:
+        """Upper position limits (n,), rad or m; +inf (no limit) unless the body has joint limits."""
+        return np.full(self.n, np.inf)
+
+    @property
+    def qdot_max(self) -> np.ndarray:
+        """Speed limits (n,), rad/s or m/s, symmetric (|qdot| <= qdot_max); +inf unless the body has limits."""
+        return np.full(self.n, np.inf)
+
+    @property
+    def tau_max(self) -> np.ndarray:
+        """Torque or force limits (n,), N·m or N, symmetric (|tau| <= tau_max); +inf unless the body has limits."""
+        return np.full(self.n, np.inf)
+
+    @property
+    def home_position(self) -> np.ndarray:
+        """Position q (n,) the body rests in before a reach (the default start): the origin unless overridden."""
+        return np.zeros(self.n)
+
     def clip_to_limits(self, q: np.ndarray) -> np.ndarray:
-        """q (n,) clipped to the joint limits; unchanged for a body without limits."""
-        return q
+        """q (n,) clipped to [q_min, q_max]; unchanged for a body without limits."""
+        return np.clip(q, self.q_min, self.q_max)
 
     @abstractmethod
     def config(self) -> dict:
