@@ -6,7 +6,10 @@ from comanip.bodies.body import Body
 from comanip.bodies.point_mass import PointMass
 
 #: body ``type`` in a config -> "module:class"; imported on use so heavy bodies cost nothing until asked for.
-BODY_TYPES = {"point_mass": "comanip.bodies.point_mass:PointMass"}
+BODY_TYPES = {
+    "point_mass": "comanip.bodies.point_mass:PointMass",
+    "panda": "comanip.bodies.panda:Panda",
+}
 
 
 def body_from_config(config: dict) -> Body:

@@ -52,3 +52,8 @@ def planar() -> ReachingModel:
 def cartesian() -> ReachingModel:
     """Cartesian point mass (n = d = 3), H = 50, h = 0.055 s."""
     return load("cartesian")
+
+
+def franka() -> ReachingModel:
+    """Franka Emika Panda (n = 7 joints, d = 3), H = 50, h = 0.035 s; start from ``model.body.home_position``."""
+    return load("franka")
