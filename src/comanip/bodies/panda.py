@@ -98,6 +98,33 @@ class Panda(Body):
     def gravity(self, q):
         return self._rigid_body["G"](q) if self.include_gravity else super().gravity(q)
 
+    @cached_property
+    def _inverse_kinematics_solver(self) -> ca.Function:
+        """IPOPT on min ½||x_ee(q) - x||² + ½ lambda ||q - q_init||² within [q_min, q_max]; p = [x; q_init]."""
+        q, x, q_init = ca.SX.sym("q", self.n), ca.SX.sym("x", self.d), ca.SX.sym("q_init", self.n)
+        # lambda (m²/rad²) only picks, among the redundant arm's many solutions, the one nearest q_init; it
+        # biases the reached point by about lambda·|q - q_init| / sigma_min(J)² (~1e-7 m), removed by the polish.
+        objective = 0.5 * ca.sumsqr(self.end_effector(q) - x) + 0.5e-6 * ca.sumsqr(q - q_init)
+        return ca.nlpsol("panda_ik", "ipopt", {"x": q, "p": ca.vertcat(x, q_init), "f": objective},
+                         {"ipopt": {"print_level": 0, "sb": "yes", "tol": 1e-12, "max_iter": 200},
+                          "print_time": False, "error_on_fail": False})
+
+    def inverse_kinematics(self, x: np.ndarray, q_init: np.ndarray, iterations: int = 100) -> np.ndarray:
+        """Joint position (n,) within the joint limits whose end effector is nearest x (3,), m.
+
+        The base class's damped least squares, clipped at the limits, can stall against a limit (about 1
+        in 30 random reachable targets did); a bound-constrained IPOPT solve does not, and a few
+        least-squares steps from its answer then remove the bias of its tie-breaking term. Out of reach,
+        the answer is the nearest reachable point within the limits.
+        """
+        q_init = self.clip_to_limits(as_vector("q_init", q_init, self.n, "joint position, rad"))
+        x = as_vector("x", x, self.d, "end-effector position, m")
+        result = self._inverse_kinematics_solver(x0=q_init, p=np.concatenate([x, q_init]), lbx=self.q_min, ubx=self.q_max)
+        q_nearest = self.clip_to_limits(np.asarray(result["x"]).ravel())  # IPOPT relaxes bounds by ~1e-8
+        q_polished = super().inverse_kinematics(x, q_nearest, iterations)
+        # Out of reach the least-squares steps leap about near the stretched-out singularity: keep the better.
+        return min((q_polished, q_nearest), key=lambda q: np.linalg.norm(np.asarray(self.kinematics_function(q)[0]).ravel() - x))
+
     @property
     def q_min(self) -> np.ndarray:
         return self._limits["q_min"].copy()
