@@ -148,10 +148,10 @@ class Planner:
 class _Deadline(ca.Callback):
     """IPOPT iteration callback that asks the solver to stop once ``time`` (perf_counter, s) has passed."""
 
-    def __init__(self, n_x: int, n_p: int):
+    def __init__(self, n_x: int, n_p: int, n_g: int = 0):
         ca.Callback.__init__(self)
         self.time = np.inf
-        self._sizes = {"x": n_x, "f": 1, "g": 0, "lam_x": n_x, "lam_g": 0, "lam_p": n_p}
+        self._sizes = {"x": n_x, "f": 1, "g": n_g, "lam_x": n_x, "lam_g": n_g, "lam_p": n_p}
         self.construct("deadline", {})
 
     @property
