@@ -13,7 +13,8 @@ from comanip.planning.planner import Planner
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("plan", help="plan one reach", description=__doc__)
     add_model_arguments(parser)
-    parser.add_argument("--start", type=vector, help="start state [q; qdot], comma-separated (default: at rest at the origin)")
+    parser.add_argument("--start", type=vector, help="start state [q; qdot], comma-separated (default: at rest at the body's home position: "
+                        "the origin for a point mass, the ready pose for the Panda)")
     parser.add_argument("--goal", type=vector, help="goal position (m), comma-separated (default: 0.3 m along x from the start)")
     parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
     parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
@@ -25,7 +26,7 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     model = load_model(args)
     planner = Planner(model)
-    start = np.zeros(2 * model.n) if args.start is None else args.start
+    start = np.concatenate([model.body.home_position, np.zeros(model.n)]) if args.start is None else args.start
     if args.goal is None:
         start_x = np.asarray(model.body.kinematics_function(planner.check_inputs(start, np.zeros(model.d), None)[0][: model.n])[0]).ravel()
         goal = start_x + 0.3 * np.eye(model.d)[0]
