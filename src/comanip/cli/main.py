@@ -10,6 +10,7 @@ from importlib import import_module
 #: subcommand modules, in the order ``comanip --help`` lists them
 SUBCOMMAND_MODULES = [
     "comanip.cli.plan_command",
+    "comanip.cli.transition_command",
 ]
 
 

@@ -1,0 +1,169 @@
+"""Transition-point data from a simulated person who reaches in two components.
+
+The person is the closed-loop reacher of :func:`comanip.execution.execute_receding_horizon`: at every step
+it replans the whole H-step reach from its current noisy state (visual feedback) and executes the first
+torque with signal-dependent noise (SPEC §2). The fast first part of the reach spreads the hand across the
+path; the replanning then corrects it, so the perpendicular dispersion rises and falls, and its peak marks
+the transition (Peternel & Babič 2019; SPEC §8).
+
+A condition is a goal at distance D = (D/L)·L along x from rest at the origin, with width w (m). N trials
+per condition give one row of the transition CSV (:mod:`comanip.multicomponent.transition_csv`). The sweep
+runs conditions in parallel on a Dask ``LocalCluster`` (one single-threaded worker process per core; each
+builds its planner once), with a tqdm progress bar.
+"""
+
+from __future__ import annotations
+
+import json
+from functools import lru_cache
+
+import numpy as np
+from tqdm import tqdm
+
+from comanip.arguments import as_positive
+from comanip.execution import execute_receding_horizon
+from comanip.model import ReachingModel
+from comanip.multicomponent.dispersion import bootstrap_transition_std, first_passage_deviations, profile_from_deviations
+from comanip.planning.planner import Planner
+
+#: Default arm length L (m) that normalises the goal distance.
+ARM_LENGTH = 0.7
+
+#: Settling criterion (SPEC §6): final speed below this fraction of the trial's peak speed.
+SETTLED_SPEED_FRACTION = 0.05
+
+
+def default_steps(model: ReachingModel) -> int:
+    """Executed steps per reach: 2H. The receding window stays H long, so a person executes more steps than
+    H to finish slow, narrow-goal reaches (30 steps left w = 0.005 m reaches unsettled, SPEC §9)."""
+    return 2 * model.H
+
+
+def simulate_paths(planner: Planner, distance: float, width: float, n_trials: int, steps: int,
+                   rng: np.random.Generator) -> tuple[np.ndarray, int, int]:
+    """Hand paths of n_trials closed-loop reaches from rest at the origin to a goal distance (m) along x.
+
+    Returns (paths (n_trials, steps+1, d) m, trials that settled in the goal, failed replans in total).
+    """
+    model = planner.model
+    goal = np.zeros(model.d)
+    goal[0] = distance
+    start = np.zeros(2 * model.n)
+    paths, settled, failed = [], 0, 0
+    for _ in range(n_trials):
+        run = execute_receding_horizon(planner, start, goal, width, steps=steps, rng=rng)
+        paths.append(run.ee)
+        speed = run.ee_speed
+        settled += bool(np.linalg.norm(run.ee[-1] - goal) <= width and speed[-1] <= SETTLED_SPEED_FRACTION * speed.max())
+        failed += run.failed_replans
+    return np.array(paths), settled, failed
+
+
+def simulate_condition(planner: Planner, distance_over_arm_length: float, width: float, n_trials: int,
+                       arm_length: float, steps: int, rng: np.random.Generator) -> dict:
+    """One transition-CSV row (dict keyed by the CSV columns) from n_trials reaches of one condition."""
+    distance = distance_over_arm_length * arm_length
+    paths, settled, failed = simulate_paths(planner, distance, width, n_trials, steps, rng)
+    goal = np.zeros(planner.model.d)
+    goal[0] = distance
+    grid, deviations = first_passage_deviations(paths, goal)
+    profile = profile_from_deviations(grid, deviations)
+    return {
+        "distance_over_arm_length": distance_over_arm_length,
+        "width_m": width,
+        "transition_distance_m": profile.transition_distance,
+        "peak_dispersion_m": profile.peak_dispersion,
+        "n_trials": n_trials,
+        "transition_distance_se_m": bootstrap_transition_std(grid, deviations, rng),
+        "settled_trials": settled,
+        "failed_replans": failed,
+    }
+
+
+def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 40, *,
+                             model: ReachingModel | None = None, arm_length: float = ARM_LENGTH,
+                             steps: int | None = None, seed: int = 0, workers: int = 2,
+                             progress: bool = True) -> list[dict]:
+    """Sweep every (D/L, w) pair and return one transition-CSV row per condition, in grid order.
+
+    Args:
+        distances_over_arm_length: goal distances D/L (> 0), dimensionless.
+        widths: goal widths w (> 0), m.
+        n_trials: closed-loop reaches per condition (≥ 3).
+        model: the person (default ``presets.planar()``; a 2-D point mass reaching along x).
+        arm_length: L (m) that turns D/L into metres.
+        steps: executed steps per reach (default :func:`default_steps`, 2H).
+        seed: seeds every condition's generator (one child of ``SeedSequence(seed)`` per condition, so the
+            result does not depend on the number of workers or their order).
+        workers: worker processes (1 runs in this process, no Dask).
+        progress: show a tqdm bar over conditions.
+    """
+    from comanip import presets
+
+    model = presets.planar() if model is None else model
+    if not isinstance(model, ReachingModel):
+        raise ValueError(f"model must be a comanip.ReachingModel, got {type(model).__name__}")
+    distances = _positive_values("distances_over_arm_length", distances_over_arm_length, "goal distance / arm length")
+    widths = _positive_values("widths", widths, "goal width, m")
+    arm_length = as_positive("arm_length", arm_length, "m")
+    n_trials = _integer_at_least("n_trials", n_trials, 3)
+    steps = default_steps(model) if steps is None else _integer_at_least("steps", steps, 1)
+    workers = _integer_at_least("workers", workers, 1)
+    seed = _integer_at_least("seed", seed, 0)
+
+    conditions = [(float(r), float(w)) for r in distances for w in widths]
+    seeds = np.random.SeedSequence(seed).spawn(len(conditions))
+    config = json.dumps(model.config())
+    tasks = [(config, r, w, n_trials, arm_length, steps, s) for (r, w), s in zip(conditions, seeds)]
+    bar = tqdm(total=len(tasks), desc="transition conditions", unit="condition", disable=not progress)
+    if workers == 1:
+        rows = []
+        for task in tasks:
+            rows.append(_condition_task(*task))
+            bar.update()
+    else:
+        rows = _run_on_local_cluster(tasks, workers, bar)
+    bar.close()
+    return rows
+
+
+def _run_on_local_cluster(tasks: list[tuple], workers: int, bar: tqdm) -> list[dict]:
+    """Run condition tasks on a Dask LocalCluster of single-threaded worker processes; rows in task order."""
+    from dask.distributed import Client, LocalCluster, as_completed
+
+    # processes, not threads: CasADi/IPOPT solves hold the GIL; no dashboard (no web server in a batch job)
+    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            Client(cluster) as client:
+        futures = client.map(_condition_task, *zip(*tasks), pure=False)
+        index = {future.key: i for i, future in enumerate(futures)}
+        rows = [None] * len(tasks)
+        for future in as_completed(futures):
+            rows[index[future.key]] = future.result()
+            bar.update()
+    return rows
+
+
+def _condition_task(model_config: str, distance_over_arm_length: float, width: float, n_trials: int,
+                    arm_length: float, steps: int, seed: np.random.SeedSequence) -> dict:
+    planner = _planner_for(model_config)
+    return simulate_condition(planner, distance_over_arm_length, width, n_trials, arm_length, steps,
+                              np.random.default_rng(seed))
+
+
+@lru_cache(maxsize=2)
+def _planner_for(model_config: str) -> Planner:
+    """One planner per model per process: a worker builds it on its first condition and reuses it."""
+    return Planner(ReachingModel.from_config(json.loads(model_config)))
+
+
+def _positive_values(name: str, values, unit: str) -> np.ndarray:
+    array = np.atleast_1d(np.asarray(values, dtype=float))
+    if array.ndim != 1 or array.size == 0 or not np.all(np.isfinite(array)) or np.any(array <= 0):
+        raise ValueError(f"{name} must be a non-empty list of finite numbers > 0 ({unit}), got {np.asarray(values).tolist()}")
+    return array
+
+
+def _integer_at_least(name: str, value, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
+    return int(value)
