@@ -97,25 +97,34 @@ class Body(ABC):
             q = self.clip_to_limits(q)
         return q
 
+    #: Joint limits as {"q_min", "q_max", "qdot_max", "tau_max"} -> (n,) arrays; None for a body without
+    #: limits, whose limit properties are then infinite.
+    joint_limits: dict[str, np.ndarray] | None = None
+
+    def _limit(self, key: str, unbounded: float) -> np.ndarray:
+        if self.joint_limits is None:
+            return np.full(self.n, unbounded)
+        return np.array(self.joint_limits[key], dtype=float)
+
     @property
     def q_min(self) -> np.ndarray:
         """Lower position limits (n,), rad or m; -inf (no limit) unless the body has joint limits."""
-        return np.full(self.n, -np.inf)
+        return self._limit("q_min", -np.inf)
 
     @property
     def q_max(self) -> np.ndarray:
         """Upper position limits (n,), rad or m; +inf (no limit) unless the body has joint limits."""
-        return np.full(self.n, np.inf)
+        return self._limit("q_max", np.inf)
 
     @property
     def qdot_max(self) -> np.ndarray:
         """Speed limits (n,), rad/s or m/s, symmetric (|qdot| <= qdot_max); +inf unless the body has limits."""
-        return np.full(self.n, np.inf)
+        return self._limit("qdot_max", np.inf)
 
     @property
     def tau_max(self) -> np.ndarray:
         """Torque or force limits (n,), N·m or N, symmetric (|tau| <= tau_max); +inf unless the body has limits."""
-        return np.full(self.n, np.inf)
+        return self._limit("tau_max", np.inf)
 
     @property
     def home_position(self) -> np.ndarray:

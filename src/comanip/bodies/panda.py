@@ -68,7 +68,7 @@ class Panda(Body):
                 raise ValueError(f"{flag} must be True or False, got {value!r}")
         self.hand, self.include_gravity = bool(hand), bool(gravity)
         self.urdf = reduced_panda_urdf(self.hand, self.tcp_offset)
-        self._limits = arm_joint_limits(self.urdf)
+        self.joint_limits = arm_joint_limits(self.urdf)  # position (rad), speed (rad/s), torque (N·m)
 
     @cached_property
     def _rigid_body(self) -> dict[str, ca.Function]:
@@ -124,22 +124,6 @@ class Panda(Body):
         q_polished = super().inverse_kinematics(x, q_nearest, iterations)
         # Out of reach the least-squares steps leap about near the stretched-out singularity: keep the better.
         return min((q_polished, q_nearest), key=lambda q: np.linalg.norm(np.asarray(self.kinematics_function(q)[0]).ravel() - x))
-
-    @property
-    def q_min(self) -> np.ndarray:
-        return self._limits["q_min"].copy()
-
-    @property
-    def q_max(self) -> np.ndarray:
-        return self._limits["q_max"].copy()
-
-    @property
-    def qdot_max(self) -> np.ndarray:
-        return self._limits["qdot_max"].copy()
-
-    @property
-    def tau_max(self) -> np.ndarray:
-        return self._limits["tau_max"].copy()
 
     @property
     def home_position(self) -> np.ndarray:
