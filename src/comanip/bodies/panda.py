@@ -72,7 +72,7 @@ class Panda(Body):
 
     @cached_property
     def _rigid_body(self) -> dict[str, ca.Function]:
-        """adam's M, x_ee, J, G as CasADi functions of q (7,) alone, built once (about 0.3 s)."""
+        """adam's M, x_ee, J, G as CasADi functions of q (7,) alone, built once on first use (under 1 s)."""
         from adam.casadi import KinDynComputations  # heavy import, paid only when the Panda is used
 
         kindyn = KinDynComputations(self.urdf, list(ARM_JOINTS))
