@@ -1,0 +1,231 @@
+"""Estimate the goal of a reach from its start and one state observed on the way (paper Section V-C, SPEC §7).
+
+The person started at s_0 and was seen in state s_o at time t_o (step n_o = floor(t_o / h), the nearest
+earlier step; :mod:`comanip.estimation.observation`). The estimate is a goal g_hat and the full predicted
+trajectory: the model's reach from s_0 to g_hat through s_o, returned as a :class:`~comanip.Plan` (so it
+plots and exports like any plan), with g_hat in ``plan.goal`` and ``plan.extras["estimated_goal"]``.
+
+Two methods:
+
+- ``"regret"`` (default): min over g of Jc(g) - V*(g) + (g - g_bar)^T W^-1 (g - g_bar), the paper's
+  constrained objective minus the value of the unconstrained plan to the same goal, which makes an exact
+  observation of a plan give back its goal (:mod:`comanip.estimation.regret_newton` explains why eq. 11 as
+  printed does not, with numbers). Solved by Newton's method from a plan (IPOPT).
+- ``"paper"``: eq. 11 as printed, one IPOPT solve over (tau, g) with the observation as a constraint.
+  Biased towards goals near the observation; kept to reproduce the paper and to compare.
+
+The regulariser (g - g_bar)^T W^-1 (g - g_bar), W from the width as the model says (W = w² I by default), is
+the paper's; without a prior goal (``prior_goal=None``) it is left out.
+
+>>> estimator = GoalEstimator(comanip.presets.cartesian())
+>>> plan = estimator.estimate(start=np.zeros(6), observed=s_o, t_obs=0.2)
+>>> plan.goal, plan.success, plan.extras["regret"]
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections import OrderedDict
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+
+from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.estimation.goal_posterior import OBSERVATION_STD, observation_covariance
+from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
+from comanip.estimation.observation import observation_step, observed_state
+from comanip.estimation.regret_newton import RegretPoint, RegretSystem, newton_solve
+from comanip.estimation.shared import cached_per_model, shared_planner, shared_step_jacobians
+from comanip.model import ReachingModel
+from comanip.objectives.reward import goal_covariance
+from comanip.planning.plan import Plan
+from comanip.planning.planner import _IPOPT_STATUS, Planner, _Deadline
+
+METHODS = ("regret", "paper")
+
+
+@dataclass(frozen=True)
+class EstimatorOptions:
+    """How the goal estimate is computed."""
+
+    tolerance: float = 1e-8
+    """Convergence: max |F| of the regret's first-order conditions (normalised objective per N·m or N, and
+    state units for the observation constraint); IPOPT's tol for the 'paper' method."""
+    max_iterations: int = 30
+    """Newton iterations ('regret') or IPOPT iterations ('paper')."""
+    step_fraction: float = 0.5
+    """Largest goal step of one Newton iteration, as a fraction of the distance from the observed hand to
+    the current goal (at least one goal width)."""
+    search_distances: tuple[float, float] = (0.01, 1.5)
+    """Range (m) of goal distances beyond the observed hand position searched for a cold start."""
+    observation_std: tuple[float, float] = OBSERVATION_STD
+    """Observation-noise floor (position std, velocity std in state units) used by the cold-start search."""
+
+    def __post_init__(self):
+        as_positive("tolerance", self.tolerance, "residual")
+        if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int) or self.max_iterations < 1:
+            raise ValueError(f"max_iterations must be an integer ≥ 1, got {self.max_iterations!r}")
+        if not (isinstance(self.step_fraction, (int, float)) and 0 < self.step_fraction <= 10):
+            raise ValueError(f"step_fraction must be in (0, 10] (fraction of the remaining reach), got {self.step_fraction!r}")
+        low, high = (as_positive(f"search_distances[{k}]", v, "m") for k, v in enumerate(self.search_distances))
+        if low >= high:
+            raise ValueError(f"search_distances must be (D_min, D_max) with D_min < D_max (m), got {self.search_distances!r}")
+        observation_covariance(self.observation_std, 1)
+
+
+class GoalEstimator:
+    """Goal estimates for one model: functions and solvers built once, reused for every observation.
+
+    The model's planner is shared with :func:`comanip.goal_posterior` (one per model). The 'paper'
+    method's NLP depends on the observed step, so one is built per n_o on first use and kept.
+    """
+
+    def __init__(self, model: ReachingModel | Planner, options: EstimatorOptions | None = None):
+        self.planner = shared_planner(model)
+        self.model = self.planner.model
+        self.problem = self.planner.problem
+        self.options = options or EstimatorOptions()
+        self._regret = RegretSystem(self.problem)
+        self._paper_solvers: dict[int, tuple[ca.Function, _Deadline]] = {}
+
+    def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, method: str = "regret",
+                 warm_start: Plan | None = None, max_wall_time: float | None = None) -> Plan:
+        """Estimate the goal of a reach from its start and a state observed at t_obs.
+
+        Args:
+            start: start state s_0 = [q; qdot] (2n,), m and m/s (rad, rad/s for joints).
+            observed: observed state s_o (2n,), same units.
+            t_obs: time of the observation after the start (s), in (0, H·h); it is matched to the step
+                n_o = floor(t_obs / h) (nearest earlier step).
+            prior_goal: g_bar (d,), m, for the regulariser; None leaves it out.
+            width: goal width w (m); the model's default when None.
+            method: 'regret' (default) or 'paper' (eq. 11 as printed).
+            warm_start: a previous estimate (its full state is reused) or any plan of this model (its torques
+                and goal seed the solve, e.g. the plan to the prior goal); None searches for a start.
+            max_wall_time: budget (s) for the whole estimate; the best estimate so far is returned with
+                status 'max_wall_time' when it runs out.
+
+        Returns:
+            A :class:`~comanip.Plan` through the observation to the estimated goal; never raises on a
+            failed solve (check ``plan.success`` and ``plan.status``).
+        """
+        t_begin = time.perf_counter()
+        model = self.model
+        start, _, width = self.planner.check_inputs(start, np.zeros(model.d), width)
+        observed = observed_state(model, observed)
+        n_o = observation_step(model, t_obs)
+        prior = None if prior_goal is None else as_vector("prior_goal", prior_goal, model.d, "task-space position, m")
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
+        point = self._warm_point(warm_start) if warm_start is not None else None
+
+        deadline = math.inf if max_wall_time is None else t_begin + max_wall_time
+
+        def remaining_time() -> float | None:
+            return None if max_wall_time is None else max(deadline - time.perf_counter(), 1e-6)
+
+        if point is None:
+            point = self._cold_point(start, observed, n_o, prior, width, remaining_time)
+        x_obs, _ = task_space_state(self.planner, observed)
+        if method == "regret":
+            result = newton_solve(self._regret, point, start, observed, n_o, prior, width, observed_position=x_obs,
+                                  tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                                  step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
+            point, status, message, iterations = result.point, result.status, result.message, result.iterations
+            extras = {"regret": self._regret.regret(point, start, width), "residual": result.residual}
+        else:
+            point, status, message, iterations = self._paper_solve(point, start, observed, n_o, prior, width, remaining_time())
+            extras = {}
+        extras.update({"estimated_goal": point.goal.copy(), "prior_goal": prior, "t_obs": float(t_obs), "observed_step": n_o,
+                       "observed_state": observed, "method": method, "multipliers": point.lam.copy(),
+                       "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()})
+        success = status in ("solved", "solved_acceptable")
+        return self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
+                                      success=success, message=message, solve_time=time.perf_counter() - t_begin,
+                                      iterations=iterations, extras=extras)
+
+    def _warm_point(self, warm_start: Plan) -> RegretPoint:
+        model = self.model
+        if not isinstance(warm_start, Plan):
+            raise ValueError(f"warm_start must be a previous estimate or a Plan of this model, got {type(warm_start).__name__}")
+        shape, unit = (model.H, model.n), "torques, N·m or N"
+        tau_c = as_matrix("warm_start.torque", warm_start.torque, shape, unit).ravel()
+        goal = as_vector("warm_start.goal", warm_start.goal, model.d, "m")
+        extras = warm_start.extras
+        if "unconstrained_torque" in extras and "multipliers" in extras:
+            tau_s = as_matrix("warm_start.extras['unconstrained_torque']", extras["unconstrained_torque"], shape, unit).ravel()
+            lam = as_vector("warm_start.extras['multipliers']", extras["multipliers"], 2 * model.n, "multipliers")
+            return RegretPoint(tau_c.copy(), lam.copy(), tau_s.copy(), goal.copy())
+        return RegretPoint(tau_c.copy(), np.zeros(2 * model.n), tau_c.copy(), goal.copy())
+
+    def _cold_point(self, start, observed, n_o, prior, width, remaining_time) -> RegretPoint:
+        """Start from the best goal along the observed direction; from the prior (or the hand) if nothing moved."""
+        R = observation_covariance(self.options.observation_std, self.model.n)
+        found = search_along_observed_direction(self.planner, start, observed, n_o, prior, width, R, self.options.search_distances,
+                                                shared_step_jacobians(self.model), remaining_time)
+        if found is None:
+            goal = prior if prior is not None else task_space_state(self.planner, observed)[0]
+            plan = self.planner.solve(start, goal, width, max_wall_time=remaining_time())
+        else:
+            goal, plan = found
+        tau = plan.torque.ravel()
+        return RegretPoint(tau.copy(), np.zeros(2 * self.model.n), tau.copy(), np.asarray(goal, dtype=float).copy())
+
+    def _paper_solver(self, n_o: int) -> tuple[ca.Function, _Deadline]:
+        """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1)."""
+        if n_o not in self._paper_solvers:
+            p, model = self.problem, self.model
+            observed = ca.SX.sym("observed", 2 * model.n)
+            prior, use_prior = ca.SX.sym("prior", model.d), ca.SX.sym("use_prior")
+            W = goal_covariance(p.width, model.d, model.goal_covariance)
+            error = p.goal - prior
+            objective = (p.objective + use_prior * ca.dot(error, ca.solve(W, error))) / (-p.best_objective)
+            x = ca.vertcat(ca.vec(p.tau), p.goal)
+            params = ca.vertcat(p.s0, observed, prior, p.width, use_prior)
+            deadline = _Deadline(x.numel(), params.numel(), 2 * model.n)
+            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations * 10, "tol": self.options.tolerance}
+            solver = ca.nlpsol(f"goal_estimate_eq11_{n_o}", "ipopt",
+                               {"x": x, "p": params, "f": objective, "g": p.means[n_o] - observed},
+                               {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
+            self._paper_solvers[n_o] = (solver, deadline)
+        return self._paper_solvers[n_o]
+
+    def _paper_solve(self, point: RegretPoint, start, observed, n_o, prior, width, budget):
+        solver, deadline = self._paper_solver(n_o)
+        deadline.time = math.inf if budget is None else time.perf_counter() + budget
+        params = np.r_[start, observed, np.zeros(self.model.d) if prior is None else prior, width, prior is not None]
+        result = solver(x0=np.r_[point.tau_c, point.goal], p=params, lbg=0, ubg=0)
+        stats = solver.stats()
+        status, _ = _IPOPT_STATUS.get(stats["return_status"], ("failed", False))
+        if stats["return_status"] == "User_Requested_Stop" and deadline.expired:
+            status = "max_wall_time"
+        x = np.asarray(result["x"]).ravel()
+        Hn = self.model.H * self.model.n
+        if not np.all(np.isfinite(x)):
+            status, x = "failed", np.r_[point.tau_c, point.goal]
+        lam = np.asarray(result["lam_g"]).ravel()
+        solved = RegretPoint(x[:Hn], lam if np.all(np.isfinite(lam)) else np.zeros_like(lam), point.tau_s, x[Hn:])
+        return solved, status, stats["return_status"], int(stats.get("iter_count", 0))
+
+
+_estimators: OrderedDict = OrderedDict()
+
+
+def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observed, t_obs, prior_goal=None,
+                  width: float | None = None, **options) -> Plan:
+    """Estimate a reach's goal from a state observed at t_obs; see :meth:`GoalEstimator.estimate`.
+
+    ``model`` may be a ReachingModel (its estimator is built on first use and kept for later calls), a
+    Planner, or a GoalEstimator. ``options`` go to :meth:`GoalEstimator.estimate` (method, warm_start,
+    max_wall_time).
+    """
+    if isinstance(model, GoalEstimator):
+        estimator = model
+    elif isinstance(model, Planner):
+        estimator = cached_per_model(_estimators, model.model, lambda m: GoalEstimator(model))
+    else:
+        estimator = cached_per_model(_estimators, shared_planner(model).model, GoalEstimator)
+    return estimator.estimate(start, observed, t_obs, prior_goal, width, **options)

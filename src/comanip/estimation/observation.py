@@ -1,0 +1,66 @@
+"""Observations of a reach in progress: checked states, their times, and the plan steps they belong to.
+
+An observation is a state s_o = [q; qdot] (2n,) measured at a time t_o (s) after the reach started. The plan
+lives on the grid t_i = i·h, so an observation belongs to step n_o = floor(t_o / h), the nearest *earlier*
+step (paper Section V-C: "the discrete time-step closest to the continuous time of measurement
+n_o = floor(t_o / h)"). A time that is a multiple of h up to rounding (e.g. 0.2 s on h = 0.02 s, where
+0.2/0.02 = 9.999…) maps to that multiple: the division is given a relative slack of 1e-9 before flooring.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from comanip.arguments import as_matrix, as_vector
+from comanip.model import ReachingModel
+
+#: Relative slack on t/h so that times on the grid are not floored one step early by rounding.
+_GRID_SLACK = 1e-9
+
+
+def observation_step(model: ReachingModel, t_obs, *, allow_start: bool = False, name: str = "t_obs") -> int:
+    """Plan step n_o = floor(t_obs / h) of an observation at t_obs (s).
+
+    t_obs must lie in (0, H·h) (or [0, H·h] with ``allow_start``, for a posterior that may see the start
+    state itself); anything else raises ValueError naming ``name``.
+    """
+    if isinstance(t_obs, bool) or not isinstance(t_obs, (int, float, np.integer, np.floating)) or not math.isfinite(t_obs):
+        raise ValueError(f"{name} must be a finite time in s, got {t_obs!r}")
+    t_obs = float(t_obs)
+    horizon = model.H * model.h
+    inside = (0.0 <= t_obs <= horizon) if allow_start else (0.0 < t_obs < horizon)
+    if not inside:
+        interval = f"[0, {horizon:g}]" if allow_start else f"(0, {horizon:g})"
+        raise ValueError(f"{name} must lie in {interval} s (the model's horizon H·h = {model.H}·{model.h:g} s), got {t_obs:g}")
+    return min(model.H, int(math.floor(t_obs / model.h * (1.0 + _GRID_SLACK))))
+
+
+def observed_state(model: ReachingModel, state, name: str = "observed") -> np.ndarray:
+    """state as a finite (2n,) array [q; qdot], else ValueError naming ``name``."""
+    return as_vector(name, state, 2 * model.n, "state [q; qdot] in m and m/s, or rad and rad/s")
+
+
+def observed_sequence(model: ReachingModel, states, times) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Checked time-ordered observations: states (K, 2n), times (K,) s in [0, H·h] -> (states, times, steps (K,)).
+
+    A single observation may be given as a state (2n,) and a scalar time.
+
+    Raises ValueError naming ``observed_states`` or ``times`` on a wrong shape, NaN, an empty sequence,
+    decreasing times or a time outside the horizon.
+    """
+    try:
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+    except (TypeError, ValueError):
+        raise ValueError(f"times must be a 1-D array of observation times (s), got {times!r}") from None
+    if times.ndim != 1 or times.size == 0:
+        raise ValueError(f"times must be a non-empty 1-D array of observation times (s), got shape {np.shape(times)}")
+    if np.ndim(states) == 1 and times.size == 1:
+        states = np.reshape(states, (1, -1))
+    states = as_matrix("observed_states", states, (times.size, 2 * model.n),
+                       "one state [q; qdot] per observation time, m and m/s or rad and rad/s")
+    if np.any(np.diff(times) < 0):
+        raise ValueError(f"times must be non-decreasing (s), got {times.tolist()}")
+    steps = np.array([observation_step(model, t, allow_start=True, name="times") for t in times])
+    return states, times, steps

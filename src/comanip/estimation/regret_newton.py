@@ -1,0 +1,263 @@
+"""Goal estimation as inverse planning: the goal whose plan the observed state departs from least.
+
+Notation as in :mod:`comanip.planning.reach_problem`: torques tau (H·n,) stacked step by step, start s_0,
+goal g (d,) m, width w (m), W = W(w) (d, d), the SPEC §4 objective J(tau, g), and the mean state mu_no(tau)
+at the observed step n_o. Objectives are divided by the planner's normaliser |J_best(w)| (the best
+attainable J), so the numbers the solver sees lie in about [-1, 0] for every width.
+
+**Why not eq. 11 as printed.** The paper (Section V-C, SPEC §7) estimates the goal by
+
+    min_{tau, g}  J(tau, g) + (g - g_bar)^T W^-1 (g - g_bar)   s.t.  mu_0 = s_0,  mu_no(tau) = s_o.
+
+Minimising J over g as well favours goals that are cheap to reach from the observation, not the goal the
+person is heading to: the reward earned near the start and the shorter remaining reach make a nearby goal
+score better. Observing a planar plan at 0.2 s and solving eq. 11 from the true goal puts the estimate at
+0.5–0.85 of the true distance, and sometimes on the start itself; on the Cartesian preset (observed at
+0.165 s) at 0.07–0.16 of it. The plan to the true goal is not even a stationary point: dJ/dg ≠ 0 there.
+
+**Regret.** Subtract what reaching g costs without the observation, V*(g) = min_tau J(tau, g) (the plan):
+
+    min_g  R(g) = Jc(g) - V*(g) + (g - g_bar)^T W^-1 (g - g_bar),    Jc(g) = min_{tau: mu_no(tau) = s_o} J(tau, g).
+
+Jc ≥ V*, with equality exactly when the plan to g passes through s_o: the regret is the extra cost the
+observation forces on a person heading to g, zero at the goal a plan was made for, so an exact observation
+of a plan gives back its goal. It keeps eq. 11's objective and constraint and only removes the term V*(g)
+that biases it; the regulariser is the paper's.
+
+**First-order conditions.** By the envelope theorem dJc/dg = dJ/dg at tau_c and dV*/dg = dJ/dg at tau_s, so
+the optimum is a root of
+
+    F1 = grad_tau J(tau_c, g) + A^T lam        (H·n)   tau_c optimal subject to the observation
+    F2 = mu_no(tau_c) - s_o                    (2n)    ... which it passes through
+    F3 = grad_tau J(tau_s, g)                  (H·n)   tau_s the unconstrained plan to g
+    F4 = grad_g J(tau_c, g) - grad_g J(tau_s, g) + 2 P (g - g_bar)   (d)
+
+with A = dmu_no/dtau and P = W^-1 / |J_best| (zero without a prior). Only second derivatives of J appear,
+the Hessians a plan's solver uses anyway: Newton's method on F costs two of them per iteration. No NLP
+solver takes a value function as an objective, so the iteration is written out here; IPOPT (through the
+planner) provides its starting point. Block elimination reduces each Newton step to a d×d system in the
+goal whose matrix is the regret's Hessian d²R/dg²; where that is not positive definite (far from the
+optimum) its eigenvalues are mirrored so the step still descends, and the goal step is limited to a
+fraction of the remaining reach.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import casadi as ca
+import numpy as np
+import scipy.linalg
+
+from comanip.estimation.buffered_function import BufferedFunction
+from comanip.objectives.reward import goal_covariance
+from comanip.planning.reach_problem import ReachProblem
+
+
+@dataclass
+class RegretPoint:
+    """An iterate: constrained torques tau_c (H·n,), multipliers lam (2n,), plan torques tau_s (H·n,), goal g (d,)."""
+
+    tau_c: np.ndarray
+    lam: np.ndarray
+    tau_s: np.ndarray
+    goal: np.ndarray
+
+    def copy(self) -> "RegretPoint":
+        return RegretPoint(self.tau_c.copy(), self.lam.copy(), self.tau_s.copy(), self.goal.copy())
+
+
+@dataclass
+class NewtonResult:
+    point: RegretPoint
+    status: str
+    """'solved', 'max_iterations', 'max_wall_time', 'not_a_minimum' or 'failed'."""
+    message: str
+    iterations: int
+    residual: float
+    """max |F| at the returned point (normalised gradient units; m, m/s or rad, rad/s for F2)."""
+
+
+class RegretSystem:
+    """The functions Newton's method on F needs, built once per model (observation step: once per n_o)."""
+
+    def __init__(self, problem: ReachProblem):
+        self.problem = problem
+        model = problem.model
+        self.n, self.d, self.H = model.n, model.d, model.H
+        tau = ca.vec(problem.tau)
+        normaliser = -problem.best_objective
+        J = problem.objective / normaliser
+        hessian, gradient = ca.hessian(J, ca.vertcat(tau, problem.goal))
+        self._derivatives = BufferedFunction("regret_derivatives", [tau, problem.goal, problem.s0, problem.width],
+                                             [J, gradient, hessian])
+        W = goal_covariance(problem.width, self.d, model.goal_covariance)
+        self._normaliser = ca.Function("normaliser", [problem.width], [normaliser])
+        self._prior_weight = ca.Function("prior_weight", [problem.width], [ca.inv(W) / normaliser])
+        self._observed = {}
+
+    def observed_mean(self, n_o: int) -> BufferedFunction:
+        """``(tau, s0, lam) -> (mu_no (2n,), A = dmu_no/dtau (2n, H·n), d²(lam^T mu_no)/dtau² (H·n, H·n))``."""
+        if n_o not in self._observed:
+            p = self.problem
+            tau = ca.vec(p.tau)
+            lam = ca.SX.sym("lam", 2 * self.n)
+            mu = p.means[n_o]
+            curvature = ca.hessian(ca.dot(lam, mu), tau)[0]
+            self._observed[n_o] = BufferedFunction(f"observed_mean_{n_o}", [tau, p.s0, lam], [mu, ca.jacobian(mu, tau), curvature])
+        return self._observed[n_o]
+
+    def prior_weight(self, width: float) -> np.ndarray:
+        """P = W^-1 / |J_best| (d, d) for width w (m)."""
+        return np.asarray(self._prior_weight(width))
+
+    def objective(self, tau: np.ndarray, goal, start, width) -> float:
+        """Normalised J at torques (H·n,)."""
+        return float(self._derivatives(tau, goal, start, width)[0])
+
+    def regret(self, point: RegretPoint, start, width) -> float:
+        """Jc - V* at an iterate, in units of J (m^-d): the extra cost the observation forces."""
+        difference = self.objective(point.tau_c, point.goal, start, width) - self.objective(point.tau_s, point.goal, start, width)
+        return float(self._normaliser(width)) * difference
+
+    def linearise(self, point: RegretPoint, start, observed, n_o: int, prior, width) -> "Linearisation":
+        """F and its Jacobian blocks at an iterate; ``prior`` None drops the regulariser."""
+        Hn = self.H * self.n
+        # the buffers are reused by the next call: copy the first evaluation before the second
+        _, grad_c, hess_c = (v.copy() for v in self._derivatives(point.tau_c, point.goal, start, width))
+        _, grad_s, hess_s = (v.copy() for v in self._derivatives(point.tau_s, point.goal, start, width))
+        mu, A, curvature = (v.copy() for v in self.observed_mean(n_o)(point.tau_c, start, point.lam))
+        P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(width)
+        pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior)
+        return Linearisation(
+            F1=grad_c[:Hn] + A.T @ point.lam, F2=mu - observed, F3=grad_s[:Hn],
+            F4=grad_c[Hn:] - grad_s[Hn:] + pull,
+            K_c=np.block([[hess_c[:Hn, :Hn] + curvature, A.T], [A, np.zeros((2 * self.n, 2 * self.n))]]),
+            H_s=hess_s[:Hn, :Hn], Hc_tau_g=hess_c[:Hn, Hn:], Hs_tau_g=hess_s[:Hn, Hn:],
+            Hc_gg=hess_c[Hn:, Hn:], Hs_gg=hess_s[Hn:, Hn:], P=P, A=A)
+
+
+@dataclass
+class Linearisation:
+    """F = (F1, F2, F3, F4) at an iterate and the blocks of its Jacobian (see the module docstring)."""
+
+    F1: np.ndarray
+    F2: np.ndarray
+    F3: np.ndarray
+    F4: np.ndarray
+    K_c: np.ndarray
+    """KKT matrix of the constrained plan [[d²L/dtau², A^T], [A, 0]] (H·n + 2n square)."""
+    H_s: np.ndarray
+    """Hessian of J in the plan's torques (H·n square)."""
+    Hc_tau_g: np.ndarray
+    Hs_tau_g: np.ndarray
+    Hc_gg: np.ndarray
+    Hs_gg: np.ndarray
+    P: np.ndarray
+    A: np.ndarray
+
+    @property
+    def residual(self) -> float:
+        return float(max(np.abs(F).max() for F in (self.F1, self.F2, self.F3, self.F4)))
+
+    def step(self, goal_step_limit: float, damping: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Newton step (d tau_c, d lam, d tau_s, d g) by block elimination.
+
+        The goal step solves (|d²R/dg²| + damping I) d g = -r (eigenvalues mirrored, Levenberg–Marquardt
+        damping) and is at most goal_step_limit (m) long; the torque steps follow it exactly.
+        """
+        Hn = len(self.F1)
+        Xc = np.linalg.solve(self.K_c, np.column_stack([np.vstack([self.Hc_tau_g, np.zeros((len(self.F2), self.Hc_tau_g.shape[1]))]),
+                                                        np.r_[self.F1, self.F2]]))
+        Xs = np.linalg.solve(self.H_s, np.column_stack([self.Hs_tau_g, self.F3]))
+        d = self.Hc_gg.shape[0]
+        reduced = self.reduced_hessian(Xc, Xs)
+        rhs = self.F4 - self.Hc_tau_g.T @ Xc[:Hn, d] + self.Hs_tau_g.T @ Xs[:, d]
+        eigenvalues, vectors = np.linalg.eigh(reduced)
+        mirrored = np.maximum(np.abs(eigenvalues), 1e-10 * max(1.0, np.abs(eigenvalues).max()))
+        d_goal = -vectors @ ((vectors.T @ rhs) / (mirrored + damping))
+        length = np.linalg.norm(d_goal)
+        if length > goal_step_limit:
+            d_goal *= goal_step_limit / length
+        d_c = -(Xc[:, d] + Xc[:, :d] @ d_goal)
+        d_s = -(Xs[:, d] + Xs[:, :d] @ d_goal)
+        return d_c[:Hn], d_c[Hn:], d_s, d_goal
+
+    def reduced_hessian(self, Xc=None, Xs=None) -> np.ndarray:
+        """d²R/dg² (d, d): the regret's Hessian in the goal with the inner problems kept optimal."""
+        Hn = len(self.F1)
+        d = self.Hc_gg.shape[0]
+        if Xc is None:
+            Xc = np.linalg.solve(self.K_c, np.vstack([self.Hc_tau_g, np.zeros((len(self.F2), d))]))
+            Xs = np.linalg.solve(self.H_s, self.Hs_tau_g)
+        reduced = (self.Hc_gg - self.Hc_tau_g.T @ Xc[:Hn, :d]) - (self.Hs_gg - self.Hs_tau_g.T @ Xs[:, :d]) + 2 * self.P
+        return 0.5 * (reduced + reduced.T)
+
+    def is_strict_minimum(self) -> tuple[bool, str]:
+        """Second-order check: the plan, the constrained plan and the regret all have positive curvature."""
+        Hn = len(self.F1)
+        if not _positive_definite(self.H_s):
+            return False, "the plan to the estimated goal is not a minimum of J"
+        Z = scipy.linalg.null_space(self.A)
+        if not _positive_definite(Z.T @ self.K_c[:Hn, :Hn] @ Z):
+            return False, "the trajectory through the observation is not a minimum of J"
+        if not _positive_definite(self.reduced_hessian()):
+            return False, "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
+        return True, ""
+
+
+def _positive_definite(matrix: np.ndarray) -> bool:
+    try:
+        np.linalg.cholesky(0.5 * (matrix + matrix.T))
+        return True
+    except np.linalg.LinAlgError:
+        return False
+
+
+def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, prior, width: float, *,
+                 observed_position: np.ndarray, tolerance: float, max_iterations: int, step_fraction: float,
+                 expired) -> NewtonResult:
+    """Newton's method on F from ``point`` until max |F| ≤ tolerance, then the second-order check.
+
+    Globalised the Levenberg–Marquardt way: a step is kept only if it lowers max |F|; otherwise it is
+    retried with more damping on the goal step (the regret is flat along the reach early in a slow one,
+    where undamped steps overshoot). The goal also moves at most step_fraction·max(|g - x_o|, w) per step,
+    x_o = ``observed_position`` (the observed end effector, m). ``expired()`` is asked before every step
+    (wall-time budget). Each trial point costs one linearisation (two Hessians of J); ``max_iterations``
+    bounds their number. Never raises: when the iteration does not converge, the iterate with the
+    smallest residual is returned with a status.
+    """
+    linearisation = system.linearise(point, start, observed, n_o, prior, width)
+    damping = 0.0
+    status, message = "max_iterations", f"no convergence in {max_iterations} Newton iterations"
+    for iteration in range(1, max_iterations + 1):
+        residual = linearisation.residual
+        if not np.isfinite(residual):
+            return NewtonResult(point, "failed", "J is not finite at the starting point", iteration - 1, residual)
+        if residual <= tolerance:
+            is_minimum, why = linearisation.is_strict_minimum()
+            status, message = ("solved", "converged") if is_minimum else ("not_a_minimum", why)
+            return NewtonResult(point, status, message, iteration - 1, residual)
+        if expired():
+            status, message = "max_wall_time", "the wall-time budget ran out"
+            break
+        limit = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+        d_tau_c, d_lam, d_tau_s, d_goal = linearisation.step(limit, damping)
+        trial = RegretPoint(point.tau_c + d_tau_c, point.lam + d_lam, point.tau_s + d_tau_s, point.goal + d_goal)
+        trial_linearisation = system.linearise(trial, start, observed, n_o, prior, width)
+        if trial_linearisation.residual < residual:
+            point, linearisation = trial, trial_linearisation
+            damping = 0.0 if damping < _DAMPING_FLOOR else damping / 4
+        else:
+            scale = np.abs(np.linalg.eigvalsh(linearisation.reduced_hessian())).max()
+            damping = max(4 * damping, _DAMPING_FLOOR * max(scale, 1.0))
+            if not np.isfinite(damping) or damping > _DAMPING_CEILING * max(scale, 1.0):
+                status, message = "failed", "the Newton iteration stalled (no step lowers the residual)"
+                break
+    return NewtonResult(point, status, message, iteration, linearisation.residual)
+
+
+#: Levenberg–Marquardt damping, relative to the largest curvature of the regret: first value after a
+#: rejected step, and the value beyond which a step is too short to matter (the iteration has stalled).
+_DAMPING_FLOOR = 1e-3
+_DAMPING_CEILING = 1e8
