@@ -10,7 +10,9 @@ from importlib import import_module
 #: subcommand modules, in the order ``comanip --help`` lists them
 SUBCOMMAND_MODULES = [
     "comanip.cli.plan_command",
+    "comanip.cli.validate_command",
     "comanip.cli.transition_command",
+    "comanip.cli.handover_command",
 ]
 
 

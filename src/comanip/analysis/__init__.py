@@ -1,0 +1,31 @@
+"""Validation analyses (paper Section IV-D, Fig. 3–5) and the calibration study: pure functions over plans
+and executions that return numbers (dataclasses), which :mod:`comanip.plots` draws and ``comanip validate``
+reports."""
+
+from comanip.analysis.calibration import (
+    CalibrationResult,
+    Configuration,
+    measure_grid,
+    run_calibration,
+    study_configurations,
+)
+from comanip.analysis.dispersion import EndpointDispersion, endpoint_dispersion
+from comanip.analysis.fitts import FITTS_FORMS, FittsFit, fit_fitts, index_of_difficulty, trend_fraction
+from comanip.analysis.minimum_jerk_baseline import (
+    minimum_jerk_asymmetry,
+    minimum_jerk_settling_fraction,
+    minimum_jerk_velocity,
+)
+from comanip.analysis.phase import PhaseCurve, phase_curves
+from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, home_start, open_loop_grid, unit_direction
+from comanip.analysis.speed_profile import SETTLING_FRACTION, SpeedMetrics, speed_metrics
+
+__all__ = [
+    "CalibrationResult", "Configuration", "measure_grid", "run_calibration", "study_configurations",
+    "EndpointDispersion", "endpoint_dispersion",
+    "FITTS_FORMS", "FittsFit", "fit_fitts", "index_of_difficulty", "trend_fraction",
+    "minimum_jerk_asymmetry", "minimum_jerk_settling_fraction", "minimum_jerk_velocity",
+    "PhaseCurve", "phase_curves",
+    "ReachOutcome", "closed_loop_grid", "home_start", "open_loop_grid", "unit_direction",
+    "SETTLING_FRACTION", "SpeedMetrics", "speed_metrics",
+]
