@@ -53,9 +53,29 @@ def point_mass_case(preset: str, paper_time: float) -> Callable[[], Case]:
     return make
 
 
+def closed_loop_reach_case() -> Case:
+    """One closed-loop reach of the transition-data person (planar, 2H = 60 replans, D = 0.3 m, w = 0.02 m):
+    the unit of `comanip transition generate` (conditions × trials reaches, spread over the workers)."""
+    from comanip.execution import execute_receding_horizon
+
+    model = comanip.presets.planar()
+    t0 = time.perf_counter()
+    planner = comanip.Planner(model)
+    build = time.perf_counter() - t0
+    rng = np.random.default_rng(0)
+
+    def solve(k: int) -> tuple[float, bool]:
+        t = time.perf_counter()
+        run = execute_receding_horizon(planner, np.zeros(4), [0.3, 0.0], 0.02, steps=2 * model.H, rng=rng)
+        return time.perf_counter() - t, run.failed_replans == 0
+
+    return Case(f"planar closed-loop reach ({2 * model.H} replans)", build, solve)
+
+
 CASES: dict[str, Callable[[], Case]] = {
     "planar": point_mass_case("planar", 0.04),
     "cartesian": point_mass_case("cartesian", 0.20),
+    "closed_loop": closed_loop_reach_case,
 }
 
 
