@@ -13,6 +13,7 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.validate_command",
     "comanip.cli.transition_command",
     "comanip.cli.handover_command",
+    "comanip.cli.estimate_command",
 ]
 
 

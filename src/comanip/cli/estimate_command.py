@@ -1,0 +1,116 @@
+"""``comanip estimate``: estimate a reach's goal from a state observed on the way (and, given candidate
+goals, the posterior over them); write the estimate and its predicted trajectory as JSON and CSV.
+
+The observation comes from arguments (``--observed`` and ``--t-obs``) or from a CSV of timestamped states
+with a header ``t_s, q0.., qdot0..`` (the columns of a plan CSV, so ``comanip plan`` output can be read back):
+its last row at or before ``--t-obs`` is the observation, a row at t = 0 is the start, and every row up
+to the horizon feeds the posterior.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import numpy as np
+
+from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.estimation import GoalEstimator, goal_posterior
+from comanip.estimation.goal_estimate import METHODS
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser("estimate", help="estimate a reach's goal from an observed state", description=__doc__)
+    add_model_arguments(parser)
+    parser.add_argument("--start", type=vector, help="start state [q; qdot], comma-separated (default: the CSV's t = 0 row, "
+                                                     "else at rest at the body's home position)")
+    parser.add_argument("--observed", type=vector, help="observed state [q; qdot], comma-separated")
+    parser.add_argument("--observations", type=Path, help="CSV of timestamped states (header t_s, q0.., qdot0..)")
+    parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, the paper's)")
+    parser.add_argument("--prior", type=vector, help="prior goal g_bar (m), comma-separated (default: no regulariser)")
+    parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
+    parser.add_argument("--method", choices=METHODS, default="regret", help="'regret' (default) or 'paper' (eq. 11 as printed)")
+    parser.add_argument("--candidates", type=candidate_list, help="candidate goals for a posterior, e.g. '0.3,0;0.2,0.2' (m)")
+    parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
+    parser.add_argument("--out", default="out/estimate", help="output folder (default: %(default)s)")
+    parser.add_argument("--png", action="store_true", help="also save figures")
+    parser.set_defaults(func=run)
+
+
+def candidate_list(text: str) -> np.ndarray:
+    """Parse '0.3,0; 0.2,0.2' into an array (C, d)."""
+    rows = [vector(part) for part in text.split(";") if part.strip()]
+    if not rows or len({len(r) for r in rows}) != 1:
+        raise ValueError(f"--candidates must be goals of equal length separated by ';', got {text!r}")
+    return np.array(rows)
+
+
+def read_observations(path: Path, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """Times (K,) s and states (K, 2n) from a CSV with columns t_s, q0..q{n-1}, qdot0..qdot{n-1}, sorted by time."""
+    if not path.exists():
+        raise ValueError(f"--observations file {str(path)!r} does not exist")
+    columns = ["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
+    with open(path, newline="") as f:
+        reader = csv.DictReader(f)
+        missing = [c for c in columns if c not in (reader.fieldnames or [])]
+        if missing:
+            raise ValueError(f"--observations needs the columns {columns}; {str(path)!r} lacks {missing}")
+        try:
+            rows = np.array([[float(row[c]) for c in columns] for row in reader])
+        except ValueError as error:
+            raise ValueError(f"--observations: a value in {str(path)!r} is not a number ({error})") from None
+    if rows.size == 0:
+        raise ValueError(f"--observations file {str(path)!r} has no rows")
+    rows = rows[np.argsort(rows[:, 0], kind="stable")]
+    return rows[:, 0], rows[:, 1:]
+
+
+def run(args) -> int:
+    model = load_model(args)
+    estimator = GoalEstimator(model)
+    body, n = model.body, model.n
+    at_rest = np.r_[body.home_position, np.zeros(n)]
+    times = states = None
+    if args.observations is not None:
+        times, states = read_observations(args.observations, n)
+        before = np.flatnonzero((times > 0) & (times <= args.t_obs))
+        if before.size == 0:
+            raise ValueError(f"--observations has no row with 0 < t_s ≤ --t-obs = {args.t_obs:g} s")
+        observed, t_obs = states[before[-1]], times[before[-1]]
+        start = args.start if args.start is not None else (states[0] if times[0] == 0 else at_rest)
+    elif args.observed is not None:
+        observed, t_obs = args.observed, args.t_obs
+        start = args.start if args.start is not None else at_rest
+    else:
+        raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+
+    estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, method=args.method, max_wall_time=args.max_wall_time)
+    out = output_dir(args.out)
+    written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
+    summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
+               "t_obs_s": float(t_obs), "observed_step": estimate.extras["observed_step"], "method": args.method,
+               "width": estimate.width, "success": estimate.success, "status": estimate.status, "message": estimate.message,
+               "solve_time_s": estimate.solve_time, "iterations": estimate.iterations, "regret": estimate.extras.get("regret")}
+    posterior = None
+    if args.candidates is not None:
+        if times is None:
+            times, states = np.array([t_obs]), np.atleast_2d(observed)
+        usable = times <= model.duration
+        posterior = goal_posterior(estimator.planner, estimate.start, states[usable], times[usable], args.candidates, args.width)
+        path = out / "posterior.json"
+        path.write_text(json.dumps(posterior.to_dict(), indent=1))
+        written.append(path)
+        summary["posterior"] = {"candidates": posterior.candidates.tolist(), "probabilities": posterior.probabilities[-1].tolist(),
+                                "most_likely": int(posterior.most_likely[-1]),
+                                "entropy_nats_first_last": [float(posterior.entropy[0]), float(posterior.entropy[-1])]}
+    if args.png:
+        from comanip.plots.estimate_figure import plot_estimate, plot_posterior
+
+        points = None if states is None else np.array([np.asarray(body.kinematics_function(s[:n])[0]).ravel() for s in states])
+        written.append(plot_estimate(estimate, out / "estimate.png", observed_points=points, observed_times=times))
+        if posterior is not None:
+            written.append(plot_posterior(posterior, out / "posterior.png"))
+    summary["files"] = [str(p) for p in written]
+    print(json.dumps(summary, indent=1))
+    return 0 if estimate.success else 1
