@@ -30,6 +30,19 @@ def as_positive(name: str, value, unit: str) -> float:
     return float(value)
 
 
+def as_positive_array(name: str, value, unit: str) -> np.ndarray:
+    """value (a number or an array of any shape) as a float array, all finite and > 0, else ValueError."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a number or array of numbers > 0 ({unit}), got {value!r}") from None
+    if not np.all(np.isfinite(array)):
+        raise ValueError(f"{name} must be finite ({unit}); got NaN or inf in {array.tolist()}")
+    if np.any(array <= 0):
+        raise ValueError(f"{name} must be > 0 ({unit}), got {array.tolist()}")
+    return array
+
+
 def as_optional_positive(name: str, value, unit: str) -> float | None:
     return None if value is None else as_positive(name, value, unit)
 

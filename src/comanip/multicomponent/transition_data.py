@@ -20,7 +20,7 @@ from functools import lru_cache
 import numpy as np
 from tqdm import tqdm
 
-from comanip.arguments import as_positive
+from comanip.arguments import as_positive, as_positive_array
 from comanip.execution import execute_receding_horizon
 from comanip.model import ReachingModel
 from comanip.multicomponent.dispersion import bootstrap_transition_std, first_passage_deviations, profile_from_deviations
@@ -103,8 +103,10 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
     model = presets.planar() if model is None else model
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel, got {type(model).__name__}")
-    distances = _positive_values("distances_over_arm_length", distances_over_arm_length, "goal distance / arm length")
-    widths = _positive_values("widths", widths, "goal width, m")
+    distances = np.ravel(as_positive_array("distances_over_arm_length", distances_over_arm_length, "D/L"))
+    widths = np.ravel(as_positive_array("widths", widths, "goal width, m"))
+    if distances.size == 0 or widths.size == 0:
+        raise ValueError(f"distances_over_arm_length and widths must not be empty, got {distances.size} and {widths.size} values")
     arm_length = as_positive("arm_length", arm_length, "m")
     n_trials = _integer_at_least("n_trials", n_trials, 3)
     steps = default_steps(model) if steps is None else _integer_at_least("steps", steps, 1)
@@ -154,13 +156,6 @@ def _condition_task(model_config: str, distance_over_arm_length: float, width: f
 def _planner_for(model_config: str) -> Planner:
     """One planner per model per process: a worker builds it on its first condition and reuses it."""
     return Planner(ReachingModel.from_config(json.loads(model_config)))
-
-
-def _positive_values(name: str, values, unit: str) -> np.ndarray:
-    array = np.atleast_1d(np.asarray(values, dtype=float))
-    if array.ndim != 1 or array.size == 0 or not np.all(np.isfinite(array)) or np.any(array <= 0):
-        raise ValueError(f"{name} must be a non-empty list of finite numbers > 0 ({unit}), got {np.asarray(values).tolist()}")
-    return array
 
 
 def _integer_at_least(name: str, value, minimum: int) -> int:
