@@ -127,21 +127,34 @@ class GoalEstimator:
         def remaining_time() -> float | None:
             return None if max_wall_time is None else max(deadline - time.perf_counter(), 1e-6)
 
-        if point is None:
-            point = self._cold_point(start, observed, n_o, prior, width, remaining_time)
-        x_obs, _ = task_space_state(self.planner, observed)
+        def cold_point() -> RegretPoint:
+            return self._cold_point(start, observed, n_o, prior, width, remaining_time)
+
         if method == "regret":
-            result = newton_solve(self._regret, point, start, observed, n_o, prior, width, observed_position=x_obs,
-                                  tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
-                                  step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
-            point, status, message, iterations = result.point, result.status, result.message, result.iterations
-            extras = {"regret": self._regret.regret(point, start, width), "residual": result.residual}
+            x_obs, _ = task_space_state(self.planner, observed)
+
+            def newton(point: RegretPoint):
+                return newton_solve(self._regret, point, start, observed, n_o, prior, width, observed_position=x_obs,
+                                    tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                                    step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
+
+            result = newton(point if point is not None else cold_point())
+            iterations = result.iterations
+            if point is not None and result.status in ("failed", "max_iterations", "not_a_minimum"):
+                # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
+                retry = newton(cold_point())
+                iterations += retry.iterations
+                if retry.status == "solved" or retry.residual < result.residual:
+                    result = retry
+            point, status, message = result.point, result.status, result.message
+            extras = {"regret": self._regret.regret(point, start, width), "residual": result.residual,
+                      "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
         else:
-            point, status, message, iterations = self._paper_solve(point, start, observed, n_o, prior, width, remaining_time())
+            point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
+                                                                   observed, n_o, prior, width, remaining_time())
             extras = {}
         extras.update({"estimated_goal": point.goal.copy(), "prior_goal": prior, "t_obs": float(t_obs), "observed_step": n_o,
-                       "observed_state": observed, "method": method, "multipliers": point.lam.copy(),
-                       "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()})
+                       "observed_state": observed, "method": method, "multipliers": point.lam.copy()})
         success = status in ("solved", "solved_acceptable")
         return self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
                                       success=success, message=message, solve_time=time.perf_counter() - t_begin,
