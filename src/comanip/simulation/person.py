@@ -1,0 +1,165 @@
+"""A simulated person holding the handle: the paper's motor-control model drives an arm impedance.
+
+The person's *intended* hand motion x_d(t) is the state of their internal model, the reaching model's point
+mass (the Cartesian preset, 2 kg), driven by the commands they plan, executed with signal-dependent motor
+noise (I + E) tau (SPEC §2):
+
+    M_p xddot_d + D_p xdot_d = (I + E_j) tau_j        (tau_j, E_j held over planning step j of length h)
+
+Every ``replan_interval`` seconds the person re-plans a reach to their goal (:class:`comanip.Planner`,
+warm-started with the previous plan shifted) from s = [x; xdot_d]: the hand position x they see, and the
+velocity of their own intended motion (their efference copy). The force on the handle is the arm's
+impedance around the intention, its only force path:
+
+    F = K_h (x_d - x) + D_h (xdot_d - xdot)
+
+Why this feedback closes a stable loop: a plan from the seen position moves the intention by the remaining
+distance to the goal, so x_d ends at the goal plus the current intention-hand offset, which is exactly what
+the impedance needs to hold the hand on the goal against a load (the object's weight) or a robot spring.
+Planning from the *measured* hand velocity instead, while the commands drive the intention, counts the
+velocity error twice (once in the plan, once in D_h) and the loop oscillates with growing amplitude.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from comanip.arguments import as_matrix, as_positive, as_vector
+from comanip.belief.noise import sample_torque_error
+from comanip.planning.plan import Plan
+from comanip.planning.planner import Planner
+
+
+@dataclass(frozen=True)
+class PersonParameters:
+    """The simulated person's arm impedance and how often they re-plan."""
+
+    stiffness: float = 800.0
+    """Hand endpoint stiffness K_h (N/m), isotropic. Arms hold roughly 300–1500 N/m, the upper part when
+    co-contracting to stabilise a load (Mussa-Ivaldi et al. 1985; Burdet et al. 2001)."""
+    damping: float = 120.0
+    """Hand endpoint damping D_h (N·s/m). The handle is heavy: the arm holding the object's attitude has an
+    apparent mass of about 5–14 kg at the TCP, plus the 1.5 kg object; 120 N·s/m damps the hand on a
+    15 kg load at ratio 0.55, where arm-only values (10–50 N·s/m, Tsuji et al. 1995) would leave it ringing
+    at ~1 Hz for seconds."""
+    replan_interval: float = 0.165
+    """Time between re-plans (s), a whole number of the model's steps h: visual feedback reaches the
+    motor plan intermittently, every 0.1–0.3 s (Loram et al. 2011)."""
+    iterations_per_replan: int = 4
+    """Solver iterations per warm-started re-plan: the person refines the previous plan, not a fresh optimum."""
+    motor_noise: bool = True
+    """Execute the commands with the model's signal-dependent noise (False: exactly as planned)."""
+    anticipates_inertia: bool = True
+    """Add the feedforward force M_load xddot_d that the handle's inertia needs to follow the intention: a
+    practised person's internal model of the object they move (Flanagan & Wing 1997). Without it a heavy
+    handle lags the intention by M_load xddot_d / K_h (about 40 % of the distance 0.2 s into a reach)."""
+
+    def __post_init__(self):
+        as_positive("stiffness", self.stiffness, "N/m")
+        as_positive("damping", self.damping, "N·s/m")
+        as_positive("replan_interval", self.replan_interval, "s")
+        if isinstance(self.iterations_per_replan, bool) or not isinstance(self.iterations_per_replan, (int, np.integer)) \
+                or self.iterations_per_replan < 1:
+            raise ValueError(f"iterations_per_replan must be an integer ≥ 1, got {self.iterations_per_replan!r}")
+
+    def impedance_force(self, intended_position, intended_velocity, position, velocity) -> np.ndarray:
+        """F = K_h (x_d - x) + D_h (xdot_d - xdot), (3,) N, from intended and actual hand states (3,) m, m/s."""
+        return self.stiffness * (intended_position - position) + self.damping * (intended_velocity - velocity)
+
+
+def solve_to_convergence(planner: Planner, start, goal, width: float, warm_start=None, rounds: int = 50) -> Plan:
+    """Solve with a planner whose iteration limit is small, continuing from each result until it converges.
+
+    Lets one planner (built once, with a per-replan iteration cap) also deliver fully converged plans.
+    Returns the last plan (check ``plan.success``); at most ``rounds`` solves.
+    """
+    plan = planner.solve(start, goal, width, warm_start=warm_start)
+    for _ in range(rounds - 1):
+        if plan.success:
+            break
+        plan = planner.solve(start, goal, width, warm_start=plan)
+    return plan
+
+
+class SimulatedPerson:
+    """One person reaching for one goal while holding the handle.
+
+    Args:
+        planner: a Planner for a point-mass model in task space (the Cartesian preset); its iteration
+            limit is the per-replan effort (see :attr:`PersonParameters.iterations_per_replan`).
+        parameters: arm impedance and replanning.
+        goal: the person's goal (3,), m; width: its width w (m).
+        rng: generator of the motor noise.
+        first_plan: a converged plan from the start state, shared by trials that start alike (computed
+            here when None).
+        load_inertia: M_load (3, 3), kg: the apparent inertia of what the hand moves, used for the
+            feedforward when ``parameters.anticipates_inertia``.
+    """
+
+    def __init__(self, planner: Planner, parameters: PersonParameters, goal, width: float,
+                 rng: np.random.Generator, first_plan: Plan | None = None, load_inertia=None):
+        body = planner.model.body
+        if not body.is_linear or body.n != 3:
+            raise ValueError(f"the person's planner needs a 3-D point-mass model (the Cartesian preset), got {planner.model.name!r}")
+        steps = parameters.replan_interval / planner.model.h
+        if abs(steps - round(steps)) > 1e-6 or round(steps) < 1:
+            raise ValueError(f"replan_interval must be a whole multiple of the model's step h = {planner.model.h} s, "
+                             f"got {parameters.replan_interval} s")
+        self.planner, self.parameters = planner, parameters
+        self.goal = as_vector("goal", goal, 3, "m")
+        self.width = as_positive("width", width, "m")
+        self.rng = rng
+        self.first_plan = first_plan
+        self._steps_per_replan = int(round(steps))
+        self._inertia = np.asarray(body.mass_matrix_function(np.zeros(3)))
+        self._inverse_inertia = np.linalg.inv(self._inertia)
+        self._damping = body.damping
+        self._load_inertia = np.zeros((3, 3))
+        if parameters.anticipates_inertia:
+            if load_inertia is None:
+                raise ValueError("load_inertia (3, 3) kg is needed when the person anticipates the load's inertia")
+            self._load_inertia = as_matrix("load_inertia", load_inertia, (3, 3), "kg")
+        self.plans: list[Plan] = []
+        self.replan_times: list[float] = []
+
+    def start(self, intended_position, t: float = 0.0) -> None:
+        """Begin the reach at time t (s), the intention at rest at intended_position (3,) m (where the person
+        held the hand before the reach; the hand itself may sag below it under a load)."""
+        self.intended_position = np.array(intended_position, dtype=float)
+        self.intended_velocity = np.zeros(3)
+        self._next_replan = t
+        self._plan = None
+
+    def force(self, t: float, position, velocity, dt: float) -> np.ndarray:
+        """Force on the handle (3,), N, with the hand at position (3,) m, velocity (3,) m/s at time t (s);
+        advances the intended motion by dt (s)."""
+        if t >= self._next_replan - 1e-9:
+            self._replan(t, position)
+        step = int((t - self._plan_time) / self.planner.model.h + 1e-9)
+        command = self._executed[step] if step < len(self._executed) else np.zeros(3)
+        acceleration = self._inverse_inertia @ (command - self._damping @ self.intended_velocity)
+        force = self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
+            + self._load_inertia @ acceleration
+        self.intended_velocity = self.intended_velocity + dt * acceleration
+        self.intended_position = self.intended_position + dt * self.intended_velocity
+        return force
+
+    def _replan(self, t: float, position) -> None:
+        start = np.r_[position, self.intended_velocity]
+        if self._plan is None:
+            self._plan = self.first_plan if self.first_plan is not None else solve_to_convergence(
+                self.planner, start, self.goal, self.width)
+        else:
+            shift = min(self._steps_per_replan, self.planner.model.H - 1)
+            warm = np.vstack([self._plan.torque[shift:], np.repeat(self._plan.torque[-1:], shift, axis=0)])
+            self._plan = self.planner.solve(start, self.goal, self.width, warm_start=warm)
+        self.plans.append(self._plan)
+        self.replan_times.append(t)
+        commands = self._plan.torque[: self._steps_per_replan]
+        model = self.planner.model
+        noise = sample_torque_error(commands, model.kappa, model.noise, self.rng) if self.parameters.motor_noise else 0.0
+        self._executed = commands + noise
+        self._plan_time = t
+        self._next_replan = t + self.parameters.replan_interval

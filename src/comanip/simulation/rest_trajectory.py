@@ -1,0 +1,39 @@
+"""A planned reach as the impedance controller's rest motion (SPEC §8: the plan's mean is the rest position).
+
+The plan gives the mean end effector x_i and velocity v_i at the steps t_i = i·h. Between steps the rest
+position follows the cubic Hermite curve through (x_i, v_i), so rest position and velocity are continuous
+at the control rate (a piecewise-linear rest would jerk the arm every h seconds); after the plan's last
+step the rest holds its final point.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import CubicHermiteSpline
+
+from comanip.planning.plan import Plan
+
+
+class RestTrajectory:
+    """Rest position and velocity of a plan, sampled once on a fine time grid and looked up per control step.
+
+    Args:
+        plan: a plan in task space (d = 3).
+        time_offset: real time (s) of the plan's step 0; the rest at time t is the plan at t - time_offset.
+        dt: control period (s) of the lookup grid.
+        duration: real time (s) the grid must cover from time_offset on.
+    """
+
+    def __init__(self, plan: Plan, time_offset: float, dt: float, duration: float):
+        spline = CubicHermiteSpline(plan.t, plan.ee_mean, plan.ee_velocity, axis=0)
+        self.time_offset, self.dt = float(time_offset), float(dt)
+        tau = np.arange(int(np.ceil(duration / dt)) + 2) * dt
+        inside = np.minimum(tau, plan.t[-1])
+        self.position = spline(inside)
+        self.velocity = np.where((tau <= plan.t[-1])[:, None], spline(inside, 1), 0.0)
+
+    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """(rest position (3,) m, rest velocity (3,) m/s) at real time t (s), held at the ends."""
+        k = int(round((t - self.time_offset) / self.dt))
+        k = min(max(k, 0), len(self.position) - 1)
+        return self.position[k], self.velocity[k]
