@@ -72,10 +72,79 @@ def closed_loop_reach_case() -> Case:
     return Case(f"planar closed-loop reach ({2 * model.H} replans)", build, solve)
 
 
+def estimate_case(preset: str) -> Callable[[], Case]:
+    """Warm goal estimates (paper Section V-C) from a state observed at 0.2 s of reaches to goals varied
+    around a nominal goal, which is the prior; each estimate warm-starts from the previous one. The observed
+    state is drawn from the hidden plan's belief at the observed step (motor noise)."""
+
+    def make() -> Case:
+        from comanip.estimation import GoalEstimator
+
+        model = comanip.presets.load(preset)
+        t0 = time.perf_counter()
+        estimator = GoalEstimator(model)
+        build = time.perf_counter() - t0
+        rng = np.random.default_rng(0)
+        start, nominal = np.zeros(2 * model.n), 0.3 * np.eye(model.d)[0]
+        n_o = int(np.floor(0.2 / model.h + 1e-9))
+        hidden = estimator.planner.solve(start, nominal)
+        previous = estimator.estimate(start, hidden.mean[n_o], 0.2, prior_goal=nominal)
+
+        def solve(k: int) -> tuple[float, bool]:
+            nonlocal previous, hidden
+            hidden = estimator.planner.solve(start, nominal + rng.uniform(-0.05, 0.05, model.d), warm_start=hidden)
+            observed = rng.multivariate_normal(hidden.mean[n_o], hidden.cov[n_o])
+            previous = estimator.estimate(start, observed, 0.2, prior_goal=nominal, warm_start=previous)
+            return previous.solve_time, previous.success
+
+        return Case(f"{preset} estimate_goal warm (t_obs 0.2 s)", build, solve)
+
+    return make
+
+
+def posterior_case(preset: str, new_start: bool) -> Callable[[], Case]:
+    """Posterior over 5 candidate goals 0.1–0.2 m apart from the first 4 observed states of a noisy reach
+    to one of them. ``new_start``: each call starts from a different state, so the 5 plans are re-solved
+    (warm); otherwise they are reused and a call only scores the observations (a reach in progress)."""
+
+    def make() -> Case:
+        from comanip.belief import sample_trajectories
+        from comanip.estimation import goal_posterior
+
+        model = comanip.presets.load(preset)
+        t0 = time.perf_counter()
+        planner = comanip.Planner(model)
+        build = time.perf_counter() - t0
+        rng = np.random.default_rng(0)
+        offsets = np.array([[0, 0, 0], [0, 1, 0], [0, -1, 0], [1, 0, 0], [-1, 0, 0]])[:, : model.d]
+        candidates = 0.3 * np.eye(model.d)[0] + 0.15 * offsets
+        times = model.h * np.arange(1, 5)
+        steps = np.arange(1, 5)
+        previous = goal_posterior(planner, np.zeros(2 * model.n), np.zeros((1, 2 * model.n)), [0.0], candidates)
+
+        def solve(k: int) -> tuple[float, bool]:
+            nonlocal previous
+            start = np.r_[rng.uniform(-0.02, 0.02, model.n), np.zeros(model.n)] if new_start else np.zeros(2 * model.n)
+            truth = previous.plans[k % len(candidates)]
+            states = sample_trajectories(model.body, model.h, model.kappa, start, truth.torque, 1, rng, model.noise)[0, steps]
+            t = time.perf_counter()
+            previous = goal_posterior(planner, start, states, times, candidates, warm_start=previous)
+            return time.perf_counter() - t, previous.success
+
+        label = "5 warm plans" if new_start else "plans reused"
+        return Case(f"{preset} goal_posterior, 5 goals ({label})", build, solve)
+
+    return make
+
+
 CASES: dict[str, Callable[[], Case]] = {
     "planar": point_mass_case("planar", 0.04),
     "cartesian": point_mass_case("cartesian", 0.20),
     "closed_loop": closed_loop_reach_case,
+    "estimate_planar": estimate_case("planar"),
+    "estimate_cartesian": estimate_case("cartesian"),
+    "posterior_cartesian": posterior_case("cartesian", new_start=True),
+    "posterior_cartesian_update": posterior_case("cartesian", new_start=False),
 }
 
 

@@ -5,10 +5,11 @@ Multi-component Reaching Strategies". See ``comanip.planning.planner`` for the p
 """
 
 from comanip import presets
+from comanip.estimation import estimate_goal, goal_posterior
 from comanip.model import ReachingModel
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning import Plan, Planner, SolverOptions, plan_reach
 
 __version__ = "0.1.0"
 
-__all__ = ["presets", "ReachingModel", "Plan", "Planner", "SolverOptions", "plan_reach", "TransitionModel"]
+__all__ = ["presets", "ReachingModel", "Plan", "Planner", "SolverOptions", "plan_reach", "TransitionModel", "estimate_goal", "goal_posterior"]

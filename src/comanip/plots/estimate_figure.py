@@ -10,6 +10,7 @@ import numpy as np
 from matplotlib.patches import Circle
 
 from comanip.planning.plan import Plan
+from comanip.plots.figure_file import save_figure
 
 _AXES = "xyz"
 
@@ -79,12 +80,8 @@ def plot_estimate(plan: Plan, path: str | Path, observed_points=None, observed_t
     ax_speed.legend(fontsize=8)
 
     method = plan.extras.get("method", "")
-    fig.suptitle(title or f"{plan.model_name} goal estimate ({method}): goal {np.round(goal, 3).tolist()} m, "
-                 f"{plan.status}, {1e3 * plan.solve_time:.0f} ms", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save_figure(fig, path, title or f"{plan.model_name} goal estimate ({method}): goal {np.round(goal, 3).tolist()} m, "
+                                           f"{plan.status}, {1e3 * plan.solve_time:.0f} ms")
 
 
 def plot_posterior(posterior, path: str | Path, title: str | None = None) -> Path:
@@ -106,9 +103,5 @@ def plot_posterior(posterior, path: str | Path, title: str | None = None) -> Pat
     ax_prob.set(xlabel="time of the latest observation (s)", ylabel="P(goal | observations so far)", ylim=(-0.02, 1.02),
                 title="posterior as observations arrive")
     ax_prob.legend(fontsize=8)
-    fig.suptitle(title or f"goal posterior over {len(posterior.candidates)} candidates; entropy "
-                 f"{posterior.entropy[0]:.2f} → {posterior.entropy[-1]:.2f} nats", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return Path(path)
+    return save_figure(fig, path, title or f"goal posterior over {len(posterior.candidates)} candidates; entropy "
+                                           f"{posterior.entropy[0]:.2f} → {posterior.entropy[-1]:.2f} nats")
