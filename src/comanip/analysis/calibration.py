@@ -26,11 +26,13 @@ from dataclasses import dataclass, field
 from itertools import product
 
 import numpy as np
+from scipy.stats import linregress
 from tqdm import tqdm
 
 from comanip.analysis.fitts import FittsFit, fit_fitts, trend_fraction
 from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, open_loop_grid
 from comanip.model import ReachingModel
+from comanip.objectives.reward import goal_covariance
 from comanip.planning.planner import Planner
 
 #: Fitts' law holds when the better of the two fits has at least this R².
@@ -105,6 +107,15 @@ class CalibrationResult:
     outcomes: list[ReachOutcome]
     fitts: FittsFit
     shannon: FittsFit
+    goal_covariance: str = "std"
+    """The W reading the configuration planned with ('std' W = w² I or 'cov' W = w I)."""
+
+    @property
+    def effective_ids(self) -> np.ndarray:
+        """Effective index of difficulty log2(2D / sqrt(W)) (nD, nW), bits: the Fitts ID with the goal's
+        standard deviation in place of w (equal to the Fitts ID under the 'std' reading)."""
+        goal_std = np.sqrt([goal_covariance(w, 1, self.goal_covariance)[0, 0] for w in self.widths])
+        return np.log2(2 * self.distances[:, None] / goal_std[None, :])
 
     @property
     def movement_times(self) -> np.ndarray:
@@ -126,9 +137,12 @@ class CalibrationResult:
         best_r2 = np.nanmax([self.fitts.r2, self.shannon.r2, -np.inf])
         fitts_law = settled and best_r2 >= FITTS_R2_MIN and width_trend == 1 and distance_trend == 1 and mt_in_range
         early_peak = settled and bool(np.all(ratio < EARLY_PEAK_MAX))
+        ids = self.effective_ids
+        finite = np.isfinite(ratio)
+        trend = linregress(ids[finite], ratio[finite]) if finite.sum() >= 3 and np.ptp(ids[finite]) > 0 else None
         return {
             "configuration": self.configuration.name, "mode": self.configuration.mode,
-            "changes": dict(self.configuration.changes),
+            "changes": dict(self.configuration.changes), "goal_covariance": self.goal_covariance,
             "all_solves_converged": all(o.success for o in self.outcomes), "all_reaches_finished": settled,
             "asymmetry_min": _nan_stat(np.nanmin, ratio), "asymmetry_median": _nan_stat(np.nanmedian, ratio),
             "asymmetry_max": _nan_stat(np.nanmax, ratio),
@@ -138,7 +152,11 @@ class CalibrationResult:
             "shannon_r2": self.shannon.r2, "shannon_slope_s_per_bit": self.shannon.b, "shannon_intercept_s": self.shannon.a,
             "width_trend": width_trend, "distance_trend": distance_trend, "mt_in_human_range": mt_in_range,
             "fitts_law": bool(fitts_law), "early_peak": early_peak, "both": bool(fitts_law and early_peak),
-            "conditions": [o.summary() for o in self.outcomes],
+            # t_peak/MT against the effective ID: its slope (per bit) and where the line crosses the 0.5 claim
+            "asymmetry_slope_per_bit": float(trend.slope) if trend else float("nan"),
+            "effective_id_at_half_bits": (float((EARLY_PEAK_MAX - trend.intercept) / trend.slope)
+                                          if trend and trend.slope != 0 else float("nan")),
+            "conditions": [o.summary() | {"effective_id_bits": float(x)} for o, x in zip(self.outcomes, ids.ravel())],
         }
 
 
@@ -146,8 +164,9 @@ def _nan_stat(stat, values) -> float:
     return float(stat(values)) if np.any(np.isfinite(values)) else float("nan")
 
 
-def measure_grid(outcomes: list[ReachOutcome], configuration: Configuration) -> CalibrationResult:
-    """A :class:`CalibrationResult` from the outcomes of a full distances × widths grid (any order)."""
+def measure_grid(outcomes: list[ReachOutcome], configuration: Configuration, goal_covariance_form: str = "std") -> CalibrationResult:
+    """A :class:`CalibrationResult` from the outcomes of a full distances × widths grid (any order), planned
+    with the W reading goal_covariance_form."""
     outcomes = sorted(outcomes, key=lambda o: (o.distance, o.width))
     distances = np.unique([o.distance for o in outcomes])
     widths = np.unique([o.width for o in outcomes])
@@ -156,7 +175,7 @@ def measure_grid(outcomes: list[ReachOutcome], configuration: Configuration) -> 
     D, w, mt = (np.array([getattr(o, k) for o in outcomes]) for k in ("distance", "width", "metrics"))
     mt = np.array([m.movement_time for m in mt])
     return CalibrationResult(configuration, distances, widths, outcomes,
-                             fit_fitts(D, w, mt, "fitts"), fit_fitts(D, w, mt, "shannon"))
+                             fit_fitts(D, w, mt, "fitts"), fit_fitts(D, w, mt, "shannon"), goal_covariance_form)
 
 
 def run_calibration(base: ReachingModel, configurations: list[Configuration], distances, widths, n_trials: int = 8,
@@ -188,20 +207,22 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
                 results[futures[future]].append(future.result())
                 bar.update(1)
     bar.close()
-    return [measure_grid(results[i], c) for i, c in enumerate(configurations)]
+    return [measure_grid(results[i], c, c.model(base).goal_covariance) for i, c in enumerate(configurations)]
 
 
-_PLANNERS: dict[str, Planner] = {}
-"""Planners built in this process, by model: a worker builds each configuration's problem once."""
+_PLANNER: dict[str, Planner] = {}
+"""The planner this process built last, by model. Conditions are submitted configuration by configuration,
+so a worker reuses it for a run of conditions; keeping one bounds the memory a worker holds."""
 
 
 def _run_condition(base_config: dict, configuration: Configuration, distance: float, width: float, n_trials: int,
                    seed_key: tuple[int, int, int]) -> ReachOutcome:
     model = configuration.model(ReachingModel.from_config(base_config))
     key = repr(model.config())
-    if key not in _PLANNERS:
-        _PLANNERS[key] = Planner(model)
-    planner = _PLANNERS[key]
+    if key not in _PLANNER:
+        _PLANNER.clear()
+        _PLANNER[key] = Planner(model)
+    planner = _PLANNER[key]
     if configuration.closed_loop:
         rng = np.random.default_rng(np.random.SeedSequence(list(seed_key)))
         return closed_loop_grid(planner, [distance], [width], n_trials, rng)[0]

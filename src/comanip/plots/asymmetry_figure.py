@@ -14,7 +14,6 @@ import numpy as np
 
 from comanip.analysis.calibration import EARLY_PEAK_MAX
 from comanip.analysis.minimum_jerk_baseline import minimum_jerk_asymmetry
-from comanip.objectives.reward import goal_covariance
 from comanip.plots.figure_file import save_figure
 
 
@@ -28,10 +27,8 @@ def plot_asymmetry_against_difficulty(rows: list[dict], nominal_id_range: tuple[
     readings = {"std": "W = w²I", "cov": "W = wI"}
     labelled = set()
     for row in rows:
-        form = row["changes"].get("goal_covariance", "std")
-        points = [(np.log2(2 * c["distance_m"] / np.sqrt(goal_covariance(c["width_m"], 1, form)[0, 0])), c["asymmetry"])
-                  for c in row["conditions"]]
-        x, y = np.array(points, dtype=float).T
+        form = row["goal_covariance"]
+        x, y = np.array([(c["effective_id_bits"], c["asymmetry"]) for c in row["conditions"]], dtype=float).T
         marker, color = styles[form, row["mode"]]
         label = None if (form, row["mode"]) in labelled else f"{readings[form]}, {row['mode']}"
         labelled.add((form, row["mode"]))

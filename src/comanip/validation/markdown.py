@@ -62,20 +62,22 @@ def _calibration_section(calibration: dict, settings: dict) -> list[str]:
         "## Calibration study (`calibration.png`)", "",
         f"Grid D ∈ {list(settings['distances'])} m × w ∈ {list(settings['widths'])} m. Fitts' law: every reach finished, "
         f"best R² ≥ {FITTS_R2_MIN}, both trends in every pair, every MT in the human range. Early peak: t_peak/MT < "
-        f"{EARLY_PEAK_MAX} in every condition. Closed loop: mean executed velocity over {settings['calibration_trials']} "
-        "trials per condition, replanning every step from the noisy state (window H, 2H steps).", "",
+        f"{EARLY_PEAK_MAX} in every condition. The last column fits t_peak/MT against the effective ID "
+        "log2(2D/√W) (√W = w for W = w²I, √w for W = wI) and says where the line crosses 0.5. Closed loop: mean "
+        f"executed velocity over {settings['calibration_trials']} trials per condition, replanning every step from the noisy state (window H, 2H steps).", "",
         verdict, "",
         f"Reference: under W = wI a scale-invariant model's MT depends on D/√w rather than D/w; an MT exactly linear in "
         f"log2(2D/√w) would reach only R² = {_num(calibration['cov_reading_fitts_r2_if_log_linear'], 3)} (Fitts form) / "
         f"{_num(calibration['cov_reading_shannon_r2_if_log_linear'], 3)} (Shannon form) on this grid.", "",
         _table(["configuration", "mode", "t_peak/MT min / median / max", "early (share)", "MT range (s)", "R² Fitts",
-                "R² Shannon", "slope (s/bit)", "width trend", "distance trend", "converged", "Fitts' law", "early peak"],
+                "R² Shannon", "slope (s/bit)", "width trend", "distance trend", "converged", "Fitts' law", "early peak",
+                "t_peak/MT = 0.5 at effective ID (bits)"],
                [[r["configuration"], r["mode"],
                  f"{_num(r['asymmetry_min'], 2)} / {_num(r['asymmetry_median'], 2)} / {_num(r['asymmetry_max'], 2)}",
                  _num(r["early_fraction"], 2), f"{_num(r['mt_min_s'], 3)}–{_num(r['mt_max_s'], 3)}", _num(r["fitts_r2"], 3),
                  _num(r["shannon_r2"], 3), _num(r["fitts_slope_s_per_bit"], 4), _num(r["width_trend"], 2),
                  _num(r["distance_trend"], 2), r["all_solves_converged"], "yes" if r["fitts_law"] else "no",
-                 "yes" if r["early_peak"] else "no"] for r in rows]),
+                 "yes" if r["early_peak"] else "no", _num(r["effective_id_at_half_bits"], 2)] for r in rows]),
     ]
 
 
