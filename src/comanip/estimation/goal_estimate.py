@@ -120,12 +120,15 @@ class GoalEstimator:
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
-        point = self._warm_point(warm_start) if warm_start is not None else None
+        point, plan_needed = self._warm_point(warm_start) if warm_start is not None else (None, False)
 
         deadline = math.inf if max_wall_time is None else t_begin + max_wall_time
 
         def remaining_time() -> float | None:
             return None if max_wall_time is None else max(deadline - time.perf_counter(), 1e-6)
+
+        if plan_needed:
+            point.tau_s = self.planner.solve(start, point.goal, width, max_wall_time=remaining_time()).torque.ravel()
 
         def cold_point() -> RegretPoint:
             return self._cold_point(start, observed, n_o, prior, width, remaining_time)
@@ -160,7 +163,8 @@ class GoalEstimator:
                                       success=success, message=message, solve_time=time.perf_counter() - t_begin,
                                       iterations=iterations, extras=extras)
 
-    def _warm_point(self, warm_start: Plan) -> RegretPoint:
+    def _warm_point(self, warm_start: Plan) -> tuple[RegretPoint, bool]:
+        """The iterate a warm start gives, and whether its plan to the goal (tau_s) must still be solved."""
         model = self.model
         if not isinstance(warm_start, Plan):
             raise ValueError(f"warm_start must be a previous estimate or a Plan of this model, got {type(warm_start).__name__}")
@@ -168,11 +172,16 @@ class GoalEstimator:
         tau_c = as_matrix("warm_start.torque", warm_start.torque, shape, unit).ravel()
         goal = as_vector("warm_start.goal", warm_start.goal, model.d, "m")
         extras = warm_start.extras
-        if "unconstrained_torque" in extras and "multipliers" in extras:
-            tau_s = as_matrix("warm_start.extras['unconstrained_torque']", extras["unconstrained_torque"], shape, unit).ravel()
+        lam = np.zeros(2 * model.n)
+        if "multipliers" in extras:
             lam = as_vector("warm_start.extras['multipliers']", extras["multipliers"], 2 * model.n, "multipliers")
-            return RegretPoint(tau_c.copy(), lam.copy(), tau_s.copy(), goal.copy())
-        return RegretPoint(tau_c.copy(), np.zeros(2 * model.n), tau_c.copy(), goal.copy())
+        if "unconstrained_torque" in extras:
+            tau_s = as_matrix("warm_start.extras['unconstrained_torque']", extras["unconstrained_torque"], shape, unit).ravel()
+            return RegretPoint(tau_c.copy(), lam.copy(), tau_s.copy(), goal.copy()), False
+        # An estimate by another method holds a trajectory through its observation, not a plan to its goal
+        # (and it may even be a poor local optimum of J that passes through it, where the regret is zero):
+        # the plan to its goal is solved afresh. A plain plan is one already.
+        return RegretPoint(tau_c.copy(), lam.copy(), tau_c.copy(), goal.copy()), "observed_step" in extras
 
     def _cold_point(self, start, observed, n_o, prior, width, remaining_time) -> RegretPoint:
         """Start from the best goal along the observed direction; from the prior (or the hand) if nothing moved."""

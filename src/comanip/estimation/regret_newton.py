@@ -44,6 +44,7 @@ fraction of the remaining reach.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import casadi as ca
 import numpy as np
@@ -124,12 +125,14 @@ class RegretSystem:
         """F and its Jacobian blocks at an iterate; ``prior`` None drops the regulariser."""
         Hn = self.H * self.n
         # the buffers are reused by the next call: copy the first evaluation before the second
-        _, grad_c, hess_c = (v.copy() for v in self._derivatives(point.tau_c, point.goal, start, width))
-        _, grad_s, hess_s = (v.copy() for v in self._derivatives(point.tau_s, point.goal, start, width))
+        J_c, grad_c, hess_c = (v.copy() for v in self._derivatives(point.tau_c, point.goal, start, width))
+        J_s, grad_s, hess_s = (v.copy() for v in self._derivatives(point.tau_s, point.goal, start, width))
         mu, A, curvature = (v.copy() for v in self.observed_mean(n_o)(point.tau_c, start, point.lam))
         P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(width)
         pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior)
+        regulariser = 0.0 if prior is None else float((point.goal - prior) @ P @ (point.goal - prior))
         return Linearisation(
+            J_c=float(J_c), J_s=float(J_s), regulariser=regulariser, grad_c=grad_c[:Hn], H_c=hess_c[:Hn, :Hn],
             F1=grad_c[:Hn] + A.T @ point.lam, F2=mu - observed, F3=grad_s[:Hn],
             F4=grad_c[Hn:] - grad_s[Hn:] + pull,
             K_c=np.block([[hess_c[:Hn, :Hn] + curvature, A.T], [A, np.zeros((2 * self.n, 2 * self.n))]]),
@@ -141,6 +144,13 @@ class RegretSystem:
 class Linearisation:
     """F = (F1, F2, F3, F4) at an iterate and the blocks of its Jacobian (see the module docstring)."""
 
+    J_c: float
+    """Normalised J at tau_c and at tau_s, and the normalised regulariser at g."""
+    J_s: float
+    regulariser: float
+    grad_c: np.ndarray
+    """dJ/dtau at tau_c (H·n,) and d²J/dtau² there (H·n square), for the predicted regret."""
+    H_c: np.ndarray
     F1: np.ndarray
     F2: np.ndarray
     F3: np.ndarray
@@ -160,22 +170,42 @@ class Linearisation:
     def residual(self) -> float:
         return float(max(np.abs(F).max() for F in (self.F1, self.F2, self.F3, self.F4)))
 
-    def step(self, goal_step_limit: float, damping: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Newton step (d tau_c, d lam, d tau_s, d g) by block elimination.
-
-        The goal step solves (|d²R/dg²| + damping I) d g = -r (eigenvalues mirrored, Levenberg–Marquardt
-        damping) and is at most goal_step_limit (m) long; the torque steps follow it exactly.
-        """
-        Hn = len(self.F1)
-        Xc = np.linalg.solve(self.K_c, np.column_stack([np.vstack([self.Hc_tau_g, np.zeros((len(self.F2), self.Hc_tau_g.shape[1]))]),
+    @cached_property
+    def _solves(self) -> tuple[np.ndarray, np.ndarray]:
+        """K_c^-1 [[Hc_tau_g, F1], [0, F2]] and H_s^-1 [Hs_tau_g, F3]: the torques' sensitivity to the goal
+        (first d columns) and their Newton step at a fixed goal (last column)."""
+        d = self.Hc_gg.shape[0]
+        Xc = np.linalg.solve(self.K_c, np.column_stack([np.vstack([self.Hc_tau_g, np.zeros((len(self.F2), d))]),
                                                         np.r_[self.F1, self.F2]]))
         Xs = np.linalg.solve(self.H_s, np.column_stack([self.Hs_tau_g, self.F3]))
+        return Xc, Xs
+
+    @property
+    def predicted_regret(self) -> float:
+        """R(g) (normalised) predicted from this iterate: J at the inner problems' Newton steps for the same
+        goal, from their quadratic models. Unlike Jc - J(tau_s) at the iterate itself it does not rise when
+        the inner problems are solved more accurately, so it can judge a step while they are not yet."""
+        Xc, Xs = self._solves
+        d, Hn = self.Hc_gg.shape[0], len(self.F1)
+        step_c, step_s = -Xc[:Hn, d], -Xs[:, d]
+        J_c = self.J_c + self.grad_c @ step_c + 0.5 * step_c @ self.H_c @ step_c
+        J_s = self.J_s + self.F3 @ step_s + 0.5 * step_s @ self.H_s @ step_s
+        return float(J_c - J_s) + self.regulariser
+
+    def step(self, goal_step_limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Newton step (d tau_c, d lam, d tau_s, d g) by block elimination.
+
+        The goal step solves |d²R/dg²| d g = -r (eigenvalues mirrored, so it descends where the regret is
+        not convex) and is at most goal_step_limit (m) long; the torque steps follow it exactly.
+        """
+        Hn = len(self.F1)
+        Xc, Xs = self._solves
         d = self.Hc_gg.shape[0]
         reduced = self.reduced_hessian(Xc, Xs)
         rhs = self.F4 - self.Hc_tau_g.T @ Xc[:Hn, d] + self.Hs_tau_g.T @ Xs[:, d]
         eigenvalues, vectors = np.linalg.eigh(reduced)
         mirrored = np.maximum(np.abs(eigenvalues), 1e-10 * max(1.0, np.abs(eigenvalues).max()))
-        d_goal = -vectors @ ((vectors.T @ rhs) / (mirrored + damping))
+        d_goal = -vectors @ ((vectors.T @ rhs) / mirrored)
         length = np.linalg.norm(d_goal)
         if length > goal_step_limit:
             d_goal *= goal_step_limit / length
@@ -219,45 +249,70 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
                  expired) -> NewtonResult:
     """Newton's method on F from ``point`` until max |F| ≤ tolerance, then the second-order check.
 
-    Globalised the Levenberg–Marquardt way: a step is kept only if it lowers max |F|; otherwise it is
-    retried with more damping on the goal step (the regret is flat along the reach early in a slow one,
-    where undamped steps overshoot). The goal also moves at most step_fraction·max(|g - x_o|, w) per step,
-    x_o = ``observed_position`` (the observed end effector, m). ``expired()`` is asked before every step
-    (wall-time budget). Each trial point costs one linearisation (two Hessians of J); ``max_iterations``
-    bounds their number. Never raises: when the iteration does not converge, the iterate with the
-    smallest residual is returned with a status.
+    Globalised by a trust region on the goal step, judged by the regret itself: a trial point is kept when
+    its predicted regret (:attr:`Linearisation.predicted_regret`) is lower, or, once the regret's changes
+    are down at rounding level, when it halves the residual max |F| (Newton's quadratic endgame). Otherwise
+    the goal step is shortened, the inner problems take a Newton step at the current goal (so the next
+    comparison is made with them solved more accurately), and the step is retried. Far from the answer the
+    regret is not convex, and early in a slow reach it is flat along the reach, where full steps overshoot.
+    The radius starts at, and never exceeds, step_fraction·max(|g - x_o|, w), x_o = ``observed_position``
+    (the observed end effector, m). ``expired()`` is asked before every step (wall-time budget).
+    ``max_iterations`` bounds the number of linearisations (two Hessians of J each), which the result
+    reports as iterations. Never raises: when the iteration does not converge, the last accepted iterate
+    is returned with a status.
     """
     linearisation = system.linearise(point, start, observed, n_o, prior, width)
-    damping = 0.0
+    radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
     status, message = "max_iterations", f"no convergence in {max_iterations} Newton iterations"
-    for iteration in range(1, max_iterations + 1):
+    count = 0
+
+    def moved(by) -> tuple[RegretPoint, Linearisation]:
+        nonlocal count
+        count += 1
+        d_tau_c, d_lam, d_tau_s, d_goal = by
+        moved_point = RegretPoint(point.tau_c + d_tau_c, point.lam + d_lam, point.tau_s + d_tau_s, point.goal + d_goal)
+        return moved_point, system.linearise(moved_point, start, observed, n_o, prior, width)
+
+    while True:
         residual = linearisation.residual
         if not np.isfinite(residual):
-            return NewtonResult(point, "failed", "J is not finite at the starting point", iteration - 1, residual)
+            return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual)
         if residual <= tolerance:
             is_minimum, why = linearisation.is_strict_minimum()
             status, message = ("solved", "converged") if is_minimum else ("not_a_minimum", why)
-            return NewtonResult(point, status, message, iteration - 1, residual)
+            return NewtonResult(point, status, message, count, residual)
+        if count >= max_iterations:
+            break
         if expired():
             status, message = "max_wall_time", "the wall-time budget ran out"
             break
-        limit = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-        d_tau_c, d_lam, d_tau_s, d_goal = linearisation.step(limit, damping)
-        trial = RegretPoint(point.tau_c + d_tau_c, point.lam + d_lam, point.tau_s + d_tau_s, point.goal + d_goal)
-        trial_linearisation = system.linearise(trial, start, observed, n_o, prior, width)
-        if trial_linearisation.residual < residual:
+        ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+        step = linearisation.step(min(radius, ceiling))
+        trial, trial_linearisation = moved(step)
+        if _acceptable(linearisation, trial_linearisation):
             point, linearisation = trial, trial_linearisation
-            damping = 0.0 if damping < _DAMPING_FLOOR else damping / 4
-        else:
-            scale = np.abs(np.linalg.eigvalsh(linearisation.reduced_hessian())).max()
-            damping = max(4 * damping, _DAMPING_FLOOR * max(scale, 1.0))
-            if not np.isfinite(damping) or damping > _DAMPING_CEILING * max(scale, 1.0):
-                status, message = "failed", "the Newton iteration stalled (no step lowers the residual)"
-                break
-    return NewtonResult(point, status, message, iteration, linearisation.residual)
+            radius = min(2 * radius, ceiling) if np.linalg.norm(step[3]) >= 0.99 * min(radius, ceiling) else radius
+            continue
+        radius = 0.25 * np.linalg.norm(step[3])
+        if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
+            status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
+            break
+        inner, inner_linearisation = moved(linearisation.step(0.0))
+        if np.isfinite(inner_linearisation.residual):
+            point, linearisation = inner, inner_linearisation
+    return NewtonResult(point, status, message, count, linearisation.residual)
 
 
-#: Levenberg–Marquardt damping, relative to the largest curvature of the regret: first value after a
-#: rejected step, and the value beyond which a step is too short to matter (the iteration has stalled).
-_DAMPING_FLOOR = 1e-3
-_DAMPING_CEILING = 1e8
+def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
+    if not np.isfinite(trial.residual):
+        return False
+    before, after = current.predicted_regret, trial.predicted_regret
+    if not np.isfinite(after):
+        return False
+    return after < before or (trial.residual < 0.5 * current.residual and after < before + _ROUNDING * (1 + abs(before)))
+
+
+#: A goal step shorter than this fraction of the goal width means the iteration has stalled.
+_SHORTEST_GOAL_STEP = 1e-7
+#: Relative change of the (normalised) regret below which it no longer tells steps apart.
+_ROUNDING = 1e-10
