@@ -150,7 +150,7 @@ class GoalEstimator:
                 if retry.status == "solved" or retry.residual < result.residual:
                     result = retry
             point, status, message = result.point, result.status, result.message
-            extras = {"regret": self._regret.regret(point, start, width), "residual": result.residual,
+            extras = {"regret": self._regret.normaliser(width) * result.regret, "residual": result.residual,
                       "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
         else:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,

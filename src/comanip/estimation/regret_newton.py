@@ -77,6 +77,8 @@ class NewtonResult:
     iterations: int
     residual: float
     """max |F| at the returned point (normalised gradient units; m, m/s or rad, rad/s for F2)."""
+    regret: float
+    """J(tau_c) - J(tau_s) at the returned point, normalised (without the regulariser)."""
 
 
 class RegretSystem:
@@ -112,14 +114,9 @@ class RegretSystem:
         """P = W^-1 / |J_best| (d, d) for width w (m)."""
         return np.asarray(self._prior_weight(width))
 
-    def objective(self, tau: np.ndarray, goal, start, width) -> float:
-        """Normalised J at torques (H·n,)."""
-        return float(self._derivatives(tau, goal, start, width)[0])
-
-    def regret(self, point: RegretPoint, start, width) -> float:
-        """Jc - V* at an iterate, in units of J (m^-d): the extra cost the observation forces."""
-        difference = self.objective(point.tau_c, point.goal, start, width) - self.objective(point.tau_s, point.goal, start, width)
-        return float(self._normaliser(width)) * difference
+    def normaliser(self, width: float) -> float:
+        """|J_best(w)|: J divided by it is what the iteration works with (m^-d)."""
+        return float(self._normaliser(width))
 
     def linearise(self, point: RegretPoint, start, observed, n_o: int, prior, width) -> "Linearisation":
         """F and its Jacobian blocks at an iterate; ``prior`` None drops the regulariser."""
@@ -276,11 +273,11 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
     while True:
         residual = linearisation.residual
         if not np.isfinite(residual):
-            return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual)
+            return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual, np.nan)
         if residual <= tolerance:
             is_minimum, why = linearisation.is_strict_minimum()
             status, message = ("solved", "converged") if is_minimum else ("not_a_minimum", why)
-            return NewtonResult(point, status, message, count, residual)
+            return NewtonResult(point, status, message, count, residual, linearisation.J_c - linearisation.J_s)
         if count >= max_iterations:
             break
         if expired():
@@ -300,7 +297,7 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
         inner, inner_linearisation = moved(linearisation.step(0.0))
         if np.isfinite(inner_linearisation.residual):
             point, linearisation = inner, inner_linearisation
-    return NewtonResult(point, status, message, count, linearisation.residual)
+    return NewtonResult(point, status, message, count, linearisation.residual, linearisation.J_c - linearisation.J_s)
 
 
 def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
