@@ -147,7 +147,8 @@ def test_observation_between_steps_uses_the_earlier_step(planar_estimator):
     model = planar_estimator.model
     assert observation_step(model, 0.2) == 10  # 0.2 / 0.02 rounds to 9.999…
     assert observation_step(model, 0.2199) == 10
-    assert observation_step(model, 0.0201) == 1
+    assert observation_step(model, 0.0599) == 2
+    assert observation_step(model, 0.0201, allow_start=True) == 1  # a posterior may score step 1 (and 0)
 
 
 def test_joint_state_covariance_matches_monte_carlo(planar_planner, rng):
@@ -175,7 +176,7 @@ def test_posterior_finds_the_true_candidate_and_sharpens(request, preset, candid
     separation = min(np.linalg.norm(a - b) for i, a in enumerate(candidates) for b in candidates[i + 1:])
     assert separation >= 0.1 - 1e-12
     start = np.zeros(2 * model.n)
-    steps = [observation_step(model, t) for t in times]
+    steps = [observation_step(model, t, allow_start=True) for t in times]
     posterior, hits, entropies = None, 0, []
     trials_per_goal = 6
     for truth in range(len(candidates)):
@@ -228,6 +229,7 @@ def test_cli_estimate_writes_the_estimate_posterior_and_figures(tmp_path, capsys
     (dict(observed=np.zeros(3)), "observed"),
     (dict(observed=[0.1, 0.0, np.nan, 0.0]), "observed"),
     (dict(t_obs=0.0), "t_obs"),
+    (dict(t_obs=0.03), "t_obs"),  # step 1: the mean position there is fixed by the start
     (dict(t_obs=0.6), "t_obs"),
     (dict(t_obs=-0.1), "t_obs"),
     (dict(t_obs=float("nan")), "t_obs"),

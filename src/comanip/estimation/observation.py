@@ -18,13 +18,18 @@ from comanip.model import ReachingModel
 
 #: Relative slack on t/h so that times on the grid are not floored one step early by rounding.
 _GRID_SLACK = 1e-9
+#: The first step whose mean position the torques can move (Euler: q_2 = q_1 + h qdot_1, qdot_1 from tau_0).
+_FIRST_ESTIMABLE_STEP = 2
 
 
 def observation_step(model: ReachingModel, t_obs, *, allow_start: bool = False, name: str = "t_obs") -> int:
     """Plan step n_o = floor(t_obs / h) of an observation at t_obs (s).
 
-    t_obs must lie in (0, H·h) (or [0, H·h] with ``allow_start``, for a posterior that may see the start
-    state itself); anything else raises ValueError naming ``name``.
+    t_obs must lie in (0, H·h), and at least two steps in: step 0 is the start itself, and at step 1 the
+    forward-Euler position q_1 = q_0 + h qdot_0 is fixed by the start, so no torque can meet an observed
+    position there (an estimate's constraint would be degenerate). With ``allow_start`` (a posterior, which
+    scores states rather than constraining them) any t_obs in [0, H·h] is accepted. Anything else raises
+    ValueError naming ``name``.
     """
     if isinstance(t_obs, bool) or not isinstance(t_obs, (int, float, np.integer, np.floating)) or not math.isfinite(t_obs):
         raise ValueError(f"{name} must be a finite time in s, got {t_obs!r}")
@@ -34,7 +39,11 @@ def observation_step(model: ReachingModel, t_obs, *, allow_start: bool = False, 
     if not inside:
         interval = f"[0, {horizon:g}]" if allow_start else f"(0, {horizon:g})"
         raise ValueError(f"{name} must lie in {interval} s (the model's horizon H·h = {model.H}·{model.h:g} s), got {t_obs:g}")
-    return min(model.H, int(math.floor(t_obs / model.h * (1.0 + _GRID_SLACK))))
+    step = min(model.H, int(math.floor(t_obs / model.h * (1.0 + _GRID_SLACK))))
+    if step < _FIRST_ESTIMABLE_STEP and not allow_start:
+        raise ValueError(f"{name} must be at least two steps (2h = {2 * model.h:g} s) into the reach, got {t_obs:g} s "
+                         f"(step {step}): before that the mean position is fixed by the start state")
+    return step
 
 
 def observed_state(model: ReachingModel, state, name: str = "observed") -> np.ndarray:

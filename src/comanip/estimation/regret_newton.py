@@ -274,27 +274,31 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
         residual = linearisation.residual
         if not np.isfinite(residual):
             return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual, np.nan)
-        if residual <= tolerance:
-            is_minimum, why = linearisation.is_strict_minimum()
-            status, message = ("solved", "converged") if is_minimum else ("not_a_minimum", why)
-            return NewtonResult(point, status, message, count, residual, linearisation.J_c - linearisation.J_s)
-        if count >= max_iterations:
+        try:
+            if residual <= tolerance:
+                is_minimum, why = linearisation.is_strict_minimum()
+                status, message = ("solved", "converged") if is_minimum else ("not_a_minimum", why)
+                return NewtonResult(point, status, message, count, residual, linearisation.J_c - linearisation.J_s)
+            if count >= max_iterations:
+                break
+            if expired():
+                status, message = "max_wall_time", "the wall-time budget ran out"
+                break
+            ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+            step = linearisation.step(min(radius, ceiling))
+            trial, trial_linearisation = moved(step)
+            if _acceptable(linearisation, trial_linearisation):
+                point, linearisation = trial, trial_linearisation
+                radius = min(2 * radius, ceiling) if np.linalg.norm(step[3]) >= 0.99 * min(radius, ceiling) else radius
+                continue
+            radius = 0.25 * np.linalg.norm(step[3])
+            if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
+                status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
+                break
+            inner, inner_linearisation = moved(linearisation.step(0.0))
+        except np.linalg.LinAlgError:
+            status, message = "failed", "a Newton system was singular (the observation does not pin the torques down)"
             break
-        if expired():
-            status, message = "max_wall_time", "the wall-time budget ran out"
-            break
-        ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-        step = linearisation.step(min(radius, ceiling))
-        trial, trial_linearisation = moved(step)
-        if _acceptable(linearisation, trial_linearisation):
-            point, linearisation = trial, trial_linearisation
-            radius = min(2 * radius, ceiling) if np.linalg.norm(step[3]) >= 0.99 * min(radius, ceiling) else radius
-            continue
-        radius = 0.25 * np.linalg.norm(step[3])
-        if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
-            status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
-            break
-        inner, inner_linearisation = moved(linearisation.step(0.0))
         if np.isfinite(inner_linearisation.residual):
             point, linearisation = inner, inner_linearisation
     return NewtonResult(point, status, message, count, linearisation.residual, linearisation.J_c - linearisation.J_s)
