@@ -143,7 +143,8 @@ class GoalEstimator:
 
             result = newton(point if point is not None else cold_point())
             iterations = result.iterations
-            if point is not None and result.status in ("failed", "max_iterations", "not_a_minimum"):
+            if (point is not None and result.status in ("failed", "max_iterations", "not_a_minimum")
+                    and time.perf_counter() < deadline):
                 # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
                 retry = newton(cold_point())
                 iterations += retry.iterations

@@ -37,8 +37,13 @@ the Hessians a plan's solver uses anyway: Newton's method on F costs two of them
 solver takes a value function as an objective, so the iteration is written out here; IPOPT (through the
 planner) provides its starting point. Block elimination reduces each Newton step to a d×d system in the
 goal whose matrix is the regret's Hessian d²R/dg²; where that is not positive definite (far from the
-optimum) its eigenvalues are mirrored so the step still descends, and the goal step is limited to a
-fraction of the remaining reach.
+optimum) its eigenvalues are mirrored so the step still descends. A trust region on the goal step, judged
+by the regret the inner problems' quadratic models predict, keeps the iteration from overshooting where
+the regret is flat (:func:`newton_solve`). The returned point is checked to be a strict local minimum.
+
+The regret is measured against the plan the iteration tracks (tau_s), a local optimum of J: started from
+a poor local optimum it can be zero at a wrong goal, which is why starting points come from the planner's
+multi-start solves or from a previous estimate.
 """
 
 from __future__ import annotations
@@ -64,12 +69,11 @@ class RegretPoint:
     tau_s: np.ndarray
     goal: np.ndarray
 
-    def copy(self) -> "RegretPoint":
-        return RegretPoint(self.tau_c.copy(), self.lam.copy(), self.tau_s.copy(), self.goal.copy())
-
 
 @dataclass
 class NewtonResult:
+    """Where :func:`newton_solve` stopped and why."""
+
     point: RegretPoint
     status: str
     """'solved', 'max_iterations', 'max_wall_time', 'not_a_minimum' or 'failed'."""
