@@ -172,8 +172,9 @@ def measure_grid(outcomes: list[ReachOutcome], configuration: Configuration, goa
     widths = np.unique([o.width for o in outcomes])
     if len(outcomes) != len(distances) * len(widths):
         raise ValueError(f"outcomes must cover a full grid: {len(outcomes)} outcomes for {len(distances)} distances × {len(widths)} widths")
-    D, w, mt = (np.array([getattr(o, k) for o in outcomes]) for k in ("distance", "width", "metrics"))
-    mt = np.array([m.movement_time for m in mt])
+    D = np.array([o.distance for o in outcomes])
+    w = np.array([o.width for o in outcomes])
+    mt = np.array([o.metrics.movement_time for o in outcomes])
     return CalibrationResult(configuration, distances, widths, outcomes,
                              fit_fitts(D, w, mt, "fitts"), fit_fitts(D, w, mt, "shannon"), goal_covariance_form)
 

@@ -12,15 +12,16 @@ import numpy as np
 from tqdm import tqdm
 
 from comanip.analysis import (
+    Configuration,
     endpoint_dispersion,
     fit_fitts,
     index_of_difficulty,
+    measure_grid,
     minimum_jerk_asymmetry,
     open_loop_grid,
     phase_curves,
     run_calibration,
     study_configurations,
-    trend_fraction,
 )
 from comanip.analysis.calibration import HUMAN_MT_RANGE, TREND_TOLERANCE
 from comanip.analysis.reach_grid import home_start, unit_direction
@@ -66,11 +67,9 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
                                   progress=progress)
     calibration_rows = [result.summary() for result in calibration]
 
-    D = np.array([o.distance for o in grid])
-    w = np.array([o.width for o in grid])
-    mt = np.array([o.metrics.movement_time for o in grid])
-    fits = [fit_fitts(D, w, mt, form) for form in ("fitts", "shannon")]
-    id_range = (float(index_of_difficulty(D, w).min()), float(index_of_difficulty(D, w).max()))
+    measured = measure_grid(grid, Configuration(model.name), model.goal_covariance)
+    grid, fits, grid_row = measured.outcomes, [measured.fitts, measured.shannon], measured.summary()
+    ids = index_of_difficulty(np.array([o.distance for o in grid]), np.array([o.width for o in grid]))
     figures = [
         plot_velocity_profiles(grid, fits[0], settings.profile_distance, settings.profile_width, out / "velocity_profiles.png",
                                f"{model.name}: speed profiles (solid), minimum jerk with the same MT (dashed)"),
@@ -80,24 +79,26 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
         plot_phase(by_distance, by_velocity, out / "phase.png", f"{model.name}: phase plots along the reach (plans)"),
         plot_calibration(calibration_rows, out / "calibration.png",
                          f"calibration study on {model.name}: {len(settings.distances)} distances × {len(settings.widths)} widths"),
-        plot_asymmetry_against_difficulty(calibration_rows, id_range, out / "asymmetry_vs_difficulty.png"),
+        plot_asymmetry_against_difficulty(calibration_rows, (float(ids.min()), float(ids.max())),
+                                          out / "asymmetry_vs_difficulty.png"),
     ]
 
-    mt_grid = mt.reshape(len(settings.distances), len(settings.widths))
     report = {
         "model": model.config(),
         "settings": settings.to_dict(),
         "fitts_grid": {
-            "conditions": [o.summary() | {"id_fitts_bits": float(index_of_difficulty(o.distance, o.width, "fitts")),
-                                          "id_shannon_bits": float(index_of_difficulty(o.distance, o.width, "shannon"))}
-                           for o in grid],
+            "conditions": [c | {"id_fitts_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "fitts")),
+                                "id_shannon_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "shannon"))}
+                           for c in grid_row["conditions"]],
             "fits": {fit.form: fit.to_dict() for fit in fits},
-            "width_trend": trend_fraction(mt_grid, increasing=False, tolerance=TREND_TOLERANCE),
-            "distance_trend": trend_fraction(mt_grid.T, increasing=True, tolerance=TREND_TOLERANCE),
+            "width_trend": grid_row["width_trend"],
+            "distance_trend": grid_row["distance_trend"],
             "trend_tolerance_s": TREND_TOLERANCE,
-            "mt_in_human_range": bool(np.all((mt >= HUMAN_MT_RANGE[0]) & (mt <= HUMAN_MT_RANGE[1]))),
+            "mt_in_human_range": grid_row["mt_in_human_range"],
             "human_mt_range_s": list(HUMAN_MT_RANGE),
-            "all_solves_converged": all(o.success for o in grid),
+            "all_solves_converged": grid_row["all_solves_converged"],
+            "asymmetry_min": grid_row["asymmetry_min"], "asymmetry_median": grid_row["asymmetry_median"],
+            "asymmetry_max": grid_row["asymmetry_max"],
             "minimum_jerk_asymmetry": minimum_jerk_asymmetry(),
         },
         "dispersion": {
@@ -112,8 +113,7 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
             "early_peak": [row["configuration"] for row in calibration_rows if row["early_peak"]],
             # Under W = w I a scale-invariant model's MT is a function of D/sqrt(w), not of D/w; even an MT exactly
             # linear in log2(2D/sqrt(w)) would fit the Fitts and Shannon forms on this grid only this well:
-            "cov_reading_fitts_r2_if_log_linear": fit_fitts(D, w, np.log2(2 * D / np.sqrt(w)), "fitts").r2,
-            "cov_reading_shannon_r2_if_log_linear": fit_fitts(D, w, np.log2(2 * D / np.sqrt(w)), "shannon").r2,
+            **{f"cov_reading_{form}_r2_if_log_linear": _r2_if_log_linear_in_d_over_sqrt_w(grid, form) for form in ("fitts", "shannon")},
         },
         "figures": [f.name for f in figures],
         "wall_time_s": time.perf_counter() - began,
@@ -121,6 +121,13 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
     (out / "report.json").write_text(json.dumps(_plain(report), indent=1))
     (out / "report.md").write_text(report_markdown(report))
     return report
+
+
+def _r2_if_log_linear_in_d_over_sqrt_w(grid, form: str) -> float:
+    """R² of the Fitts fit (form) to an MT exactly linear in log2(2D/sqrt(w)) over the grid's conditions."""
+    D = np.array([o.distance for o in grid])
+    w = np.array([o.width for o in grid])
+    return fit_fitts(D, w, np.log2(2 * D / np.sqrt(w)), form).r2
 
 
 def _plain(value):
