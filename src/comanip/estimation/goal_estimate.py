@@ -31,6 +31,7 @@ from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
+from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.estimation.goal_posterior import OBSERVATION_STD, observation_covariance
@@ -88,6 +89,7 @@ class GoalEstimator:
         self.problem = self.planner.problem
         self.options = options or EstimatorOptions()
         self._regret = RegretSystem(self.problem)
+        self._blas = ThreadpoolController()
         self._paper_solvers: dict[int, tuple[ca.Function, _Deadline]] = {}
 
     def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, method: str = "regret",
@@ -137,9 +139,12 @@ class GoalEstimator:
             x_obs, _ = task_space_state(self.planner, observed)
 
             def newton(point: RegretPoint):
-                return newton_solve(self._regret, point, start, observed, n_o, prior, width, observed_position=x_obs,
-                                    tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
-                                    step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
+                # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
+                # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
+                with self._blas.limit(limits=1, user_api="blas"):
+                    return newton_solve(self._regret, point, start, observed, n_o, prior, width, observed_position=x_obs,
+                                        tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                                        step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
 
             result = newton(point if point is not None else cold_point())
             iterations = result.iterations
