@@ -109,3 +109,10 @@ def test_validate_quick_writes_figures_and_a_complete_report(tmp_path, grid):
     assert [c["movement_time"] for c in default["conditions"]] == pytest.approx([o.metrics.movement_time for o in grid], rel=1e-6)
     markdown = (out / "report.md").read_text()
     assert "## Calibration study" in markdown and "W=cov iso exp H=30" in markdown
+
+
+@pytest.mark.parametrize("argv, word", [(["--workers", "0"], "workers"), (["--seed", "-1"], "seed")])
+def test_validate_rejects_bad_options_before_any_work(tmp_path, capsys, argv, word):
+    assert main(["validate", "--quick", "--out", str(tmp_path / "v"), *argv]) == 2
+    assert word in capsys.readouterr().err
+    assert not (tmp_path / "v").exists()

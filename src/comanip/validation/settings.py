@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import asdict, dataclass
 
 
@@ -37,6 +38,24 @@ class ValidationSettings:
     """Processes for the calibration study (default: the CPU count)."""
     seed: int = 0
     """Seed of every random draw (Monte Carlo and closed-loop noise)."""
+
+    def __post_init__(self):
+        for name in ("distances", "widths", "dispersion_widths", "phase_distances"):
+            values = getattr(self, name)
+            if len(values) == 0 or not all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in values):
+                raise ValueError(f"{name} must be a non-empty sequence of finite numbers > 0 (m), got {values!r}")
+        for name in ("profile_distance", "profile_width", "dispersion_distance", "phase_width"):
+            value = getattr(self, name)
+            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite number > 0 (m), got {value!r}")
+        if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.phase_initial_velocities):
+            raise ValueError(f"phase_initial_velocities must be finite numbers (m/s), got {self.phase_initial_velocities!r}")
+        for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0)):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, int) or value < least:
+                raise ValueError(f"{name} must be an integer ≥ {least}, got {value!r}")
+        if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1):
+            raise ValueError(f"workers must be an integer ≥ 1 (processes) or None (the CPU count), got {self.workers!r}")
 
     @classmethod
     def quick_run(cls, **changes) -> "ValidationSettings":
