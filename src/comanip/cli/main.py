@@ -12,6 +12,7 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.plan_command",
     "comanip.cli.validate_command",
     "comanip.cli.transition_command",
+    "comanip.cli.handover_command",
     "comanip.cli.estimate_command",
 ]
 

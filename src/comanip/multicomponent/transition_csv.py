@@ -78,7 +78,7 @@ def read_transition_csv(path: str | Path) -> dict[str, np.ndarray]:
 def check_transition_columns(columns: dict, source: str = "data") -> dict[str, np.ndarray]:
     """Validated float arrays (N,) of the required columns (and any optional ones), else ValueError.
 
-    D/L > 0, w > 0 (m), transition distance ≥ 0 (m), all finite, at least 3 rows of equal length.
+    D/L > 0, w > 0 (m), transition distance ≥ 0 (m), all finite, columns of equal length.
     """
     missing = [c for c in REQUIRED_COLUMNS if c not in columns]
     if missing:
@@ -87,8 +87,6 @@ def check_transition_columns(columns: dict, source: str = "data") -> dict[str, n
     lengths = {name: len(v) for name, v in out.items()}
     if len(set(lengths.values())) != 1:
         raise ValueError(f"{source}: columns must have equal lengths, got {lengths}")
-    if lengths[REQUIRED_COLUMNS[0]] < 3:
-        raise ValueError(f"{source}: need at least 3 rows to fit a transition model, got {lengths[REQUIRED_COLUMNS[0]]}")
     for name in REQUIRED_COLUMNS:
         bad = np.flatnonzero(~np.isfinite(out[name]))
         if bad.size:

@@ -69,10 +69,15 @@ class TransitionModel:
     def fit(self, data) -> "TransitionModel":
         """Fit on a transition CSV path, a mapping of its columns, or arrays (D/L, w (m), T (m)); returns self."""
         columns = _as_columns(data)
+        if len(columns["width_m"]) < 3:
+            raise ValueError(f"need at least 3 rows (conditions) to fit a transition model, got {len(columns['width_m'])}")
         self._fit_columns(columns, hyperparameters=None)
         return self
 
     def _fit_columns(self, columns: dict, hyperparameters: dict | None) -> None:
+        # scikit-learn is imported here, not at the top: it takes over a second to import, and `import comanip`
+        # (every CLI call, every worker process) should not pay that unless a transition model is fitted
+        from sklearn.exceptions import ConvergenceWarning
         from sklearn.gaussian_process import GaussianProcessRegressor
         from sklearn.preprocessing import StandardScaler
 
@@ -85,7 +90,12 @@ class TransitionModel:
         gp = GaussianProcessRegressor(kernel=_kernel(hyperparameters), optimizer=None if fixed else "fmin_l_bfgs_b",
                                       n_restarts_optimizer=0 if fixed else self.n_restarts,
                                       random_state=self.random_state, normalize_y=False)
-        self._gp = gp.fit(self._x_scaler.transform(X), self._y_scaler.transform(y).ravel())
+        with warnings.catch_warnings():
+            # On standardised data a bound reached is itself the answer, not a failed fit: a length scale at its
+            # upper bound (1000 data standard deviations) means that input has no detectable effect; the noise
+            # at its lower bound (1e-6 of the variance) means the data are practically exact.
+            warnings.simplefilter("ignore", ConvergenceWarning)
+            self._gp = gp.fit(self._x_scaler.transform(X), self._y_scaler.transform(y).ravel())
 
     @property
     def is_fitted(self) -> bool:

@@ -1,0 +1,79 @@
+"""``comanip handover``: plan the robot-led reach, predict the transition, and write the impedance schedule.
+
+For each goal: plan with the Cartesian preset, find when the planned hand comes within the predicted
+transition distance of the goal, ramp the translational stiffness from 400 N/m to 0 there, and save the
+rest-position trajectory and stiffness (JSON and CSV, optionally resampled to a controller rate) and one
+figure over distance to the goal (paper Fig. 8 layout).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import warnings
+
+import numpy as np
+
+from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, plan_handover
+from comanip.multicomponent.transition_csv import shipped_dataset_path
+from comanip.multicomponent.transition_data import ARM_LENGTH
+from comanip.planning.planner import Planner
+
+#: A near and a far goal from the origin (m), as in the paper's experiment (Fig. 8).
+DEFAULT_GOALS = ("0.2,0.1,0", "0.4,0.25,-0.1")
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser("handover", help="robot→person authority handover at the predicted transition",
+                                   description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_model_arguments(parser, default_preset="cartesian")
+    parser.add_argument("--start", type=vector, help="start state [x; xdot] (m, m/s), comma-separated (default: at rest at the origin)")
+    parser.add_argument("--goal", type=vector, action="append",
+                        help=f"goal position (m), comma-separated; repeat for several (default: {' and '.join(DEFAULT_GOALS)})")
+    parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
+    parser.add_argument("--ramp-time", type=float, default=DEFAULT_RAMP_TIME,
+                        help="stiffness ramp to 0 (s); 0 switches at once (default: %(default)s)")
+    parser.add_argument("--stiffness", type=float, default=LEADING_STIFFNESS,
+                        help="translational stiffness while the robot leads (N/m) (default: %(default)s)")
+    parser.add_argument("--rate", type=float, help="resample the schedule at this controller rate (Hz), e.g. 1000")
+    parser.add_argument("--transition-model", help="a model JSON from 'comanip transition fit' (default: fit on the shipped data)")
+    parser.add_argument("--arm-length", type=float, default=ARM_LENGTH, help="arm length L (m) (default: %(default)s)")
+    parser.add_argument("--max-wall-time", type=float, help="planning budget per goal (s)")
+    parser.add_argument("--out", default="out/handover", help="output folder (default: %(default)s)")
+    parser.add_argument("--no-plot", action="store_true", help="skip the figure")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from comanip.multicomponent.transition_model import ExtrapolationWarning, TransitionModel
+
+    model = load_model(args)
+    if args.transition_model:
+        transition = TransitionModel.load(args.transition_model)
+        transition.arm_length = args.arm_length
+    else:
+        transition = TransitionModel(shipped_dataset_path(), arm_length=args.arm_length)
+    planner = Planner(model)
+    start = np.zeros(2 * model.n) if args.start is None else args.start
+    goals = args.goal or [vector(g) for g in DEFAULT_GOALS]
+    out = output_dir(args.out)
+    plans, schedules, report = [], [], []
+    for k, goal in enumerate(goals):
+        plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", ExtrapolationWarning)
+            schedule = plan_handover(plan, transition, ramp_time=args.ramp_time, leading_stiffness=args.stiffness,
+                                     rate=args.rate)
+        files = [schedule.save_json(out / f"handover_{k}.json"), schedule.save_csv(out / f"handover_{k}.csv")]
+        plans.append(plan)
+        schedules.append(schedule)
+        report.append({**schedule.summary(), "plan_status": plan.status, "plan_success": plan.success,
+                       "warnings": [str(w.message) for w in caught], "files": [str(f) for f in files]})
+    if not args.no_plot:
+        from comanip.plots.handover_figure import plot_handover
+
+        figure = plot_handover(plans, schedules, out / "handover.png")
+        report.append({"figure": str(figure)})
+    print(json.dumps(report, indent=1))
+    return 0 if all(p.success for p in plans) else 1
