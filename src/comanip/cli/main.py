@@ -14,6 +14,7 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.transition_command",
     "comanip.cli.handover_command",
     "comanip.cli.estimate_command",
+    "comanip.cli.simulate_command",
 ]
 
 

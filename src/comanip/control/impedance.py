@@ -9,12 +9,14 @@ M (n, n); gravity torque g(q) (n,). The law (Ott 2008, "Cartesian Impedance Cont
 Flexible-Joint Robots"):
 
     tau = g(q) + J^T F + N^T tau_0
-    F   = K e + D (e_dot),  e = [x_r - x;  e_R],  e_R = 1/2 vee(R_r R^T - R R_r^T) = sin(theta) axis
+    F   = K e + D e_dot,  e = [x_r - x;  e_R],  e_R = 1/2 vee(R_r R^T - R R_r^T) = sin(theta) axis
     tau_0 = K_0 (q_r - q) - D_0 qdot,   N^T = I - J^T Jbar^T,  Jbar = M^-1 J^T Lambda
 
 K = diag(k_x, k_y, k_z, k_R, k_R, k_R). D is designed from K and the apparent inertia
 Lambda = (J M^-1 J^T)^-1 by double diagonalisation (Albu-Schäffer et al. 2003): each of the six Cartesian
-modes gets damping ratio zeta, so a zero stiffness gives zero damping along that direction.
+modes gets damping ratio zeta, so a zero stiffness gives zero damping along that direction. There is no
+feedforward of the rest motion's acceleration: with a person pushing the same handle toward the same goal,
+a robot that also pushes the handle's whole inertia makes the pair overshoot.
 
 Passivity: only gravity is compensated (Coriolis compensation would break the energy balance), the
 rotational term is the gradient of the potential k_R (1 - cos theta), and D and D_0 are positive
@@ -25,6 +27,7 @@ grows without an external input.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -47,7 +50,7 @@ class ImpedanceGains:
     """Stiffness of the orientation (N·m/rad), ≥ 0; high, so the carried object keeps its attitude."""
     damping_ratio: float = 1.0
     """Damping ratio zeta of every Cartesian mode (dimensionless), ≥ 0; 1 is critical damping."""
-    nullspace_stiffness: float = 5.0
+    nullspace_stiffness: float = 10.0
     """Stiffness pulling the joints toward the rest posture inside the task's nullspace (N·m/rad), ≥ 0."""
     nullspace_damping_ratio: float = 1.0
     """Damping ratio of the nullspace term per joint, relative to the joint's own inertia M_ii, ≥ 0."""
@@ -82,7 +85,7 @@ class RobotState:
     gravity: np.ndarray
     """Gravity torque g(q) (n,), N·m, of the arm alone (the controller's model)."""
 
-    @property
+    @cached_property
     def velocity(self) -> np.ndarray:
         """TCP linear velocity (3,), m/s."""
         return self.jacobian[:3] @ self.qdot

@@ -1,14 +1,21 @@
 """A simulated person holding the handle: the paper's motor-control model drives an arm impedance.
 
 The person's *intended* hand motion x_d(t) is the state of their internal model, the reaching model's point
-mass (the Cartesian preset, 2 kg), driven by the commands they plan, executed with signal-dependent motor
-noise (I + E) tau (SPEC §2):
+mass (the Cartesian preset, 2 kg) in the model's own discrete time (SPEC §2, forward Euler with step h),
+driven by the commands they plan, executed with signal-dependent motor noise (I + E) tau:
 
-    M_p xddot_d + D_p xdot_d = (I + E_j) tau_j        (tau_j, E_j held over planning step j of length h)
+    v_{j+1} = v_j + h M_p^-1 ((I + E_j) tau_j - D_p v_j),   x_{j+1} = x_j + h v_j
+
+and between the steps x_d(t) follows a C² cubic spline through the positions x_j, leaving with the
+intention's current velocity. No smooth curve can match both the Euler positions and velocities (x_j moves
+with v_j over the whole step, so a smooth velocity through the step's ends must ripple); the positions are
+kept because a goal estimator reading the hand is far more sensitive to them: on a 0.35 m reach, a hand
+h v / 2 ≈ 3 mm ahead of the model's position 0.165 s in (a finely integrated point mass) moves the estimate
+by 0.24 m, a velocity lagging the model's by h a / 2 only by 3 cm.
 
 Every ``replan_interval`` seconds the person re-plans a reach to their goal (:class:`comanip.Planner`,
-warm-started with the previous plan shifted) from s = [x; xdot_d]: the hand position x they see, and the
-velocity of their own intended motion (their efference copy). The force on the handle is the arm's
+warm-started with the previous plan shifted) from s = [x; v_j]: the hand position x they see, and the
+velocity of their own intended motion, the model's v_j (their efference copy). The force on the handle is the arm's
 impedance around the intention, its only force path:
 
     F = K_h (x_d - x) + D_h (xdot_d - xdot)
@@ -25,6 +32,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.interpolate import CubicSpline
 
 from comanip.arguments import as_matrix, as_positive, as_vector
 from comanip.belief.noise import sample_torque_error
@@ -44,9 +52,9 @@ class PersonParameters:
     apparent mass of about 5–14 kg at the TCP, plus the 1.5 kg object; 120 N·s/m damps the hand on a
     15 kg load at ratio 0.55, where arm-only values (10–50 N·s/m, Tsuji et al. 1995) would leave it ringing
     at ~1 Hz for seconds."""
-    replan_interval: float = 0.165
-    """Time between re-plans (s), a whole number of the model's steps h: visual feedback reaches the
-    motor plan intermittently, every 0.1–0.3 s (Loram et al. 2011)."""
+    replan_interval: float = 0.22
+    """Time between re-plans (s), a whole number of the model's steps h (4 × 0.055 s): visual feedback
+    reaches the motor plan intermittently, about every 0.2–0.3 s (Loram et al. 2011)."""
     iterations_per_replan: int = 4
     """Solver iterations per warm-started re-plan: the person refines the previous plan, not a fresh optimum."""
     motor_noise: bool = True
@@ -129,25 +137,27 @@ class SimulatedPerson:
         held the hand before the reach; the hand itself may sag below it under a load)."""
         self.intended_position = np.array(intended_position, dtype=float)
         self.intended_velocity = np.zeros(3)
+        self._model_velocity = np.zeros(3)    # the Euler model's velocity at the current step
         self._next_replan = t
         self._plan = None
 
-    def force(self, t: float, position, velocity, dt: float) -> np.ndarray:
+    def force(self, t: float, position, velocity) -> np.ndarray:
         """Force on the handle (3,), N, with the hand at position (3,) m, velocity (3,) m/s at time t (s);
-        advances the intended motion by dt (s)."""
+        sets the intention (``intended_position``, ``intended_velocity``) to time t."""
         if t >= self._next_replan - 1e-9:
             self._replan(t, position)
-        step = int((t - self._plan_time) / self.planner.model.h + 1e-9)
-        command = self._executed[step] if step < len(self._executed) else np.zeros(3)
-        acceleration = self._inverse_inertia @ (command - self._damping @ self.intended_velocity)
-        force = self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
+        h = self.planner.model.h
+        j = min(int((t - self._plan_time) / h + 1e-9), self._spline.shape[1] - 1)
+        tau = t - self._plan_time - j * h
+        c3, c2, c1, c0 = self._spline[:, j]            # x = c3 tau³ + c2 tau² + c1 tau + c0 on step j
+        self.intended_position = ((c3 * tau + c2) * tau + c1) * tau + c0
+        self.intended_velocity = (3 * c3 * tau + 2 * c2) * tau + c1
+        acceleration = 6 * c3 * tau + 2 * c2
+        return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
             + self._load_inertia @ acceleration
-        self.intended_velocity = self.intended_velocity + dt * acceleration
-        self.intended_position = self.intended_position + dt * self.intended_velocity
-        return force
 
     def _replan(self, t: float, position) -> None:
-        start = np.r_[position, self.intended_velocity]
+        start = np.r_[position, self._model_velocity]
         if self._plan is None:
             self._plan = self.first_plan if self.first_plan is not None else solve_to_convergence(
                 self.planner, start, self.goal, self.width)
@@ -160,6 +170,15 @@ class SimulatedPerson:
         commands = self._plan.torque[: self._steps_per_replan]
         model = self.planner.model
         noise = sample_torque_error(commands, model.kappa, model.noise, self.rng) if self.parameters.motor_noise else 0.0
-        self._executed = commands + noise
+        # the intention's positions at the coming steps: the model's Euler steps under the executed commands
+        # (then two more of the plan, so the spline's free end lies beyond the interval), from where the
+        # intention is: its offset from the hand carries over
+        x, v = [self.intended_position], [self._model_velocity]
+        for command in np.vstack([commands + noise, self._plan.torque[len(commands) : len(commands) + 2]]):
+            x.append(x[-1] + model.h * v[-1])
+            v.append(v[-1] + model.h * self._inverse_inertia @ (command - self._damping @ v[-1]))
+        spline = CubicSpline(model.h * np.arange(len(x)), np.array(x), bc_type=((1, self.intended_velocity), "not-a-knot"))
+        self._spline = spline.c[:, : len(commands)]  # (4, steps, 3) polynomial coefficients per step
+        self._model_velocity = v[len(commands)]
         self._plan_time = t
         self._next_replan = t + self.parameters.replan_interval

@@ -1,14 +1,20 @@
 """Pictures of a simulated trial: an offscreen frame strip, and a replay in MuJoCo's viewer when a display exists.
 
-Offscreen rendering needs an OpenGL backend chosen *before* MuJoCo is imported: on a machine without a
-display, call :func:`choose_headless_backend` first (it selects EGL, or OSMesa, when their libraries are
-installed). Without a working backend the strip is skipped with the reason, never an error.
+Offscreen rendering needs an OpenGL backend chosen *before* MuJoCo is imported (MUJOCO_GL), and a missing
+one can abort the process rather than raise. So the strip is drawn in a child process with the backend set
+(:func:`headless_backend`: EGL, else OSMesa, when their libraries exist); when that fails the strip is
+skipped with the reason, and the simulation's results are unaffected.
+
+    python -m comanip.simulation.rendering frames.npz strip.png    # what the child runs
 """
 
 from __future__ import annotations
 
 import ctypes.util
 import os
+import subprocess
+import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -19,47 +25,60 @@ def has_display() -> bool:
     return bool(os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"))
 
 
-def choose_headless_backend() -> str | None:
-    """Set MUJOCO_GL for offscreen rendering when there is no display and it is unset; returns the backend
-    in effect ('egl', 'osmesa', the user's choice, or None when none is available). Call before importing mujoco."""
-    if "MUJOCO_GL" in os.environ or has_display():
-        return os.environ.get("MUJOCO_GL")
+def headless_backend() -> str | None:
+    """The MUJOCO_GL value for offscreen rendering here: the user's, else 'egl' or 'osmesa' when their
+    library is installed, else 'glfw' with a display; None when nothing can render."""
+    if "MUJOCO_GL" in os.environ:
+        return os.environ["MUJOCO_GL"]
     for backend, library in (("egl", "EGL"), ("osmesa", "OSMesa")):
         if ctypes.util.find_library(library):
-            os.environ["MUJOCO_GL"] = backend
             return backend
-    return None
+    return "glfw" if has_display() else None
 
 
-def render_frame_strip(model, qpos: np.ndarray, path: str | Path, markers=(), frames: int = 6,
-                       size: tuple[int, int] = (240, 320)) -> tuple[Path | None, str]:
-    """Render `frames` evenly spaced postures of qpos (K, nq) side by side into a PNG, with green spheres
-    at the marker positions (each (3,), m; e.g. the goal).
+def frame_strip(object_mass: float, qpos: np.ndarray, path: str | Path, markers=(), frames: int = 6) -> tuple[Path | None, str]:
+    """Draw `frames` evenly spaced postures of qpos (K, 7) of the Panda carrying object_mass (kg) side by
+    side into a PNG at path, green spheres at the markers (each (3,), m), in a child process.
 
     Returns (path, "") on success or (None, reason) when offscreen rendering is not available here.
     """
+    backend = headless_backend()
+    if backend is None:
+        return None, "no offscreen OpenGL backend (EGL or OSMesa) and no display"
+    with tempfile.TemporaryDirectory() as folder:
+        inputs = Path(folder) / "frames.npz"
+        np.savez(inputs, object_mass=object_mass, qpos=np.asarray(qpos)[np.linspace(0, len(qpos) - 1, frames).astype(int)],
+                 markers=np.asarray(markers, dtype=float).reshape(-1, 3))
+        child = subprocess.run([sys.executable, "-m", "comanip.simulation.rendering", str(inputs), str(path)],
+                               env=os.environ | {"MUJOCO_GL": backend}, capture_output=True, text=True, timeout=300)
+    if child.returncode != 0 or not Path(path).exists():
+        lines = (child.stderr or child.stdout).strip().splitlines()
+        return None, f"offscreen rendering with MUJOCO_GL={backend} failed: {lines[-1] if lines else f'exit {child.returncode}'}"
+    return Path(path), ""
+
+
+def render_frames(model, qpos: np.ndarray, path: str | Path, markers=(), size: tuple[int, int] = (240, 320)) -> Path:
+    """Render every posture of qpos (F, nq) side by side into a PNG (in this process: MUJOCO_GL must already
+    suit the machine), with green spheres at the markers (each (3,), m)."""
     import matplotlib.pyplot as plt
     import mujoco
 
-    try:
-        renderer = mujoco.Renderer(model, *size)
-    except Exception as error:  # no GL context: the backend's libraries or a display are missing
-        return None, f"offscreen rendering unavailable ({type(error).__name__}: {error})"
+    renderer = mujoco.Renderer(model, *size)
     data = mujoco.MjData(model)
     camera = mujoco.MjvCamera()
     camera.lookat[:] = [0.4, 0.15, 0.3]
     camera.distance, camera.azimuth, camera.elevation = 1.4, 140.0, -20.0
     images = []
     with renderer:
-        for k in np.linspace(0, len(qpos) - 1, frames).astype(int):
-            data.qpos[:] = qpos[k]
+        for posture in qpos:
+            data.qpos[:] = posture
             mujoco.mj_forward(model, data)
             renderer.update_scene(data, camera)
             for position in markers:
                 _add_sphere(renderer.scene, position, 0.02, (0.1, 0.8, 0.2, 0.8))
             images.append(renderer.render().copy())
     plt.imsave(path, np.concatenate(images, axis=1))
-    return Path(path), ""
+    return Path(path)
 
 
 def replay_in_viewer(model, t: np.ndarray, qpos: np.ndarray) -> str:
@@ -94,3 +113,11 @@ def _add_sphere(scene, position, radius: float, rgba) -> None:
     mujoco.mjv_initGeom(scene.geoms[scene.ngeom], mujoco.mjtGeom.mjGEOM_SPHERE, np.full(3, radius),
                         np.asarray(position, dtype=float), np.eye(3).ravel(), np.asarray(rgba, dtype=np.float32))
     scene.ngeom += 1
+
+
+if __name__ == "__main__":
+    from comanip.simulation.panda_model import build_panda_model
+
+    frames_file, png = sys.argv[1:3]
+    with np.load(frames_file) as inputs:
+        render_frames(build_panda_model(float(inputs["object_mass"])), inputs["qpos"], png, markers=inputs["markers"])

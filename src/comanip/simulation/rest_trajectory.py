@@ -1,15 +1,17 @@
 """A planned reach as the impedance controller's rest motion (SPEC §8: the plan's mean is the rest position).
 
-The plan gives the mean end effector x_i and velocity v_i at the steps t_i = i·h. Between steps the rest
-position follows the cubic Hermite curve through (x_i, v_i), so rest position and velocity are continuous
-at the control rate (a piecewise-linear rest would jerk the arm every h seconds); after the plan's last
-step the rest holds its final point.
+The plan gives the mean end effector x_i at the steps t_i = i·h. Between steps the rest position follows
+a C² cubic spline through the x_i (leaving and arriving with the plan's first and last velocities), so
+rest position and velocity are smooth at the control rate (a piecewise-linear rest would jerk the arm
+every h seconds). The spline goes through the positions, not the plan's velocities: the model's forward
+Euler step moves x_i with v_i over a whole step, so no smooth curve honours both (see
+:mod:`comanip.simulation.person`). After the plan's last step the rest holds its final point.
 """
 
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import CubicHermiteSpline
+from scipy.interpolate import CubicSpline
 
 from comanip.planning.plan import Plan
 
@@ -25,7 +27,7 @@ class RestTrajectory:
     """
 
     def __init__(self, plan: Plan, time_offset: float, dt: float, duration: float):
-        spline = CubicHermiteSpline(plan.t, plan.ee_mean, plan.ee_velocity, axis=0)
+        spline = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
         self.time_offset, self.dt = float(time_offset), float(dt)
         tau = np.arange(int(np.ceil(duration / dt)) + 2) * dt
         inside = np.minimum(tau, plan.t[-1])

@@ -20,16 +20,19 @@ from comanip.simulation.person import PersonParameters, SimulatedPerson
 from comanip.simulation.world import CoManipulationWorld
 
 #: Named goals (m, robot base frame) on a table whose placing height (z = 0.2 m) is fixed and known, as in
-#: the paper's synchronisation task; from the ready pose's TCP (0.31, 0, 0.49) they lie 0.35 m and 0.57 m away.
-NAMED_GOALS = {"near": (0.45, 0.15, 0.20), "far": (0.60, 0.40, 0.20)}
+#: the paper's synchronisation task. From the ready pose's TCP (0.31, 0, 0.47 after the object's sag) they
+#: lie 0.35 m and 0.54 m away; from the table centre (the robot's prior goal) 0.07 m and 0.25 m.
+NAMED_GOALS = {"near": (0.45, 0.15, 0.20), "far": (0.45, 0.45, 0.20)}
 #: The centre of the table's placing area (m): the robot's prior goal when it must guess the person's.
 TABLE_CENTRE = (0.50, 0.20, 0.20)
 #: Shoulder (joint 2 axis) position in the base frame, m.
 SHOULDER = np.array([0.0, 0.0, 0.333])
 #: Wrist centre above the TCP with the hand pointing down (flange 0.107 m + hand 0.1034 m), m.
 WRIST_ABOVE_TCP = 0.2104
-#: Largest shoulder-to-wrist distance accepted (m); the Panda's links allow about 0.79 m fully stretched.
-MAX_WRIST_REACH = 0.75
+#: Largest shoulder-to-wrist distance accepted (m). The Panda's links allow about 0.79 m fully stretched, but
+#: near that the apparent mass at the handle grows without bound along the arm (48 kg at 0.73 m, against
+#: 15–17 kg inside this limit), and a person can hardly steer it.
+MAX_WRIST_REACH = 0.70
 #: Smallest horizontal distance of a goal from the base axis (m), to keep the object off the robot's base.
 MIN_RADIUS = 0.25
 #: Lowest TCP height above the table top (m), so the carried box (5 cm high) clears the table.
@@ -210,7 +213,7 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
     for k in range(steps):
         state = world.observe()
         position, velocity = state.position, state.velocity
-        force = person.force(t[k], position, velocity, dt)
+        force = person.force(t[k], position, velocity)
         record["intended_position"][k] = person.intended_position
         record["intended_velocity"][k] = person.intended_velocity
         rest_position, rest_velocity = robot.command(t[k], state)

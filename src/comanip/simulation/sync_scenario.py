@@ -1,11 +1,12 @@
 """Scenario ``sync`` (paper VI-A, SPEC §8): the person leads x–y, the robot estimates the goal and leads z.
 
 The robot starts with zero translational stiffness and the person starts their reach. At t_o = 0.2 s the
-robot observes the handle's state s_o, estimates the goal and the person's whole trajectory from s_0 and
-s_o (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), sends the estimated trajectory's z as its
-rest motion and sets the translational stiffness to [0, 0, 400] N/m. It never replans. The estimate
-matches s_o to step n_o = floor(t_o / h), so the estimated trajectory is shifted in time by t_o - n_o h to
-pass through the handle at t_o.
+robot estimates the goal and the person's whole trajectory (:class:`comanip.estimation.GoalEstimator`,
+Cartesian preset) from the start s_0 and the observed state s_o, sends the estimated trajectory's z as its
+rest motion and sets the translational stiffness to [0, 0, 400] N/m. It never replans. As in the paper,
+s_o is the handle's state at the model's step n_o = floor(t_o / h) (0.165 s), which the robot has recorded
+on the way: handing the estimator the state at t_o itself, 35 ms later than the step it stands for, makes
+the person look faster than they are, and the estimate overshoots the goal by tens of centimetres.
 
 Per trial: the estimated goal, the error between the estimated trajectory and the handle over time
 normalised by the movement time (paper Fig. 7, per axis), the time each axis reaches the goal, and the
@@ -40,6 +41,9 @@ class SyncSettings(ScenarioSettings):
     """t_o (s): when the robot observes the handle and estimates the goal (paper: 0.2 s)."""
     prior_goal: tuple = TABLE_CENTRE
     """The robot's prior goal g_bar (3,), m: where on the table things are usually placed."""
+    known_height: bool = True
+    """The placing height (the goal's z) is known, as in the paper: the estimated trajectory's z is moved,
+    in proportion to its progress, to end there (:func:`end_at_height`). False: the estimate as it is."""
 
     def __post_init__(self):
         super().__post_init__()
@@ -57,6 +61,11 @@ class SyncRobot:
         self.controller, self.estimator, self.settings = controller, estimator, settings
         self.start, self.prior_goal, self.width = start, prior_goal, width
         self.dt, self.duration = dt, duration
+        h = estimator.model.h
+        self.observation_step = int(np.floor(settings.observation_time / h + 1e-9))
+        self.observation_time = self.observation_step * h
+        """When s_o is taken (s): the model's step n_o."""
+        self.observed: np.ndarray | None = None
         self.warm_start = warm_start
         """A previous trial's estimate to start the solver from (None: the estimator's own search)."""
         self.estimate: Plan | None = None
@@ -66,18 +75,32 @@ class SyncRobot:
     def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
         position, velocity = state.position, state.velocity
         t_o = self.settings.observation_time
+        if self.observed is None and t >= self.observation_time - 0.5 * self.dt:
+            self.observed = np.r_[position, velocity]
         if self.rest is None:
             if t < t_o - 1e-9:
                 return position, velocity            # no stiffness: the rest follows the handle
-            self.estimate = self.estimator.estimate(self.start.state, np.r_[position, velocity], t_o,
+            self.estimate = self.estimator.estimate(self.start.state, self.observed, self.observation_time,
                                                     self.prior_goal, self.width, warm_start=self.warm_start)
-            n_o = self.estimate.extras["observed_step"]
-            h = self.estimator.model.h
-            self.rest = RestTrajectory(self.estimate, t_o - n_o * h, self.dt, self.duration + h)
+            self.rest = RestTrajectory(self.estimate, 0.0, self.dt, self.duration)
+            if self.settings.known_height:
+                end_at_height(self.rest, self.settings.goal[2])
             self.controller.translational_stiffness = [0.0, 0.0, self.settings.robot_stiffness]
         rest_position, rest_velocity = self.rest(t)
         # x and y are the person's: the rest follows the handle there, so only z is led
         return np.r_[position[:2], rest_position[2]], np.r_[velocity[:2], rest_velocity[2]]
+
+
+def end_at_height(rest: RestTrajectory, height: float) -> None:
+    """Move the rest motion's z (in place) by (height - z_end) times its progress
+    ||x(t) - x(0)|| / ||x_end - x(0)|| (clipped to [0, 1]): the estimated timing is kept, the end is the
+    known height (m), and the start (the observed hand) is untouched."""
+    position = rest.position
+    progress = np.linalg.norm(position - position[0], axis=1) / max(np.linalg.norm(position[-1] - position[0]), 1e-9)
+    progress = np.clip(progress, 0.0, 1.0)
+    shift = height - position[-1, 2]
+    position[:, 2] += shift * progress
+    rest.velocity[:, 2] += shift * np.gradient(progress, rest.dt)
 
 
 @dataclass
@@ -88,7 +111,8 @@ class SyncTrial:
     estimate: Plan
     """The robot's estimated trajectory (``estimate.goal`` is g_hat); time axis of the plan."""
     estimated_position: np.ndarray
-    """The estimated trajectory at the record's times (K, 3), m (the controller's rest, before x–y are freed)."""
+    """The estimated trajectory at the record's times (K, 3), m (with the known height, when used): the
+    controller's rest before x–y are freed."""
     metrics: dict
     """Scalar measures (see :func:`sync_metrics`)."""
     normalised_time: np.ndarray

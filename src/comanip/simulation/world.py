@@ -65,7 +65,8 @@ class CoManipulationWorld:
         return self.kinematics(self.data.qpos, self.data.qvel)
 
     def step(self, state: RobotState, handle_force, position_rest, velocity_rest=None) -> np.ndarray:
-        """Advance one control period: impedance torques toward the rest pose, handle_force (3,) N at the TCP.
+        """Advance one control period: impedance torques toward the rest motion (position (3,) m, velocity
+        (3,) m/s or None), handle_force (3,) N at the TCP.
 
         ``state`` is :meth:`observe`'s result for the current instant. Returns the joint torques (7,), N·m.
         """

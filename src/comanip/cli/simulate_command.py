@@ -1,0 +1,106 @@
+"""``comanip simulate sync|handover``: the paper's collaborative scenarios (Section VI) with a simulated Panda
+under impedance control and a simulated person, in MuJoCo. Writes a figure, one CSV per trial, a summary
+JSON and (where offscreen rendering works) a frame strip per goal."""
+
+from __future__ import annotations
+
+import json
+import time
+
+from comanip.cli.arguments import output_dir
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser("simulate", help="simulate the sync or handover co-manipulation scenario", description=__doc__)
+    parser.add_argument("scenario", help="sync (paper VI-A) or handover (paper VI-B)")
+    parser.add_argument("--trials", type=int, default=5, help="trials per goal, each with its own seed (default: %(default)s)")
+    parser.add_argument("--goal", action="append",
+                        help="the person's goal: near, far or x,y,z in m (robot base frame); repeat for several "
+                             "(default: near and far)")
+    parser.add_argument("--width", type=float, help="the person's goal width (m) (default: the Cartesian preset's)")
+    parser.add_argument("--kappa", type=float, help="the person's motor-noise variance (default: the preset's)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the first trial (default: %(default)s)")
+    parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
+    parser.add_argument("--out", default="out/simulate", help="output folder (default: %(default)s)")
+    parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
+    parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from comanip.simulation import SCENARIOS, ScenarioSetup, resolve_goal, scenario
+
+    settings_class, runner = scenario(args.scenario)
+    goals = args.goal or ["near", "far"]
+    common = {"trials": args.trials, "width": args.width, "kappa": args.kappa, "seed": args.seed, "duration": args.duration}
+    # every setting is checked here, before any solver or model is built
+    all_settings = {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in goals}
+    setup = ScenarioSetup(next(iter(all_settings.values())))
+    out = output_dir(args.out)
+
+    results, timing = {}, {}
+    for label, settings in all_settings.items():
+        begin = time.perf_counter()
+        results[label] = runner(settings, setup)
+        wall = time.perf_counter() - begin
+        simulated = settings.trials * setup.duration
+        timing[label] = {"wall_s": wall, "simulated_s": simulated, "real_time_factor": simulated / wall}
+
+    from comanip.simulation.report import settings_dict, summarise, write_summary, write_trials
+
+    files, goals_out, strips = [], {}, {}
+    for label, result in results.items():
+        trials = result if args.scenario == "sync" else result.trials
+        stem = f"{args.scenario}_{label}"
+        files += write_trials([trial.record for trial in trials], out, stem)
+        metrics = [trial.metrics for trial in trials]
+        goals_out[label] = {"goal_m": list(all_settings[label].goal), "trials": metrics, "summary": summarise(metrics),
+                            "timing": timing[label]}
+        if args.scenario == "handover":
+            goals_out[label]["schedule"] = result.schedule.summary()
+        if not args.no_frames:
+            from comanip.simulation.rendering import frame_strip
+
+            path, reason = frame_strip(setup.settings.object_mass, trials[0].record.qpos, out / f"{stem}_frames.png",
+                                       markers=[trials[0].record.goal])
+            strips[label] = str(path) if path else reason
+            files += [path] if path else []
+    if args.scenario == "sync":
+        from comanip.plots.simulation_sync import plot_sync
+
+        files.append(plot_sync(results, next(iter(all_settings.values())).observation_time, out / "sync.png"))
+    else:
+        from comanip.plots.simulation_handover import plot_handover
+
+        files.append(plot_handover({k: r for k, r in results.items() if r.dispersion is not None}, out / "handover.png"))
+    summary_path = out / f"{args.scenario}_summary.json"
+    files.append(summary_path)
+    write_summary(summary_path, {"scenario": args.scenario, "scenarios_available": sorted(SCENARIOS),
+                                 "settings": settings_dict(next(iter(all_settings.values()))), "goals": goals_out,
+                                 "frame_strips": strips,
+                                 "files": [str(p) for p in files]})
+    if args.viewer:
+        from comanip.simulation.rendering import replay_in_viewer
+
+        first = next(iter(results.values()))
+        record = (first if args.scenario == "sync" else first.trials)[0].record
+        print(replay_in_viewer(setup.world.model, record.t, record.qpos))
+    print(json.dumps({label: {"summary": _headline(goals_out[label]["summary"]), "timing": timing[label]}
+                      for label in goals_out}, indent=1, default=float))
+    print(f"wrote {len(files)} files to {out}")
+    return 0
+
+
+def _label(goal: str) -> str:
+    """A file-name-safe label of a goal argument: the name, or x_y_z in mm."""
+    from comanip.simulation import NAMED_GOALS, resolve_goal
+
+    if goal in NAMED_GOALS:
+        return goal
+    return "_".join(str(int(round(1e3 * v))) for v in resolve_goal(goal))
+
+
+def _headline(summary: dict) -> dict:
+    """Means (or fractions) of the summary, rounded, for the terminal."""
+    return {k: (round(v["mean"], 4) if v.get("mean") is not None else v.get("fraction")) for k, v in summary.items()
+            if "mean" in v or "fraction" in v}

@@ -1,0 +1,33 @@
+"""Co-manipulation in physics simulation (paper Section VI): a MuJoCo Panda under Cartesian impedance
+control carrying an object with a simulated person whose hand follows the motor-control model.
+
+>>> from comanip.simulation import SyncSettings, run_sync
+>>> trials = run_sync(SyncSettings(goal="far", trials=5))
+>>> [trial.metrics["goal_error_m"] for trial in trials]
+
+Layers: :mod:`panda_model` (the MuJoCo model from the URDF), :mod:`kinematics` (MuJoCo as the controller's
+backend), :mod:`world` (plant + controller at 1 kHz), :mod:`person` (the simulated person), :mod:`scenario`
+(settings, workspace, the trial loop), :mod:`sync_scenario` and :mod:`handover_scenario` (paper VI-A, VI-B).
+"""
+
+from comanip.simulation.handover_scenario import HandoverRun, HandoverSettings, HandoverTrial, run_handover
+from comanip.simulation.person import PersonParameters, SimulatedPerson
+from comanip.simulation.scenario import NAMED_GOALS, ScenarioSettings, TrialRecord, resolve_goal
+from comanip.simulation.setup import ScenarioSetup
+from comanip.simulation.sync_scenario import SyncSettings, SyncTrial, run_sync
+from comanip.simulation.world import CoManipulationWorld
+
+#: scenario name -> (its settings class, its runner)
+SCENARIOS = {"sync": (SyncSettings, run_sync), "handover": (HandoverSettings, run_handover)}
+
+
+def scenario(name: str):
+    """(settings class, runner) of a scenario by name, or ValueError listing the names."""
+    if name not in SCENARIOS:
+        raise ValueError(f"scenario must be one of {sorted(SCENARIOS)}, got {name!r}")
+    return SCENARIOS[name]
+
+
+__all__ = ["CoManipulationWorld", "HandoverRun", "HandoverSettings", "HandoverTrial", "NAMED_GOALS", "PersonParameters",
+           "SCENARIOS", "ScenarioSettings", "ScenarioSetup", "SimulatedPerson", "SyncSettings", "SyncTrial", "TrialRecord",
+           "resolve_goal", "run_handover", "run_sync", "scenario"]

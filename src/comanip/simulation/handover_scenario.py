@@ -1,0 +1,184 @@
+"""Scenario ``handover`` (paper VI-B, SPEC §8): the robot leads, then hands the fine positioning to the person.
+
+The robot plans a reach to the nominal goal with the Cartesian preset and holds the handle to it at
+400 N/m (:func:`comanip.multicomponent.handover.plan_handover` gives the rest motion and the predicted
+transition point: the distance T from the goal where a person would switch from the fast initial
+sub-movement to the corrective one). When the handle itself comes within T of the goal, the stiffness
+ramps to 0 (raised cosine) and the person, who reaches for their own goal (the nominal one moved by the
+trial's task variation), finishes alone.
+
+Per trial: when and where the switch happened against the prediction, the largest velocity change around
+the switch, and the final positioning error. Over trials: the perpendicular position spread and the
+velocity mean ± std against the distance to the goal, with the transition marked (paper Fig. 8).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from tqdm import tqdm
+
+from comanip.control.impedance import CartesianImpedanceController, RobotState
+from comanip.multicomponent.dispersion import DispersionProfile, _first_passage, perpendicular_dispersion_profile
+from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
+from comanip.multicomponent.transition_model import TransitionModel
+from comanip.planning.plan import Plan
+from comanip.simulation.person import solve_to_convergence
+from comanip.simulation.scenario import ScenarioSettings, TrialRecord, run_trial
+from comanip.simulation.setup import ScenarioSetup
+
+#: Half-width (s) of the window over which a velocity change counts as one jump: v(t + 25 ms) - v(t - 25 ms).
+JUMP_HALF_WINDOW = 0.025
+#: Points of the distance-to-goal grid of the scenario's profiles.
+PROFILE_POINTS = 101
+
+
+@dataclass(frozen=True)
+class HandoverSettings(ScenarioSettings):
+    """Inputs of the handover scenario (see :class:`ScenarioSettings` for the shared ones)."""
+
+    ramp_time: float = DEFAULT_RAMP_TIME
+    """Duration (s) of the stiffness ramp from 400 N/m to 0 (raised cosine)."""
+    goal_variation: float = 0.0
+    """Std (m) of the person's goal about the robot's, per horizontal axis and trial: task variation for the
+    person's fine positioning to absorb. 0 (default): the person's own motor noise is the only variation,
+    so the position spread shows where their reaches disperse (a variation of 1 cm outgrows it and moves
+    the spread's peak onto the goal)."""
+
+    def __post_init__(self):
+        super().__post_init__()
+        if not (isinstance(self.ramp_time, (int, float)) and np.isfinite(self.ramp_time) and self.ramp_time >= 0):
+            raise ValueError(f"ramp_time must be a finite number ≥ 0 (s), got {self.ramp_time!r}")
+        if not (isinstance(self.goal_variation, (int, float)) and np.isfinite(self.goal_variation) and self.goal_variation >= 0):
+            raise ValueError(f"goal_variation must be a finite number ≥ 0 (m), got {self.goal_variation!r}")
+
+
+class HandoverRobot:
+    """Leads along the schedule's rest motion at 400 N/m; ramps to 0 once the handle is within T of the goal."""
+
+    def __init__(self, controller: CartesianImpedanceController, schedule: HandoverSchedule, dt: float):
+        self.controller, self.schedule, self.dt = controller, schedule, dt
+        self.switch_time: float | None = None
+        self.switch_position: np.ndarray | None = None
+        self.controller.translational_stiffness = np.full(3, schedule.leading_stiffness)
+
+    def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
+        schedule = self.schedule
+        if self.switch_time is None and np.linalg.norm(state.position - schedule.goal) <= schedule.transition_distance:
+            self.switch_time, self.switch_position = t, state.position.copy()
+        if self.switch_time is not None:
+            stiffness = float(stiffness_profile(t, self.switch_time, schedule.ramp_time, schedule.leading_stiffness))
+            self.controller.translational_stiffness = np.full(3, stiffness)
+        k = min(int(round((t - schedule.t[0]) / self.dt)), len(schedule.t) - 1)
+        return schedule.rest_position[k], schedule.rest_velocity[k]
+
+
+@dataclass
+class HandoverTrial:
+    """One handover trial: the record and its measures."""
+
+    record: TrialRecord
+    metrics: dict
+    """Scalar measures (see :func:`handover_metrics`)."""
+
+
+@dataclass
+class HandoverRun:
+    """All trials of one goal, the robot's plan and schedule, and the profiles over distance to the goal."""
+
+    trials: list[HandoverTrial]
+    plan: Plan
+    """The robot's plan to the nominal goal."""
+    schedule: HandoverSchedule
+    """Its rest motion and the predicted transition."""
+    dispersion: DispersionProfile
+    """Perpendicular spread of the handle paths over progress toward the nominal goal."""
+    speed_mean: np.ndarray
+    """Handle speed at the first passage of each progress value (P,), m/s, mean over trials."""
+    speed_std: np.ndarray
+    """Its standard deviation over trials (P,), m/s."""
+
+    @property
+    def distance_to_goal(self) -> np.ndarray:
+        """The profiles' grid as distance from the nominal goal along the start→goal line (P,), m."""
+        return self.dispersion.distance_to_goal
+
+
+def velocity_jump(record: TrialRecord, start: float, end: float) -> float:
+    """Largest ||v(t + 25 ms) - v(t - 25 ms)|| (m/s) for t in [start, end] (s): how much the handle's velocity
+    changes within 50 ms anywhere in the window."""
+    dt = record.t[1] - record.t[0]
+    half = int(round(JUMP_HALF_WINDOW / dt))
+    k = np.flatnonzero((record.t >= start) & (record.t <= end))
+    k = k[(k >= half) & (k < len(record.t) - half)]
+    if len(k) == 0:
+        return float("nan")
+    return float(np.max(np.linalg.norm(record.velocity[k + half] - record.velocity[k - half], axis=1)))
+
+
+def handover_metrics(record: TrialRecord, robot: HandoverRobot, width: float) -> dict:
+    """Measures of one trial: switch time and distance against the prediction, the largest velocity change
+    during the ramp (and, for comparison, over the same time just before it), and the final error."""
+    schedule = robot.schedule
+    switched = robot.switch_time is not None
+    t_s = robot.switch_time if switched else float("nan")
+    ramp_end = t_s + max(schedule.ramp_time, 2 * JUMP_HALF_WINDOW)
+    final_error = float(np.linalg.norm(record.position[-1] - record.goal))
+    return {
+        "switched": switched,
+        "switch_time_s": t_s,
+        "predicted_switch_time_s": schedule.transition_time,
+        "switch_delay_s": t_s - schedule.transition_time,
+        "switch_distance_m": float(np.linalg.norm(robot.switch_position - schedule.goal)) if switched else float("nan"),
+        "predicted_transition_distance_m": schedule.transition_distance,
+        "velocity_jump_at_switch_m_per_s": velocity_jump(record, t_s, ramp_end) if switched else float("nan"),
+        "velocity_change_before_switch_m_per_s":
+            velocity_jump(record, 2 * t_s - ramp_end, t_s) if switched else float("nan"),
+        "final_error_m": final_error,
+        "within_width": final_error <= width,
+        "person_goal_m": record.goal.tolist(),
+        "replans": record.replans,
+        "failed_replans": record.failed_replans,
+    }
+
+
+def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Mean and std over trials (P,), m/s, of the speed (N, K) at the first passage of each progress value
+    grid (P,), m, along the line from the common start paths[:, 0] (N, K, 3) to goal (3,)."""
+    start = paths[0, 0]
+    u = (goal - start) / np.linalg.norm(goal - start)
+    along = (paths - start) @ u
+    at_grid = np.stack([_first_passage(a, v[:, None], grid)[:, 0] for a, v in zip(along, speeds)])
+    return np.nanmean(at_grid, axis=0), np.nanstd(at_grid, axis=0, ddof=1)
+
+
+def run_handover(settings: HandoverSettings, setup: ScenarioSetup | None = None, transition_model: TransitionModel | None = None,
+                 progress: bool = True) -> HandoverRun:
+    """Run the handover scenario's trials (one per seed), with a progress bar unless progress=False.
+
+    transition_model: the model that predicts the transition distance (default: fitted on the shipped dataset).
+    """
+    setup = setup or ScenarioSetup(settings)
+    transition_model = transition_model or TransitionModel()
+    dt, duration = setup.world.timestep, setup.duration
+    start = setup.settled_start(np.full(3, settings.robot_stiffness))
+    goal, width = np.asarray(settings.goal), setup.width
+    plan = solve_to_convergence(setup.planner, start.state, goal, width)
+    schedule = plan_handover(plan, transition_model, settings.ramp_time, settings.robot_stiffness, rate=1.0 / dt)
+    trials = []
+    for k in tqdm(range(settings.trials), desc=f"handover to {np.round(goal, 2).tolist()}", disable=not progress):
+        variation = np.random.default_rng((settings.seed + k, 1)).standard_normal(2)   # apart from the motor noise
+        person_goal = goal + np.r_[settings.goal_variation * variation, 0.0]
+        person = setup.person(start, person_goal, settings.seed + k)
+        robot = HandoverRobot(setup.world.controller, schedule, dt)
+        record = run_trial(setup.world, start, person, robot, duration)
+        trials.append(HandoverTrial(record, handover_metrics(record, robot, width)))
+    paths = np.stack([trial.record.position for trial in trials])
+    speeds = np.stack([np.linalg.norm(trial.record.velocity, axis=1) for trial in trials])
+    if len(trials) >= 2:
+        dispersion = perpendicular_dispersion_profile(paths, goal, PROFILE_POINTS)
+        speed_mean, speed_std = speed_profile(paths, speeds, goal, dispersion.progress)
+    else:
+        dispersion, speed_mean, speed_std = None, None, None
+    return HandoverRun(trials, plan, schedule, dispersion, speed_mean, speed_std)

@@ -1,0 +1,111 @@
+"""The simulated collaborative scenarios (paper VI): synchronisation and handover, and their input checks."""
+
+import numpy as np
+import pytest
+
+from comanip.simulation import HandoverSettings, ScenarioSetup, SyncSettings, resolve_goal, run_handover, run_sync, scenario
+
+TRIALS = 5
+
+
+@pytest.fixture(scope="module")
+def sync_runs():
+    """5 trials to the near and to the far goal, sharing one setup (the solvers are built once)."""
+    near = SyncSettings(goal="near", trials=TRIALS)
+    setup = ScenarioSetup(near)
+    return {"near": run_sync(near, setup, progress=False),
+            "far": run_sync(SyncSettings(goal="far", trials=TRIALS), setup, progress=False)}
+
+
+@pytest.fixture(scope="module")
+def handover_run():
+    settings = HandoverSettings(goal="near", trials=TRIALS)
+    setup = ScenarioSetup(settings)
+    return run_handover(settings, setup, progress=False), setup
+
+
+def _mean(trials, key):
+    return float(np.mean([trial.metrics[key] for trial in trials]))
+
+
+def test_sync_reports_bounded_goal_and_z_tracking_errors(sync_runs):
+    """Every trial yields a finite estimate; the estimated goal lies within 0.25 m of the person's; the robot
+    (400 N/m in z) keeps the handle within 4 cm RMS of its estimated z from t_o on; the person lands on the
+    goal (within the goal width) although the robot leads z."""
+    for label, trials in sync_runs.items():
+        for trial in trials:
+            m = trial.metrics
+            assert np.all(np.isfinite(m["estimated_goal_m"])), label
+            assert m["goal_error_m"] < 0.25, (label, m["goal_error_m"])
+            assert m["rms_error_z_m"] < 0.04, (label, m["rms_error_z_m"])
+            assert m["final_error_m"] < 0.05, (label, m["final_error_m"])
+            assert np.all(np.isfinite(trial.normalised_error))
+
+
+def test_sync_far_goal_shows_the_larger_xy_error(sync_runs):
+    """Paper VI-A: the error between the estimated trajectory and the end effector is larger in x–y when the
+    goal is farther (speed–accuracy trade-off)."""
+    assert _mean(sync_runs["far"], "rms_error_xy_m") > _mean(sync_runs["near"], "rms_error_xy_m")
+    assert _mean(sync_runs["far"], "goal_error_xy_m") > _mean(sync_runs["near"], "goal_error_xy_m")
+
+
+def test_sync_robot_leads_z_only_after_the_observation(sync_runs):
+    trial = sync_runs["near"][0]
+    record, t_o = trial.record, 0.2
+    before, after = record.t < t_o, record.t > t_o + 0.01
+    assert np.all(record.stiffness[before] == 0.0)
+    np.testing.assert_array_equal(record.stiffness[after], np.tile([0.0, 0.0, 400.0], (after.sum(), 1)))
+
+
+def test_handover_switches_on_time_smoothly_and_the_person_finishes(handover_run):
+    """The stiffness starts to fall within one planning step (h = 0.055 s) of the predicted transition; the
+    handle's velocity changes by less than 0.1 m/s within any 50 ms of the ramp (no jump); every trial
+    ends within the goal width of the person's goal."""
+    run, setup = handover_run
+    h = setup.model.h
+    for trial in run.trials:
+        m = trial.metrics
+        assert m["switched"]
+        assert abs(m["switch_delay_s"]) <= h, m["switch_delay_s"]
+        assert m["velocity_jump_at_switch_m_per_s"] < 0.1, m["velocity_jump_at_switch_m_per_s"]
+        assert m["within_width"] and m["final_error_m"] <= setup.width, m["final_error_m"]
+        stiffness = trial.record.stiffness[:, 0]
+        assert stiffness[0] == 400.0 and stiffness[-1] == 0.0
+
+
+def test_handover_profiles_mark_a_transition(handover_run):
+    run, _ = handover_run
+    assert run.dispersion.peak_dispersion > 0
+    assert np.all(np.isfinite(run.speed_mean[np.isfinite(run.dispersion.dispersion)]))
+    assert 0 < run.schedule.transition_distance < run.schedule.goal_distance
+
+
+@pytest.mark.parametrize("goal, message", [
+    ((0.1, 0.0, 0.3), "horizontal distance"),
+    ((1.2, 0.0, 0.3), "beyond the arm"),
+    ((0.5, 0.0, -0.1), "below"),
+    ("middle", "near"),
+])
+def test_goal_outside_the_workspace_is_rejected(goal, message):
+    with pytest.raises(ValueError, match=message):
+        resolve_goal(goal)
+    with pytest.raises(ValueError, match="goal"):
+        SyncSettings(goal=goal)
+
+
+def test_bad_trials_and_unknown_scenario_are_rejected():
+    with pytest.raises(ValueError, match="trials must be an integer ≥ 1"):
+        HandoverSettings(trials=-2)
+    with pytest.raises(ValueError, match="scenario must be one of"):
+        scenario("dance")
+
+
+def test_cli_rejects_bad_input_before_building_anything(capsys):
+    from comanip.cli.main import main
+
+    assert main(["simulate", "dance"]) == 2
+    assert "scenario must be one of" in capsys.readouterr().err
+    assert main(["simulate", "sync", "--trials", "-1"]) == 2
+    assert "trials" in capsys.readouterr().err
+    assert main(["simulate", "handover", "--goal", "2,0,0.3"]) == 2
+    assert "workspace" in capsys.readouterr().err
