@@ -14,9 +14,9 @@ import warnings
 
 import numpy as np
 
+from comanip.arguments import as_positive
 from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
-from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, plan_handover
-from comanip.multicomponent.transition_csv import shipped_dataset_path
+from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH
 from comanip.planning.planner import Planner
 
@@ -38,7 +38,8 @@ def add_parser(subparsers) -> None:
                         help="translational stiffness while the robot leads (N/m) (default: %(default)s)")
     parser.add_argument("--rate", type=float, help="resample the schedule at this controller rate (Hz), e.g. 1000")
     parser.add_argument("--transition-model", help="a model JSON from 'comanip transition fit' (default: fit on the shipped data)")
-    parser.add_argument("--arm-length", type=float, default=ARM_LENGTH, help="arm length L (m) (default: %(default)s)")
+    parser.add_argument("--arm-length", type=float,
+                        help=f"arm length L (m) that normalises the goal distance (default: the model's, {ARM_LENGTH} for the shipped one)")
     parser.add_argument("--max-wall-time", type=float, help="planning budget per goal (s)")
     parser.add_argument("--out", default="out/handover", help="output folder (default: %(default)s)")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
@@ -48,12 +49,12 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     from comanip.multicomponent.transition_model import ExtrapolationWarning, TransitionModel
 
+    check_schedule_arguments(args.ramp_time, args.stiffness, args.rate)
+    arm_length = None if args.arm_length is None else as_positive("arm_length", args.arm_length, "m")
     model = load_model(args)
-    if args.transition_model:
-        transition = TransitionModel.load(args.transition_model)
-        transition.arm_length = args.arm_length
-    else:
-        transition = TransitionModel(shipped_dataset_path(), arm_length=args.arm_length)
+    transition = TransitionModel.load(args.transition_model) if args.transition_model else TransitionModel()
+    if arm_length is not None:
+        transition.arm_length = arm_length
     planner = Planner(model)
     start = np.zeros(2 * model.n) if args.start is None else args.start
     goals = args.goal or [vector(g) for g in DEFAULT_GOALS]

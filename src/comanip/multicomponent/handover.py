@@ -153,6 +153,14 @@ def stiffness_step_bound(leading_stiffness: float, ramp_time: float, sample_time
     return leading_stiffness * math.sin(min(math.pi * sample_time / (2 * ramp_time), math.pi / 2))
 
 
+def check_schedule_arguments(ramp_time, leading_stiffness, rate) -> tuple[float, float, float | None]:
+    """(ramp_time ≥ 0 s, leading_stiffness > 0 N/m, rate > 0 Hz or None) as floats, else ValueError."""
+    if isinstance(ramp_time, bool) or not isinstance(ramp_time, (int, float)) or not math.isfinite(ramp_time) or ramp_time < 0:
+        raise ValueError(f"ramp_time must be a finite number ≥ 0 (s), got {ramp_time!r}")
+    return (float(ramp_time), as_positive("leading_stiffness", leading_stiffness, "N/m"),
+            as_optional_positive("rate", rate, "Hz"))
+
+
 def plan_handover(plan: Plan, model: TransitionModel, ramp_time: float = DEFAULT_RAMP_TIME,
                   leading_stiffness: float = LEADING_STIFFNESS, rate: float | None = None) -> HandoverSchedule:
     """When and where the robot hands the reach over, and the schedule its impedance controller follows.
@@ -169,10 +177,7 @@ def plan_handover(plan: Plan, model: TransitionModel, ramp_time: float = DEFAULT
         raise ValueError(f"plan must be a comanip.Plan (from Planner.solve), got {type(plan).__name__}")
     if not isinstance(model, TransitionModel) or not model.is_fitted:
         raise ValueError("model must be a fitted comanip.TransitionModel (e.g. comanip.TransitionModel())")
-    if isinstance(ramp_time, bool) or not isinstance(ramp_time, (int, float)) or not math.isfinite(ramp_time) or ramp_time < 0:
-        raise ValueError(f"ramp_time must be a finite number ≥ 0 (s), got {ramp_time!r}")
-    leading_stiffness = as_positive("leading_stiffness", leading_stiffness, "N/m")
-    rate = as_optional_positive("rate", rate, "Hz")
+    ramp_time, leading_stiffness, rate = check_schedule_arguments(ramp_time, leading_stiffness, rate)
     if not np.all(np.isfinite(plan.ee_mean)):
         raise ValueError(f"plan holds a non-finite hand path (status {plan.status!r}); replan before handing over")
 
@@ -191,10 +196,10 @@ def plan_handover(plan: Plan, model: TransitionModel, ramp_time: float = DEFAULT
     velocity = np.where(held[:, None], 0.0, path(np.minimum(t, plan.t[-1]), 1))
     return HandoverSchedule(
         t=t, rest_position=position, rest_velocity=velocity,
-        stiffness=stiffness_profile(t, transition_time, float(ramp_time), leading_stiffness),
+        stiffness=stiffness_profile(t, transition_time, ramp_time, leading_stiffness),
         goal=goal, width=float(plan.width), goal_distance=goal_distance, transition_distance=float(mean),
         transition_distance_std=float(std), transition_time=float(transition_time),
-        transition_position=np.asarray(path(min(transition_time, plan.t[-1]))), ramp_time=float(ramp_time),
+        transition_position=np.asarray(path(min(transition_time, plan.t[-1]))), ramp_time=ramp_time,
         leading_stiffness=leading_stiffness, status=status, rate=rate)
 
 
