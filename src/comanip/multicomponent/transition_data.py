@@ -20,6 +20,7 @@ from functools import lru_cache
 import numpy as np
 from tqdm import tqdm
 
+from comanip import presets
 from comanip.arguments import as_positive, as_positive_array
 from comanip.execution import execute_receding_horizon
 from comanip.model import ReachingModel
@@ -95,11 +96,10 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
         steps: executed steps per reach (default :func:`default_steps`, 2H).
         seed: seeds every condition's generator (one child of ``SeedSequence(seed)`` per condition, so the
             result does not depend on the number of workers or their order).
-        workers: worker processes (1 runs in this process, no Dask).
+        workers: worker processes (1 runs in this process, no Dask). Workers start new Python processes, so
+            a script that calls this with workers > 1 needs the ``if __name__ == "__main__":`` guard.
         progress: show a tqdm bar over conditions.
     """
-    from comanip import presets
-
     model = presets.planar() if model is None else model
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel, got {type(model).__name__}")
