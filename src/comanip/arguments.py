@@ -58,3 +58,15 @@ def as_matrix(name: str, value, shape: tuple[int, ...], unit: str) -> np.ndarray
     if not np.all(np.isfinite(array)):
         raise ValueError(f"{name} must be finite ({unit}); it holds NaN or inf")
     return array
+
+
+def as_square_matrix(name: str, value, n: int, unit: str, positive_definite: bool = False) -> np.ndarray:
+    """A scalar (times the identity) or an (n, n) finite matrix, optionally symmetric positive definite."""
+    matrix = np.asarray(value, dtype=float)
+    if matrix.ndim == 0:
+        matrix = float(matrix) * np.eye(n)
+    if matrix.shape != (n, n) or not np.all(np.isfinite(matrix)):
+        raise ValueError(f"{name} must be a finite scalar or ({n}, {n}) matrix ({unit}), got shape {matrix.shape}")
+    if positive_definite and (not np.allclose(matrix, matrix.T) or np.linalg.eigvalsh(matrix).min() <= 0):
+        raise ValueError(f"{name} must be symmetric positive definite ({unit}), got {matrix.tolist()}")
+    return matrix

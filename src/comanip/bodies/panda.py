@@ -13,10 +13,9 @@ from functools import cached_property
 import casadi as ca
 import numpy as np
 
-from comanip.arguments import as_vector
+from comanip.arguments import as_square_matrix, as_vector
 from comanip.bodies.body import Body
 from comanip.bodies.panda_urdf import ARM_JOINTS, HAND_TCP_OFFSET, TCP_LINK, arm_joint_limits, reduced_panda_urdf
-from comanip.bodies.point_mass import _as_matrix
 
 #: Reflected rotor inertia per joint (kg·m²), added to the diagonal of M. Franka publishes none; these are
 #: the armature values identified for the Franka Research 3 in MuJoCo Menagerie's ``franka_fr3/fr3.xml``
@@ -58,7 +57,7 @@ class Panda(Body):
 
     def __init__(self, damping: float | np.ndarray = 0.3, armature=PANDA_ARMATURE, tcp_offset=HAND_TCP_OFFSET,
                  hand: bool = True, gravity: bool = False):
-        self.damping = _as_matrix("damping", damping, self.n, positive_definite=False)
+        self.damping = as_square_matrix("damping", damping, self.n, "N·m·s/rad")
         self.armature = as_vector("armature", armature, self.n, "reflected rotor inertia per joint, kg·m²")
         if np.any(self.armature < 0):
             raise ValueError(f"armature must be ≥ 0 (kg·m²), got {self.armature.tolist()}")

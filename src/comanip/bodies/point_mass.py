@@ -5,6 +5,7 @@ from __future__ import annotations
 import casadi as ca
 import numpy as np
 
+from comanip.arguments import as_square_matrix
 from comanip.bodies.body import Body
 
 
@@ -22,8 +23,8 @@ class PointMass(Body):
             raise ValueError(f"n must be 1, 2 or 3 (point-mass dimension), got {n!r}")
         self.n = self.d = n
         self.name = {1: "line", 2: "planar", 3: "cartesian"}[n]
-        self.M = _as_matrix("mass", mass, n, positive_definite=True)
-        self.damping = _as_matrix("damping", damping, n, positive_definite=False)
+        self.M = as_square_matrix("mass", mass, n, "kg", positive_definite=True)
+        self.damping = as_square_matrix("damping", damping, n, "N·s/m")
 
     def mass_matrix(self, q: ca.SX) -> ca.SX:
         return ca.SX(self.M)
@@ -43,14 +44,3 @@ class PointMass(Body):
 
     def config(self) -> dict:
         return {"type": "point_mass", "n": self.n, "mass": self.M.tolist(), "damping": self.damping.tolist()}
-
-
-def _as_matrix(name: str, value, n: int, positive_definite: bool) -> np.ndarray:
-    matrix = np.asarray(value, dtype=float)
-    if matrix.ndim == 0:
-        matrix = float(matrix) * np.eye(n)
-    if matrix.shape != (n, n) or not np.all(np.isfinite(matrix)):
-        raise ValueError(f"{name} must be a finite scalar or ({n}, {n}) matrix, got shape {matrix.shape}")
-    if positive_definite and (not np.allclose(matrix, matrix.T) or np.linalg.eigvalsh(matrix).min() <= 0):
-        raise ValueError(f"{name} must be symmetric positive definite, got {matrix.tolist()}")
-    return matrix
