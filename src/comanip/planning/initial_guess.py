@@ -37,7 +37,33 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
     """Torques (H, n) that make the mean follow a joint-space minimum-jerk reach from start (2n,) to goal_q (n,)."""
     t = h * np.arange(H)
     q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n :], goal_q, duration, t)
+    if body.is_linear:  # constant M and G: inverse dynamics of all steps at once
+        M = np.asarray(body.mass_matrix_function(q[0]))
+        G = np.asarray(body.gravity_function(q[0])).ravel()
+        return qddot @ M.T + qdot @ body.damping.T + G
     return np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(H)])
+
+
+def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations) -> list[np.ndarray]:
+    """A linear body's planned torques (H, n) with a rest-to-rest minimum-jerk move by shift_q (n,)
+    superposed, one result per duration (s).
+
+    The mean of a linear body is affine in the torques, so each result moves the whole planned mean path
+    by a smooth reach of shift_q: a plan for one goal becomes a good start for a nearby goal (three to
+    four times fewer Newton iterations than the unmodified plan, benchmarks/README.md).
+    """
+    if not body.is_linear:
+        raise ValueError(f"retargeting by superposition needs a linear body, got {body.name!r}")
+    M = np.asarray(body.mass_matrix_function(np.zeros(body.n)))
+    t = h * np.arange(H)
+    results = []
+    for T in durations:
+        s = np.clip(t / T, 0.0, 1.0)
+        # x(t) = shift_q (10 s³ - 15 s⁴ + 6 s⁵): Flash–Hogan from rest to rest
+        speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / T
+        acceleration = (60 * s - 180 * s**2 + 120 * s**3) / T**2
+        results.append(torque + np.outer(acceleration, M @ shift_q) + np.outer(speed, body.damping @ shift_q))
+    return results
 
 
 def guess_durations(horizon_s: float, count: int) -> np.ndarray:

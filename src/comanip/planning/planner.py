@@ -5,8 +5,17 @@
 
 Single shooting: the torques are the only decision variables and mu, Sigma are CasADi expressions of
 them, so Sigma stays positive semi-definite at every iterate (multiple shooting over Sigma lets iterates go
-indefinite, SPEC §9). Start state, goal and width are NLP parameters, so one build serves every solve.
-The point-mass problems are unconstrained and solved by IPOPT with the exact Hessian.
+indefinite, SPEC §9). Start state, goal and width are parameters, so one build serves every solve.
+
+Two solvers (``SolverOptions.method``):
+
+- ``newton`` (default): a damped Newton method (:mod:`comanip.planning.newton`) on a Hessian assembled
+  from per-step pieces (:mod:`comanip.planning.curvature`; exact for point masses) with compiled,
+  disk-cached objective and gradient. About five times faster than IPOPT here (benchmarks/README.md).
+- ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference.
+
+Both minimise the same objective, normalised by |J_best(w)| (the best attainable J) so that tolerances
+mean the same for every width; ``plan.objective`` is always the SPEC §4 J itself.
 """
 
 from __future__ import annotations
@@ -17,11 +26,17 @@ from dataclasses import dataclass, field
 import casadi as ca
 import numpy as np
 
+from threadpoolctl import ThreadpoolController
+
 from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.model import ReachingModel
-from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques
+from comanip.planning.curvature import ReachCurvature
+from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
+from comanip.planning.newton import newton_minimize
 from comanip.planning.plan import Plan
 from comanip.planning.reach_problem import ReachProblem
+
+SOLVER_METHODS = ("newton", "ipopt")
 
 _IPOPT_STATUS = {
     "Solve_Succeeded": ("solved", True),
@@ -36,16 +51,28 @@ _IPOPT_STATUS = {
 class SolverOptions:
     """How the planner's NLP is solved."""
 
+    method: str = "newton"
+    """'newton' (damped Newton on the structure-exploiting Hessian, fast) or 'ipopt' (IPOPT with CasADi's
+    exact Hessian, the reference)."""
     max_iterations: int = 200
-    """IPOPT iteration limit per start."""
+    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations)."""
     tolerance: float = 1e-8
-    """IPOPT convergence tolerance on the normalised objective (J divided by the goal's peak reward times
-    the sum of discount weights, so it lies in about [-1, 0])."""
+    """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
+    times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``."""
     n_starts: int = 3
     """Minimum-jerk initial guesses tried on a cold solve (durations spread over the horizon); the best
     converged plan is returned. A warm-started solve uses the warm start only."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
+
+    def __post_init__(self):
+        if self.method not in SOLVER_METHODS:
+            raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
+        for name in ("max_iterations", "n_starts"):
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
+                raise ValueError(f"{name} must be an integer ≥ 1, got {value!r}")
+        as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
 
 
 class Planner:
@@ -65,14 +92,25 @@ class Planner:
 
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
-        params = ca.vertcat(problem.s0, problem.goal, problem.width)
-        ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations,
-                 "tol": self.options.tolerance, **self.options.ipopt}
-        self._deadline = _Deadline(problem.tau.numel(), params.shape[0])
-        self._solver = ca.nlpsol("planner", "ipopt",
-                                 {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
-                                 {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
-                                  "iteration_callback": self._deadline})
+        self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
+        self._curvature = ReachCurvature(problem) if self.options.method == "newton" else None
+        self._blas = ThreadpoolController()
+        self._ipopt = None
+
+    @property
+    def _solver(self) -> ca.Function:
+        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian (built on first use)."""
+        if self._ipopt is None:
+            problem = self.problem
+            params = ca.vertcat(problem.s0, problem.goal, problem.width)
+            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations,
+                     "tol": self.options.tolerance, **self.options.ipopt}
+            self._deadline = _Deadline(problem.tau.numel(), params.shape[0])
+            self._ipopt = ca.nlpsol("planner", "ipopt",
+                                    {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
+                                    {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
+                                     "iteration_callback": self._deadline})
+        return self._ipopt
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (2n,), goal (d,), width) or ValueError naming the argument."""
@@ -98,51 +136,87 @@ class Planner:
         """
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
-        guesses = self._initial_guesses(start, goal, warm_start)
-        return self._solve_from(guesses, start, goal, width, max_wall_time)
+        t_begin = time.perf_counter()
+        guesses = self._initial_guesses(start, goal, width, warm_start)
+        return self._solve_from(guesses, start, goal, width, t_begin, max_wall_time)
 
-    def _initial_guesses(self, start, goal, warm_start) -> list[np.ndarray]:
-        model = self.model
+    def _initial_guesses(self, start, goal, width, warm_start) -> list[np.ndarray]:
+        model, body = self.model, self.model.body
         if warm_start is not None:
             torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
-            return [as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")]
-        goal_q = model.body.inverse_kinematics(goal, start[: model.n])
-        return [minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, T)
+            torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
+            if isinstance(warm_start, Plan) and body.is_linear and warm_start.goal.shape == goal.shape \
+                    and not np.array_equal(warm_start.goal, goal):
+                # a plan for another goal: also try it moved onto the new goal, and start from the best
+                q_end = warm_start.mean[-1, : model.n]
+                shift_q = body.inverse_kinematics(goal, q_end) - body.inverse_kinematics(warm_start.goal, q_end)
+                candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
+                                                           guess_durations(model.duration, 4))
+                params = np.concatenate([start, goal, [width]])
+                return [min(candidates, key=lambda c: self._objective(c, params))]
+            return [torque]
+        goal_q = body.inverse_kinematics(goal, start[: model.n])
+        return [minimum_jerk_torques(body, model.h, model.H, start, goal_q, T)
                 for T in guess_durations(model.duration, self.options.n_starts)]
 
-    def _solve_from(self, guesses, start, goal, width, max_wall_time) -> Plan:
-        t_begin = time.perf_counter()
+    def _objective(self, torque: np.ndarray, params: np.ndarray) -> float:
+        """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
+        if self._curvature is not None:
+            return self._curvature.value(np.ravel(torque), params)
+        n2, d = 2 * self.model.n, self.model.d
+        return self.problem.objective_value(torque, params[:n2], params[n2:n2 + d], params[-1])
+
+    def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None) -> Plan:
+        deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         params = np.concatenate([start, goal, [width]])
+        normaliser = float(self._normaliser(width))
         best = None
         iterations = 0
-        for guess in guesses:
-            remaining = None if max_wall_time is None else max_wall_time - (time.perf_counter() - t_begin)
-            if remaining is not None and remaining <= 0 and best is not None:
-                break
-            torque, status, success, message, nit = self._run_solver(guess, params, remaining)
-            iterations += nit
-            objective = self.problem.objective_value(torque, start, goal, width)
-            if not np.all(np.isfinite(torque)) or not np.isfinite(objective):
-                torque, status, success = guess, "failed", False
-                objective = self.problem.objective_value(guess, start, goal, width)
-                message = "solver returned a non-finite plan; returning the initial guess"
-            candidate = (not success, objective, torque, status, success, message)
-            if best is None or candidate[:2] < best[:2]:
-                best = candidate
+        # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
+        # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
+        with self._blas.limit(limits=1, user_api="blas"):
+            for guess in guesses:
+                if time.perf_counter() > deadline and best is not None:
+                    break
+                torque, f, status, success, message, nit = self._run_solver(guess, params, deadline)
+                iterations += nit
+                if not np.all(np.isfinite(torque)) or not np.isfinite(f):
+                    torque, status, success = guess, "failed", False
+                    f = self.problem.objective_value(guess, start, goal, width) / normaliser
+                    message = "solver returned a non-finite plan; returning the initial guess"
+                candidate = (not success, f, torque, status, success, message)
+                if best is None or candidate[:2] < best[:2]:
+                    best = candidate
         _, _, torque, status, success, message = best
         return self.problem.make_plan(torque, start, goal, width, status=status, success=success, message=message,
                                       solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
-    def _run_solver(self, guess: np.ndarray, params: np.ndarray, budget: float | None):
-        """One IPOPT run from torques guess (H, n); returns (torques (H, n), status, success, message, iterations)."""
-        self._deadline.time = np.inf if budget is None else time.perf_counter() + budget
-        result = self._solver(x0=np.ravel(guess), p=params)
-        stats = self._solver.stats()
+    def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float):
+        """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s).
+
+        Returns (torques (H, n), normalised objective, status, success, message, iterations).
+        """
+        if self._curvature is None:
+            return self._run_ipopt(guess, params, deadline)
+        curvature = self._curvature
+        result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
+                                 np.full(guess.size, -np.inf), np.full(guess.size, np.inf),
+                                 tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                                 expired=lambda: time.perf_counter() > deadline)
+        success = result.status in ("solved", "solved_acceptable")
+        return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
+                result.message, result.iterations)
+
+    def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float):
+        solver = self._solver
+        self._deadline.time = deadline
+        result = solver(x0=np.ravel(guess), p=params)
+        stats = solver.stats()
         status, success = _IPOPT_STATUS.get(stats["return_status"], ("failed", False))
         if stats["return_status"] == "User_Requested_Stop" and self._deadline.expired:
             status = "max_wall_time"
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
-        return torque, status, success, stats["return_status"], int(stats.get("iter_count", 0))
+        return torque, float(result["f"]), status, success, stats["return_status"], int(stats.get("iter_count", 0))
 
 
 class _Deadline(ca.Callback):

@@ -40,7 +40,8 @@ class ReachProblem:
         ee_beliefs = [ee(m, S) for m, S in zip(self.means, self.covs)]
         self.ee_means = [x for x, _ in ee_beliefs]
         self.ee_covs = [S for _, S in ee_beliefs]
-        weights = discount_weights(model.gamma, H, model.discount)
+        self.weights = weights = discount_weights(model.gamma, H, model.discount)
+        """Discount weights w_i (H+1,) of the reward terms."""
         self.W = goal_covariance(self.width, d, model.goal_covariance)
         self.objective = reach_objective(self.ee_means, self.ee_covs, [self.tau[:, i] for i in range(H)],
                                          self.goal, self.W, weights, model.nu)

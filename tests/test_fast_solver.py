@@ -1,0 +1,124 @@
+"""The fast solver layer: structured Hessian, compiled functions and their cache, the Newton method, and
+its optimum against IPOPT with CasADi's exact Hessian (the reference)."""
+
+import warnings
+
+import casadi as ca
+import numpy as np
+import pytest
+import scipy.optimize
+
+import comanip
+from comanip.planning.compiled import BufferedFunction, compiled
+from comanip.planning.curvature import ReachCurvature
+from comanip.planning.newton import newton_minimize
+from comanip.planning.planner import Planner, SolverOptions
+from comanip.planning.reach_problem import ReachProblem
+
+
+@pytest.fixture(scope="module")
+def planar_reference():
+    return Planner(comanip.presets.planar(), SolverOptions(method="ipopt"))
+
+
+@pytest.mark.parametrize("preset, noise", [("planar", "isotropic"), ("planar", "per_channel"), ("planar", "rank_one"),
+                                           ("cartesian", "isotropic")])
+def test_structured_hessian_equals_casadi_exact_hessian(preset, noise, rng):
+    """The per-step assembly against CasADi's forward-over-reverse Hessian of the whole rollout."""
+    model = comanip.presets.load(preset).replace(noise=noise, H=12)
+    problem = ReachProblem(model)
+    curvature = ReachCurvature(problem)
+    x = ca.vec(problem.tau)
+    f = problem.objective / -problem.best_objective
+    exact = ca.Function("exact", [x, problem.s0, problem.goal, problem.width], [ca.hessian(f, x)[0], ca.gradient(f, x), f])
+    for _ in range(3):
+        tau = rng.normal(scale=3.0, size=x.numel())
+        p = np.r_[rng.normal(scale=0.1, size=2 * model.n), rng.uniform(0.1, 0.3, model.d), rng.uniform(0.01, 0.05)]
+        value, gradient, data = curvature.evaluate(tau, p)
+        H_exact, g_exact, f_exact = (np.asarray(v) for v in exact(tau, p[: 2 * model.n], p[2 * model.n:-1], p[-1]))
+        assert value == pytest.approx(f_exact.item(), rel=1e-12)
+        np.testing.assert_allclose(gradient, g_exact.ravel(), rtol=1e-10, atol=1e-12 * np.abs(g_exact).max())
+        np.testing.assert_allclose(curvature.hessian(data), H_exact, rtol=1e-9, atol=1e-11 * np.abs(H_exact).max())
+
+
+def test_newton_optimum_equals_ipopt_exact_hessian_optimum(planar_planner, planar_reference, rng):
+    """Same start, same problem: the fast solver and the reference converge to the same plan."""
+    model = planar_planner.model
+    for start, goal, width in [(np.zeros(4), [0.3, 0.0], 0.02), (np.zeros(4), [0.45, 0.1], 0.005),
+                               (np.r_[0.05, -0.05, 0.3, 0.1], [0.2, 0.15], 0.04)]:
+        fast = planar_planner.solve(start, goal, width)
+        reference = planar_reference.solve(start, goal, width, warm_start=fast.torque + rng.normal(scale=0.3, size=(model.H, 2)))
+        again = planar_planner.solve(start, goal, width, warm_start=reference)
+        assert fast.success and reference.success and again.success
+        assert again.objective == pytest.approx(reference.objective, rel=1e-8)
+        np.testing.assert_allclose(again.torque, reference.torque, atol=1e-4 * np.abs(reference.torque).max())
+        assert fast.objective <= reference.objective + 1e-8 * abs(reference.objective)
+
+
+def test_cartesian_warm_solves_match_the_reference(cartesian_planner):
+    """Warm solves to nearby goals (the benchmark's pattern) reach the reference's optimum from the same start."""
+    reference = Planner(comanip.presets.cartesian(), SolverOptions(method="ipopt"))
+    start = np.zeros(6)
+    previous = cartesian_planner.solve(start, [0.3, 0.0, 0.0])
+    for goal in ([0.33, 0.04, -0.02], [0.28, -0.03, 0.05]):
+        fast = cartesian_planner.solve(start, goal, warm_start=previous)
+        ref = reference.solve(start, goal, warm_start=previous)
+        assert fast.success and ref.success
+        assert fast.objective == pytest.approx(ref.objective, rel=1e-7)
+        previous = fast
+
+
+def test_newton_matches_scipy_on_a_bounded_rosenbrock():
+    """An independent check of the method: the bounded Rosenbrock minimiser found by L-BFGS-B."""
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    lb, ub = np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5]
+    result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(6, -1.2), lb, ub, tolerance=1e-8, max_iterations=200)
+    reference = scipy.optimize.minimize(scipy.optimize.rosen, np.full(6, -1.2), jac=scipy.optimize.rosen_der,
+                                        method="L-BFGS-B", bounds=list(zip(lb, ub)), options={"ftol": 1e-15, "gtol": 1e-12})
+    assert result.status == "solved"
+    assert result.x[-1] == pytest.approx(0.5)  # the bound is active
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-6)
+    assert result.f <= reference.fun + 1e-12
+
+
+def test_newton_stops_at_the_deadline():
+    calls = []
+
+    def evaluate(x):
+        calls.append(1)
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(4, -1.2), np.full(4, -np.inf), np.full(4, np.inf),
+                             tolerance=1e-12, max_iterations=100, expired=lambda: len(calls) > 3)
+    assert result.status == "max_wall_time" and np.isfinite(result.f)
+
+
+def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(tmp_path, monkeypatch):
+    monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
+    x = ca.SX.sym("x", 3)
+    for kappa in (1.0, 2.0):
+        f = ca.Function("cached_test", [x], [kappa * ca.sin(x) * ca.sumsqr(x)])
+        fast = compiled(f)
+        point = np.array([0.3, -1.0, 2.0])
+        np.testing.assert_allclose(np.asarray(fast(point)).ravel(), np.asarray(f(point)).ravel(), rtol=1e-14)
+    libraries = sorted(tmp_path.glob("cached_test_*.so"))
+    assert len(libraries) == 2  # a changed constant is a changed function: a new library
+    stamp = libraries[0].stat().st_mtime_ns
+    compiled(ca.Function("cached_test", [x], [1.0 * ca.sin(x) * ca.sumsqr(x)]))
+    assert libraries[0].stat().st_mtime_ns == stamp and len(list(tmp_path.glob("*.so"))) == 2  # reused, not rebuilt
+    monkeypatch.setenv("CC", str(tmp_path / "no-such-compiler"))
+    g = ca.Function("uncompiled_test", [x], [ca.cos(x)])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        fallback = compiled(g)
+    assert any("could not compile" in str(w.message) for w in caught)
+    np.testing.assert_allclose(BufferedFunction(fallback)(np.ones(3))[0].ravel(), np.cos(np.ones(3)))
+
+
+@pytest.mark.parametrize("kwargs, word", [(dict(method="lbfgs"), "method"), (dict(tolerance=0.0), "tolerance"),
+                                          (dict(max_iterations=0), "max_iterations"), (dict(n_starts=1.5), "n_starts")])
+def test_bad_solver_options_name_the_field(kwargs, word):
+    with pytest.raises(ValueError, match=word):
+        SolverOptions(**kwargs)
