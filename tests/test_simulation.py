@@ -18,10 +18,11 @@ def sync_runs():
 
 
 @pytest.fixture(scope="module")
-def handover_run():
-    settings = HandoverSettings(goal="near", trials=TRIALS)
-    setup = ScenarioSetup(settings)
-    return run_handover(settings, setup, progress=False), setup
+def handover_runs():
+    """5 trials to the near and to the far goal."""
+    setup = ScenarioSetup(HandoverSettings())
+    return {goal: run_handover(HandoverSettings(goal=goal, trials=TRIALS), setup, progress=False)
+            for goal in ("near", "far")}, setup
 
 
 def _mean(trials, key):
@@ -30,21 +31,23 @@ def _mean(trials, key):
 
 def test_sync_reports_bounded_goal_and_z_tracking_errors(sync_runs):
     """Every trial yields a finite estimate; the estimated goal lies within 0.25 m of the person's; the robot
-    (400 N/m in z) keeps the handle within 4 cm RMS of its estimated z from t_o on; the person lands on the
-    goal (within the goal width) although the robot leads z."""
+    (400 N/m in z) keeps the handle within 4 cm RMS of its estimated z from t_o on; the person still lands
+    within 1 cm of the goal."""
     for label, trials in sync_runs.items():
         for trial in trials:
             m = trial.metrics
             assert np.all(np.isfinite(m["estimated_goal_m"])), label
             assert m["goal_error_m"] < 0.25, (label, m["goal_error_m"])
             assert m["rms_error_z_m"] < 0.04, (label, m["rms_error_z_m"])
-            assert m["final_error_m"] < 0.05, (label, m["final_error_m"])
+            assert m["final_error_m"] < 0.01, (label, m["final_error_m"])
             assert np.all(np.isfinite(trial.normalised_error))
 
 
-def test_sync_far_goal_shows_the_larger_xy_error(sync_runs):
-    """Paper VI-A: the error between the estimated trajectory and the end effector is larger in x–y when the
-    goal is farther (speed–accuracy trade-off)."""
+def test_sync_errors_are_larger_in_xy_and_for_the_far_goal(sync_runs):
+    """Paper VI-A: the error between the estimated trajectory and the end effector is larger in x–y (led by
+    the person) than in z (led by the robot), and larger in x–y when the goal is farther."""
+    for trials in sync_runs.values():
+        assert _mean(trials, "rms_error_xy_m") > _mean(trials, "rms_error_z_m")
     assert _mean(sync_runs["far"], "rms_error_xy_m") > _mean(sync_runs["near"], "rms_error_xy_m")
     assert _mean(sync_runs["far"], "goal_error_xy_m") > _mean(sync_runs["near"], "goal_error_xy_m")
 
@@ -57,27 +60,33 @@ def test_sync_robot_leads_z_only_after_the_observation(sync_runs):
     np.testing.assert_array_equal(record.stiffness[after], np.tile([0.0, 0.0, 400.0], (after.sum(), 1)))
 
 
-def test_handover_switches_on_time_smoothly_and_the_person_finishes(handover_run):
-    """The stiffness starts to fall within one planning step (h = 0.055 s) of the predicted transition; the
-    handle's velocity changes by less than 0.1 m/s within any 50 ms of the ramp (no jump); every trial
-    ends within the goal width of the person's goal."""
-    run, setup = handover_run
-    h = setup.model.h
-    for trial in run.trials:
-        m = trial.metrics
-        assert m["switched"]
-        assert abs(m["switch_delay_s"]) <= h, m["switch_delay_s"]
-        assert m["velocity_jump_at_switch_m_per_s"] < 0.1, m["velocity_jump_at_switch_m_per_s"]
-        assert m["within_width"] and m["final_error_m"] <= setup.width, m["final_error_m"]
-        stiffness = trial.record.stiffness[:, 0]
-        assert stiffness[0] == 400.0 and stiffness[-1] == 0.0
+def test_handover_switches_on_time_smoothly_and_the_person_finishes(handover_runs):
+    """The stiffness starts to fall within one planning step (h = 0.055 s) of the predicted transition; no
+    velocity jump: within any 50 ms of the ramp the handle's velocity changes by less than 0.1 m/s and by at
+    most twice as much as in the 50 ms windows just before the switch; every trial ends within the goal
+    width of the person's goal."""
+    runs, setup = handover_runs
+    for label, run in runs.items():
+        for trial in run.trials:
+            m = trial.metrics
+            assert m["switched"], label
+            assert abs(m["switch_delay_s"]) <= setup.model.h, (label, m["switch_delay_s"])
+            assert m["velocity_jump_at_switch_m_per_s"] < 0.1, (label, m["velocity_jump_at_switch_m_per_s"])
+            assert m["velocity_jump_at_switch_m_per_s"] < 2 * m["velocity_change_before_switch_m_per_s"], label
+            assert m["within_width"] and m["final_error_m"] <= setup.width, (label, m["final_error_m"])
+            stiffness = trial.record.stiffness[:, 0]
+            assert stiffness[0] == 400.0 and stiffness[-1] == 0.0
 
 
-def test_handover_profiles_mark_a_transition(handover_run):
-    run, _ = handover_run
-    assert run.dispersion.peak_dispersion > 0
-    assert np.all(np.isfinite(run.speed_mean[np.isfinite(run.dispersion.dispersion)]))
-    assert 0 < run.schedule.transition_distance < run.schedule.goal_distance
+def test_handover_profiles_mark_a_transition_farther_out_for_the_far_goal(handover_runs):
+    """The predicted transition lies inside the reach and farther from the goal for the far goal (Peternel &
+    Babič 2019); the measured spread of the reaches peaks farther out for the far goal too."""
+    runs, _ = handover_runs
+    for run in runs.values():
+        assert 0 < run.schedule.transition_distance < run.schedule.goal_distance
+        assert np.all(np.isfinite(run.speed_mean[np.isfinite(run.dispersion.dispersion)]))
+    assert runs["far"].schedule.transition_distance > runs["near"].schedule.transition_distance
+    assert runs["far"].dispersion.transition_distance > runs["near"].dispersion.transition_distance
 
 
 @pytest.mark.parametrize("goal, message", [

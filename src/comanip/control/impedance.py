@@ -103,16 +103,17 @@ class CartesianImpedanceController:
         gains: the gains; the translational stiffness can change later through :attr:`translational_stiffness`.
         rest_posture: joint posture q_r (n,) the nullspace term pulls toward, rad.
         torque_limit: symmetric joint torque limits (n,), N·m; commands are clipped to them (None: no clipping).
-        redesign_angle: the damping design (an eigen-decomposition, the costliest part of a call) is redone
-            when the stiffness changes or some joint has moved more than this (rad) since the last design;
-            the apparent inertia changes by well under 1 % in between. 0 redesigns on every call.
+        redesign_angle: the configuration-dependent parts (the damping design, an eigen-decomposition, and
+            the nullspace projector: most of a call's cost) are redone when the stiffness changes or some
+            joint has moved more than this (rad) since the last design; the apparent inertia changes by
+            about 1 % in between. 0 redesigns on every call.
 
     >>> controller = CartesianImpedanceController(ImpedanceGains(), rest_posture=q0, torque_limit=limits)
     >>> controller.translational_stiffness = [0, 0, 400]
     >>> tau = controller(state, position_rest=x_r, rotation_rest=R_r)
     """
 
-    def __init__(self, gains: ImpedanceGains, rest_posture, torque_limit=None, redesign_angle: float = 0.005):
+    def __init__(self, gains: ImpedanceGains, rest_posture, torque_limit=None, redesign_angle: float = 0.02):
         if not isinstance(gains, ImpedanceGains):
             raise ValueError(f"gains must be an ImpedanceGains, got {type(gains).__name__}")
         self.gains = gains
@@ -142,28 +143,32 @@ class CartesianImpedanceController:
         """Joint torques (n,), N·m, for the rest pose (position_rest (3,) m, rotation_rest (3, 3)) moving at
         velocity_rest (3,) m/s (zero when None)."""
         g = self.gains
-        J, M, q, qdot = state.jacobian, state.mass_matrix, state.q, state.qdot
-        M_inv_JT = np.linalg.solve(M, J.T)
-        Lambda_inv = J @ M_inv_JT
+        J, q, qdot = state.jacobian, state.q, state.qdot
         if self._damping is None or np.max(np.abs(q - self._designed_at)) > self.redesign_angle:
-            self._damping = modal_damping(Lambda_inv, self._stiffness, g.damping_ratio)
-            self._designed_at = q.copy()
-        Lambda = np.linalg.inv(Lambda_inv)
-
+            self._design(state)
         error = np.concatenate((np.asarray(position_rest) - state.position, orientation_error(rotation_rest, state.rotation)))
         twist_error = -(J @ qdot)
         if velocity_rest is not None:
             twist_error[:3] += velocity_rest
         wrench = self._stiffness * error + self._damping @ twist_error
-
-        tau_0 = g.nullspace_stiffness * (self.rest_posture - q) \
-            - (2.0 * g.nullspace_damping_ratio * np.sqrt(g.nullspace_stiffness * M.diagonal())) * qdot
-        # dynamically consistent nullspace projection, N^T tau_0 = tau_0 - J^T Lambda J M^-1 tau_0:
-        # tau_0 then produces no task-space acceleration
-        tau = state.gravity + tau_0 + J.T @ (wrench - Lambda @ (M_inv_JT.T @ tau_0))
+        tau_0 = g.nullspace_stiffness * (self.rest_posture - q) - self._nullspace_damping * qdot
+        tau = state.gravity + J.T @ wrench + self._nullspace_projector @ tau_0
         if self.torque_limit is not None:
             tau = np.minimum(np.maximum(tau, -self.torque_limit), self.torque_limit)
         return tau
+
+    def _design(self, state: RobotState) -> None:
+        """The configuration-dependent parts, refreshed when the joints have moved (see redesign_angle): the
+        modal damping D, the nullspace damping 2 zeta_0 sqrt(K_0 M_ii), and the dynamically consistent
+        projector N^T = I - J^T Lambda J M^-1, with which the posture torque produces no task-space
+        acceleration."""
+        J, M, g = state.jacobian, state.mass_matrix, self.gains
+        M_inv_JT = np.linalg.solve(M, J.T)
+        Lambda_inv = J @ M_inv_JT
+        self._damping = modal_damping(Lambda_inv, self._stiffness, g.damping_ratio)
+        self._nullspace_projector = np.eye(len(state.q)) - J.T @ np.linalg.solve(Lambda_inv, M_inv_JT.T)
+        self._nullspace_damping = 2.0 * g.nullspace_damping_ratio * np.sqrt(g.nullspace_stiffness * M.diagonal())
+        self._designed_at = state.q.copy()
 
 
 def orientation_error(rotation_rest: np.ndarray, rotation: np.ndarray) -> np.ndarray:

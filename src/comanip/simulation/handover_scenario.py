@@ -67,7 +67,7 @@ class HandoverRobot:
         schedule = self.schedule
         if self.switch_time is None and np.linalg.norm(state.position - schedule.goal) <= schedule.transition_distance:
             self.switch_time, self.switch_position = t, state.position.copy()
-        if self.switch_time is not None:
+        if self.switch_time is not None and t <= self.switch_time + schedule.ramp_time + self.dt:
             stiffness = float(stiffness_profile(t, self.switch_time, schedule.ramp_time, schedule.leading_stiffness))
             self.controller.translational_stiffness = np.full(3, stiffness)
         k = min(int(round((t - schedule.t[0]) / self.dt)), len(schedule.t) - 1)

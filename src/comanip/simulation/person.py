@@ -147,12 +147,11 @@ class SimulatedPerson:
         if t >= self._next_replan - 1e-9:
             self._replan(t, position)
         h = self.planner.model.h
-        j = min(int((t - self._plan_time) / h + 1e-9), self._spline.shape[1] - 1)
+        j = min(int((t - self._plan_time) / h + 1e-9), len(self._spline) - 1)
         tau = t - self._plan_time - j * h
-        c3, c2, c1, c0 = self._spline[:, j]            # x = c3 tau³ + c2 tau² + c1 tau + c0 on step j
-        self.intended_position = ((c3 * tau + c2) * tau + c1) * tau + c0
-        self.intended_velocity = (3 * c3 * tau + 2 * c2) * tau + c1
-        acceleration = 6 * c3 * tau + 2 * c2
+        # on step j, x = c3 tau³ + c2 tau² + c1 tau + c0: position, velocity, acceleration (3, 3) at once
+        self.intended_position, self.intended_velocity, acceleration = np.array(
+            [[tau**3, tau**2, tau, 1.0], [3 * tau**2, 2 * tau, 1.0, 0.0], [6 * tau, 2.0, 0.0, 0.0]]) @ self._spline[j]
         return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
             + self._load_inertia @ acceleration
 
@@ -178,7 +177,7 @@ class SimulatedPerson:
             x.append(x[-1] + model.h * v[-1])
             v.append(v[-1] + model.h * self._inverse_inertia @ (command - self._damping @ v[-1]))
         spline = CubicSpline(model.h * np.arange(len(x)), np.array(x), bc_type=((1, self.intended_velocity), "not-a-knot"))
-        self._spline = spline.c[:, : len(commands)]  # (4, steps, 3) polynomial coefficients per step
+        self._spline = spline.c[:, : len(commands)].transpose(1, 0, 2)  # (steps, 4, 3) coefficients per step
         self._model_velocity = v[len(commands)]
         self._plan_time = t
         self._next_replan = t + self.parameters.replan_interval

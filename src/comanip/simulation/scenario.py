@@ -8,6 +8,7 @@ object weight has already sagged onto the impedances), then runs for ``duration`
 
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -156,6 +157,10 @@ class TrialRecord:
     """Re-plans the person made."""
     failed_replans: int = 0
     """Re-plans that stopped at their iteration limit before converging (the refined plan was still used)."""
+    wall_time: float = 0.0
+    """Wall time of the trial (s), robot solves and the person's re-plans included."""
+    replan_time: float = 0.0
+    """Wall time of the person's re-plans (s) within wall_time."""
 
     COLUMNS = ("position", "velocity", "intended_position", "intended_velocity", "rest_position", "stiffness", "person_force")
 
@@ -203,6 +208,7 @@ def settle(world: CoManipulationWorld, person: PersonParameters, stiffness, dura
 def run_trial(world: CoManipulationWorld, start: SettledStart, person: SimulatedPerson, robot: RobotBehaviour,
               duration: float) -> TrialRecord:
     """Simulate one reach of ``duration`` seconds from the settled start, at the world's control rate."""
+    begin = time.perf_counter()
     world.reset(start.qpos, start.qvel)
     person.start(start.hold)
     dt = world.timestep
@@ -224,8 +230,10 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
         qpos[k] = state.q
         if k < steps - 1:
             world.step(state, force, rest_position, rest_velocity)
-    failed = sum(not plan.success for plan in person.plans[1:])
-    return TrialRecord(t=t, goal=person.goal.copy(), qpos=qpos, replans=len(person.plans), failed_replans=failed, **record)
+    replans = person.plans[1:]      # the first plan is made before the trial (shared by trials alike)
+    return TrialRecord(t=t, goal=person.goal.copy(), qpos=qpos, replans=len(person.plans),
+                       failed_replans=sum(not plan.success for plan in replans), wall_time=time.perf_counter() - begin,
+                       replan_time=sum(plan.solve_time for plan in replans), **record)
 
 
 def reach_times(record: TrialRecord, tolerance: float) -> np.ndarray:

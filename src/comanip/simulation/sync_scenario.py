@@ -88,7 +88,9 @@ class SyncRobot:
             self.controller.translational_stiffness = [0.0, 0.0, self.settings.robot_stiffness]
         rest_position, rest_velocity = self.rest(t)
         # x and y are the person's: the rest follows the handle there, so only z is led
-        return np.r_[position[:2], rest_position[2]], np.r_[velocity[:2], rest_velocity[2]]
+        position, velocity = position.copy(), velocity.copy()
+        position[2], velocity[2] = rest_position[2], rest_velocity[2]
+        return position, velocity
 
 
 def end_at_height(rest: RestTrajectory, height: float) -> None:
