@@ -69,7 +69,7 @@ def run(args) -> int:
         from comanip.plots.simulation_sync import plot_sync
 
         files.append(plot_sync(results, next(iter(all_settings.values())).observation_time, out / "sync.png"))
-    else:
+    elif any(run.dispersion is not None for run in results.values()):     # the profiles need ≥ 2 trials
         from comanip.plots.simulation_handover import plot_handover
 
         files.append(plot_handover({k: r for k, r in results.items() if r.dispersion is not None}, out / "handover.png"))

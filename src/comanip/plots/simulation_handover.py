@@ -34,7 +34,7 @@ def plot_handover(runs: dict[str, HandoverRun], path: str | Path, title: str = "
             ax.axvline(transition, color=color, ls="--", lw=1.2)
         ax_spread.text(transition, 0.0, f" predicted\n transition\n {transition:.3f} m", color=color, fontsize=8, va="bottom")
     ax_spread.set(ylabel="position spread ⊥ path (mm)", title="position spread over distance to goal (std over trials)")
-    ax_speed.set(xlabel="distance to goal (m)", ylabel="speed (m/s)", title="velocity over distance to goal (mean ± std)")
+    ax_speed.set(xlabel="distance to goal along the start→goal line (m)", ylabel="speed (m/s)", title="velocity over distance to goal (mean ± std)")
     for ax in (ax_spread, ax_speed):
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
