@@ -70,7 +70,7 @@ class ReachCurvature:
             hess, grad = step_terms(mu_x, vech, problem.goal, problem.width, w / scale)
             hessians.append(hess)
             gradients.append(grad)
-        return ca.Function(f"reach_terms_{model.name}", [x, problem.s0, problem.goal, problem.width],
+        return ca.Function("reach_terms", [x, problem.s0, problem.goal, problem.width],
                            [f, ca.gradient(f, x), ca.horzcat(*hessians), ca.horzcat(*gradients)],
                            ["x", "s0", "goal", "width"], ["f", "grad", "phi_hess", "phi_grad"])
 
