@@ -85,7 +85,7 @@ def first_passage_deviations(paths, goal, n_points: int = 101) -> tuple[np.ndarr
     along = offsets @ u                                   # (N, K+1)
     perpendicular = offsets - along[..., None] * u        # (N, K+1, d)
     grid = np.linspace(0.0, D, n_points)
-    return grid, np.stack([_first_passage(a, e, grid) for a, e in zip(along, perpendicular)])
+    return grid, np.stack([values_at_first_passage(a, e, grid) for a, e in zip(along, perpendicular)])
 
 
 def profile_from_deviations(grid: np.ndarray, deviations: np.ndarray) -> DispersionProfile:
@@ -109,8 +109,9 @@ def bootstrap_transition_std(grid: np.ndarray, deviations: np.ndarray, rng: np.r
     return float(np.std(distances, ddof=1))
 
 
-def _first_passage(along: np.ndarray, perpendicular: np.ndarray, grid: np.ndarray) -> np.ndarray:
-    """Perpendicular deviation (P, d) at the first time progress along (K+1,) reaches each grid value (P,).
+def values_at_first_passage(along: np.ndarray, perpendicular: np.ndarray, grid: np.ndarray) -> np.ndarray:
+    """Values (P, d) of a per-sample quantity perpendicular (K+1, d) (e.g. the perpendicular deviation, m, or
+    a speed) at the first time progress along (K+1,) reaches each grid value (P,).
 
     Linear in time between samples; NaN for grid values the trial never reaches.
     """

@@ -20,7 +20,7 @@ import numpy as np
 from tqdm import tqdm
 
 from comanip.control.impedance import CartesianImpedanceController, RobotState
-from comanip.multicomponent.dispersion import DispersionProfile, _first_passage, perpendicular_dispersion_profile
+from comanip.multicomponent.dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan
@@ -149,7 +149,7 @@ def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid:
     start = paths[0, 0]
     u = (goal - start) / np.linalg.norm(goal - start)
     along = (paths - start) @ u
-    at_grid = np.stack([_first_passage(a, v[:, None], grid)[:, 0] for a, v in zip(along, speeds)])
+    at_grid = np.stack([values_at_first_passage(a, v[:, None], grid)[:, 0] for a, v in zip(along, speeds)])
     return np.nanmean(at_grid, axis=0), np.nanstd(at_grid, axis=0, ddof=1)
 
 
