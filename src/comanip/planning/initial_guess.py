@@ -44,17 +44,23 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
     return np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(H)])
 
 
-def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations) -> list[np.ndarray]:
-    """A linear body's planned torques (H, n) with a rest-to-rest minimum-jerk move by shift_q (n,)
-    superposed, one result per duration (s).
+def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations,
+                       mean: np.ndarray | None = None) -> list[np.ndarray]:
+    """A plan's torques (H, n) with a rest-to-rest minimum-jerk move by shift_q (n,) superposed, one result
+    per duration (s): delta tau = M(q_i) delta qddot_i + D delta qdot_i along the plan's mean (H+1, 2n).
 
-    The mean of a linear body is affine in the torques, so each result moves the whole planned mean path
+    For a linear body the mean is affine in the torques, so each result moves the whole planned mean path
     by a smooth reach of shift_q: a plan for one goal becomes a good start for a nearby goal (three to
-    four times fewer Newton iterations than the unmodified plan, benchmarks/README.md).
+    four times fewer Newton iterations than the unmodified plan, benchmarks/README.md). For a nonlinear
+    body (M evaluated along ``mean``, required then) it holds to first order.
     """
-    if not body.is_linear:
-        raise ValueError(f"retargeting by superposition needs a linear body, got {body.name!r}")
-    M = np.asarray(body.mass_matrix_function(np.zeros(body.n)))
+    if body.is_linear:
+        inertia = np.broadcast_to(np.asarray(body.mass_matrix_function(np.zeros(body.n))), (H, body.n, body.n))
+    elif mean is None:
+        raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
+    else:
+        inertia = np.asarray(body.mass_matrix_function.map(H)(mean[:H, : body.n].T)).reshape(body.n, H, body.n).transpose(1, 0, 2)
+    push = inertia @ shift_q  # (H, n)
     t = h * np.arange(H)
     results = []
     for T in durations:
@@ -62,7 +68,7 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
         # x(t) = shift_q (10 s³ - 15 s⁴ + 6 s⁵): Flash–Hogan from rest to rest
         speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / T
         acceleration = (60 * s - 180 * s**2 + 120 * s**3) / T**2
-        results.append(torque + np.outer(acceleration, M @ shift_q) + np.outer(speed, body.damping @ shift_q))
+        results.append(torque + acceleration[:, None] * push + np.outer(speed, body.damping @ shift_q))
     return results
 
 

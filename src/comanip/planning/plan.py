@@ -20,7 +20,8 @@ class Plan:
     success: bool
     """True when the solver converged (to its tolerance or an acceptable level) to a finite plan."""
     status: str
-    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'unreachable', 'failed'."""
+    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'unreachable' (goal out of the arm's
+    reach), 'limits_violated' (joint limits could not be met) or 'failed'."""
     message: str
     """What the solver said, in words."""
     objective: float

@@ -32,7 +32,8 @@ from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_v
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
-from comanip.planning.newton import newton_minimize
+from comanip.planning.linearised_curvature import LinearisedCurvature
+from comanip.planning.path_limits import PathLimits, minimize_within_limits
 from comanip.planning.plan import Plan
 from comanip.planning.reach_problem import ReachProblem
 
@@ -64,6 +65,11 @@ class SolverOptions:
     converged plan is returned. A warm-started solve uses the warm start only."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
+    compile: bool | None = None
+    """Compile the Newton method's per-solve function to C (cached on disk, see comanip.planning.compiled).
+    None: only for nonlinear bodies, where CasADi's virtual machine is ten times slower (a first build takes
+    about a minute for the Panda); a point mass's function runs fast enough uncompiled (benchmarks/README.md)
+    and compiling costs seconds for every new model."""
 
     def __post_init__(self):
         if self.method not in SOLVER_METHODS:
@@ -73,6 +79,8 @@ class SolverOptions:
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise ValueError(f"{name} must be an integer ≥ 1, got {value!r}")
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
+        if self.compile not in (None, True, False):
+            raise ValueError(f"compile must be None, True or False, got {self.compile!r}")
 
 
 class Planner:
@@ -88,14 +96,28 @@ class Planner:
             raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")
         self.model = model
         self.options = options or SolverOptions()
+        if self.options.method == "ipopt" and not model.body.is_linear:
+            raise ValueError(f"method 'ipopt' (exact Hessian of the expanded problem) is for point masses; the "
+                             f"{model.body.name!r} body needs method 'newton'")
         self._build()
 
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
         self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
-        self._curvature = ReachCurvature(problem) if self.options.method == "newton" else None
+        self._curvature = self._newton_terms() if self.options.method == "newton" else None
+        body, H = self.model.body, self.model.H
+        self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
+        self._limits = PathLimits.of(self.model)
         self._blas = ThreadpoolController()
         self._ipopt = None
+
+    def _newton_terms(self):
+        """Objective, gradient and Hessian for the Newton method: exact for linear bodies, structured
+        approximation with secant corrections for nonlinear ones."""
+        compile = self.options.compile
+        if self.model.body.is_linear:
+            return ReachCurvature(self.problem, compile=bool(compile))
+        return LinearisedCurvature(self.problem, compile=compile is not False)
 
     @property
     def _solver(self) -> ca.Function:
@@ -137,23 +159,54 @@ class Planner:
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
+        unreachable = self._unreachable_plan(start, goal, width, warm_start, t_begin)
+        if unreachable is not None:
+            return unreachable
         guesses = self._initial_guesses(start, goal, width, warm_start)
+        extras = warm_start.extras if isinstance(warm_start, Plan) else {}
+        self._warm_multipliers = {"multipliers": extras["limit_multipliers"], "rho": extras["limit_penalty"]} \
+            if "limit_multipliers" in extras else {}
+        self._extras = {}
         return self._solve_from(guesses, start, goal, width, t_begin, max_wall_time)
+
+    def _unreachable_plan(self, start, goal, width, warm_start, t_begin: float) -> Plan | None:
+        """A plan with status 'unreachable' when no joint position within the limits puts the end effector
+        within the goal width of the goal (inverse-kinematics residual > w); None otherwise.
+
+        Point masses reach everywhere; an arm is checked before any solver work (about 10 ms for the Panda).
+        """
+        model, body = self.model, self.model.body
+        if body.is_linear:
+            return None
+        seed = warm_start.mean[-1, : model.n] if isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, 2 * model.n) \
+            else start[: model.n]
+        q = body.inverse_kinematics(goal, seed)
+        residual = float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - goal))
+        if residual <= width:
+            return None
+        message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
+                   f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
+        torque = np.zeros((model.H, model.n))
+        params = np.concatenate([start, goal, [width]])
+        return self._make_plan(torque, params, status="unreachable", success=False, message=message,
+                               solve_time=time.perf_counter() - t_begin, iterations=0)
 
     def _initial_guesses(self, start, goal, width, warm_start) -> list[np.ndarray]:
         model, body = self.model, self.model.body
         if warm_start is not None:
             torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
             torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
-            if isinstance(warm_start, Plan) and body.is_linear and warm_start.goal.shape == goal.shape \
+            if isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape and warm_start.mean.shape[0] == model.H + 1 \
                     and not np.array_equal(warm_start.goal, goal):
                 # a plan for another goal: also try it moved onto the new goal, and start from the best
                 q_end = warm_start.mean[-1, : model.n]
-                shift_q = body.inverse_kinematics(goal, q_end) - body.inverse_kinematics(warm_start.goal, q_end)
+                J = np.asarray(body.kinematics_function(q_end)[1])
+                shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
                 candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
-                                                           guess_durations(model.duration, 4))
+                                                           guess_durations(model.duration, 4), warm_start.mean)
                 params = np.concatenate([start, goal, [width]])
-                return [min(candidates, key=lambda c: self._objective(c, params))]
+                low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
+                return [min((np.clip(c, low, high) for c in candidates), key=lambda c: self._objective(c, params))]
             return [torque]
         goal_q = body.inverse_kinematics(goal, start[: model.n])
         return [minimum_jerk_torques(body, model.h, model.H, start, goal_q, T)
@@ -184,12 +237,22 @@ class Planner:
                     torque, status, success = guess, "failed", False
                     f = self.problem.objective_value(guess, start, goal, width) / normaliser
                     message = "solver returned a non-finite plan; returning the initial guess"
-                candidate = (not success, f, torque, status, success, message)
+                candidate = (not success, f, torque, status, success, message, dict(self._extras))
                 if best is None or candidate[:2] < best[:2]:
                     best = candidate
-        _, _, torque, status, success, message = best
-        return self.problem.make_plan(torque, start, goal, width, status=status, success=success, message=message,
-                                      solve_time=time.perf_counter() - t_begin, iterations=iterations)
+        _, _, torque, status, success, message, extras = best
+        return self._make_plan(torque, params, status=status, success=success, message=message,
+                               solve_time=time.perf_counter() - t_begin, iterations=iterations, extras=extras)
+
+    def _make_plan(self, torque, params, **fields) -> Plan:
+        n2, d = 2 * self.model.n, self.model.d
+        start, goal, width = params[:n2], params[n2:n2 + d], params[-1]
+        curvature = self._curvature
+        if curvature is None or curvature.exact:  # a point mass's expanded rollout is cheap
+            return self.problem.make_plan(torque, start, goal, width, **fields)
+        f, _, data = curvature.evaluate(np.ravel(torque), params)
+        return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
+                                      objective=f * curvature.normaliser(width), **fields)
 
     def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float):
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s).
@@ -199,10 +262,13 @@ class Planner:
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
-        result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
-                                 np.full(guess.size, -np.inf), np.full(guess.size, np.inf),
-                                 tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
-                                 expired=lambda: time.perf_counter() > deadline)
+        limited = minimize_within_limits(curvature, self._limits, params, np.ravel(guess), *self._torque_bounds,
+                                         tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                                         secant=not curvature.exact, expired=lambda: time.perf_counter() > deadline,
+                                         **self._warm_multipliers)
+        result = limited.result
+        if limited.multipliers is not None:
+            self._extras = {"limit_multipliers": limited.multipliers, "limit_penalty": limited.rho}
         success = result.status in ("solved", "solved_acceptable")
         return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
                 result.message, result.iterations)

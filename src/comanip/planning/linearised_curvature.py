@@ -1,0 +1,197 @@
+"""Objective, exact gradient and a structured approximate Hessian for nonlinear bodies (the Panda).
+
+Notation as in :mod:`comanip.planning.curvature`: x = tau flattened (H·n,), z_i = (mu_x,i, vech Sigma_x,i),
+phi_i = -w_i R / |J_best|, T_ik = d mu_q,i / d tau_k (n, n), G_ik = J_i T_ik. For a nonlinear body A_i,
+B_i and J_i depend on the mean path, and the exact Hessian needs third derivatives of the rigid-body
+dynamics along all of it (CasADi's: about 20 s per evaluation for the Panda). The Hessian here keeps
+
+- Z_i's mean rows exactly (G_ik, by the chain rule along the mean: T_{i+1,k} = A_i T_ik, T_{k+1,k} = B_k);
+- Z_i's covariance rows from the noise injected at each step (A, B held fixed) and from J_i's dependence
+  on q_i (d vech(J Sigma_qq Jᵀ)/dq_i · T_i);
+- the curvature of the kinematics, Σ_i T_iᵀ ∇²_q [∇_mu phi_i · x_ee(q) + <Λ_i, J(q) Sigma_qq J(q)ᵀ>] T_i;
+- the noise's own curvature and the effort, as for linear bodies;
+
+and leaves out the curvature of the dynamics and the dependence of A_i, B_i on the mean path. Along the
+eigenvectors of the exact Hessian it agrees to a few per cent except in a handful of directions of
+negative curvature (measured on the Panda, benchmarks/README.md); the Newton method's secant corrections
+learn those. The gradient is exact, so the optimum is that of the SPEC §4 objective.
+
+The objective, gradient and per-step pieces come from one CasADi function: an MX graph over per-step SX
+functions (belief step, reward, kinematics), compiled to C on first use (:mod:`comanip.planning.compiled`);
+generating C for the expanded problem instead gives hundreds of megabytes that do not compile in minutes.
+"""
+
+from __future__ import annotations
+
+import casadi as ca
+import numpy as np
+
+from comanip.belief.propagation import belief_step_function, linearised_step_function
+from comanip.objectives.reward import expected_reward, goal_covariance
+from comanip.planning.compiled import BufferedFunction, compiled
+from comanip.planning.curvature import _causal_gram, _noise_second_derivatives, _reward_derivatives_function
+from comanip.planning.reach_problem import ReachProblem
+
+
+class LinearisedCurvature:
+    """f, its exact gradient and an approximate Hessian for a nonlinear body; same interface as
+    :class:`comanip.planning.curvature.ReachCurvature`.
+
+    Args:
+        problem: the model's :class:`ReachProblem` (its weights and normaliser are used).
+        compile: build the per-solve function as C (recommended: about ten times faster than CasADi's
+            virtual machine for the Panda; the first build takes a minute and is cached on disk).
+    """
+
+    exact = False
+    """The Hessian is an approximation (the solver adds secant corrections)."""
+
+    def __init__(self, problem: ReachProblem, compile: bool = True):
+        model = self.model = problem.model
+        self.problem = problem
+        d = model.d
+        self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
+        function = self._terms_function(problem)
+        self._terms = BufferedFunction(compiled(function) if compile else function)
+        self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
+        self._last_normaliser = (None, 1.0)
+        self._noise_hessian = _noise_second_derivatives(model)
+
+    def _terms_function(self, problem: ReachProblem) -> ca.Function:
+        """``(x, s0, goal, width) -> (f, grad, mean, cov, A, B, J, phi_hess, phi_grad, W, dvech/dq)``, all
+        per-step outputs stacked horizontally (see :meth:`evaluate`)."""
+        model, body = problem.model, problem.model.body
+        n, d, H = model.n, model.d, model.H
+        x = ca.MX.sym("x", n * H)
+        s0, goal, width = ca.MX.sym("s0", 2 * n), ca.MX.sym("goal", d), ca.MX.sym("width")
+        scale = ca.Function("normaliser", [problem.width], [-problem.best_objective])(width)
+        weights = ca.DM(problem.weights).T / scale
+        tau = ca.reshape(x, n, H)
+        step = belief_step_function(body, model.h, model.kappa, model.noise)
+        cost = _stage_cost_function(model)
+        mean, cov = [s0], [ca.MX.zeros(2 * n, 2 * n)]
+        for i in range(H):
+            mu, Sigma = step(mean[-1], cov[-1], tau[:, i])
+            mean.append(mu)
+            cov.append(Sigma)
+        means, covs = ca.horzcat(*mean), ca.horzcat(*cov)
+        f = ca.sum2(cost.map(H + 1)(means, covs, goal, width, weights)) + model.nu * ca.sumsqr(x) / scale
+        _, A, B = linearised_step_function(body, model.h).map(H)(means[:, :H], tau)
+        J, phi_hess, phi_grad, W, dvech = _stage_curvature_function(model, self._triangle).map(H + 1)(
+            means, covs, goal, width, weights)
+        return ca.Function("arm_reach_terms", [x, s0, goal, width],
+                           [f, ca.gradient(f, x), means, covs, A, B, J, phi_hess, phi_grad, W, dvech],
+                           ["x", "s0", "goal", "width"],
+                           ["f", "grad", "mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "W", "dvech"])
+
+    def normaliser(self, width: float) -> float:
+        """|J_best(w)|: the objective is divided by it."""
+        if self._last_normaliser[0] != width:
+            self._last_normaliser = (width, float(self._normaliser(width)))
+        return self._last_normaliser[1]
+
+    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, tuple]:
+        """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""
+        n2, d = 2 * self.model.n, self.model.d
+        out = self._terms(x, params[:n2], params[n2:n2 + d], params[-1])
+        return float(out[0].item()), out[1].ravel(), (np.array(x, dtype=float), params[-1], *out[2:])
+
+    def value(self, x: np.ndarray, params: np.ndarray) -> float:
+        return self.evaluate(x, params)[0]
+
+    def mean_sensitivities(self, data: tuple) -> np.ndarray:
+        """T[i, :, k, :] = d mu_i / d tau_k (H+1, 2n, H, n) along the mean of the evaluated torques (exact)."""
+        model = self.model
+        n, H = model.n, model.H
+        A = data[4].reshape(2 * n, H, 2 * n).transpose(1, 0, 2)
+        B = data[5].reshape(2 * n, H, n).transpose(1, 0, 2)
+        T = np.zeros((H + 1, 2 * n, H, n))
+        for i in range(H):
+            T[i + 1, :, :i] = (A[i] @ T[i, :, :i].reshape(2 * n, -1)).reshape(2 * n, i, n)
+            T[i + 1, :, i] = B[i]
+        return T
+
+    def hessian(self, data: tuple) -> np.ndarray:
+        """Approximate ∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
+        x, width, _, _, _, _, J, phi_hess, phi_grad, W, dvech = data
+        model = self.model
+        n, d, H = model.n, model.d, model.H
+        nv, nz = len(self._triangle), phi_hess.shape[0]
+        a, b = self._triangle.T
+        tau = x.reshape(H, n)
+        J = J.reshape(d, H + 1, n).transpose(1, 0, 2)
+        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
+        W = W.reshape(n, H + 1, n).transpose(1, 0, 2)
+        dvech = dvech.reshape(nv, H + 1, n).transpose(1, 0, 2)
+        Tq = self.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
+        # rows per step: mean (d), covariance (nv), joint positions (n, for the kinematic curvature W)
+        left = np.empty((H + 1, nz + n, H * n))
+        G = np.matmul(J, Tq, out=left[:, :d])
+        np.matmul(dvech, Tq, out=left[:, d:nz])
+        left[:, d:nz] += self._noise_rows(G.reshape(H + 1, d, H, n), tau).reshape(H + 1, nv, H * n)
+        left[:, nz:] = Tq
+        right = np.empty_like(left)
+        np.matmul(Q, left[:, :nz], out=right[:, :nz])
+        np.matmul(W, Tq, out=right[:, nz:])
+        hessian = _causal_gram(left.reshape(-1, H * n), right.reshape(-1, H * n), nz + n, n)
+        # the noise's own curvature: Σ_i <Λ_i, G_ik ∂²N G_ikᵀ>, block-diagonal in k
+        Lambda = np.zeros((H + 1, d, d))
+        Lambda[:, a, b] = Lambda[:, b, a] = (phi_grad[d:] * np.where(a == b, 1.0, 0.5)[:, None]).T
+        G = G.reshape(H + 1, d, H, n)
+        S = np.einsum("iakr,iab,ibks->krs", G, Lambda, G, optimize=True)
+        blocks = np.einsum("krs,jlrs->kjl", S, self._noise_hessian)
+        steps = np.arange(H)
+        hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks
+        hessian[np.diag_indices(H * n)] += 2 * model.nu / self.normaliser(width)
+        return hessian
+
+    def _noise_rows(self, G: np.ndarray, tau: np.ndarray) -> np.ndarray:
+        """d vech Sigma_x,i / d tau_kj through the noise injected at step k (A, B held): (H+1, nv, H, n).
+
+        G (H+1, d, H, n). With E_kj = dN/dtau_j at tau_k, the row is vech(G_ik E_kj G_ikᵀ); for isotropic
+        noise E_kj = 2 kappa tau_kj I and the rows are 2 kappa tau_kj vech(G_ik G_ikᵀ).
+        """
+        a, b = self._triangle.T
+        if self.model.noise == "isotropic":
+            GG = np.einsum("iakj,ibkj->iabk", G, G, optimize=True)[:, a, b]  # (H+1, nv, H)
+            return 2 * self.model.kappa * GG[..., None] * tau
+        E = np.einsum("jlrs,kl->kjrs", self._noise_hessian, tau)
+        return np.einsum("iakr,kjrs,ibks->iabkj", G, E, G, optimize=True)[:, a, b]
+
+    def trajectory(self, data: tuple) -> tuple[np.ndarray, np.ndarray]:
+        """Mean (H+1, 2n) and covariance (H+1, 2n, 2n) of the evaluated torques."""
+        n2, H = 2 * self.model.n, self.model.H
+        return data[2].T.copy(), data[3].reshape(n2, H + 1, n2).transpose(1, 0, 2).copy()
+
+
+def _stage_cost_function(model) -> ca.Function:
+    """``(mu (2n,), Sigma (2n, 2n), goal, width, weight) -> -weight R(x_ee(mu_q), J Sigma_qq Jᵀ)``."""
+    body, n, d = model.body, model.n, model.d
+    mu, Sigma = ca.SX.sym("mu", 2 * n), ca.SX.sym("Sigma", 2 * n, 2 * n)
+    goal, width, weight = ca.SX.sym("goal", d), ca.SX.sym("width"), ca.SX.sym("weight")
+    q = mu[:n]
+    J = body.jacobian(q)
+    R = expected_reward(body.end_effector(q), ca.mtimes([J, Sigma[:n, :n], J.T]), goal,
+                        goal_covariance(width, d, model.goal_covariance))
+    return ca.Function("stage_cost", [mu, Sigma, goal, width, weight], [-weight * R])
+
+
+def _stage_curvature_function(model, triangle: np.ndarray) -> ca.Function:
+    """``(mu, Sigma, goal, width, weight) -> (J, ∇²phi, ∇phi, W, d vech Sigma_x / dq)`` at one step.
+
+    phi's derivatives are w.r.t. z = (mu_x, vech Sigma_x); W = ∇²_q [λ·x_ee(q) + <Λ, J(q) Sigma_qq J(q)ᵀ>]
+    with λ = ∇_mu_x phi and Λ = ∇_Sigma_x phi held at their values.
+    """
+    body, n, d = model.body, model.n, model.d
+    mu, Sigma = ca.SX.sym("mu", 2 * n), ca.SX.sym("Sigma", 2 * n, 2 * n)
+    goal, width, weight = ca.SX.sym("goal", d), ca.SX.sym("width"), ca.SX.sym("weight")
+    q = mu[:n]
+    J = body.jacobian(q)
+    Sigma_x = ca.mtimes([J, Sigma[:n, :n], J.T])
+    vech = ca.vertcat(*[Sigma_x[a, b] for a, b in triangle])
+    phi_hess, phi_grad = _reward_derivatives_function(model)(body.end_effector(q), vech, goal, width, weight)
+    lam, vech_weights = ca.SX.sym("lambda", d), ca.SX.sym("vech_weights", len(triangle))
+    kinematic_value = ca.dot(lam, body.end_effector(q)) + ca.dot(vech_weights, vech)
+    W = ca.Function("W", [mu, Sigma, lam, vech_weights], [ca.hessian(kinematic_value, mu)[0][:n, :n]])
+    return ca.Function("stage_curvature", [mu, Sigma, goal, width, weight],
+                       [J, phi_hess, phi_grad, W(mu, Sigma, phi_grad[:d], phi_grad[d:]), ca.jacobian(vech, mu)[:, :n]])
