@@ -1,6 +1,6 @@
 """Solve-time benchmark: median and p90 wall time of repeated solves, one row per case.
 
-    .venv/bin/python benchmarks/solve_times.py [--repeats 50] [--only planar,cartesian]
+    .venv/bin/python benchmarks/solve_times.py [--repeats 50] [--only planar,cartesian,franka]
 
 Each case builds its solver once (build time reported apart), runs one cold solve, then times `repeats`
 warm solves with varied goals. Add a case by adding to CASES a key (used by --only) and a function that
@@ -17,6 +17,7 @@ from typing import Callable
 import numpy as np
 
 import comanip
+from comanip.planning.planner import SolverOptions
 
 
 @dataclass
@@ -29,16 +30,21 @@ class Case:
     paper_time: float | None = None
 
 
-def point_mass_case(preset: str, paper_time: float) -> Callable[[], Case]:
+def reach_case(preset: str, paper_time: float, options: SolverOptions | None = None, label: str = "",
+               reach=(0.3, 0.0, 0.0)) -> Callable[[], Case]:
+    """Warm solves to goals drawn uniformly within ±5 cm (per axis) of a base goal, each warm-started from
+    the previous plan. The base goal is ``reach`` (m) from the body's home position (at rest there); the
+    first, cold solve is not timed (it also builds any compiled function)."""
+
     def make() -> Case:
         model = comanip.presets.load(preset)
         t0 = time.perf_counter()
-        planner = comanip.Planner(model)
+        planner = comanip.Planner(model, options)
         build = time.perf_counter() - t0
         rng = np.random.default_rng(0)
-        start = np.zeros(2 * model.n)
-        base = np.zeros(model.d)
-        base[0] = 0.3
+        home = model.body.home_position
+        start = np.concatenate([home, np.zeros(model.n)])
+        base = np.asarray(model.body.kinematics_function(home)[0]).ravel() + np.asarray(reach)[: model.d]
         previous = planner.solve(start, base, model.width)
 
         def solve(k: int) -> tuple[float, bool]:
@@ -48,7 +54,7 @@ def point_mass_case(preset: str, paper_time: float) -> Callable[[], Case]:
             previous = plan
             return plan.solve_time, plan.success
 
-        return Case(f"{preset} warm (H={model.H}, n={model.n})", build, solve, paper_time)
+        return Case(f"{preset} warm (H={model.H}, n={model.n}){label}", build, solve, paper_time)
 
     return make
 
@@ -138,8 +144,13 @@ def posterior_case(preset: str, new_start: bool) -> Callable[[], Case]:
 
 
 CASES: dict[str, Callable[[], Case]] = {
-    "planar": point_mass_case("planar", 0.04),
-    "cartesian": point_mass_case("cartesian", 0.20),
+    "planar": reach_case("planar", 0.04),
+    "cartesian": reach_case("cartesian", 0.20),
+    "planar_compiled": reach_case("planar", 0.04, SolverOptions(compile=True), " compiled"),
+    "cartesian_compiled": reach_case("cartesian", 0.20, SolverOptions(compile=True), " compiled"),
+    "planar_ipopt": reach_case("planar", 0.04, SolverOptions(method="ipopt"), " IPOPT"),
+    "cartesian_ipopt": reach_case("cartesian", 0.20, SolverOptions(method="ipopt"), " IPOPT"),
+    "franka": reach_case("franka", 1.3, reach=(0.15, 0.1, -0.1)),
     "closed_loop": closed_loop_reach_case,
     "estimate_planar": estimate_case("planar"),
     "estimate_cartesian": estimate_case("cartesian"),

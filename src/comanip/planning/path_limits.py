@@ -11,7 +11,8 @@ minimises
 
 and after each minimisation the multipliers become y ← max(0, y + rho c(x)) and rho grows tenfold while
 the largest violation has not shrunk by a factor of four (the classical augmented Lagrangian; Nocedal &
-Wright 2006, ch. 17.4). A plan carries its final y and rho (``plan.extras``), and a solve warm-started
+Wright 2006, ch. 17.4, Algorithm 17.4 minimises inexactly in the same way). Once the limits hold, a last
+round minimises to the full tolerance. A plan carries its final y and rho (``plan.extras``), and a solve warm-started
 from it begins there. The Hessian of the penalty is its Gauss–Newton part rho Σ_active ∇c ∇cᵀ, exact up
 to the curvature of the mean path; ∇c are rows of d mu_i / d tau, which the curvature object provides.
 """
@@ -26,6 +27,9 @@ from comanip.planning.newton import NewtonResult, newton_minimize
 
 LIMIT_TOLERANCE = 1e-6
 """Largest violation (rad or rad/s, m or m/s) a plan may keep."""
+ROUGH_TOLERANCE = 1e-5
+"""Gradient tolerance of the rounds before the limits hold (an inexact augmented Lagrangian: the
+multipliers are still moving, so the tail of a tight minimisation would be wasted)."""
 
 
 @dataclass(frozen=True)
@@ -71,6 +75,8 @@ def minimize_within_limits(curvature, limits: PathLimits, params: np.ndarray, x0
                            multipliers: np.ndarray | None = None, rho: float = 1e2, max_outer: int = 8) -> LimitedResult:
     """Minimise the normalised objective of ``curvature`` over torque bounds and the path limits.
 
+    ``max_iterations`` applies to each inner Newton solve.
+
     ``multipliers`` and ``rho`` from a previous, similar solve start the augmented Lagrangian where that
     one ended, so a warm solve whose limits bind like its predecessor's needs one inner solve. The status
     is 'limits_violated' when the limits still do not hold after ``max_outer`` updates.
@@ -83,19 +89,21 @@ def minimize_within_limits(curvature, limits: PathLimits, params: np.ndarray, x0
     y = np.zeros((2,) + limits.lower.shape) if multipliers is None else np.array(multipliers, dtype=float)
     x, iterations, violation = x0, 0, np.inf
     for _ in range(max_outer):
+        # rounds that still move the multipliers need only a rough minimum; the last one polishes
+        polish = violation <= LIMIT_TOLERANCE
+        inner = dict(options, tolerance=tolerance if polish else max(tolerance, ROUGH_TOLERANCE))
         penalised = _AugmentedLagrangian(curvature, limits, params, y, rho)
-        result = newton_minimize(penalised.evaluate, penalised.hessian, x, lb, ub,
-                                 max_iterations=max(1, max_iterations - iterations), **options)
+        result = newton_minimize(penalised.evaluate, penalised.hessian, x, lb, ub, max_iterations=max_iterations, **inner)
         x, iterations = result.x, iterations + result.iterations
         c = limits.constraints(curvature.trajectory(curvature.evaluate(x, params)[2])[0])
-        y = np.maximum(0.0, y + rho * c)
         new_violation = float(max(0.0, np.max(c)))
-        done = new_violation <= LIMIT_TOLERANCE or result.status in ("max_wall_time", "failed", "max_iterations")
-        if not done and new_violation > 0.25 * violation:
+        if result.status in ("max_wall_time", "failed", "max_iterations") or (polish and new_violation <= LIMIT_TOLERANCE):
+            violation = new_violation
+            break
+        y = np.maximum(0.0, y + rho * c)
+        if new_violation > LIMIT_TOLERANCE and new_violation > 0.25 * violation:
             rho *= 10
         violation = new_violation
-        if done:
-            break
     status, message = result.status, result.message
     if violation > LIMIT_TOLERANCE and status not in ("max_wall_time", "failed", "max_iterations"):
         status, message = "limits_violated", f"joint limits violated by {violation:.3g} after the augmented Lagrangian"

@@ -55,8 +55,10 @@ class SolverOptions:
     method: str = "newton"
     """'newton' (damped Newton on the structure-exploiting Hessian, fast) or 'ipopt' (IPOPT with CasADi's
     exact Hessian, the reference)."""
-    max_iterations: int = 200
-    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations)."""
+    max_iterations: int | None = None
+    """Iteration limit per start (Newton: Hessian evaluations, per augmented-Lagrangian round when joint
+    limits bind; IPOPT: its iterations). None: 200 for point masses, 1000 for nonlinear bodies, whose
+    approximate Hessian converges linearly."""
     tolerance: float = 1e-8
     """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
     times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``."""
@@ -76,6 +78,8 @@ class SolverOptions:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
         for name in ("max_iterations", "n_starts"):
             value = getattr(self, name)
+            if name == "max_iterations" and value is None:
+                continue
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
                 raise ValueError(f"{name} must be an integer ≥ 1, got {value!r}")
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
@@ -111,6 +115,12 @@ class Planner:
         self._blas = ThreadpoolController()
         self._ipopt = None
 
+    @property
+    def _max_iterations(self) -> int:
+        if self.options.max_iterations is not None:
+            return self.options.max_iterations
+        return 200 if self.model.body.is_linear else 1000
+
     def _newton_terms(self):
         """Objective, gradient and Hessian for the Newton method: exact for linear bodies, structured
         approximation with secant corrections for nonlinear ones."""
@@ -125,7 +135,7 @@ class Planner:
         if self._ipopt is None:
             problem = self.problem
             params = ca.vertcat(problem.s0, problem.goal, problem.width)
-            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations,
+            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
                      "tol": self.options.tolerance, **self.options.ipopt}
             self._deadline = _Deadline(problem.tau.numel(), params.shape[0])
             self._ipopt = ca.nlpsol("planner", "ipopt",
@@ -193,24 +203,32 @@ class Planner:
 
     def _initial_guesses(self, start, goal, width, warm_start) -> list[np.ndarray]:
         model, body = self.model, self.model.body
-        if warm_start is not None:
-            torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
-            torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
-            if isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape and warm_start.mean.shape[0] == model.H + 1 \
-                    and not np.array_equal(warm_start.goal, goal):
-                # a plan for another goal: also try it moved onto the new goal, and start from the best
-                q_end = warm_start.mean[-1, : model.n]
-                J = np.asarray(body.kinematics_function(q_end)[1])
-                shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
-                candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
-                                                           guess_durations(model.duration, 4), warm_start.mean)
-                params = np.concatenate([start, goal, [width]])
-                low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
-                return [min((np.clip(c, low, high) for c in candidates), key=lambda c: self._objective(c, params))]
+        if warm_start is None:
+            return self._cold_guesses(start, goal, self.options.n_starts)
+        torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
+        torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
+        if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
+                and warm_start.mean.shape[0] == model.H + 1 and not np.array_equal(warm_start.goal, goal)):
             return [torque]
-        goal_q = body.inverse_kinematics(goal, start[: model.n])
-        return [minimum_jerk_torques(body, model.h, model.H, start, goal_q, T)
-                for T in guess_durations(model.duration, self.options.n_starts)]
+        # a plan for another goal: also try it moved onto the new goal, and start from the best
+        q_end = warm_start.mean[-1, : model.n]
+        J = np.asarray(body.kinematics_function(q_end)[1])
+        shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
+        candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
+                                                   guess_durations(model.duration, 4), warm_start.mean)
+        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > 3 * width:
+            # far beyond the goal's reward (it underflows there): fresh reaches compete too
+            candidates += self._cold_guesses(start, goal, self.options.n_starts)
+        params = np.concatenate([start, goal, [width]])
+        low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
+        return [min((np.clip(c, low, high) for c in candidates), key=lambda c: self._objective(c, params))]
+
+    def _cold_guesses(self, start, goal, count: int) -> list[np.ndarray]:
+        """Minimum-jerk reaches to the inverse-kinematics solution, ``count`` durations."""
+        model = self.model
+        goal_q = model.body.inverse_kinematics(goal, start[: model.n])
+        return [minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, T)
+                for T in guess_durations(model.duration, count)]
 
     def _objective(self, torque: np.ndarray, params: np.ndarray) -> float:
         """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
@@ -263,7 +281,7 @@ class Planner:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
         limited = minimize_within_limits(curvature, self._limits, params, np.ravel(guess), *self._torque_bounds,
-                                         tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                                         tolerance=self.options.tolerance, max_iterations=self._max_iterations,
                                          secant=not curvature.exact, expired=lambda: time.perf_counter() > deadline,
                                          **self._warm_multipliers)
         result = limited.result
