@@ -1,27 +1,35 @@
-"""A regularised Newton method for smooth problems with simple bounds: min f(x) subject to lb ≤ x ≤ ub.
+"""A regularised Newton method for smooth problems with inequality constraints (active-set SQP):
+
+    min f(x)  subject to  lb ≤ x ≤ ub  and  c(x) ≤ 0.
 
 The planner's problem has a few hundred unknowns, a dense Hessian that is cheap to assemble from per-step
-pieces (:mod:`comanip.planning.curvature`), and no constraints but torque limits. A general NLP solver
-spends more per iteration on its own machinery than the Hessian costs (IPOPT with MUMPS: about 1 ms per
-iteration for 150 unknowns), so the iteration is written out here, following IPOPT's choices for an
-unconstrained problem:
+pieces (:mod:`comanip.planning.curvature`), and constraints (torque bounds, joint limits on the mean path)
+that bind at a handful of steps at most. A general NLP solver spends more per iteration on its own
+machinery than the Hessian costs (IPOPT with MUMPS: about 1 ms per iteration for 150 unknowns), so the
+iteration is written out here:
 
-- Direction: p = -(H_FF + delta·s·I)^-1 g_F on the free variables F (those not held at a bound by a
-  gradient pushing outwards), s = max |diag H_FF|, by Cholesky. delta is 0 whenever H_FF is positive
-  definite; otherwise the smallest of delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for which
-  the factorisation succeeds (IPOPT's inertia correction).
-- Step: backtracking along the projected path x(alpha) = clip(x + alpha p, lb, ub), alpha = 1, 1/2, ...,
-  until the Armijo condition f(x(alpha)) ≤ f(x) + 1e-4 g·(x(alpha) - x) holds.
+- Working set W: the constraints within ``margin`` of binding (c_j > -margin), bounds included as rows of
+  ±I. Without any, the step is the Newton step.
+- Direction: minimise the quadratic model gᵀp + ½ pᵀ(H + delta·s·I)p subject to the linearised working
+  constraints c_W + A_W p = 0, by one Cholesky factorisation and a Schur complement on the few rows of W;
+  a constraint that is not binding (c_j < 0) and gets a negative multiplier leaves W and the step is
+  recomputed. s = max |diag H|; delta is 0 whenever H is positive definite, otherwise the smallest of
+  delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for which the factorisation succeeds (IPOPT's
+  inertia correction).
+- Step: backtracking, alpha = 1, 1/2, ..., on the l1 merit f + mu Σ max(0, c) (mu ≥ 2 max multiplier)
+  until it decreases by 1e-4 of its directional derivative (Armijo).
 - Secant correction (``secant=True``, for approximate Hessians): C is updated after every step s with
   the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (H + C) s, y the change of gradient, and
   H + C is used in place of H. It learns the curvature the approximation misses along the directions
   the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md).
-- Convergence: max |projected gradient| ≤ tolerance ('solved'). If no step decreases f any more in
-  floating point, the point is 'solved_acceptable' when the projected gradient is within 100 × tolerance.
-  It is 'solved_acceptable' too when f has decreased by less than 1e-8 |f| over the last five iterations
-  with a projected gradient below 1e-4: along the nearly flat directions of a redundant arm an approximate
-  Hessian converges linearly and slowly, while the plan stopped changing long before (Panda:
-  |f| resolved to 1e-8 after a third of the iterations a 1e-8 gradient needs).
+- Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
+  the violated constraints' linearisation is taken if it halves the violation.
+- Convergence: max |∇f + A_Wᵀ lambda| ≤ tolerance with every constraint violated by at most
+  ``constraint_tolerance`` ('solved'). If the merit cannot be decreased any more in floating point, the
+  point is 'solved_acceptable' when the constraints are met and that gradient is below 1e-4 (or 100 ×
+  tolerance, if larger). It is 'solved_acceptable' too when f has decreased by less than 1e-8 |f| over the last five iterations with the gradient below
+  1e-4 and the constraints met: along the nearly flat directions of a redundant arm an approximate
+  Hessian converges linearly and slowly, while the plan stopped changing long before.
 
 f must be finite at x0; a trial point where f is not finite is treated as a failed trial.
 """
@@ -38,7 +46,7 @@ _ARMIJO = 1e-4
 """Fraction of the linearly predicted decrease a step must achieve."""
 _BACKTRACKS = 30
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
-"""Iterations, relative decrease of f over them, and projected gradient for the stagnation test."""
+"""Iterations, relative decrease of f over them, and gradient for the stagnation test."""
 
 
 @dataclass
@@ -49,83 +57,197 @@ class NewtonResult:
     """Best point found (N,)."""
     f: float
     status: str
-    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time' or 'failed'."""
+    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'constraints_violated' or 'failed'."""
     message: str
     iterations: int
     """Hessian evaluations (one per accepted step)."""
     projected_gradient: float
-    """max |projected gradient| at x."""
+    """max |∇f + A_Wᵀ lambda| (the Lagrangian's gradient over the working set) at x."""
+    violation: float = 0.0
+    """Largest constraint violation max(0, c) at x, bounds included."""
 
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
                     hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
                     tolerance: float, max_iterations: int, secant: bool = False,
+                    constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
+                    constraint_tolerance: float = 1e-6, margin: float = 1e-3,
                     expired: Callable[[], bool] = lambda: False) -> NewtonResult:
-    """Minimise f over the box [lb, ub] from x0.
+    """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0.
 
     Args:
-        evaluate: x (N,) -> (f, grad f (N,), data); ``data`` is handed to ``hessian``.
+        evaluate: x (N,) -> (f, grad f (N,), data); ``data`` is handed to ``hessian`` and ``constraints``.
         hessian: data -> ∇²f (N, N), symmetric.
         x0: start (N,), projected onto the box; lb, ub: bounds (N,), ±inf allowed.
-        tolerance: on max |projected gradient|.
+        tolerance: on max |gradient of the Lagrangian|.
         max_iterations: Hessian evaluations allowed.
         secant: add symmetric rank-one corrections to an approximate Hessian.
+        constraints: (x, data) -> (c (m,), rows), rows(indices) -> dc_indices/dx (len(indices), N); None
+            for none. Entries of c may be -inf (no constraint).
+        constraint_tolerance: largest violation a solution may keep (units of c).
+        margin: constraints with c > -margin are in the working set.
         expired: called between evaluations; True stops with status 'max_wall_time'.
     """
+    problem = _Constraints(lb, ub, constraints)
     x = np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
     if not (np.isfinite(f) and np.all(np.isfinite(g))):
         return NewtonResult(x, f, "failed", "objective or gradient not finite at the start", 0, np.inf)
-    delta_last = 0.0
-    iterations = 0
+    c, A = problem(x, data)
+    delta_last, mu, iterations = 0.0, 0.0, 0
     correction, previous = None, None  # secant correction; (x, g) before the last step
     history = [f]
+
+    def result(status, message, gradient):
+        return NewtonResult(x, f, status, message, iterations, gradient, problem.violation(c))
+
     while True:
-        free = ~(((x <= lb) & (g > 0)) | ((x >= ub) & (g < 0)))
-        projected = float(np.max(np.abs(g[free]), initial=0.0))
-        if projected <= tolerance:
-            return NewtonResult(x, f, "solved", "projected gradient below tolerance", iterations, projected)
-        if len(history) > _STALL_WINDOW and projected <= _STALL_GRADIENT \
-                and history[-1 - _STALL_WINDOW] - f <= _STALL_DECREASE * abs(f):
-            return NewtonResult(x, f, "solved_acceptable", f"objective unchanged to {_STALL_DECREASE:g} over "
-                                f"{_STALL_WINDOW} iterations", iterations, projected)
         if iterations >= max_iterations:
-            return NewtonResult(x, f, "max_iterations", f"{iterations} iterations", iterations, projected)
+            return result("max_iterations", f"{iterations} iterations", np.inf)
         if expired():
-            return NewtonResult(x, f, "max_wall_time", "wall-time budget spent", iterations, projected)
+            return result("max_wall_time", "wall-time budget spent", np.inf)
         H = hessian(data)
         iterations += 1
         if not np.all(np.isfinite(H)):
-            return NewtonResult(x, f, "failed", "Hessian not finite", iterations, projected)
+            return result("failed", "Hessian not finite", np.inf)
         if secant:
             correction = np.zeros_like(H) if correction is None else correction
             if previous is not None:
                 _symmetric_rank_one_update(correction, H, x - previous[0], g - previous[1])
             H = H + correction
             previous = (x, g)
-        H_free = H if free.all() else H[np.ix_(free, free)]
-        factor, delta_last = _regularised_cholesky(H_free, delta_last)
+        factor, delta_last = _regularised_cholesky(H, delta_last)
         if factor is None:
-            return NewtonResult(x, f, "failed", "no positive definite regularised Hessian", iterations, projected)
-        step = np.zeros_like(x)
-        step[free] = -scipy.linalg.cho_solve(factor, g[free], check_finite=False)
-        alpha = 1.0
-        for _ in range(_BACKTRACKS):
-            trial = np.clip(x + alpha * step, lb, ub)
-            decrease = g @ (trial - x)
-            if not decrease < -1e-16 * max(1.0, abs(f)):
+            return result("failed", "no positive definite regularised Hessian", np.inf)
+        step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin)
+        lagrangian_gradient = float(np.max(np.abs(g + A(working).T @ multipliers)))
+        violation = problem.violation(c)
+        if lagrangian_gradient <= tolerance and violation <= constraint_tolerance:
+            return result("solved", "gradient of the Lagrangian below tolerance", lagrangian_gradient)
+        if len(history) > _STALL_WINDOW and lagrangian_gradient <= _STALL_GRADIENT and violation <= constraint_tolerance \
+                and history[-1 - _STALL_WINDOW] - f <= _STALL_DECREASE * abs(f):
+            return result("solved_acceptable", f"objective unchanged to {_STALL_DECREASE:g} over {_STALL_WINDOW} "
+                          "iterations", lagrangian_gradient)
+        mu = max(mu, 2 * float(np.max(multipliers, initial=0.0)))
+        merit = f + mu * np.sum(np.maximum(c, 0.0))
+        slope = g @ step - mu * np.sum(np.maximum(c, 0.0))  # directional derivative of the merit
+        alpha, accepted = 1.0, False
+        for attempt in range(_BACKTRACKS):
+            if not slope < -1e-16 * max(1.0, abs(merit)):
                 break
+            trial = x + alpha * step
             f_trial, g_trial, data_trial = evaluate(trial)
-            if np.isfinite(f_trial) and np.all(np.isfinite(g_trial)) and f_trial <= f + _ARMIJO * decrease:
-                x, f, g, data = trial, f_trial, g_trial, data_trial
-                history.append(f)
-                break
+            if np.isfinite(f_trial) and np.all(np.isfinite(g_trial)):
+                c_trial, A_trial = problem(trial, data_trial)
+                if attempt == 0 and len(working) and np.sum(np.maximum(c_trial, 0.0)) > np.sum(np.maximum(c, 0.0)):
+                    # second-order correction: the full step broke the curved constraints; pull it back onto
+                    # their linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3)
+                    corrected = trial + correct(c_trial[working])
+                    f_corr, g_corr, data_corr = evaluate(corrected)
+                    if np.isfinite(f_corr) and np.all(np.isfinite(g_corr)):
+                        c_corr, A_corr = problem(corrected, data_corr)
+                        if f_corr + mu * np.sum(np.maximum(c_corr, 0.0)) <= merit + _ARMIJO * slope:
+                            trial, f_trial, g_trial, data_trial, c_trial, A_trial = corrected, f_corr, g_corr, data_corr, c_corr, A_corr
+                if f_trial + mu * np.sum(np.maximum(c_trial, 0.0)) <= merit + _ARMIJO * alpha * slope:
+                    x, f, g, data, c, A = trial, f_trial, g_trial, data_trial, c_trial, A_trial
+                    history.append(f)
+                    accepted = True
+                    break
             alpha /= 2
-        else:
-            decrease = 0.0
-        if not decrease < -1e-16 * max(1.0, abs(f)):
-            status = "solved_acceptable" if projected <= 100 * tolerance else "failed"
-            return NewtonResult(x, f, status, "no step decreases the objective any further", iterations, projected)
+        if not accepted and problem.violation(c) > constraint_tolerance:
+            restored = _restore(evaluate, problem, x, c, A)
+            if restored is not None:
+                x, f, g, data, c, A = restored
+                history.append(f)
+                continue
+        if not accepted:
+            violation = problem.violation(c)
+            if lagrangian_gradient <= max(100 * tolerance, _STALL_GRADIENT) and violation <= constraint_tolerance:
+                return result("solved_acceptable", "no step decreases the objective any further", lagrangian_gradient)
+            status = "constraints_violated" if violation > constraint_tolerance else "failed"
+            return result(status, f"no step decreases the merit any further (violation {violation:.3g}, gradient "
+                          f"{lagrangian_gradient:.3g})", lagrangian_gradient)
+
+
+def _restore(evaluate, problem, x, c, A):
+    """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over the
+    violated rows V, halved until the largest violation shrinks; None if it does not."""
+    violated = np.flatnonzero(c > 0)
+    rows = A(violated)
+    step = -rows.T @ np.linalg.lstsq(rows @ rows.T, c[violated], rcond=None)[0]
+    for alpha in (1.0, 0.5, 0.25, 0.125):
+        trial = x + alpha * step
+        f, g, data = evaluate(trial)
+        if np.isfinite(f) and np.all(np.isfinite(g)):
+            c_trial, A_trial = problem(trial, data)
+            if problem.violation(c_trial) < 0.5 * problem.violation(c):
+                return trial, f, g, data, c_trial, A_trial
+    return None
+
+
+class _Constraints:
+    """c(x) ≤ 0 and rows of its Jacobian on demand: the finite bounds (rows of ±I), then the user's."""
+
+    def __init__(self, lb, ub, constraints):
+        self.constraints = constraints
+        self.upper = np.flatnonzero(np.isfinite(ub))
+        self.lower = np.flatnonzero(np.isfinite(lb))
+        self.lb, self.ub, self.size = lb, ub, len(lb)
+
+    def __call__(self, x, data):
+        bounds = np.concatenate([x[self.upper] - self.ub[self.upper], self.lb[self.lower] - x[self.lower]])
+        if self.constraints is None:
+            return bounds, self._bound_rows
+        c_user, user_rows = self.constraints(x, data)
+        n_bounds = len(bounds)
+
+        def rows(indices):
+            out = np.zeros((len(indices), self.size))
+            is_bound = indices < n_bounds
+            out[is_bound] = self._bound_rows(indices[is_bound])
+            if not is_bound.all():
+                out[~is_bound] = user_rows(indices[~is_bound] - n_bounds)
+            return out
+
+        return np.concatenate([bounds, c_user]), rows
+
+    def _bound_rows(self, indices):
+        out = np.zeros((len(indices), self.size))
+        n_upper = len(self.upper)
+        upper = indices < n_upper
+        out[np.flatnonzero(upper), self.upper[indices[upper]]] = 1.0
+        out[np.flatnonzero(~upper), self.lower[indices[~upper] - n_upper]] = -1.0
+        return out
+
+    @staticmethod
+    def violation(c) -> float:
+        return float(max(0.0, np.max(c, initial=0.0)))
+
+
+def _constrained_step(factor, g, c, A, margin: float):
+    """Newton step under the working set's linearised constraints.
+
+    A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row that is not
+    binding (c_j < 0) with a negative multiplier is dropped and the step recomputed. Returns (step,
+    multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
+    """
+    Hg = scipy.linalg.cho_solve(factor, g, check_finite=False)
+    working = np.flatnonzero(c > -margin)
+    while len(working):
+        rows = A(working)
+        HA = scipy.linalg.cho_solve(factor, rows.T, check_finite=False)
+        schur = rows @ HA
+        multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
+        dropping = (multipliers < 0) & (c[working] < 0)
+        if not dropping.any():
+            multipliers = np.maximum(multipliers, 0.0)
+
+            def correct(c_working, HA=HA, schur=schur):
+                return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
+
+            return -(Hg + HA @ multipliers), multipliers, working, correct
+        working = working[~dropping]
+    return -Hg, np.zeros(0), working, None
 
 
 def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> None:

@@ -21,7 +21,7 @@ class Plan:
     """True when the solver converged (to its tolerance or an acceptable level) to a finite plan."""
     status: str
     """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'unreachable' (goal out of the arm's
-    reach), 'limits_violated' (joint limits could not be met) or 'failed'."""
+    reach), 'constraints_violated' (joint limits could not be met) or 'failed'."""
     message: str
     """What the solver said, in words."""
     objective: float

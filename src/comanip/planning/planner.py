@@ -33,7 +33,8 @@ from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
 from comanip.planning.linearised_curvature import LinearisedCurvature
-from comanip.planning.path_limits import PathLimits, minimize_within_limits
+from comanip.planning.newton import newton_minimize
+from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
 from comanip.planning.reach_problem import ReachProblem
 
@@ -56,9 +57,8 @@ class SolverOptions:
     """'newton' (damped Newton on the structure-exploiting Hessian, fast) or 'ipopt' (IPOPT with CasADi's
     exact Hessian, the reference)."""
     max_iterations: int | None = None
-    """Iteration limit per start (Newton: Hessian evaluations, per augmented-Lagrangian round when joint
-    limits bind; IPOPT: its iterations). None: 200 for point masses, 1000 for nonlinear bodies, whose
-    approximate Hessian converges linearly."""
+    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations). None: 200 for point
+    masses, 1000 for nonlinear bodies, whose approximate Hessian converges linearly."""
     tolerance: float = 1e-8
     """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
     times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``."""
@@ -173,10 +173,6 @@ class Planner:
         if unreachable is not None:
             return unreachable
         guesses = self._initial_guesses(start, goal, width, warm_start)
-        extras = warm_start.extras if isinstance(warm_start, Plan) else {}
-        self._warm_multipliers = {"multipliers": extras["limit_multipliers"], "rho": extras["limit_penalty"]} \
-            if "limit_multipliers" in extras else {}
-        self._extras = {}
         return self._solve_from(guesses, start, goal, width, t_begin, max_wall_time)
 
     def _unreachable_plan(self, start, goal, width, warm_start, t_begin: float) -> Plan | None:
@@ -255,12 +251,12 @@ class Planner:
                     torque, status, success = guess, "failed", False
                     f = self.problem.objective_value(guess, start, goal, width) / normaliser
                     message = "solver returned a non-finite plan; returning the initial guess"
-                candidate = (not success, f, torque, status, success, message, dict(self._extras))
+                candidate = (not success, f, torque, status, success, message)
                 if best is None or candidate[:2] < best[:2]:
                     best = candidate
-        _, _, torque, status, success, message, extras = best
+        _, _, torque, status, success, message = best
         return self._make_plan(torque, params, status=status, success=success, message=message,
-                               solve_time=time.perf_counter() - t_begin, iterations=iterations, extras=extras)
+                               solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
     def _make_plan(self, torque, params, **fields) -> Plan:
         n2, d = 2 * self.model.n, self.model.d
@@ -280,13 +276,11 @@ class Planner:
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
-        limited = minimize_within_limits(curvature, self._limits, params, np.ravel(guess), *self._torque_bounds,
-                                         tolerance=self.options.tolerance, max_iterations=self._max_iterations,
-                                         secant=not curvature.exact, expired=lambda: time.perf_counter() > deadline,
-                                         **self._warm_multipliers)
-        result = limited.result
-        if limited.multipliers is not None:
-            self._extras = {"limit_multipliers": limited.multipliers, "limit_penalty": limited.rho}
+        result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
+                                 *self._torque_bounds, tolerance=self.options.tolerance,
+                                 max_iterations=self._max_iterations, secant=not curvature.exact,
+                                 constraints=self._limits.for_newton(curvature) if self._limits.active else None,
+                                 constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline)
         success = result.status in ("solved", "solved_acceptable")
         return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
                 result.message, result.iterations)
