@@ -1,7 +1,8 @@
 """The reaching planner: the belief-space optimal control problem, built once and solved many times.
 
     minimise over tau_{0:H-1}   J = Σ_{i=0..H} -w_i R(mu_i, Sigma_i; g, W(w)) + nu Σ ||tau_i||²
-    subject to                  mu_0 = s_0, Sigma_0 = 0, and the belief dynamics of SPEC §2.
+    subject to                  mu_0 = s_0, Sigma_0 = 0, and the belief dynamics of SPEC §2,
+                                |tau_i| ≤ tau_max and the joint limits on the mean (bodies that have them).
 
 Single shooting: the torques are the only decision variables and mu, Sigma are CasADi expressions of
 them, so Sigma stays positive semi-definite at every iterate (multiple shooting over Sigma lets iterates go
@@ -9,10 +10,16 @@ indefinite, SPEC §9). Start state, goal and width are parameters, so one build 
 
 Two solvers (``SolverOptions.method``):
 
-- ``newton`` (default): a damped Newton method (:mod:`comanip.planning.newton`) on a Hessian assembled
-  from per-step pieces (:mod:`comanip.planning.curvature`; exact for point masses) with compiled,
-  disk-cached objective and gradient. About five times faster than IPOPT here (benchmarks/README.md).
-- ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference.
+- ``newton`` (default): a regularised Newton method with an active set for the limits
+  (:mod:`comanip.planning.newton`) on a Hessian assembled from per-step pieces: exact for point masses
+  (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
+  (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
+  Two to four times faster than IPOPT on the point masses (benchmarks/README.md).
+- ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference,
+  point masses only.
+
+Goals out of an arm's reach (inverse-kinematics residual beyond the goal width) return a plan with
+status 'unreachable' before any solver work.
 
 Both minimise the same objective, normalised by |J_best(w)| (the best attainable J) so that tolerances
 mean the same for every width; ``plan.objective`` is always the SPEC §4 J itself.
