@@ -90,11 +90,6 @@ class RobotState:
         """TCP linear velocity (3,), m/s."""
         return self.jacobian[:3] @ self.qdot
 
-    @property
-    def angular_velocity(self) -> np.ndarray:
-        """TCP angular velocity (3,), rad/s."""
-        return self.jacobian[3:] @ self.qdot
-
 
 class CartesianImpedanceController:
     """Torque-level Cartesian impedance law (module docstring) with run-time translational stiffness.

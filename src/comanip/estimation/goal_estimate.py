@@ -42,7 +42,7 @@ from comanip.estimation.shared import cached_per_model, shared_planner, shared_s
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
 from comanip.planning.plan import Plan
-from comanip.planning.planner import _IPOPT_STATUS, Planner, _Deadline
+from comanip.planning.planner import IPOPT_STATUS, IpoptDeadline, Planner
 
 METHODS = ("regret", "paper")
 
@@ -90,7 +90,7 @@ class GoalEstimator:
         self.options = options or EstimatorOptions()
         self._regret = RegretSystem(self.problem)
         self._blas = ThreadpoolController()
-        self._paper_solvers: dict[int, tuple[ca.Function, _Deadline]] = {}
+        self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
 
     def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, method: str = "regret",
                  warm_start: Plan | None = None, max_wall_time: float | None = None) -> Plan:
@@ -202,7 +202,7 @@ class GoalEstimator:
         tau = plan.torque.ravel()
         return RegretPoint(tau.copy(), np.zeros(2 * self.model.n), tau.copy(), np.asarray(goal, dtype=float).copy())
 
-    def _paper_solver(self, n_o: int) -> tuple[ca.Function, _Deadline]:
+    def _paper_solver(self, n_o: int) -> tuple[ca.Function, IpoptDeadline]:
         """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1)."""
         if n_o not in self._paper_solvers:
             p, model = self.problem, self.model
@@ -213,7 +213,7 @@ class GoalEstimator:
             objective = (p.objective + use_prior * ca.dot(error, ca.solve(W, error))) / (-p.best_objective)
             x = ca.vertcat(ca.vec(p.tau), p.goal)
             params = ca.vertcat(p.s0, observed, prior, p.width, use_prior)
-            deadline = _Deadline(x.numel(), params.numel(), 2 * model.n)
+            deadline = IpoptDeadline(x.numel(), params.numel(), 2 * model.n)
             ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations * 10, "tol": self.options.tolerance}
             solver = ca.nlpsol(f"goal_estimate_eq11_{n_o}", "ipopt",
                                {"x": x, "p": params, "f": objective, "g": p.means[n_o] - observed},
@@ -227,7 +227,7 @@ class GoalEstimator:
         params = np.r_[start, observed, np.zeros(self.model.d) if prior is None else prior, width, prior is not None]
         result = solver(x0=np.r_[point.tau_c, point.goal], p=params, lbg=0, ubg=0)
         stats = solver.stats()
-        status, _ = _IPOPT_STATUS.get(stats["return_status"], ("failed", False))
+        status, _ = IPOPT_STATUS.get(stats["return_status"], ("failed", False))
         if stats["return_status"] == "User_Requested_Stop" and deadline.expired:
             status = "max_wall_time"
         x = np.asarray(result["x"]).ravel()

@@ -47,7 +47,8 @@ from comanip.planning.reach_problem import ReachProblem
 
 SOLVER_METHODS = ("newton", "ipopt")
 
-_IPOPT_STATUS = {
+#: IPOPT return_status -> (comanip status, success); shared by every IPOPT-solved problem (planner, eq. 11).
+IPOPT_STATUS = {
     "Solve_Succeeded": ("solved", True),
     "Solved_To_Acceptable_Level": ("solved_acceptable", True),
     "Maximum_Iterations_Exceeded": ("max_iterations", False),
@@ -144,7 +145,7 @@ class Planner:
             params = ca.vertcat(problem.s0, problem.goal, problem.width)
             ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
                      "tol": self.options.tolerance, **self.options.ipopt}
-            self._deadline = _Deadline(problem.tau.numel(), params.shape[0])
+            self._deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])
             self._ipopt = ca.nlpsol("planner", "ipopt",
                                     {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
                                     {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
@@ -297,14 +298,14 @@ class Planner:
         self._deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params)
         stats = solver.stats()
-        status, success = _IPOPT_STATUS.get(stats["return_status"], ("failed", False))
+        status, success = IPOPT_STATUS.get(stats["return_status"], ("failed", False))
         if stats["return_status"] == "User_Requested_Stop" and self._deadline.expired:
             status = "max_wall_time"
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return torque, float(result["f"]), status, success, stats["return_status"], int(stats.get("iter_count", 0))
 
 
-class _Deadline(ca.Callback):
+class IpoptDeadline(ca.Callback):
     """IPOPT iteration callback that asks the solver to stop once ``time`` (perf_counter, s) has passed."""
 
     def __init__(self, n_x: int, n_p: int, n_g: int = 0):
