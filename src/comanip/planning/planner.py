@@ -124,6 +124,12 @@ class Planner:
         self._ipopt = None
 
     @property
+    def curvature(self) -> ReachCurvature | LinearisedCurvature | None:
+        """The Newton method's objective, gradient and Hessian terms (None for ``method="ipopt"``); the goal
+        estimator reuses them."""
+        return self._curvature
+
+    @property
     def _max_iterations(self) -> int:
         if self.options.max_iterations is not None:
             return self.options.max_iterations
