@@ -145,6 +145,37 @@ class LinearisedCurvature:
         hessian[np.diag_indices(H * n)] += 2 * model.nu / self.normaliser(width)
         return hessian
 
+    def goal_derivatives(self, data: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned.
+
+        phi_i depends on the goal only through x_ee(q_i) - g, so ∂phi_i/∂g = -∂phi_i/∂mu_x,i and
+        ∂²phi_i/∂z_i∂g = -∂²phi_i/∂z_i∂mu_x,i (columns of the per-step derivatives), and
+        ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g with the rows Z_i of :meth:`hessian`, contracted here without
+        forming them. ∂f/∂g, ∂²f/∂g² and the mean rows' part of ∂²f/∂x∂g are exact; the covariance rows'
+        part carries the Hessian's approximation (A_i, B_i held along the path).
+        """
+        x, _, _, _, _, _, J, phi_hess, phi_grad, W, dvech = data
+        model = self.model
+        n, d, H = model.n, model.d, model.H
+        nv, nz = len(self._triangle), phi_hess.shape[0]
+        a, b = self._triangle.T
+        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
+        c_mean, c_vech = -Q[:, :d, :d], -Q[:, d:, :d]  # ∂²phi_i/∂mu_x∂g (H+1, d, d), ∂²phi_i/∂vech∂g (H+1, nv, d)
+        J = J.reshape(d, H + 1, n).transpose(1, 0, 2)
+        dvech = dvech.reshape(nv, H + 1, n).transpose(1, 0, 2)
+        Tq = self.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
+        # mean rows J_i T_i and the rows of J(q_i)'s effect on Sigma_x, d vech/dq_i T_i, share T_i
+        per_q = np.swapaxes(J, 1, 2) @ c_mean + np.swapaxes(dvech, 1, 2) @ c_vech  # (H+1, n, d)
+        cross = np.einsum("iqx,iqm->xm", Tq, per_q, optimize=True)
+        # rows of the noise injected at step k, vech(G_ik E_kj G_ikᵀ): contracted with c as <C_i, G_ik E_kj G_ikᵀ>
+        C = np.zeros((H + 1, d, d, d))
+        C[:, a, b] = C[:, b, a] = c_vech * np.where(a == b, 1.0, 0.5)[None, :, None]
+        G = (J @ Tq).reshape(H + 1, d, H, n)
+        S = np.einsum("iakr,iabm,ibks->krsm", G, C, G, optimize=True)
+        E = np.einsum("jlrs,kl->kjrs", self._noise_hessian, x.reshape(H, n))
+        cross += np.einsum("krsm,kjrs->kjm", S, E, optimize=True).reshape(H * n, d)
+        return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
+
     def _noise_rows(self, G: np.ndarray, tau: np.ndarray) -> np.ndarray:
         """d vech Sigma_x,i / d tau_kj through the noise injected at step k (A, B held): (H+1, nv, H, n).
 
