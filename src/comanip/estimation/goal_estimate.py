@@ -88,7 +88,7 @@ class GoalEstimator:
         self.model = self.planner.model
         self.problem = self.planner.problem
         self.options = options or EstimatorOptions()
-        self._regret = RegretSystem(self.problem)
+        self._regret = RegretSystem(self.planner)
         self._blas = ThreadpoolController()
         self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
 

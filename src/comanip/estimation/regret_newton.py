@@ -55,9 +55,10 @@ import casadi as ca
 import numpy as np
 import scipy.linalg
 
-from comanip.estimation.buffered_function import BufferedFunction
 from comanip.objectives.reward import goal_covariance
-from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.compiled import BufferedFunction
+from comanip.planning.curvature import ReachCurvature
+from comanip.planning.planner import Planner
 
 
 @dataclass
@@ -86,59 +87,86 @@ class NewtonResult:
 
 
 class RegretSystem:
-    """The functions Newton's method on F needs, built once per model (observation step: once per n_o)."""
+    """The derivatives Newton's method on F needs, from the planner's own Newton terms (built once per model).
 
-    def __init__(self, problem: ReachProblem):
-        self.problem = problem
+    J and its derivatives in tau come from the planner's structured Hessian (:mod:`comanip.planning.curvature`,
+    exact for point masses; :mod:`comanip.planning.linearised_curvature`, approximate, for the Panda), and
+    those in the goal from the same per-step pieces (``goal_derivatives``). The observed mean mu_no and
+    A = dmu_no/dtau are exact. For a point mass mu_no is linear in tau, so A is constant and the
+    constraint adds no curvature to the Lagrangian; for the Panda that curvature, d²(lam^T mu_no)/dtau², is
+    left out (lam is small: the observation is a state the plan nearly passes through), which like the
+    approximate Hessian only slows the iteration down: F itself is exact, so its root is unchanged.
+    """
+
+    def __init__(self, planner: Planner):
+        problem = self.problem = planner.problem
         model = problem.model
         self.n, self.d, self.H = model.n, model.d, model.H
-        tau = ca.vec(problem.tau)
-        normaliser = -problem.best_objective
-        J = problem.objective / normaliser
-        hessian, gradient = ca.hessian(J, ca.vertcat(tau, problem.goal))
-        self._derivatives = BufferedFunction("regret_derivatives", [tau, problem.goal, problem.s0, problem.width],
-                                             [J, gradient, hessian])
-        W = goal_covariance(problem.width, self.d, model.goal_covariance)
-        self._normaliser = ca.Function("normaliser", [problem.width], [normaliser])
-        self._prior_weight = ca.Function("prior_weight", [problem.width], [ca.inv(W) / normaliser])
-        self._observed = {}
+        self.linear = model.body.is_linear
+        self.curvature = planner.curvature if planner.curvature is not None else ReachCurvature(problem)
+        self._goal_covariance_form = model.goal_covariance
+        self._observed: dict[int, tuple[BufferedFunction, np.ndarray]] = {}
 
-    def observed_mean(self, n_o: int) -> BufferedFunction:
-        """``(tau, s0, lam) -> (mu_no (2n,), A = dmu_no/dtau (2n, H·n), d²(lam^T mu_no)/dtau² (H·n, H·n))``."""
+    def derivatives(self, tau: np.ndarray, goal: np.ndarray, start: np.ndarray, width: float) -> "Derivatives":
+        """Normalised J and its first and second derivatives in (tau, g) at torques tau (H·n,) and goal g (d,)."""
+        curvature = self.curvature
+        f, grad, data = curvature.evaluate(np.asarray(tau, dtype=float), np.r_[start, goal, width])
+        grad_g, cross, hess_gg = curvature.goal_derivatives(data)
+        return Derivatives(f, grad, grad_g, curvature.hessian(data), cross, hess_gg, data)
+
+    def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> tuple[np.ndarray, np.ndarray]:
+        """(mu_no (2n,), A = dmu_no/dtau (2n, H·n)) at torques tau; ``data`` from the same evaluation."""
+        if not self.linear:
+            A = self.curvature.mean_sensitivities(data)[n_o].reshape(2 * self.n, -1)
+            return self.curvature.trajectory(data)[0][n_o], A
         if n_o not in self._observed:
             p = self.problem
-            tau = ca.vec(p.tau)
-            lam = ca.SX.sym("lam", 2 * self.n)
-            mu = p.means[n_o]
-            curvature = ca.hessian(ca.dot(lam, mu), tau)[0]
-            self._observed[n_o] = BufferedFunction(f"observed_mean_{n_o}", [tau, p.s0, lam], [mu, ca.jacobian(mu, tau), curvature])
-        return self._observed[n_o]
+            tau_symbol = ca.vec(p.tau)
+            mean = ca.Function(f"observed_mean_{n_o}", [tau_symbol, p.s0], [p.means[n_o]])
+            # a linear body's mean is affine in tau: its Jacobian is a constant matrix
+            self._observed[n_o] = (BufferedFunction(mean), np.asarray(ca.evalf(ca.jacobian(p.means[n_o], tau_symbol))))
+        mean, A = self._observed[n_o]
+        return mean(tau, start)[0].ravel(), A
 
     def prior_weight(self, width: float) -> np.ndarray:
         """P = W^-1 / |J_best| (d, d) for width w (m)."""
-        return np.asarray(self._prior_weight(width))
+        return np.linalg.inv(goal_covariance(width, self.d, self._goal_covariance_form)) / self.normaliser(width)
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: J divided by it is what the iteration works with (m^-d)."""
-        return float(self._normaliser(width))
+        return self.curvature.normaliser(width)
 
     def linearise(self, point: RegretPoint, start, observed, n_o: int, prior, width) -> "Linearisation":
         """F and its Jacobian blocks at an iterate; ``prior`` None drops the regulariser."""
-        Hn = self.H * self.n
-        # the buffers are reused by the next call: copy the first evaluation before the second
-        J_c, grad_c, hess_c = (v.copy() for v in self._derivatives(point.tau_c, point.goal, start, width))
-        J_s, grad_s, hess_s = (v.copy() for v in self._derivatives(point.tau_s, point.goal, start, width))
-        mu, A, curvature = (v.copy() for v in self.observed_mean(n_o)(point.tau_c, start, point.lam))
+        c = self.derivatives(point.tau_c, point.goal, start, width)
+        s = self.derivatives(point.tau_s, point.goal, start, width)
+        mu, A = self.observed_mean(n_o, point.tau_c, start, c.data)
         P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(width)
         pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior)
         regulariser = 0.0 if prior is None else float((point.goal - prior) @ P @ (point.goal - prior))
         return Linearisation(
-            J_c=float(J_c), J_s=float(J_s), regulariser=regulariser, grad_c=grad_c[:Hn], H_c=hess_c[:Hn, :Hn],
-            F1=grad_c[:Hn] + A.T @ point.lam, F2=mu - observed, F3=grad_s[:Hn],
-            F4=grad_c[Hn:] - grad_s[Hn:] + pull,
-            K_c=np.block([[hess_c[:Hn, :Hn] + curvature, A.T], [A, np.zeros((2 * self.n, 2 * self.n))]]),
-            H_s=hess_s[:Hn, :Hn], Hc_tau_g=hess_c[:Hn, Hn:], Hs_tau_g=hess_s[:Hn, Hn:],
-            Hc_gg=hess_c[Hn:, Hn:], Hs_gg=hess_s[Hn:, Hn:], P=P, A=A)
+            J_c=c.f, J_s=s.f, regulariser=regulariser, grad_c=c.grad, H_c=c.hess,
+            F1=c.grad + A.T @ point.lam, F2=mu - observed, F3=s.grad, F4=c.grad_g - s.grad_g + pull,
+            H_s=s.hess, Hc_tau_g=c.cross, Hs_tau_g=s.cross, Hc_gg=c.hess_gg, Hs_gg=s.hess_gg, P=P, A=A)
+
+
+@dataclass
+class Derivatives:
+    """Normalised J at one (tau, g) and its derivatives."""
+
+    f: float
+    grad: np.ndarray
+    """dJ/dtau (H·n,)."""
+    grad_g: np.ndarray
+    """dJ/dg (d,)."""
+    hess: np.ndarray
+    """d²J/dtau² (H·n, H·n)."""
+    cross: np.ndarray
+    """d²J/dtau dg (H·n, d)."""
+    hess_gg: np.ndarray
+    """d²J/dg² (d, d)."""
+    data: tuple
+    """What the curvature object's ``evaluate`` returned (for further terms of the same point)."""
 
 
 @dataclass
@@ -150,14 +178,13 @@ class Linearisation:
     J_s: float
     regulariser: float
     grad_c: np.ndarray
-    """dJ/dtau at tau_c (H·n,) and d²J/dtau² there (H·n square), for the predicted regret."""
+    """dJ/dtau at tau_c (H·n,) and d²J/dtau² there (H·n square), which is also the Hessian of the constrained
+    plan's Lagrangian (the observation constraint's curvature is zero or left out, see RegretSystem)."""
     H_c: np.ndarray
     F1: np.ndarray
     F2: np.ndarray
     F3: np.ndarray
     F4: np.ndarray
-    K_c: np.ndarray
-    """KKT matrix of the constrained plan [[d²L/dtau², A^T], [A, 0]] (H·n + 2n square)."""
     H_s: np.ndarray
     """Hessian of J in the plan's torques (H·n square)."""
     Hc_tau_g: np.ndarray
@@ -172,13 +199,34 @@ class Linearisation:
         return float(max(np.abs(F).max() for F in (self.F1, self.F2, self.F3, self.F4)))
 
     @cached_property
+    def _cholesky(self) -> tuple[tuple | None, tuple | None]:
+        """Cholesky factors of H_c and H_s, None where one is not positive definite."""
+        return _cholesky_or_none(self.H_c), _cholesky_or_none(self.H_s)
+
+    @cached_property
     def _solves(self) -> tuple[np.ndarray, np.ndarray]:
-        """K_c^-1 [[Hc_tau_g, F1], [0, F2]] and H_s^-1 [Hs_tau_g, F3]: the torques' sensitivity to the goal
-        (first d columns) and their Newton step at a fixed goal (last column)."""
+        """K_c^-1 [[Hc_tau_g, F1], [0, F2]] and H_s^-1 [Hs_tau_g, F3], K_c = [[H_c, A^T], [A, 0]] the
+        constrained plan's KKT matrix: the torques' sensitivity to the goal (first d columns; multipliers in
+        Xc's last 2n rows) and their Newton step at a fixed goal (last column).
+
+        Raises LinAlgError when a system is singular."""
         d = self.Hc_gg.shape[0]
-        Xc = np.linalg.solve(self.K_c, np.column_stack([np.vstack([self.Hc_tau_g, np.zeros((len(self.F2), d))]),
-                                                        np.r_[self.F1, self.F2]]))
-        Xs = np.linalg.solve(self.H_s, np.column_stack([self.Hs_tau_g, self.F3]))
+        factor_c, factor_s = self._cholesky
+        right_c = np.column_stack([self.Hc_tau_g, self.F1])
+        right_obs = np.column_stack([np.zeros((len(self.F2), d)), self.F2])
+        if factor_c is not None:
+            # block elimination on H_c's factor: A x = r2 with H_c x + A^T y = r1 gives (A H_c^-1 A^T) y = A H_c^-1 r1 - r2
+            solved = scipy.linalg.cho_solve(factor_c, np.column_stack([right_c, self.A.T]), check_finite=False)
+            x_right, x_At = solved[:, :d + 1], solved[:, d + 1:]
+            y = np.linalg.solve(self.A @ x_At, self.A @ x_right - right_obs)
+            Xc = np.vstack([x_right - x_At @ y, y])
+        else:
+            n2 = len(self.F2)
+            K_c = np.block([[self.H_c, self.A.T], [self.A, np.zeros((n2, n2))]])
+            Xc = np.linalg.solve(K_c, np.vstack([right_c, right_obs]))
+        right_s = np.column_stack([self.Hs_tau_g, self.F3])
+        Xs = (scipy.linalg.cho_solve(factor_s, right_s, check_finite=False) if factor_s is not None
+              else np.linalg.solve(self.H_s, right_s))
         return Xc, Xs
 
     @property
@@ -202,7 +250,7 @@ class Linearisation:
         Hn = len(self.F1)
         Xc, Xs = self._solves
         d = self.Hc_gg.shape[0]
-        reduced = self.reduced_hessian(Xc, Xs)
+        reduced = self.reduced_hessian()
         rhs = self.F4 - self.Hc_tau_g.T @ Xc[:Hn, d] + self.Hs_tau_g.T @ Xs[:, d]
         eigenvalues, vectors = np.linalg.eigh(reduced)
         mirrored = np.maximum(np.abs(eigenvalues), 1e-10 * max(1.0, np.abs(eigenvalues).max()))
@@ -214,35 +262,34 @@ class Linearisation:
         d_s = -(Xs[:, d] + Xs[:, :d] @ d_goal)
         return d_c[:Hn], d_c[Hn:], d_s, d_goal
 
-    def reduced_hessian(self, Xc=None, Xs=None) -> np.ndarray:
+    def reduced_hessian(self) -> np.ndarray:
         """d²R/dg² (d, d): the regret's Hessian in the goal with the inner problems kept optimal."""
         Hn = len(self.F1)
         d = self.Hc_gg.shape[0]
-        if Xc is None:
-            Xc = np.linalg.solve(self.K_c, np.vstack([self.Hc_tau_g, np.zeros((len(self.F2), d))]))
-            Xs = np.linalg.solve(self.H_s, self.Hs_tau_g)
+        Xc, Xs = self._solves
         reduced = (self.Hc_gg - self.Hc_tau_g.T @ Xc[:Hn, :d]) - (self.Hs_gg - self.Hs_tau_g.T @ Xs[:, :d]) + 2 * self.P
         return 0.5 * (reduced + reduced.T)
 
     def is_strict_minimum(self) -> tuple[bool, str]:
         """Second-order check: the plan, the constrained plan and the regret all have positive curvature."""
-        Hn = len(self.F1)
-        if not _positive_definite(self.H_s):
+        factor_c, factor_s = self._cholesky
+        if factor_s is None:
             return False, "the plan to the estimated goal is not a minimum of J"
-        Z = scipy.linalg.null_space(self.A)
-        if not _positive_definite(Z.T @ self.K_c[:Hn, :Hn] @ Z):
-            return False, "the trajectory through the observation is not a minimum of J"
-        if not _positive_definite(self.reduced_hessian()):
+        if factor_c is None:  # positive definite on the constraint's null space is enough
+            Z = scipy.linalg.null_space(self.A)
+            if _cholesky_or_none(Z.T @ self.H_c @ Z) is None:
+                return False, "the trajectory through the observation is not a minimum of J"
+        if _cholesky_or_none(self.reduced_hessian()) is None:
             return False, "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
         return True, ""
 
 
-def _positive_definite(matrix: np.ndarray) -> bool:
+def _cholesky_or_none(matrix: np.ndarray):
+    """scipy's Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
     try:
-        np.linalg.cholesky(0.5 * (matrix + matrix.T))
-        return True
+        return scipy.linalg.cho_factor(0.5 * (matrix + matrix.T), check_finite=False)
     except np.linalg.LinAlgError:
-        return False
+        return None
 
 
 def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, prior, width: float, *,

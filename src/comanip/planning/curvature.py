@@ -134,17 +134,9 @@ class ReachCurvature:
         n, d, H = model.n, model.d, model.H
         nz = phi_hess.shape[0]
         rank = self._U.shape[2]
-        tau = np.asarray(x).reshape(H, n)
         T = self._T
         Q = np.swapaxes(T, 1, 2) @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
-        # Z~_i = dz~_i/dx stacked (H+1, d + r, H, n): mean rows fixed, covariance rows linear in tau
-        Z = np.empty((H + 1, d + rank, H, n))
-        Z[:, :d] = self._mean_rows
-        if self._K_diagonal is not None:
-            np.multiply(self._K_diagonal, tau, out=Z[:, d:])
-        else:
-            np.einsum("irkjl,kl->irkj", self._K, tau, out=Z[:, d:])
-        Z = Z.reshape(H + 1, d + rank, H * n)
+        Z = self._reduced_rows(x)
         QZ = np.matmul(Q, Z)
         hessian = _causal_gram(Z.reshape(-1, H * n), QZ.reshape(-1, H * n), d + rank, n)
         # ∇²_tau Σ_i Σ_v (dphi_i/dvech_v) Sigma_x,i[v]: the noise's own curvature, block-diagonal in k
@@ -154,6 +146,37 @@ class ReachCurvature:
         hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks.reshape(H, n, n)
         hessian[np.diag_indices(H * n)] += self._effort / self.normaliser(width)
         return hessian
+
+    def goal_derivatives(self, data: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned, exact.
+
+        phi_i depends on the goal only through mu_x,i - g (the reward is a density of their difference), so
+        ∂phi_i/∂g = -∂phi_i/∂mu_x,i, ∂²phi_i/∂z_i∂g = -∂²phi_i/∂z_i∂mu_x,i and ∂²phi_i/∂g² = ∂²phi_i/∂mu_x,i²:
+        columns of the per-step derivatives the Hessian uses anyway. Then ∂f/∂g = Σ_i ∂phi_i/∂g,
+        ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
+        """
+        x, _, phi_hess, phi_grad = data
+        H, d = self.model.H, self.model.d
+        nz = phi_hess.shape[0]
+        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
+        Z = self._reduced_rows(x)
+        # Z_iᵀ M = Z~_iᵀ T_iᵀ M: the rows are kept in the reduced basis z~_i (see _build_constant_products)
+        goal_columns = -np.swapaxes(self._T, 1, 2) @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
+        cross = Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
+        return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
+
+    def _reduced_rows(self, x: np.ndarray) -> np.ndarray:
+        """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n): mean rows fixed, covariance rows linear in tau."""
+        model = self.model
+        n, d, H = model.n, model.d, model.H
+        tau = np.asarray(x).reshape(H, n)
+        Z = np.empty((H + 1, d + self._U.shape[2], H, n))
+        Z[:, :d] = self._mean_rows
+        if self._K_diagonal is not None:
+            np.multiply(self._K_diagonal, tau, out=Z[:, d:])
+        else:
+            np.einsum("irkjl,kl->irkj", self._K, tau, out=Z[:, d:])
+        return Z.reshape(H + 1, d + self._U.shape[2], H * n)
 
     def _split(self, params):
         n2, d = 2 * self.model.n, self.model.d
