@@ -2,6 +2,7 @@
 and executions that return numbers (dataclasses), which :mod:`comanip.plots` draws and ``comanip validate``
 reports."""
 
+from comanip.analysis.arm_reaches import ArmReach, LimitUsage, arm_reaches, joint_limit_usage, summarise_reaches
 from comanip.analysis.calibration import (
     CalibrationResult,
     Configuration,
@@ -21,6 +22,7 @@ from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, home_sta
 from comanip.analysis.speed_profile import SETTLING_FRACTION, SpeedMetrics, speed_metrics
 
 __all__ = [
+    "ArmReach", "LimitUsage", "arm_reaches", "joint_limit_usage", "summarise_reaches",
     "CalibrationResult", "Configuration", "measure_grid", "run_calibration", "study_configurations",
     "EndpointDispersion", "endpoint_dispersion",
     "FITTS_FORMS", "FittsFit", "fit_fitts", "index_of_difficulty", "trend_fraction",

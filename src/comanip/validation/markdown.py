@@ -4,53 +4,99 @@ from __future__ import annotations
 
 import math
 
+from comanip.analysis.arm_reaches import LIMIT_KINDS
 from comanip.analysis.calibration import EARLY_PEAK_MAX, FITTS_R2_MIN
 
 
 def report_markdown(report: dict) -> str:
-    """Markdown with every number of the report: one section per analysis, then the calibration table."""
-    model, settings, grid = report["model"], report["settings"], report["fitts_grid"]
+    """Markdown with every number of the report: one section per analysis (the point-mass analyses and the
+    calibration table when the report has them, then the Franka section when it has one), then the figures."""
+    model, settings = report["model"], report["settings"]
     lines = [f"# comanip validation report: {model['name']}", "",
-             f"Model: H = {model['H']}, h = {model['h']} s, gamma = {model['gamma']}, nu = {model['nu']}, "
-             f"kappa = {model['kappa']}, noise {model['noise']}, W reading {model['goal_covariance']}, "
-             f"{model['discount']} discounting. Run: {'quick' if settings['quick'] else 'full'}, seed {settings['seed']}, "
-             f"{_num(report['wall_time_s'], 1)} s.", "",
-             "## Velocity profiles and asymmetry (paper Fig. 3, top; `velocity_profiles.png`)", "",
-             "Open-loop plans from rest. MT: first time after the peak with speed below 5 % of the peak (SPEC §6). "
-             f"A minimum-jerk reach has t_peak/MT = {_num(grid['minimum_jerk_asymmetry'], 3)} under this definition.", "",
-             _table(["D (m)", "w (m)", "ID Fitts", "ID Shannon", "t_peak (s)", "MT (s)", "t_peak/MT", "min-jerk t_peak/MT",
-                     "peak speed (m/s)", "final error (mm)", "converged"],
-                    [[c["distance_m"], c["width_m"], _num(c["id_fitts_bits"], 2), _num(c["id_shannon_bits"], 2),
-                      _num(c["t_peak"], 3), _num(c["movement_time"], 3), _num(c["asymmetry"], 3),
-                      _num(grid["minimum_jerk_asymmetry"], 3), _num(c["peak_speed"], 3), _num(1e3 * c["final_error_m"], 2),
-                      c["success"]] for c in grid["conditions"]]), "",
-             "## Fitts' law (paper Fig. 3, bottom; `fitts.png`)", "",
-             _table(["form", "a (s)", "b (s/bit)", "R²", "points"],
-                    [[f["form"], _num(f["a"], 4), _num(f["b"], 4), _num(f["r2"], 4), f["n_points"]] for f in grid["fits"].values()]),
-             "",
-             f"- wider goal → no slower at fixed D (pairs within {grid['trend_tolerance_s']} s count as equal): "
-             f"{_num(100 * grid['width_trend'], 0)} % of neighbouring pairs",
-             f"- farther goal → no faster at fixed w: {_num(100 * grid['distance_trend'], 0)} % of neighbouring pairs",
-             f"- every MT in {grid['human_mt_range_s'][0]}–{grid['human_mt_range_s'][1]} s: {grid['mt_in_human_range']}",
-             f"- every solve converged: {grid['all_solves_converged']}", "",
-             "## Endpoint dispersion (paper Fig. 4; `dispersion.png`)", "",
-             f"Open-loop Monte Carlo of the planned torques to the goal {report['dispersion']['goal_m']} m; the hand at "
-             "the first step at or after MT, split along and across the movement; 'predicted' is the plan's closed-form "
-             "J Σ_qq Jᵀ at that step.", "",
-             _table(["w (m)", "samples", "t (s)", "along std (mm)", "predicted (mm)", "across std (mm)", "predicted (mm)",
-                     "Gaussian fit mean (mm)", "Gaussian fit std (mm)", "hit rate"],
-                    [[d["width"], d["samples"], _num(d["time"], 3), _num(1e3 * d["along_std"], 3),
-                      _num(1e3 * d["predicted_along_std"], 3), _num(1e3 * d["across_std"], 3),
-                      _num(1e3 * d["predicted_across_std"], 3), _num(1e3 * d["across_fit_mean"], 3),
-                      _num(1e3 * d["across_fit_std"], 3), _num(d["hit_rate"], 3)] for d in report["dispersion"]["widths"]]),
-             "", "## Phase plots (paper Fig. 5; `phase.png`)", "",
-             _table(["D (m)", "v0 (m/s)", "peak velocity (m/s)", "t_peak (s)", "MT (s)", "final error (mm)", "converged"],
-                    [[c["distance_m"], c["initial_velocity_m_per_s"], _num(c["peak_velocity_m_per_s"], 3), _num(c["t_peak"], 3),
-                      _num(c["movement_time"], 3), _num(1e3 * c["final_error_m"], 2), c["success"]]
-                     for c in report["phase"]["by_distance"] + report["phase"]["by_initial_velocity"]]),
-             "", *_calibration_section(report["calibration"], settings), "",
-             "Figures: " + ", ".join(f"`{f}`" for f in report["figures"]), ""]
+             f"Model: {_model_line(model)}. Run: {'quick' if settings['quick'] else 'full'}, seed {settings['seed']}, "
+             f"{_num(report['wall_time_s'], 1)} s.", ""]
+    if "fitts_grid" in report:
+        lines += _point_mass_sections(report)
+    if "franka" in report:
+        lines += _franka_section(report["franka"], report["model"])
+    lines += ["Figures: " + ", ".join(f"`{f}`" for f in report["figures"]), ""]
     return "\n".join(lines)
+
+
+def _model_line(model: dict) -> str:
+    return (f"H = {model['H']}, h = {model['h']} s, gamma = {model['gamma']}, nu = {model['nu']}, kappa = {model['kappa']}, "
+            f"noise {model['noise']}, W reading {model['goal_covariance']}, {model['discount']} discounting")
+
+
+def _point_mass_sections(report: dict) -> list[str]:
+    settings, grid = report["settings"], report["fitts_grid"]
+    return ["## Velocity profiles and asymmetry (paper Fig. 3, top; `velocity_profiles.png`)", "",
+            "Open-loop plans from rest. MT: first time after the peak with speed below 5 % of the peak (SPEC §6). "
+            f"A minimum-jerk reach has t_peak/MT = {_num(grid['minimum_jerk_asymmetry'], 3)} under this definition.", "",
+            _table(["D (m)", "w (m)", "ID Fitts", "ID Shannon", "t_peak (s)", "MT (s)", "t_peak/MT", "min-jerk t_peak/MT",
+                    "peak speed (m/s)", "final error (mm)", "converged"],
+                   [[c["distance_m"], c["width_m"], _num(c["id_fitts_bits"], 2), _num(c["id_shannon_bits"], 2),
+                     _num(c["t_peak"], 3), _num(c["movement_time"], 3), _num(c["asymmetry"], 3),
+                     _num(grid["minimum_jerk_asymmetry"], 3), _num(c["peak_speed"], 3), _num(1e3 * c["final_error_m"], 2),
+                     c["success"]] for c in grid["conditions"]]), "",
+            "## Fitts' law (paper Fig. 3, bottom; `fitts.png`)", "",
+            _table(["form", "a (s)", "b (s/bit)", "R²", "points"],
+                   [[f["form"], _num(f["a"], 4), _num(f["b"], 4), _num(f["r2"], 4), f["n_points"]] for f in grid["fits"].values()]),
+            "",
+            f"- wider goal → no slower at fixed D (pairs within {grid['trend_tolerance_s']} s count as equal): "
+            f"{_num(100 * grid['width_trend'], 0)} % of neighbouring pairs",
+            f"- farther goal → no faster at fixed w: {_num(100 * grid['distance_trend'], 0)} % of neighbouring pairs",
+            f"- every MT in {grid['human_mt_range_s'][0]}–{grid['human_mt_range_s'][1]} s: {grid['mt_in_human_range']}",
+            f"- every solve converged: {grid['all_solves_converged']}", "",
+            "## Endpoint dispersion (paper Fig. 4; `dispersion.png`)", "",
+            f"Open-loop Monte Carlo of the planned torques to the goal {report['dispersion']['goal_m']} m; the hand at "
+            "the first step at or after MT, split along and across the movement; 'predicted' is the plan's closed-form "
+            "J Σ_qq Jᵀ at that step.", "",
+            _table(["w (m)", "samples", "t (s)", "along std (mm)", "predicted (mm)", "across std (mm)", "predicted (mm)",
+                    "Gaussian fit mean (mm)", "Gaussian fit std (mm)", "hit rate"],
+                   [[d["width"], d["samples"], _num(d["time"], 3), _num(1e3 * d["along_std"], 3),
+                     _num(1e3 * d["predicted_along_std"], 3), _num(1e3 * d["across_std"], 3),
+                     _num(1e3 * d["predicted_across_std"], 3), _num(1e3 * d["across_fit_mean"], 3),
+                     _num(1e3 * d["across_fit_std"], 3), _num(d["hit_rate"], 3)] for d in report["dispersion"]["widths"]]),
+            "", "## Phase plots (paper Fig. 5; `phase.png`)", "",
+            _table(["D (m)", "v0 (m/s)", "peak velocity (m/s)", "t_peak (s)", "MT (s)", "final error (mm)", "converged"],
+                   [[c["distance_m"], c["initial_velocity_m_per_s"], _num(c["peak_velocity_m_per_s"], 3), _num(c["t_peak"], 3),
+                     _num(c["movement_time"], 3), _num(1e3 * c["final_error_m"], 2), c["success"]]
+                    for c in report["phase"]["by_distance"] + report["phase"]["by_initial_velocity"]]),
+            "", *_calibration_section(report["calibration"], settings), ""]
+
+
+def _franka_section(section: dict, run_model: dict) -> list[str]:
+    arm, summary, rows = section["model"], section["summary"], section["reaches"]
+    build = (f"building the planner took {_num(section['planner_build_s'], 1)} s "
+             + ("(its C functions were compiled on this run; later runs load them from the cache)"
+                if section["compiled_on_this_run"] else "(compiled C functions loaded from the cache)"))
+    warm = summary["warm_solve_time_median_s"]
+    return [
+        "## Franka Emika Panda (paper Section V-B; `franka_*.png`)", "",
+        *([f"Arm model `{arm['name']}`: {_model_line(arm)}.", ""] if arm["name"] != run_model["name"] else []),
+        f"Reaches from rest at the ready pose q = {[round(v, 4) for v in section['home_position_rad']]} rad (hand at "
+        f"{[round(v, 3) for v in section['home_ee_m']]} m, base frame) to goals at the offsets below. The first goal is "
+        "solved cold (multi-start), each later one warm-started from the plan before it. Speed: ||J(μ_q) μ_q̇||; "
+        "MT: first time after the peak with speed below 5 % of the peak (SPEC §6). Limit usage: largest fraction of the limit over the mean "
+        "path (1 = at the limit; joint positions measured from the middle of their range), with its joint. "
+        f"The paper reports 1.3 s per solve; {build}.", "",
+        f"**{summary['successes']}/{summary['reaches']} solves succeeded, {summary['within_width']}/{summary['reaches']} "
+        f"end within the goal width, {summary['within_limits']}/{summary['reaches']} keep every limit. Cold solve "
+        f"{_num(summary['cold_solve_time_s'], 2)} s; warm solves median {_num(warm, 2)} s, max "
+        f"{_num(summary['warm_solve_time_max_s'], 2)} s. Largest usage: position {_num(summary['position_usage_max'], 2)}, "
+        f"velocity {_num(summary['velocity_usage_max'], 2)}, torque {_num(summary['torque_usage_max'], 2)}.**", "",
+        _table(["goal offset", "D (m)", "w (m)", "status", "start", "solve time (s)", "iterations", "final error (mm)",
+                "within w", "t_peak (s)", "MT (s)", "t_peak/MT", "peak speed (m/s)", "final speed (m/s)",
+                "position usage (joint)", "velocity usage (joint)", "torque usage (joint)", "within limits"],
+               [[r["goal_label"], _num(r["distance_m"], 3), r["width_m"], r["status"], "warm" if r["warm_started"] else "cold",
+                 _num(r["solve_time_s"], 2), r["iterations"], _num(1e3 * r["final_error_m"], 1), r["within_width"],
+                 _num(r["t_peak"], 3), _num(r["movement_time"], 3), _num(r["asymmetry"], 2), _num(r["peak_speed"], 3),
+                 _num(r["final_speed"], 3),
+                 *(f"{_num(r[f'{kind}_usage_max'], 2)} ({r[f'{kind}_usage_joint']})" for kind in LIMIT_KINDS),
+                 r["within_limits"]] for r in rows]),
+        "", "Per-reach rows: `franka_reaches.csv`; every plan step by step: `franka_plans/goal_<k>.csv`.", "",
+    ]
 
 
 def _calibration_section(calibration: dict, settings: dict) -> list[str]:

@@ -1,5 +1,11 @@
-"""A validation run: every analysis of the paper's Section IV-D on one model, its figures, and the
-calibration study, written as PNGs, ``report.json`` (every number) and ``report.md`` (the same, as tables)."""
+"""A validation run: every analysis of the paper's Section IV-D on one model, its figures, the calibration
+study and the Franka section (Section V-B), written as PNGs, CSV files, ``report.json`` (every number) and
+``report.md`` (the same, as tables).
+
+A point-mass model gets the Section IV-D analyses and, unless ``settings.franka`` is False, the Franka
+section planned with the built-in ``franka`` preset. An arm model (the Panda) gets the Franka section alone:
+the point-mass grids (a dozen cold solves, hundreds of closed-loop replans) are not what its section shows.
+"""
 
 from __future__ import annotations
 
@@ -11,6 +17,7 @@ from pathlib import Path
 import numpy as np
 from tqdm import tqdm
 
+from comanip import presets
 from comanip.analysis import (
     Configuration,
     endpoint_dispersion,
@@ -33,17 +40,44 @@ from comanip.plots.dispersion_figure import plot_dispersion
 from comanip.plots.fitts_figure import plot_fitts
 from comanip.plots.phase_figure import plot_phase
 from comanip.plots.velocity_profiles import plot_velocity_profiles
+from comanip.validation.arm_section import run_arm_section
 from comanip.validation.markdown import report_markdown
 from comanip.validation.settings import ValidationSettings
 
 
 def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSettings | None = None,
                    progress: bool = True) -> dict:
-    """Run every analysis on model, write figures and reports into out; returns the report dictionary."""
+    """Run every analysis on model, write figures and reports into out; returns the report dictionary.
+
+    Raises ValueError, before any work, for an arm model with ``settings.franka`` False (nothing to run).
+    """
     settings = settings or ValidationSettings()
+    point_mass = model.body.is_linear
+    if not point_mass and not settings.franka:
+        raise ValueError(f"franka is False (--no-franka) but the model {model.name!r} is an arm ({model.body.name}), whose "
+                         "validation is the Franka section alone: nothing to run (the other analyses need a point-mass "
+                         "preset such as planar)")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     began = time.perf_counter()
+    report = {"model": model.config(), "settings": settings.to_dict()}
+    figures = []
+    if point_mass:
+        sections, figures = _point_mass_sections(model, out, settings, progress)
+        report |= sections
+    if settings.franka:
+        arm = model if not point_mass else presets.load("franka")
+        report["franka"], arm_figures = run_arm_section(arm, out, settings, progress)
+        figures += arm_figures
+    report |= {"figures": [f.name for f in figures], "wall_time_s": time.perf_counter() - began}
+    (out / "report.json").write_text(json.dumps(_plain(report), indent=1))
+    (out / "report.md").write_text(report_markdown(report))
+    return report
+
+
+def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSettings,
+                         progress: bool) -> tuple[dict, list[Path]]:
+    """The Section IV-D analyses and the calibration study: report entries and figure paths."""
     planner = Planner(model)
     rng = np.random.default_rng(settings.seed)
     n_grid = len(settings.distances) * len(settings.widths)
@@ -84,8 +118,6 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
     ]
 
     report = {
-        "model": model.config(),
-        "settings": settings.to_dict(),
         "fitts_grid": {
             "conditions": [c | {"id_fitts_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "fitts")),
                                 "id_shannon_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "shannon"))}
@@ -115,12 +147,8 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
             # linear in log2(2D/sqrt(w)) would fit the Fitts and Shannon forms on this grid only this well:
             **{f"cov_reading_{form}_r2_if_log_linear": _r2_if_log_linear_in_d_over_sqrt_w(grid, form) for form in ("fitts", "shannon")},
         },
-        "figures": [f.name for f in figures],
-        "wall_time_s": time.perf_counter() - began,
     }
-    (out / "report.json").write_text(json.dumps(_plain(report), indent=1))
-    (out / "report.md").write_text(report_markdown(report))
-    return report
+    return report, figures
 
 
 def _r2_if_log_linear_in_d_over_sqrt_w(grid, form: str) -> float:

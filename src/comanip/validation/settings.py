@@ -1,9 +1,16 @@
-"""What ``comanip validate`` measures: the grids of the paper's Section IV-D and the calibration study."""
+"""What ``comanip validate`` measures: the grids of the paper's Section IV-D, the calibration study and the
+Franka section (Section V-B)."""
 
 from __future__ import annotations
 
 import math
 from dataclasses import asdict, dataclass
+
+#: Goals of the Franka section: offsets (m) from the ready pose's end effector (about [0.307, 0, 0.487] m in
+#: the base frame, x forward, z up), 0.15–0.2 m along each axis both ways, all within reach. Ordered so
+#: that the first three (the quick run's) already go forward, sideways and down.
+FRANKA_GOAL_OFFSETS = ((0.2, 0.0, 0.0), (0.0, 0.2, 0.0), (0.0, 0.0, -0.15),
+                       (-0.15, 0.0, 0.0), (0.0, -0.2, 0.0), (0.0, 0.0, 0.15))
 
 
 @dataclass(frozen=True)
@@ -38,29 +45,49 @@ class ValidationSettings:
     """Processes for the calibration study (default: the CPU count)."""
     seed: int = 0
     """Seed of every random draw (Monte Carlo and closed-loop noise)."""
+    franka: bool = True
+    """Run the Franka section: Panda reaches from the ready pose. A point-mass model's run plans with the
+    built-in ``franka`` preset; an arm model's run is this section alone."""
+    franka_goal_offsets: tuple[tuple[float, ...], ...] = FRANKA_GOAL_OFFSETS
+    """Goals of the Franka section as offsets from the ready pose's end-effector position (m, base frame);
+    the first is solved cold, each later one warm-started from the plan before it."""
+    franka_width: float | None = None
+    """Goal width of the Franka reaches (m); the arm model's own (0.05 m for the preset) when None."""
+    franka_max_wall_time: float = 60.0
+    """Wall-time budget per Franka solve (s); a solve that runs out reports status 'max_wall_time'."""
 
     def __post_init__(self):
         for name in ("distances", "widths", "dispersion_widths", "phase_distances"):
             values = getattr(self, name)
             if len(values) == 0 or not all(isinstance(v, (int, float)) and math.isfinite(v) and v > 0 for v in values):
                 raise ValueError(f"{name} must be a non-empty sequence of finite numbers > 0 (m), got {values!r}")
-        for name in ("profile_distance", "profile_width", "dispersion_distance", "phase_width"):
+        positive = [(name, "m") for name in ("profile_distance", "profile_width", "dispersion_distance", "phase_width")]
+        positive += [("franka_max_wall_time", "s")] + ([("franka_width", "m")] if self.franka_width is not None else [])
+        for name, unit in positive:
             value = getattr(self, name)
-            if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
-                raise ValueError(f"{name} must be a finite number > 0 (m), got {value!r}")
+            if isinstance(value, bool) or not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+                raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}")
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.phase_initial_velocities):
             raise ValueError(f"phase_initial_velocities must be finite numbers (m/s), got {self.phase_initial_velocities!r}")
         for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < least:
                 raise ValueError(f"{name} must be an integer ≥ {least}, got {value!r}")
+        if not isinstance(self.franka, bool):
+            raise ValueError(f"franka must be True or False, got {self.franka!r}")
+        offsets = self.franka_goal_offsets
+        if len(offsets) == 0 or not all(len(o) == 3 and all(isinstance(v, (int, float)) and math.isfinite(v) for v in o)
+                                        for o in offsets):
+            raise ValueError("franka_goal_offsets must be a non-empty sequence of (x, y, z) offsets of finite numbers (m), "
+                             f"got {offsets!r}")
         if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1):
             raise ValueError(f"workers must be an integer ≥ 1 (processes) or None (the CPU count), got {self.workers!r}")
 
     @classmethod
     def quick_run(cls, **changes) -> "ValidationSettings":
-        """The ``--quick`` settings: the same grids, fewer samples and configurations."""
-        return cls(**({"dispersion_samples": 500, "calibration_trials": 2, "quick": True} | changes))
+        """The ``--quick`` settings: the same grids, fewer samples and configurations, three Franka goals."""
+        return cls(**({"dispersion_samples": 500, "calibration_trials": 2, "quick": True,
+                       "franka_goal_offsets": FRANKA_GOAL_OFFSETS[:3]} | changes))
 
     def to_dict(self) -> dict:
         return asdict(self)

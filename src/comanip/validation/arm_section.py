@@ -1,0 +1,118 @@
+"""The Franka section of a validation run (paper Section V-B): Panda reaches from the ready pose to goals
+around it, their numbers (:mod:`comanip.analysis.arm_reaches`), figures, and CSV files.
+
+Building the Panda's planner compiles its per-solve functions to C the first time (about a minute, then
+cached on disk; :mod:`comanip.planning.compiled`), so the build gets its own progress line.
+"""
+
+from __future__ import annotations
+
+import csv
+import threading
+import time
+from contextlib import contextmanager
+from pathlib import Path
+
+import numpy as np
+from tqdm import tqdm
+
+from comanip.analysis.arm_reaches import arm_reaches, summarise_reaches
+from comanip.model import ReachingModel
+from comanip.planning.compiled import cache_dir
+from comanip.planning.planner import Planner
+from comanip.plots.arm_figure import plot_arm_paths, plot_arm_speed_profiles, plot_joint_trajectories
+from comanip.validation.settings import ValidationSettings
+
+#: Figure files of the section, in the order the report lists them.
+ARM_FIGURES = ("franka_speed_profiles.png", "franka_joint_positions.png", "franka_joint_velocities.png", "franka_paths.png")
+
+
+def run_arm_section(model: ReachingModel, out: Path, settings: ValidationSettings, progress: bool = True) -> tuple[dict, list[Path]]:
+    """Plan the reaches of ``settings.franka_goal_offsets`` with model (an arm), write figures and CSV files
+    into out; returns the section's report dictionary and the figure paths."""
+    planner, build_time, compiled_now = build_arm_planner(model, progress)
+    offsets = np.array(settings.franka_goal_offsets, dtype=float)
+    with tqdm(total=len(offsets), desc=f"franka: planning reaches ({model.name})", unit="reach", disable=not progress) as bar:
+        reaches = arm_reaches(planner, offsets, settings.franka_width, settings.franka_max_wall_time, progress=bar.update)
+    body = model.body
+    name = model.name
+    figures = [
+        plot_arm_speed_profiles(reaches, out / ARM_FIGURES[0], f"{name}: hand speed of plans from the ready pose"),
+        plot_joint_trajectories(reaches, body.q_min, body.q_max, False, out / ARM_FIGURES[1],
+                                f"{name}: joint positions of the plans (dashed: URDF limits)"),
+        plot_joint_trajectories(reaches, -body.qdot_max, body.qdot_max, True, out / ARM_FIGURES[2],
+                                f"{name}: joint velocities of the plans (dashed: URDF limits)"),
+        plot_arm_paths(reaches, out / ARM_FIGURES[3], f"{name}: hand paths from the ready pose (base frame)"),
+    ]
+    rows = [reach.summary() for reach in reaches]
+    _write_csv(rows, out / "franka_reaches.csv")
+    plan_folder = out / "franka_plans"
+    plan_folder.mkdir(exist_ok=True)
+    for k, reach in enumerate(reaches):
+        reach.plan.save_csv(plan_folder / f"goal_{k}.csv")
+    section = {
+        "model": model.config(),
+        "home_position_rad": body.home_position.tolist(),
+        "home_ee_m": reaches[0].plan.ee_mean[0].tolist(),
+        "planner_build_s": build_time,
+        "compiled_on_this_run": compiled_now,
+        "reaches": rows,
+        "summary": summarise_reaches(reaches),
+        "files": ["franka_reaches.csv", *(f"franka_plans/goal_{k}.csv" for k in range(len(reaches)))],
+    }
+    return section, figures
+
+
+def build_arm_planner(model: ReachingModel, progress: bool = True) -> tuple[Planner, float, bool]:
+    """The model's :class:`Planner`, built under a progress line that shows the elapsed time.
+
+    Returns the planner, the build's wall time (s), and whether it compiled new C libraries (first use
+    of this model on this machine) rather than loading them from the cache.
+    """
+    before = _cached_libraries()
+    began = time.perf_counter()
+    description = f"franka: building the {model.body.name.capitalize()}'s compiled functions (first use ~1 min, cached after)"
+    with tqdm(desc=description, bar_format="{desc}: {elapsed}", disable=not progress) as bar, _ticking(bar):
+        planner = Planner(model)
+    return planner, time.perf_counter() - began, bool(_cached_libraries() - before)
+
+
+def _cached_libraries() -> set[Path]:
+    folder = cache_dir()
+    return set(folder.glob("*.so")) if folder.is_dir() else set()
+
+
+@contextmanager
+def _ticking(bar: tqdm, every: float = 1.0):
+    """Redraw bar every ``every`` seconds while the block runs, so its elapsed time moves during a long call."""
+    stop = threading.Event()
+
+    def tick():
+        while not stop.wait(every):
+            bar.refresh()
+
+    thread = threading.Thread(target=tick, daemon=True)
+    thread.start()
+    try:
+        yield
+    finally:
+        stop.set()
+        thread.join()
+
+
+def _write_csv(rows: list[dict], path: Path) -> None:
+    """One row per reach; list-valued fields (offsets, goals, per-joint usage) as one column per entry."""
+    flat = []
+    for row in rows:
+        entries = {}
+        for key, value in row.items():
+            if isinstance(value, list):
+                entries |= {f"{key}_{k + 1}": v for k, v in enumerate(value)}
+            else:
+                entries[key] = value
+        flat.append(entries)
+    with open(path, "w", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=list(flat[0]))
+        writer.writeheader()
+        writer.writerows(flat)
+
