@@ -81,6 +81,8 @@ def test_limits_hold_on_every_step_and_the_usage_is_what_the_plans_show(franka_r
         nearest_limit = np.minimum(panda.q_max - q, q - panda.q_min).min(axis=0)  # rad, per joint
         half_range = (panda.q_max - panda.q_min) / 2
         np.testing.assert_allclose(r["position_usage_per_joint"], 1 - nearest_limit / half_range, rtol=1e-9)
+        after_mt = plan["t_s"][1:] > r["movement_time"]
+        assert r["velocity_usage_after_mt"] == pytest.approx(np.max(np.abs(qdot[after_mt]) / panda.qdot_max), rel=1e-9)
     summary = report["franka"]["summary"]
     assert summary["within_limits"] == 3
     assert 0 < summary["torque_usage_max"] < 1 + 1e-9 and summary["velocity_usage_max"] < 1 + 1e-6

@@ -65,6 +65,14 @@ def joint_limit_usage(model, plan: Plan) -> LimitUsage:
     return LimitUsage(position, velocity, torque, within)
 
 
+def _velocity_usage_after(model, plan: Plan, time: float) -> float:
+    """Largest |qdot| / qdot_max over the joints and the steps after time (s); NaN for a NaN time or no step."""
+    after = plan.t > time  # False everywhere for a NaN time
+    if not after.any():
+        return float("nan")
+    return float(np.max(np.abs(plan.mean[after, model.n:]) / model.body.qdot_max))
+
+
 @dataclass
 class ArmReach:
     """One planned reach of an arm from its home pose; T = H+1 steps."""
@@ -77,6 +85,9 @@ class ArmReach:
     metrics: SpeedMetrics
     """SPEC §6 timing of the hand speed."""
     limits: LimitUsage
+    velocity_usage_after_mt: float
+    """Largest |qdot| / qdot_max of any joint after MT: how fast the arm still moves (in its null space) once
+    the hand has stopped; NaN when the hand never settles."""
 
     @property
     def label(self) -> str:
@@ -100,7 +111,8 @@ class ArmReach:
                 "success": plan.success, "status": plan.status, "message": plan.message,
                 "warm_started": self.warm_started, "solve_time_s": plan.solve_time, "iterations": plan.iterations,
                 "final_error_m": plan.final_error, "within_width": self.within_width,
-                **self.metrics.to_dict(), "final_speed": float(plan.ee_speed[-1]), **self.limits.summary()}
+                **self.metrics.to_dict(), "final_speed": float(plan.ee_speed[-1]), **self.limits.summary(),
+                "velocity_usage_after_mt": self.velocity_usage_after_mt}
 
 
 def arm_reaches(planner: Planner, offsets, width: float | None = None, max_wall_time: float | None = None,
@@ -125,7 +137,9 @@ def arm_reaches(planner: Planner, offsets, width: float | None = None, max_wall_
         warm = plan is not None
         plan = planner.solve(start, x0 + offset, width, warm_start=plan,
                              max_wall_time=max_wall_time)
-        reaches.append(ArmReach(offset, plan, warm, speed_metrics(plan.t, plan.ee_speed), joint_limit_usage(model, plan)))
+        metrics = speed_metrics(plan.t, plan.ee_speed)
+        reaches.append(ArmReach(offset, plan, warm, metrics, joint_limit_usage(model, plan),
+                                _velocity_usage_after(model, plan, metrics.movement_time)))
         if progress:
             progress(1)
     return reaches
@@ -133,13 +147,15 @@ def arm_reaches(planner: Planner, offsets, width: float | None = None, max_wall_
 
 def summarise_reaches(reaches: list[ArmReach]) -> dict:
     """Numbers over all reaches: successes, goals within width, cold and median warm solve time (s), the
-    largest usage of each limit kind."""
+    largest usage of each limit kind and the largest joint speed usage after MT."""
     warm = [r.plan.solve_time for r in reaches if r.warm_started]
     cold = [r.plan.solve_time for r in reaches if not r.warm_started]
+    after_mt = [r.velocity_usage_after_mt for r in reaches if np.isfinite(r.velocity_usage_after_mt)]
     return {"reaches": len(reaches), "successes": sum(r.plan.success for r in reaches),
             "within_width": sum(r.within_width for r in reaches),
             "within_limits": sum(r.limits.within_limits for r in reaches),
             "cold_solve_time_s": cold[0] if cold else None,
             "warm_solve_time_median_s": float(np.median(warm)) if warm else None,
             "warm_solve_time_max_s": max(warm) if warm else None,
-            **{f"{kind}_usage_max": float(max(np.max(getattr(r.limits, kind)) for r in reaches)) for kind in LIMIT_KINDS}}
+            **{f"{kind}_usage_max": float(max(np.max(getattr(r.limits, kind)) for r in reaches)) for kind in LIMIT_KINDS},
+            "velocity_usage_after_mt_max": max(after_mt) if after_mt else None}

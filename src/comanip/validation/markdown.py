@@ -79,22 +79,25 @@ def _franka_section(section: dict, run_model: dict) -> list[str]:
         f"{[round(v, 3) for v in section['home_ee_m']]} m, base frame) to goals at the offsets below. The first goal is "
         "solved cold (multi-start), each later one warm-started from the plan before it. Speed: ||J(μ_q) μ_q̇||; "
         "MT: first time after the peak with speed below 5 % of the peak (SPEC §6). Limit usage: largest fraction of the limit over the mean "
-        "path (1 = at the limit; joint positions measured from the middle of their range), with its joint. "
+        "path (1 = at the limit; joint positions measured from the middle of their range), with its joint; 'after MT': the "
+        "fastest joint once the hand has stopped (motion in the arm's null space). "
         f"The paper reports 1.3 s per solve; {build}.", "",
         f"**{summary['successes']}/{summary['reaches']} solves succeeded, {summary['within_width']}/{summary['reaches']} "
         f"end within the goal width, {summary['within_limits']}/{summary['reaches']} keep every limit. Cold solve "
         f"{_num(summary['cold_solve_time_s'], 2)} s; warm solves median {_num(warm, 2)} s, max "
         f"{_num(summary['warm_solve_time_max_s'], 2)} s. Largest usage: position {_num(summary['position_usage_max'], 2)}, "
-        f"velocity {_num(summary['velocity_usage_max'], 2)}, torque {_num(summary['torque_usage_max'], 2)}.**", "",
+        f"velocity {_num(summary['velocity_usage_max'], 2)}, torque {_num(summary['torque_usage_max'], 2)}; joint velocity "
+        f"after the hand has stopped {_num(summary['velocity_usage_after_mt_max'], 2)}.**", "",
         _table(["goal offset", "D (m)", "w (m)", "status", "start", "solve time (s)", "iterations", "final error (mm)",
                 "within w", "t_peak (s)", "MT (s)", "t_peak/MT", "peak speed (m/s)", "final speed (m/s)",
-                "position usage (joint)", "velocity usage (joint)", "torque usage (joint)", "within limits"],
+                "position usage (joint)", "velocity usage (joint)", "torque usage (joint)", "velocity usage after MT",
+                "within limits"],
                [[r["goal_label"], _num(r["distance_m"], 3), r["width_m"], r["status"], "warm" if r["warm_started"] else "cold",
                  _num(r["solve_time_s"], 2), r["iterations"], _num(1e3 * r["final_error_m"], 1), r["within_width"],
                  _num(r["t_peak"], 3), _num(r["movement_time"], 3), _num(r["asymmetry"], 2), _num(r["peak_speed"], 3),
                  _num(r["final_speed"], 3),
                  *(f"{_num(r[f'{kind}_usage_max'], 2)} ({r[f'{kind}_usage_joint']})" for kind in LIMIT_KINDS),
-                 r["within_limits"]] for r in rows]),
+                 _num(r["velocity_usage_after_mt"], 2), r["within_limits"]] for r in rows]),
         "", "Per-reach rows: `franka_reaches.csv`; every plan step by step: `franka_plans/goal_<k>.csv`.", "",
     ]
 
