@@ -19,8 +19,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--out", default="out/validate", help="output folder (default: %(default)s)")
     parser.add_argument("--quick", action="store_true",
                         help="fewer Monte Carlo samples, closed-loop trials and calibration configurations, three Franka "
-                             "goals instead of six (about 40 s, plus about a minute the first time the Panda's "
-                             "functions are compiled)")
+                             "goals instead of six (about 30 s; about 110 s the first time, when the Panda's "
+                             "functions are compiled and cached)")
     parser.add_argument("--no-franka", dest="franka", action="store_false",
                         help="skip the Franka section (no Panda planner is built)")
     parser.add_argument("--workers", type=int, help="processes for the calibration study (default: the CPU count)")
