@@ -51,15 +51,21 @@ class LinearisedCurvature:
         self.problem = problem
         d = model.d
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
-        function = self._terms_function(problem)
-        self._terms = BufferedFunction(compiled(function) if compile else function)
+        terms, value = self._functions(problem)
+        self._terms = BufferedFunction(compiled(terms) if compile else terms)
+        self._value = BufferedFunction(compiled(value) if compile else value)
+        self._sensitivities = (None, None)  # (data, T): the last mean_sensitivities, reused by hessian and limits
         self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
         self._last_normaliser = (None, 1.0)
         self._noise_hessian = _noise_second_derivatives(model)
 
-    def _terms_function(self, problem: ReachProblem) -> ca.Function:
-        """``(x, s0, goal, width) -> (f, grad, mean, cov, A, B, J, phi_hess, phi_grad, W, dvech/dq)``, all
-        per-step outputs stacked horizontally (see :meth:`evaluate`)."""
+    def _functions(self, problem: ReachProblem) -> tuple[ca.Function, ca.Function]:
+        """The per-solve functions, both ``(x, s0, goal, width) -> ...`` with per-step outputs stacked horizontally:
+
+        - terms: ``(f, grad, mean, cov, A, B, J, phi_hess, phi_grad, W, dvech/dq)`` (see :meth:`evaluate`);
+        - value: ``(f, mean)``, the forward rollout alone (a quarter of the terms' cost), for line-search
+          trials and comparisons of initial guesses.
+        """
         model, body = problem.model, problem.model.body
         n, d, H = model.n, model.d, model.H
         x = ca.MX.sym("x", n * H)
@@ -79,10 +85,12 @@ class LinearisedCurvature:
         _, A, B = linearised_step_function(body, model.h).map(H)(means[:, :H], tau)
         J, phi_hess, phi_grad, W, dvech = _stage_curvature_function(model, self._triangle).map(H + 1)(
             means, covs, goal, width, weights)
-        return ca.Function("arm_reach_terms", [x, s0, goal, width],
-                           [f, ca.gradient(f, x), means, covs, A, B, J, phi_hess, phi_grad, W, dvech],
-                           ["x", "s0", "goal", "width"],
-                           ["f", "grad", "mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "W", "dvech"])
+        inputs, input_names = [x, s0, goal, width], ["x", "s0", "goal", "width"]
+        terms = ca.Function("arm_reach_terms", inputs,
+                            [f, ca.gradient(f, x), means, covs, A, B, J, phi_hess, phi_grad, W, dvech], input_names,
+                            ["f", "grad", "mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "W", "dvech"])
+        value = ca.Function("arm_reach_value", inputs, [f, means], input_names, ["f", "mean"])
+        return terms, value
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: the objective is divided by it."""
@@ -97,10 +105,26 @@ class LinearisedCurvature:
         return float(out[0].item()), out[1].ravel(), (np.array(x, dtype=float), params[-1], *out[2:])
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
-        return self.evaluate(x, params)[0]
+        return self.value_and_mean(x, params)[0]
+
+    def value_and_mean(self, x: np.ndarray, params: np.ndarray) -> tuple[float, tuple]:
+        """(f, data for :meth:`mean_path`) at torques x: the forward rollout alone, without derivatives."""
+        n2, d = 2 * self.model.n, self.model.d
+        f, means = self._value(x, params[:n2], params[n2:n2 + d], params[-1])
+        return float(f.item()), (np.array(x, dtype=float), params[-1], means)
+
+    @staticmethod
+    def mean_path(data: tuple) -> np.ndarray:
+        """Mean state trajectory (H+1, 2n) from the data of :meth:`evaluate` or :meth:`value_and_mean`."""
+        return data[2].T.copy()
 
     def mean_sensitivities(self, data: tuple) -> np.ndarray:
-        """T[i, :, k, :] = d mu_i / d tau_k (H+1, 2n, H, n) along the mean of the evaluated torques (exact)."""
+        """T[i, :, k, :] = d mu_i / d tau_k (H+1, 2n, H, n) along the mean of the evaluated torques (exact).
+
+        The last result is kept: the Hessian and the limits' rows ask for the same evaluation's T.
+        """
+        if self._sensitivities[0] is data:
+            return self._sensitivities[1]
         model = self.model
         n, H = model.n, model.H
         A = data[4].reshape(2 * n, H, 2 * n).transpose(1, 0, 2)
@@ -109,6 +133,7 @@ class LinearisedCurvature:
         for i in range(H):
             T[i + 1, :, :i] = (A[i] @ T[i, :, :i].reshape(2 * n, -1)).reshape(2 * n, i, n)
             T[i + 1, :, i] = B[i]
+        self._sensitivities = (data, T)
         return T
 
     def hessian(self, data: tuple) -> np.ndarray:

@@ -72,7 +72,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
                     tolerance: float, max_iterations: int, secant: bool = False,
                     constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
                     constraint_tolerance: float = 1e-6, margin: float = 1e-3,
-                    expired: Callable[[], bool] = lambda: False) -> NewtonResult:
+                    expired: Callable[[], bool] = lambda: False,
+                    value: Callable[[np.ndarray], tuple[float, Any]] | None = None) -> NewtonResult:
     """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0.
 
     Args:
@@ -87,7 +88,20 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         constraint_tolerance: largest violation a solution may keep (units of c).
         margin: constraints with c > -margin are in the working set.
         expired: called between evaluations; True stops with status 'max_wall_time'.
+        value: x -> (f, data) without the gradient, for line-search trials when that is much cheaper than
+            ``evaluate`` (``data`` then only needs what ``constraints`` reads); ``evaluate`` runs once a trial
+            is accepted. None: trials use ``evaluate``.
     """
+    def probe(point):
+        """(f, gradient or None, data) at a trial point."""
+        if value is None:
+            return evaluate(point)
+        f_point, data_point = value(point)
+        return f_point, None, data_point
+
+    def finite(f_point, g_point) -> bool:
+        return bool(np.isfinite(f_point)) and (g_point is None or bool(np.all(np.isfinite(g_point))))
+
     problem = _Constraints(lb, ub, constraints)
     x = np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
@@ -136,23 +150,27 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             if not slope < -1e-16 * max(1.0, abs(merit)):
                 break
             trial = x + alpha * step
-            f_trial, g_trial, data_trial = evaluate(trial)
-            if np.isfinite(f_trial) and np.all(np.isfinite(g_trial)):
+            f_trial, g_trial, data_trial = probe(trial)
+            if finite(f_trial, g_trial):
                 c_trial, A_trial = problem(trial, data_trial)
                 if attempt == 0 and len(working) and np.sum(np.maximum(c_trial, 0.0)) > np.sum(np.maximum(c, 0.0)):
                     # second-order correction: the full step broke the curved constraints; pull it back onto
                     # their linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3)
                     corrected = trial + correct(c_trial[working])
-                    f_corr, g_corr, data_corr = evaluate(corrected)
-                    if np.isfinite(f_corr) and np.all(np.isfinite(g_corr)):
+                    f_corr, g_corr, data_corr = probe(corrected)
+                    if finite(f_corr, g_corr):
                         c_corr, A_corr = problem(corrected, data_corr)
                         if f_corr + mu * np.sum(np.maximum(c_corr, 0.0)) <= merit + _ARMIJO * slope:
                             trial, f_trial, g_trial, data_trial, c_trial, A_trial = corrected, f_corr, g_corr, data_corr, c_corr, A_corr
                 if f_trial + mu * np.sum(np.maximum(c_trial, 0.0)) <= merit + _ARMIJO * alpha * slope:
-                    x, f, g, data, c, A = trial, f_trial, g_trial, data_trial, c_trial, A_trial
-                    history.append(f)
-                    accepted = True
-                    break
+                    if g_trial is None:
+                        f_trial, g_trial, data_trial = evaluate(trial)
+                        c_trial, A_trial = problem(trial, data_trial)
+                    if finite(f_trial, g_trial):
+                        x, f, g, data, c, A = trial, f_trial, g_trial, data_trial, c_trial, A_trial
+                        history.append(f)
+                        accepted = True
+                        break
             alpha /= 2
         if not accepted and problem.violation(c) > constraint_tolerance:
             restored = _restore(evaluate, problem, x, c, A)

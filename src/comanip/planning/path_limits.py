@@ -51,7 +51,7 @@ class PathLimits:
         """The callback :func:`newton_minimize` takes: (x, data) -> (c (2·H·2n,), rows(indices))."""
 
         def constraints(x, data):
-            c = self.constraints(curvature.trajectory(data)[0]).ravel()
+            c = self.constraints(curvature.mean_path(data)).ravel()
 
             def rows(indices):
                 T = curvature.mean_sensitivities(data)[1:].reshape(c.size // 2, -1)  # d mu_i / d tau, rows (i, entry)

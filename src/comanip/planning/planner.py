@@ -294,7 +294,8 @@ class Planner:
                                  *self._torque_bounds, tolerance=self.options.tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
-                                 constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline)
+                                 constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
+                                 value=(lambda x: curvature.value_and_mean(x, params)) if hasattr(curvature, "value_and_mean") else None)
         success = result.status in ("solved", "solved_acceptable")
         return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
                 result.message, result.iterations)
