@@ -191,14 +191,17 @@ class LinearisedCurvature:
         Tq = self.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
         # mean rows J_i T_i and the rows of J(q_i)'s effect on Sigma_x, d vech/dq_i T_i, share T_i
         per_q = np.swapaxes(J, 1, 2) @ c_mean + np.swapaxes(dvech, 1, 2) @ c_vech  # (H+1, n, d)
-        cross = np.einsum("iqx,iqm->xm", Tq, per_q, optimize=True)
-        # rows of the noise injected at step k, vech(G_ik E_kj G_ikᵀ): contracted with c as <C_i, G_ik E_kj G_ikᵀ>
-        C = np.zeros((H + 1, d, d, d))
+        cross = Tq.reshape(-1, H * n).T @ per_q.reshape(-1, d)
+        # rows of the noise injected at step k, vech(G_ik E_kj G_ikᵀ), contracted with column m of c_vech as
+        # <C_im, G_ik E_kj G_ikᵀ> = <S_km, E_kj>, S_km = Σ_i G_ikᵀ C_im G_ik (n, n), C_im symmetric from vech
+        C = np.zeros((H + 1, d, d, d))  # (i, a, b, m)
         C[:, a, b] = C[:, b, a] = c_vech * np.where(a == b, 1.0, 0.5)[None, :, None]
         G = (J @ Tq).reshape(H + 1, d, H, n)
-        S = np.einsum("iakr,iabm,ibks->krsm", G, C, G, optimize=True)
-        E = np.einsum("jlrs,kl->kjrs", self._noise_hessian, x.reshape(H, n))
-        cross += np.einsum("krsm,kjrs->kjm", S, E, optimize=True).reshape(H * n, d)
+        CG = np.einsum("iabm,ibks->kiams", C, G, optimize=True).reshape(H, (H + 1) * d, d * n)
+        S = np.swapaxes(G.transpose(2, 0, 1, 3).reshape(H, (H + 1) * d, n), 1, 2) @ CG  # (k, r, (m, s))
+        S = S.reshape(H, n, d, n).transpose(0, 1, 3, 2).reshape(H, n * n, d)
+        E = np.einsum("jlrs,kl->kjrs", self._noise_hessian, x.reshape(H, n)).reshape(H, n, n * n)
+        cross += (E @ S).reshape(H * n, d)
         return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
 
     def _noise_rows(self, G: np.ndarray, tau: np.ndarray) -> np.ndarray:
