@@ -12,18 +12,22 @@ iteration is written out here:
   ±I. Without any, the step is the Newton step.
 - Direction: minimise the quadratic model gᵀp + ½ pᵀ(H + delta·s·I)p subject to the linearised working
   constraints c_W + A_W p = 0, by one Cholesky factorisation and a Schur complement on the few rows of W;
-  a constraint that is not binding (c_j < 0) and gets a negative multiplier leaves W and the step is
-  recomputed. s = max |diag H|; delta is 0 whenever H is positive definite, otherwise the smallest of
+  a constraint that is not violated beyond ``constraint_tolerance`` and gets a negative multiplier leaves W
+  and the step is recomputed. s = max |diag H|; delta is 0 whenever H is positive definite, otherwise the smallest of
   delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for which the factorisation succeeds (IPOPT's
   inertia correction).
-- Step: backtracking, alpha = 1, 1/2, ..., on the l1 merit f + mu Σ max(0, c) (mu ≥ 2 max multiplier)
-  until it decreases by 1e-4 of its directional derivative (Armijo).
+- Step: backtracking, alpha = 1, 1/2, ..., on the l1 merit f + mu Σ max(0, c - constraint_tolerance/2)
+  (mu ≥ 2 max multiplier) until it decreases by 1e-4 of its directional derivative (Armijo); a trial that
+  raises the violation gets a second-order correction first.
 - Secant correction (``secant=True``, for approximate Hessians): C is updated after every step s with
   the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (H + C) s, y the change of gradient, and
   H + C is used in place of H. It learns the curvature the approximation misses along the directions
   the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md).
 - Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
   the violated constraints' linearisation is taken if it halves the violation.
+- Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
+  recomputed with delta ≥ 1e-3, then 1e-2, 1e-1 (turning it towards steepest descent), before giving up.
+  On the Panda a quarter of closed-loop replans ended without it at points that were not optimal.
 - Convergence: max |∇f + A_Wᵀ lambda| ≤ tolerance with every constraint violated by at most
   ``constraint_tolerance`` ('solved'). If the merit cannot be decreased any more in floating point, the
   point is 'solved_acceptable' when the constraints are met and that gradient is below 1e-4 (or 100 ×
@@ -45,6 +49,8 @@ import scipy.linalg
 _ARMIJO = 1e-4
 """Fraction of the linearly predicted decrease a step must achieve."""
 _BACKTRACKS = 30
+_RECOVERIES, _RECOVERY_SHIFT = 3, 1e-3
+"""Attempts after a failed line search, and the least relative shift delta of the first (ten times more each after)."""
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
 
@@ -99,6 +105,11 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         f_point, data_point = value(point)
         return f_point, None, data_point
 
+    def penalty(c_point) -> float:
+        """The merit's l1 violation, counted from half the tolerance: violations the solution may keep cost
+        nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
+        return float(np.sum(np.maximum(c_point - 0.5 * constraint_tolerance, 0.0)))
+
     def finite(f_point, g_point) -> bool:
         return bool(np.isfinite(f_point)) and (g_point is None or bool(np.all(np.isfinite(g_point))))
 
@@ -110,6 +121,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     c, A = problem(x, data)
     delta_last, mu, iterations = 0.0, 0.0, 0
     correction, previous = None, None  # secant correction; (x, g) before the last step
+    recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
     history = [f]
 
     def result(status, message, gradient):
@@ -130,10 +142,11 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
                 _symmetric_rank_one_update(correction, H, x - previous[0], g - previous[1])
             H = H + correction
             previous = (x, g)
-        factor, delta_last = _regularised_cholesky(H, delta_last)
+        # after a failed line search, a stronger shift turns the step towards steepest descent
+        factor, delta_last = _regularised_cholesky(H, delta_last, least=_RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0)
         if factor is None:
             return result("failed", "no positive definite regularised Hessian", np.inf)
-        step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin)
+        step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin, constraint_tolerance)
         lagrangian_gradient = float(np.max(np.abs(g + A(working).T @ multipliers)))
         violation = problem.violation(c)
         if lagrangian_gradient <= tolerance and violation <= constraint_tolerance:
@@ -143,8 +156,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             return result("solved_acceptable", f"objective unchanged to {_STALL_DECREASE:g} over {_STALL_WINDOW} "
                           "iterations", lagrangian_gradient)
         mu = max(mu, 2 * float(np.max(multipliers, initial=0.0)))
-        merit = f + mu * np.sum(np.maximum(c, 0.0))
-        slope = g @ step - mu * np.sum(np.maximum(c, 0.0))  # directional derivative of the merit
+        merit = f + mu * penalty(c)
+        slope = g @ step - mu * penalty(c)  # directional derivative of the merit
         alpha, accepted = 1.0, False
         for attempt in range(_BACKTRACKS):
             if not slope < -1e-16 * max(1.0, abs(merit)):
@@ -153,16 +166,17 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             f_trial, g_trial, data_trial = probe(trial)
             if finite(f_trial, g_trial):
                 c_trial, A_trial = problem(trial, data_trial)
-                if attempt == 0 and len(working) and np.sum(np.maximum(c_trial, 0.0)) > np.sum(np.maximum(c, 0.0)):
-                    # second-order correction: the full step broke the curved constraints; pull it back onto
-                    # their linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3)
+                if len(working) and penalty(c_trial) > penalty(c):
+                    # second-order correction: the step broke the curved constraints; pull it back onto their
+                    # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
+                    # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
                     corrected = trial + correct(c_trial[working])
                     f_corr, g_corr, data_corr = probe(corrected)
                     if finite(f_corr, g_corr):
                         c_corr, A_corr = problem(corrected, data_corr)
-                        if f_corr + mu * np.sum(np.maximum(c_corr, 0.0)) <= merit + _ARMIJO * slope:
+                        if f_corr + mu * penalty(c_corr) <= merit + _ARMIJO * alpha * slope:
                             trial, f_trial, g_trial, data_trial, c_trial, A_trial = corrected, f_corr, g_corr, data_corr, c_corr, A_corr
-                if f_trial + mu * np.sum(np.maximum(c_trial, 0.0)) <= merit + _ARMIJO * alpha * slope:
+                if f_trial + mu * penalty(c_trial) <= merit + _ARMIJO * alpha * slope:
                     if g_trial is None:
                         f_trial, g_trial, data_trial = evaluate(trial)
                         c_trial, A_trial = problem(trial, data_trial)
@@ -172,19 +186,27 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
                         accepted = True
                         break
             alpha /= 2
-        if not accepted and problem.violation(c) > constraint_tolerance:
+        if accepted:
+            recoveries = 0
+            continue
+        if problem.violation(c) > constraint_tolerance:
             restored = _restore(evaluate, problem, x, c, A)
             if restored is not None:
                 x, f, g, data, c, A = restored
                 history.append(f)
                 continue
-        if not accepted:
-            violation = problem.violation(c)
-            if lagrangian_gradient <= max(100 * tolerance, _STALL_GRADIENT) and violation <= constraint_tolerance:
-                return result("solved_acceptable", "no step decreases the objective any further", lagrangian_gradient)
-            status = "constraints_violated" if violation > constraint_tolerance else "failed"
-            return result(status, f"no step decreases the merit any further (violation {violation:.3g}, gradient "
-                          f"{lagrangian_gradient:.3g})", lagrangian_gradient)
+        if recoveries < _RECOVERIES:
+            # The quadratic model was wrong along this step: forget the secant corrections (they may have
+            # learnt curvature from far away) and regularise harder, then try again from the same point.
+            recoveries += 1
+            correction, previous = None, None
+            continue
+        violation = problem.violation(c)
+        if lagrangian_gradient <= max(100 * tolerance, _STALL_GRADIENT) and violation <= constraint_tolerance:
+            return result("solved_acceptable", "no step decreases the objective any further", lagrangian_gradient)
+        status = "constraints_violated" if violation > constraint_tolerance else "failed"
+        return result(status, f"no step decreases the merit any further (violation {violation:.3g}, gradient "
+                      f"{lagrangian_gradient:.3g})", lagrangian_gradient)
 
 
 def _restore(evaluate, problem, x, c, A):
@@ -242,11 +264,14 @@ class _Constraints:
         return float(max(0.0, np.max(c, initial=0.0)))
 
 
-def _constrained_step(factor, g, c, A, margin: float):
+def _constrained_step(factor, g, c, A, margin: float, tolerance: float):
     """Newton step under the working set's linearised constraints.
 
-    A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row that is not
-    binding (c_j < 0) with a negative multiplier is dropped and the step recomputed. Returns (step,
+    A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row with a negative
+    multiplier is dropped and the step recomputed unless it is violated by more than ``tolerance`` (then
+    the step must restore it). (Keeping a row met to within the tolerance, say at 3e-8 past a joint limit,
+    held the Panda's plans on the limit while the objective pulled them off it: the step vanished and
+    the solve stalled with a large Lagrangian gradient.) Returns (step,
     multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
     """
     Hg = scipy.linalg.cho_solve(factor, g, check_finite=False)
@@ -256,7 +281,7 @@ def _constrained_step(factor, g, c, A, margin: float):
         HA = scipy.linalg.cho_solve(factor, rows.T, check_finite=False)
         schur = rows @ HA
         multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
-        dropping = (multipliers < 0) & (c[working] < 0)
+        dropping = (multipliers < 0) & (c[working] <= tolerance)
         if not dropping.any():
             multipliers = np.maximum(multipliers, 0.0)
 
@@ -277,20 +302,22 @@ def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndar
         correction += np.outer(r, r) / denominator
 
 
-def _regularised_cholesky(H: np.ndarray, delta_last: float):
-    """Cholesky factor of H + delta·s·I with the least delta tried that works; returns (factor, delta_last).
+def _regularised_cholesky(H: np.ndarray, delta_last: float, least: float = 0.0):
+    """Cholesky factor of H + delta·s·I with the least delta ≥ ``least`` tried that works; returns
+    (factor, delta_last).
 
-    delta = 0 first; then delta_last/3 (or 1e-4 if no regularisation was needed before), growing by 8
-    (by 100 the first time), as IPOPT does. s = max |diag H| makes delta relative.
+    delta = 0 first (unless ``least`` > 0); then delta_last/3 (or 1e-4 if no regularisation was needed
+    before), growing by 8 (by 100 the first time), as IPOPT does. s = max |diag H| makes delta relative.
     """
-    try:
-        return scipy.linalg.cho_factor(H, check_finite=False), delta_last
-    except scipy.linalg.LinAlgError:
-        pass
+    if least == 0.0:
+        try:
+            return scipy.linalg.cho_factor(H, check_finite=False), delta_last
+        except scipy.linalg.LinAlgError:
+            pass
     diagonal = np.diag(H)
     scale = max(float(np.max(np.abs(diagonal))), np.finfo(float).tiny)
     shifted = H.copy()
-    delta = 1e-4 if delta_last == 0 else max(delta_last / 3, 1e-20)
+    delta = max(least, 1e-4 if delta_last == 0 else max(delta_last / 3, 1e-20))
     growth = 100.0 if delta_last == 0 else 8.0
     while delta < 1e20:
         np.fill_diagonal(shifted, diagonal + delta * scale)

@@ -265,7 +265,10 @@ class Planner:
                     torque, status, success = guess, "failed", False
                     f = self.problem.objective_value(guess, start, goal, width) / normaliser
                     message = "solver returned a non-finite plan; returning the initial guess"
-                candidate = (not success, f, torque, status, success, message)
+                # The plan within the limits with the lowest objective wins, whatever its status: a start that
+                # stalls short of the tolerances can still be far better than one that converged on the
+                # zero-reward plateau (seen on the Panda), and the status then says it did not converge.
+                candidate = (status == "constraints_violated", f, torque, status, success, message)
                 if best is None or candidate[:2] < best[:2]:
                     best = candidate
         _, _, torque, status, success, message = best
