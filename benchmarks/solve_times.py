@@ -112,10 +112,11 @@ def franka_replan_case() -> Case:
     return Case(f"franka closed-loop replan (H={model.H}, n={model.n})", build, solve, 1.3)
 
 
-def estimate_case(preset: str) -> Callable[[], Case]:
+def estimate_case(preset: str, reach=(0.3, 0.0, 0.0)) -> Callable[[], Case]:
     """Warm goal estimates (paper Section V-C) from a state observed at 0.2 s of reaches to goals varied
-    around a nominal goal, which is the prior; each estimate warm-starts from the previous one. The observed
-    state is drawn from the hidden plan's belief at the observed step (motor noise)."""
+    (±5 cm per axis) around a nominal goal ``reach`` (m) from the body's home position, which is the prior;
+    each estimate warm-starts from the previous one. The observed state is drawn from the hidden plan's
+    belief at the observed step (motor noise)."""
 
     def make() -> Case:
         from comanip.estimation import GoalEstimator
@@ -125,7 +126,9 @@ def estimate_case(preset: str) -> Callable[[], Case]:
         estimator = GoalEstimator(model)
         build = time.perf_counter() - t0
         rng = np.random.default_rng(0)
-        start, nominal = np.zeros(2 * model.n), 0.3 * np.eye(model.d)[0]
+        home = model.body.home_position
+        start = np.concatenate([home, np.zeros(model.n)])
+        nominal = np.asarray(model.body.kinematics_function(home)[0]).ravel() + np.asarray(reach)[: model.d]
         n_o = int(np.floor(0.2 / model.h + 1e-9))
         hidden = estimator.planner.solve(start, nominal)
         previous = estimator.estimate(start, hidden.mean[n_o], 0.2, prior_goal=nominal)
@@ -189,6 +192,7 @@ CASES: dict[str, Callable[[], Case]] = {
     "franka_replan": franka_replan_case,
     "estimate_planar": estimate_case("planar"),
     "estimate_cartesian": estimate_case("cartesian"),
+    "estimate_franka": estimate_case("franka", reach=(0.15, 0.1, -0.1)),
     "posterior_cartesian": posterior_case("cartesian", new_start=True),
     "posterior_cartesian_update": posterior_case("cartesian", new_start=False),
 }

@@ -229,7 +229,7 @@ def test_cli_estimate_writes_the_estimate_posterior_and_figures(tmp_path, capsys
     (dict(observed=np.zeros(3)), "observed"),
     (dict(observed=[0.1, 0.0, np.nan, 0.0]), "observed"),
     (dict(t_obs=0.0), "t_obs"),
-    (dict(t_obs=0.03), "t_obs"),  # step 1: the mean position there is fixed by the start
+    (dict(t_obs=0.01), "prior_goal"),  # step 0 says nothing about the goal: without a prior there is no estimate
     (dict(t_obs=0.6), "t_obs"),
     (dict(t_obs=-0.1), "t_obs"),
     (dict(t_obs=float("nan")), "t_obs"),

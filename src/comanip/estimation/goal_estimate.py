@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import time
 from collections import OrderedDict
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import casadi as ca
 import numpy as np
@@ -36,8 +36,9 @@ from threadpoolctl import ThreadpoolController
 from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.estimation.goal_posterior import OBSERVATION_STD, observation_covariance
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
-from comanip.estimation.observation import observation_step, observed_state
-from comanip.estimation.regret_newton import RegretPoint, RegretSystem, newton_solve
+from comanip.estimation.observation import observation_step, observed_rows, observed_state
+from comanip.estimation.regret_newton import newton_solve
+from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.shared import cached_per_model, shared_planner, shared_step_jacobians
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
@@ -54,8 +55,9 @@ class EstimatorOptions:
     tolerance: float = 1e-8
     """Convergence: max |F| of the regret's first-order conditions (normalised objective per N·m or N, and
     state units for the observation constraint); IPOPT's tol for the 'paper' method."""
-    max_iterations: int = 30
-    """Newton iterations ('regret') or IPOPT iterations ('paper')."""
+    max_iterations: int | None = None
+    """Newton iterations ('regret'), or a tenth of IPOPT's ('paper'). None: 30 for point masses (exact
+    Jacobian, quadratic convergence), 100 for arms (approximate Jacobian, linear convergence)."""
     step_fraction: float = 0.5
     """Largest goal step of one Newton iteration, as a fraction of the distance from the observed hand to
     the current goal (at least one goal width)."""
@@ -66,8 +68,9 @@ class EstimatorOptions:
 
     def __post_init__(self):
         as_positive("tolerance", self.tolerance, "residual")
-        if isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int) or self.max_iterations < 1:
-            raise ValueError(f"max_iterations must be an integer ≥ 1, got {self.max_iterations!r}")
+        if self.max_iterations is not None and (isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int)
+                                                or self.max_iterations < 1):
+            raise ValueError(f"max_iterations must be None or an integer ≥ 1, got {self.max_iterations!r}")
         if not (isinstance(self.step_fraction, (int, float)) and 0 < self.step_fraction <= 10):
             raise ValueError(f"step_fraction must be in (0, 10] (fraction of the remaining reach), got {self.step_fraction!r}")
         low, high = (as_positive(f"search_distances[{k}]", v, "m") for k, v in enumerate(self.search_distances))
@@ -100,7 +103,11 @@ class GoalEstimator:
             start: start state s_0 = [q; qdot] (2n,), m and m/s (rad, rad/s for joints).
             observed: observed state s_o (2n,), same units.
             t_obs: time of the observation after the start (s), in (0, H·h); it is matched to the step
-                n_o = floor(t_obs / h) (nearest earlier step).
+                n_o = floor(t_obs / h) (nearest earlier step). At n_o = 1 only the observed velocity is
+                held (the position there is fixed by the start); before h (n_o = 0) the observation says
+                nothing about the goal and the estimate is the plan to ``prior_goal`` (status
+                'uninformative', success False), which must then be given
+                (:mod:`comanip.estimation.observation`).
             prior_goal: g_bar (d,), m, for the regulariser; None leaves it out.
             width: goal width w (m); the model's default when None.
             method: 'regret' (default) or 'paper' (eq. 11 as printed).
@@ -111,7 +118,10 @@ class GoalEstimator:
 
         Returns:
             A :class:`~comanip.Plan` through the observation to the estimated goal; never raises on a
-            failed solve (check ``plan.success`` and ``plan.status``).
+            failed solve (check ``plan.success`` and ``plan.status``). ``extras`` hold the estimated goal,
+            the observed step, ``observation_residual`` (mean at n_o minus the observed state, (2n,)) and,
+            for the regret, ``regret`` (J units), ``residual`` (max |F|) and ``unconstrained_torque`` (the
+            plan to the estimated goal, not held to the observation, (H, n)).
         """
         t_begin = time.perf_counter()
         model = self.model
@@ -122,7 +132,13 @@ class GoalEstimator:
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
-        point, plan_needed = self._warm_point(warm_start) if warm_start is not None else (None, False)
+        rows = observed_rows(model, n_o)
+        if n_o == 0:
+            if prior is None:
+                raise ValueError(f"t_obs = {float(t_obs):g} s falls on step 0 (before h = {model.h:g} s): the observed state is the "
+                                 "start itself and says nothing about the goal; give prior_goal (the estimate is then the plan to it)")
+            return self._uninformative(start, observed, float(t_obs), prior, width, method, warm_start, max_wall_time, t_begin)
+        point, plan_needed = self._warm_point(warm_start, len(rows)) if warm_start is not None else (None, False)
 
         deadline = math.inf if max_wall_time is None else t_begin + max_wall_time
 
@@ -133,7 +149,7 @@ class GoalEstimator:
             point.tau_s = self.planner.solve(start, point.goal, width, max_wall_time=remaining_time()).torque.ravel()
 
         def cold_point() -> RegretPoint:
-            return self._cold_point(start, observed, n_o, prior, width, remaining_time)
+            return self._cold_point(start, observed, n_o, len(rows), prior, width, remaining_time)
 
         if method == "regret":
             x_obs, _ = task_space_state(self.planner, observed)
@@ -142,8 +158,8 @@ class GoalEstimator:
                 # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
                 # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
                 with self._blas.limit(limits=1, user_api="blas"):
-                    return newton_solve(self._regret, point, start, observed, n_o, prior, width, observed_position=x_obs,
-                                        tolerance=self.options.tolerance, max_iterations=self.options.max_iterations,
+                    return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
+                                        tolerance=self.options.tolerance, max_iterations=self._max_iterations,
                                         step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
 
             result = newton(point if point is not None else cold_point())
@@ -153,23 +169,42 @@ class GoalEstimator:
                 # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
                 retry = newton(cold_point())
                 iterations += retry.iterations
-                if retry.status == "solved" or retry.residual < result.residual:
+                if retry.status in ("solved", "solved_acceptable") or retry.residual < result.residual:
                     result = retry
             point, status, message = result.point, result.status, result.message
             extras = {"regret": self._regret.normaliser(width) * result.regret, "residual": result.residual,
                       "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
         else:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
-                                                                   observed, n_o, prior, width, remaining_time())
+                                                                   observed, n_o, rows, prior, width, remaining_time())
             extras = {}
         extras.update({"estimated_goal": point.goal.copy(), "prior_goal": prior, "t_obs": float(t_obs), "observed_step": n_o,
                        "observed_state": observed, "method": method, "multipliers": point.lam.copy()})
         success = status in ("solved", "solved_acceptable")
-        return self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
-                                      success=success, message=message, solve_time=time.perf_counter() - t_begin,
-                                      iterations=iterations, extras=extras)
+        estimate = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
+                                          success=success, message=message, solve_time=time.perf_counter() - t_begin,
+                                          iterations=iterations, extras=extras)
+        estimate.extras["observation_residual"] = estimate.mean[n_o] - observed
+        return estimate
 
-    def _warm_point(self, warm_start: Plan) -> tuple[RegretPoint, bool]:
+    def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> Plan:
+        """The estimate from an observation at step 0: the plan to the prior goal, status 'uninformative'."""
+        plan = self.planner.solve(start, prior, width, warm_start=warm_start, max_wall_time=max_wall_time)
+        message = (f"the observation at t_obs = {t_obs:g} s falls on step 0, the start itself, and says nothing about the goal: "
+                   f"the estimate is the prior goal and the trajectory its plan (plan status '{plan.status}')")
+        extras = {"estimated_goal": prior.copy(), "prior_goal": prior, "t_obs": t_obs, "observed_step": 0,
+                  "observed_state": observed, "method": method, "observation_residual": plan.mean[0] - observed,
+                  "plan_status": plan.status}
+        return replace(plan, success=False, status="uninformative", message=message, extras=extras,
+                       solve_time=time.perf_counter() - t_begin)
+
+    @property
+    def _max_iterations(self) -> int:
+        if self.options.max_iterations is not None:
+            return self.options.max_iterations
+        return 30 if self._regret.exact else 100
+
+    def _warm_point(self, warm_start: Plan, n_rows: int) -> tuple[RegretPoint, bool]:
         """The iterate a warm start gives, and whether its plan to the goal (tau_s) must still be solved."""
         model = self.model
         if not isinstance(warm_start, Plan):
@@ -178,9 +213,9 @@ class GoalEstimator:
         tau_c = as_matrix("warm_start.torque", warm_start.torque, shape, unit).ravel()
         goal = as_vector("warm_start.goal", warm_start.goal, model.d, "m")
         extras = warm_start.extras
-        lam = np.zeros(2 * model.n)
-        if "multipliers" in extras:
-            lam = as_vector("warm_start.extras['multipliers']", extras["multipliers"], 2 * model.n, "multipliers")
+        lam = np.zeros(n_rows)
+        if "multipliers" in extras and np.size(extras["multipliers"]) == n_rows:  # from an estimate at a step like this one's
+            lam = as_vector("warm_start.extras['multipliers']", extras["multipliers"], n_rows, "multipliers")
         if "unconstrained_torque" in extras:
             tau_s = as_matrix("warm_start.extras['unconstrained_torque']", extras["unconstrained_torque"], shape, unit).ravel()
             return RegretPoint(tau_c.copy(), lam.copy(), tau_s.copy(), goal.copy()), False
@@ -189,7 +224,7 @@ class GoalEstimator:
         # the plan to its goal is solved afresh. A plain plan is one already.
         return RegretPoint(tau_c.copy(), lam.copy(), tau_c.copy(), goal.copy()), "observed_step" in extras
 
-    def _cold_point(self, start, observed, n_o, prior, width, remaining_time) -> RegretPoint:
+    def _cold_point(self, start, observed, n_o, n_rows, prior, width, remaining_time) -> RegretPoint:
         """Start from the best goal along the observed direction; from the prior (or the hand) if nothing moved."""
         R = observation_covariance(self.options.observation_std, self.model.n)
         found = search_along_observed_direction(self.planner, start, observed, n_o, prior, width, R, self.options.search_distances,
@@ -200,10 +235,11 @@ class GoalEstimator:
         else:
             goal, plan = found
         tau = plan.torque.ravel()
-        return RegretPoint(tau.copy(), np.zeros(2 * self.model.n), tau.copy(), np.asarray(goal, dtype=float).copy())
+        return RegretPoint(tau.copy(), np.zeros(n_rows), tau.copy(), np.asarray(goal, dtype=float).copy())
 
-    def _paper_solver(self, n_o: int) -> tuple[ca.Function, IpoptDeadline]:
-        """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1)."""
+    def _paper_solver(self, n_o: int, rows: np.ndarray) -> tuple[ca.Function, IpoptDeadline]:
+        """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1); the
+        constraint holds the observed ``rows`` (fixed by n_o) of the state."""
         if n_o not in self._paper_solvers:
             p, model = self.problem, self.model
             observed = ca.SX.sym("observed", 2 * model.n)
@@ -213,16 +249,16 @@ class GoalEstimator:
             objective = (p.objective + use_prior * ca.dot(error, ca.solve(W, error))) / (-p.best_objective)
             x = ca.vertcat(ca.vec(p.tau), p.goal)
             params = ca.vertcat(p.s0, observed, prior, p.width, use_prior)
-            deadline = IpoptDeadline(x.numel(), params.numel(), 2 * model.n)
-            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.options.max_iterations * 10, "tol": self.options.tolerance}
+            deadline = IpoptDeadline(x.numel(), params.numel(), len(rows))
+            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations * 10, "tol": self.options.tolerance}
             solver = ca.nlpsol(f"goal_estimate_eq11_{n_o}", "ipopt",
-                               {"x": x, "p": params, "f": objective, "g": p.means[n_o] - observed},
+                               {"x": x, "p": params, "f": objective, "g": (p.means[n_o] - observed)[rows.tolist()]},
                                {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
             self._paper_solvers[n_o] = (solver, deadline)
         return self._paper_solvers[n_o]
 
-    def _paper_solve(self, point: RegretPoint, start, observed, n_o, prior, width, budget):
-        solver, deadline = self._paper_solver(n_o)
+    def _paper_solve(self, point: RegretPoint, start, observed, n_o, rows, prior, width, budget):
+        solver, deadline = self._paper_solver(n_o, rows)
         deadline.time = math.inf if budget is None else time.perf_counter() + budget
         params = np.r_[start, observed, np.zeros(self.model.d) if prior is None else prior, width, prior is not None]
         result = solver(x0=np.r_[point.tau_c, point.goal], p=params, lbg=0, ubg=0)

@@ -5,6 +5,16 @@ lives on the grid t_i = i·h, so an observation belongs to step n_o = floor(t_o 
 step (paper Section V-C: "the discrete time-step closest to the continuous time of measurement
 n_o = floor(t_o / h)"). A time that is a multiple of h up to rounding (e.g. 0.2 s on h = 0.02 s, where
 0.2/0.02 = 9.999…) maps to that multiple: the division is given a relative slack of 1e-9 before flooring.
+
+What an observation can tell about the goal depends on its step (forward Euler, SPEC §2):
+
+- n_o ≥ 2 (t_o ≥ 2h): the whole state depends on the torques; an estimate holds its plan to all of it.
+- n_o = 1 (h ≤ t_o < 2h): q_1 = q_0 + h qdot_0 is fixed by the start, and only the velocity qdot_1 (through
+  tau_0) depends on the torques: an estimate holds its plan to the observed velocity only, and reports
+  the position's mismatch (``extras["observation_residual"]``).
+- n_o = 0 (0 < t_o < h): the state at step 0 is the start itself; the observation says nothing about the
+  goal. An estimate is then the plan to the prior goal (status 'uninformative'), and without a prior goal
+  there is nothing to return (ValueError).
 """
 
 from __future__ import annotations
@@ -18,18 +28,14 @@ from comanip.model import ReachingModel
 
 #: Relative slack on t/h so that times on the grid are not floored one step early by rounding.
 _GRID_SLACK = 1e-9
-#: The first step whose mean position the torques can move (Euler: q_2 = q_1 + h qdot_1, qdot_1 from tau_0).
-_FIRST_ESTIMABLE_STEP = 2
 
 
 def observation_step(model: ReachingModel, t_obs, *, allow_start: bool = False, name: str = "t_obs") -> int:
     """Plan step n_o = floor(t_obs / h) of an observation at t_obs (s).
 
-    t_obs must lie in (0, H·h), and at least two steps in: step 0 is the start itself, and at step 1 the
-    forward-Euler position q_1 = q_0 + h qdot_0 is fixed by the start, so no torque can meet an observed
-    position there (an estimate's constraint would be degenerate). With ``allow_start`` (a posterior, which
-    scores states rather than constraining them) any t_obs in [0, H·h] is accepted. Anything else raises
-    ValueError naming ``name``.
+    t_obs must lie in (0, H·h) (an estimate; the module docstring says what each step can tell), or in
+    [0, H·h] with ``allow_start`` (a posterior, which scores states rather than constraining them).
+    Anything else raises ValueError naming ``name``.
     """
     if isinstance(t_obs, bool) or not isinstance(t_obs, (int, float, np.integer, np.floating)) or not math.isfinite(t_obs):
         raise ValueError(f"{name} must be a finite time in s, got {t_obs!r}")
@@ -39,11 +45,14 @@ def observation_step(model: ReachingModel, t_obs, *, allow_start: bool = False, 
     if not inside:
         interval = f"[0, {horizon:g}]" if allow_start else f"(0, {horizon:g})"
         raise ValueError(f"{name} must lie in {interval} s (the model's horizon H·h = {model.H}·{model.h:g} s), got {t_obs:g}")
-    step = min(model.H, int(math.floor(t_obs / model.h * (1.0 + _GRID_SLACK))))
-    if step < _FIRST_ESTIMABLE_STEP and not allow_start:
-        raise ValueError(f"{name} must be at least two steps (2h = {2 * model.h:g} s) into the reach, got {t_obs:g} s "
-                         f"(step {step}): before that the mean position is fixed by the start state")
-    return step
+    return min(model.H, int(math.floor(t_obs / model.h * (1.0 + _GRID_SLACK))))
+
+
+def observed_rows(model: ReachingModel, step: int) -> np.ndarray:
+    """Entries of the state [q; qdot] (2n,) the torques can move at ``step``: all from step 2, the
+    velocity at step 1, none at step 0 (module docstring)."""
+    n = model.n
+    return np.arange(2 * n) if step >= 2 else np.arange(n, 2 * n) if step == 1 else np.zeros(0, dtype=int)
 
 
 def observed_state(model: ReachingModel, state, name: str = "observed") -> np.ndarray:

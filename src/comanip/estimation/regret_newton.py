@@ -29,10 +29,14 @@ the optimum is a root of
 
     F1 = grad_tau J(tau_c, g) + A^T lam        (H·n)   tau_c optimal subject to the observation
     F2 = mu_no(tau_c) - s_o                    (2n)    ... which it passes through
-    F3 = grad_tau J(tau_s, g)                  (H·n)   tau_s the unconstrained plan to g
+    F3 = grad_tau J(tau_s, g)                  (H·n)   tau_s the plan to g
     F4 = grad_g J(tau_c, g) - grad_g J(tau_s, g) + 2 P (g - g_bar)   (d)
 
-with A = dmu_no/dtau and P = W^-1 / |J_best| (zero without a prior). Only second derivatives of J appear,
+with A = dmu_no/dtau and P = W^-1 / |J_best| (zero without a prior). For an arm both plans also keep the
+joint position and velocity limits the planner keeps (the wrist's velocity limits bind in most Panda
+reaches): the binding ones are held as equalities with their own multipliers, so that the plan tau_s is
+the planner's plan, and the active sets are updated once F is solved (a violated limit joins, one with a
+negative multiplier leaves) until they settle (:mod:`comanip.estimation.regret_system` writes F out). Only second derivatives of J appear,
 the Hessians a plan's solver uses anyway: Newton's method on F costs two of them per iteration. No NLP
 solver takes a value function as an objective, so the iteration is written out here; IPOPT (through the
 planner) provides its starting point. Block elimination reduces each Newton step to a d×d system in the
@@ -41,6 +45,15 @@ optimum) its eigenvalues are mirrored so the step still descends. A trust region
 by the regret the inner problems' quadratic models predict, keeps the iteration from overshooting where
 the regret is flat (:func:`newton_solve`). The returned point is checked to be a strict local minimum.
 
+**Arms.** The Panda's Hessian of J is an approximation (:mod:`comanip.planning.linearised_curvature`), so
+F's Jacobian is too: the iteration converges linearly, its inner steps are shortened until the residual
+falls, and it stops ('solved_acceptable') once the Newton goal step is below 1e-2 goal widths with both
+plans stationary to 1e-4 (the planner's own acceptable gradient) and the constraints met to 1e-6; the
+second-order check is then made on the regret's d×d Hessian only. Secant (SR1) corrections of the two
+Hessians, which the planner uses, were tried here and made the iteration worse (3 of 4 warm estimates
+stalled against 0 of 4 without): the regret's curvature in g is a small difference of the two plans'
+curvatures, and corrections learned from steps of both plans and the goal at once unsettle it.
+
 The regret is measured against the plan the iteration tracks (tau_s), a local optimum of J: started from
 a poor local optimum it can be zero at a wrong goal, which is why starting points come from the planner's
 multi-start solves or from a previous estimate.
@@ -48,27 +61,12 @@ multi-start solves or from a previous estimate.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from functools import cached_property
+from dataclasses import dataclass, replace
 
-import casadi as ca
 import numpy as np
-import scipy.linalg
 
-from comanip.objectives.reward import goal_covariance
-from comanip.planning.compiled import BufferedFunction
-from comanip.planning.curvature import ReachCurvature
-from comanip.planning.planner import Planner
-
-
-@dataclass
-class RegretPoint:
-    """An iterate: constrained torques tau_c (H·n,), multipliers lam (2n,), plan torques tau_s (H·n,), goal g (d,)."""
-
-    tau_c: np.ndarray
-    lam: np.ndarray
-    tau_s: np.ndarray
-    goal: np.ndarray
+from comanip.estimation.regret_system import Linearisation, RegretPoint, RegretSystem
+from comanip.planning.path_limits import LIMIT_TOLERANCE
 
 
 @dataclass
@@ -77,7 +75,8 @@ class NewtonResult:
 
     point: RegretPoint
     status: str
-    """'solved', 'max_iterations', 'max_wall_time', 'not_a_minimum' or 'failed'."""
+    """'solved', 'solved_acceptable' (approximate Jacobian, see the module docstring), 'max_iterations',
+    'max_wall_time', 'not_a_minimum' or 'failed'."""
     message: str
     iterations: int
     residual: float
@@ -86,214 +85,8 @@ class NewtonResult:
     """J(tau_c) - J(tau_s) at the returned point, normalised (without the regulariser)."""
 
 
-class RegretSystem:
-    """The derivatives Newton's method on F needs, from the planner's own Newton terms (built once per model).
-
-    J and its derivatives in tau come from the planner's structured Hessian (:mod:`comanip.planning.curvature`,
-    exact for point masses; :mod:`comanip.planning.linearised_curvature`, approximate, for the Panda), and
-    those in the goal from the same per-step pieces (``goal_derivatives``). The observed mean mu_no and
-    A = dmu_no/dtau are exact. For a point mass mu_no is linear in tau, so A is constant and the
-    constraint adds no curvature to the Lagrangian; for the Panda that curvature, d²(lam^T mu_no)/dtau², is
-    left out (lam is small: the observation is a state the plan nearly passes through), which like the
-    approximate Hessian only slows the iteration down: F itself is exact, so its root is unchanged.
-    """
-
-    def __init__(self, planner: Planner):
-        problem = self.problem = planner.problem
-        model = problem.model
-        self.n, self.d, self.H = model.n, model.d, model.H
-        self.linear = model.body.is_linear
-        self.curvature = planner.curvature if planner.curvature is not None else ReachCurvature(problem)
-        self._goal_covariance_form = model.goal_covariance
-        self._observed: dict[int, tuple[BufferedFunction, np.ndarray]] = {}
-
-    def derivatives(self, tau: np.ndarray, goal: np.ndarray, start: np.ndarray, width: float) -> "Derivatives":
-        """Normalised J and its first and second derivatives in (tau, g) at torques tau (H·n,) and goal g (d,)."""
-        curvature = self.curvature
-        f, grad, data = curvature.evaluate(np.asarray(tau, dtype=float), np.r_[start, goal, width])
-        grad_g, cross, hess_gg = curvature.goal_derivatives(data)
-        return Derivatives(f, grad, grad_g, curvature.hessian(data), cross, hess_gg, data)
-
-    def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> tuple[np.ndarray, np.ndarray]:
-        """(mu_no (2n,), A = dmu_no/dtau (2n, H·n)) at torques tau; ``data`` from the same evaluation."""
-        if not self.linear:
-            A = self.curvature.mean_sensitivities(data)[n_o].reshape(2 * self.n, -1)
-            return self.curvature.trajectory(data)[0][n_o], A
-        if n_o not in self._observed:
-            p = self.problem
-            tau_symbol = ca.vec(p.tau)
-            mean = ca.Function(f"observed_mean_{n_o}", [tau_symbol, p.s0], [p.means[n_o]])
-            # a linear body's mean is affine in tau: its Jacobian is a constant matrix
-            self._observed[n_o] = (BufferedFunction(mean), np.asarray(ca.evalf(ca.jacobian(p.means[n_o], tau_symbol))))
-        mean, A = self._observed[n_o]
-        return mean(tau, start)[0].ravel(), A
-
-    def prior_weight(self, width: float) -> np.ndarray:
-        """P = W^-1 / |J_best| (d, d) for width w (m)."""
-        return np.linalg.inv(goal_covariance(width, self.d, self._goal_covariance_form)) / self.normaliser(width)
-
-    def normaliser(self, width: float) -> float:
-        """|J_best(w)|: J divided by it is what the iteration works with (m^-d)."""
-        return self.curvature.normaliser(width)
-
-    def linearise(self, point: RegretPoint, start, observed, n_o: int, prior, width) -> "Linearisation":
-        """F and its Jacobian blocks at an iterate; ``prior`` None drops the regulariser."""
-        c = self.derivatives(point.tau_c, point.goal, start, width)
-        s = self.derivatives(point.tau_s, point.goal, start, width)
-        mu, A = self.observed_mean(n_o, point.tau_c, start, c.data)
-        P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(width)
-        pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior)
-        regulariser = 0.0 if prior is None else float((point.goal - prior) @ P @ (point.goal - prior))
-        return Linearisation(
-            J_c=c.f, J_s=s.f, regulariser=regulariser, grad_c=c.grad, H_c=c.hess,
-            F1=c.grad + A.T @ point.lam, F2=mu - observed, F3=s.grad, F4=c.grad_g - s.grad_g + pull,
-            H_s=s.hess, Hc_tau_g=c.cross, Hs_tau_g=s.cross, Hc_gg=c.hess_gg, Hs_gg=s.hess_gg, P=P, A=A)
-
-
-@dataclass
-class Derivatives:
-    """Normalised J at one (tau, g) and its derivatives."""
-
-    f: float
-    grad: np.ndarray
-    """dJ/dtau (H·n,)."""
-    grad_g: np.ndarray
-    """dJ/dg (d,)."""
-    hess: np.ndarray
-    """d²J/dtau² (H·n, H·n)."""
-    cross: np.ndarray
-    """d²J/dtau dg (H·n, d)."""
-    hess_gg: np.ndarray
-    """d²J/dg² (d, d)."""
-    data: tuple
-    """What the curvature object's ``evaluate`` returned (for further terms of the same point)."""
-
-
-@dataclass
-class Linearisation:
-    """F = (F1, F2, F3, F4) at an iterate and the blocks of its Jacobian (see the module docstring)."""
-
-    J_c: float
-    """Normalised J at tau_c and at tau_s, and the normalised regulariser at g."""
-    J_s: float
-    regulariser: float
-    grad_c: np.ndarray
-    """dJ/dtau at tau_c (H·n,) and d²J/dtau² there (H·n square), which is also the Hessian of the constrained
-    plan's Lagrangian (the observation constraint's curvature is zero or left out, see RegretSystem)."""
-    H_c: np.ndarray
-    F1: np.ndarray
-    F2: np.ndarray
-    F3: np.ndarray
-    F4: np.ndarray
-    H_s: np.ndarray
-    """Hessian of J in the plan's torques (H·n square)."""
-    Hc_tau_g: np.ndarray
-    Hs_tau_g: np.ndarray
-    Hc_gg: np.ndarray
-    Hs_gg: np.ndarray
-    P: np.ndarray
-    A: np.ndarray
-
-    @property
-    def residual(self) -> float:
-        return float(max(np.abs(F).max() for F in (self.F1, self.F2, self.F3, self.F4)))
-
-    @cached_property
-    def _cholesky(self) -> tuple[tuple | None, tuple | None]:
-        """Cholesky factors of H_c and H_s, None where one is not positive definite."""
-        return _cholesky_or_none(self.H_c), _cholesky_or_none(self.H_s)
-
-    @cached_property
-    def _solves(self) -> tuple[np.ndarray, np.ndarray]:
-        """K_c^-1 [[Hc_tau_g, F1], [0, F2]] and H_s^-1 [Hs_tau_g, F3], K_c = [[H_c, A^T], [A, 0]] the
-        constrained plan's KKT matrix: the torques' sensitivity to the goal (first d columns; multipliers in
-        Xc's last 2n rows) and their Newton step at a fixed goal (last column).
-
-        Raises LinAlgError when a system is singular."""
-        d = self.Hc_gg.shape[0]
-        factor_c, factor_s = self._cholesky
-        right_c = np.column_stack([self.Hc_tau_g, self.F1])
-        right_obs = np.column_stack([np.zeros((len(self.F2), d)), self.F2])
-        if factor_c is not None:
-            # block elimination on H_c's factor: A x = r2 with H_c x + A^T y = r1 gives (A H_c^-1 A^T) y = A H_c^-1 r1 - r2
-            solved = scipy.linalg.cho_solve(factor_c, np.column_stack([right_c, self.A.T]), check_finite=False)
-            x_right, x_At = solved[:, :d + 1], solved[:, d + 1:]
-            y = np.linalg.solve(self.A @ x_At, self.A @ x_right - right_obs)
-            Xc = np.vstack([x_right - x_At @ y, y])
-        else:
-            n2 = len(self.F2)
-            K_c = np.block([[self.H_c, self.A.T], [self.A, np.zeros((n2, n2))]])
-            Xc = np.linalg.solve(K_c, np.vstack([right_c, right_obs]))
-        right_s = np.column_stack([self.Hs_tau_g, self.F3])
-        Xs = (scipy.linalg.cho_solve(factor_s, right_s, check_finite=False) if factor_s is not None
-              else np.linalg.solve(self.H_s, right_s))
-        return Xc, Xs
-
-    @property
-    def predicted_regret(self) -> float:
-        """R(g) (normalised) predicted from this iterate: J at the inner problems' Newton steps for the same
-        goal, from their quadratic models. Unlike Jc - J(tau_s) at the iterate itself it does not rise when
-        the inner problems are solved more accurately, so it can judge a step while they are not yet."""
-        Xc, Xs = self._solves
-        d, Hn = self.Hc_gg.shape[0], len(self.F1)
-        step_c, step_s = -Xc[:Hn, d], -Xs[:, d]
-        J_c = self.J_c + self.grad_c @ step_c + 0.5 * step_c @ self.H_c @ step_c
-        J_s = self.J_s + self.F3 @ step_s + 0.5 * step_s @ self.H_s @ step_s
-        return float(J_c - J_s) + self.regulariser
-
-    def step(self, goal_step_limit: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Newton step (d tau_c, d lam, d tau_s, d g) by block elimination.
-
-        The goal step solves |d²R/dg²| d g = -r (eigenvalues mirrored, so it descends where the regret is
-        not convex) and is at most goal_step_limit (m) long; the torque steps follow it exactly.
-        """
-        Hn = len(self.F1)
-        Xc, Xs = self._solves
-        d = self.Hc_gg.shape[0]
-        reduced = self.reduced_hessian()
-        rhs = self.F4 - self.Hc_tau_g.T @ Xc[:Hn, d] + self.Hs_tau_g.T @ Xs[:, d]
-        eigenvalues, vectors = np.linalg.eigh(reduced)
-        mirrored = np.maximum(np.abs(eigenvalues), 1e-10 * max(1.0, np.abs(eigenvalues).max()))
-        d_goal = -vectors @ ((vectors.T @ rhs) / mirrored)
-        length = np.linalg.norm(d_goal)
-        if length > goal_step_limit:
-            d_goal *= goal_step_limit / length
-        d_c = -(Xc[:, d] + Xc[:, :d] @ d_goal)
-        d_s = -(Xs[:, d] + Xs[:, :d] @ d_goal)
-        return d_c[:Hn], d_c[Hn:], d_s, d_goal
-
-    def reduced_hessian(self) -> np.ndarray:
-        """d²R/dg² (d, d): the regret's Hessian in the goal with the inner problems kept optimal."""
-        Hn = len(self.F1)
-        d = self.Hc_gg.shape[0]
-        Xc, Xs = self._solves
-        reduced = (self.Hc_gg - self.Hc_tau_g.T @ Xc[:Hn, :d]) - (self.Hs_gg - self.Hs_tau_g.T @ Xs[:, :d]) + 2 * self.P
-        return 0.5 * (reduced + reduced.T)
-
-    def is_strict_minimum(self) -> tuple[bool, str]:
-        """Second-order check: the plan, the constrained plan and the regret all have positive curvature."""
-        factor_c, factor_s = self._cholesky
-        if factor_s is None:
-            return False, "the plan to the estimated goal is not a minimum of J"
-        if factor_c is None:  # positive definite on the constraint's null space is enough
-            Z = scipy.linalg.null_space(self.A)
-            if _cholesky_or_none(Z.T @ self.H_c @ Z) is None:
-                return False, "the trajectory through the observation is not a minimum of J"
-        if _cholesky_or_none(self.reduced_hessian()) is None:
-            return False, "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
-        return True, ""
-
-
-def _cholesky_or_none(matrix: np.ndarray):
-    """scipy's Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
-    try:
-        return scipy.linalg.cho_factor(0.5 * (matrix + matrix.T), check_finite=False)
-    except np.linalg.LinAlgError:
-        return None
-
-
-def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, prior, width: float, *,
-                 observed_position: np.ndarray, tolerance: float, max_iterations: int, step_fraction: float,
+def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, prior,
+                 width: float, *, observed_position: np.ndarray, tolerance: float, max_iterations: int, step_fraction: float,
                  expired) -> NewtonResult:
     """Newton's method on F from ``point`` until max |F| ≤ tolerance, then the second-order check.
 
@@ -304,31 +97,51 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
     comparison is made with them solved more accurately), and the step is retried. Far from the answer the
     regret is not convex, and early in a slow reach it is flat along the reach, where full steps overshoot.
     The radius starts at, and never exceeds, step_fraction·max(|g - x_o|, w), x_o = ``observed_position``
-    (the observed end effector, m). ``expired()`` is asked before every step (wall-time budget).
+    (the observed end effector, m). ``observed_rows`` are the entries of the state s_o (2n,) the
+    constrained plan must meet. ``expired()`` is asked before every step (wall-time budget).
     ``max_iterations`` bounds the number of linearisations (two Hessians of J each), which the result
     reports as iterations. Never raises: when the iteration does not converge, the last accepted iterate
     is returned with a status.
     """
-    linearisation = system.linearise(point, start, observed, n_o, prior, width)
-    radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-    status, message = "max_iterations", f"no convergence in {max_iterations} Newton iterations"
     count = 0
+    excluded_c = system.limits_at_step(n_o) if system.path_limits.active else np.zeros(0, dtype=int)
 
-    def moved(by) -> tuple[RegretPoint, Linearisation]:
+    def linearise(at: RegretPoint) -> Linearisation:
+        return system.linearise(at, start, observed, n_o, observed_rows, prior, width)
+
+    def moved(base: RegretPoint, step: RegretPoint, scale: float = 1.0) -> tuple[RegretPoint, Linearisation]:
         nonlocal count
         count += 1
-        d_tau_c, d_lam, d_tau_s, d_goal = by
-        moved_point = RegretPoint(point.tau_c + d_tau_c, point.lam + d_lam, point.tau_s + d_tau_s, point.goal + d_goal)
-        return moved_point, system.linearise(moved_point, start, observed, n_o, prior, width)
+        at = base.plus(step, scale)
+        return at, linearise(at)
 
+    linearisation = linearise(point)
+    # the limits binding at the start (within 1e-4) are held from the first step on
+    updated = _updated_active_sets(point, linearisation, excluded_c, threshold=-_INITIAL_MARGIN)
+    if updated is not None:
+        point, linearisation = updated, linearise(updated)
+    radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+    status, message = "max_iterations", f"no convergence in {max_iterations} Newton iterations"
+    active_set_rounds = 0
     while True:
         residual = linearisation.residual
         if not np.isfinite(residual):
             return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual, np.nan)
         try:
-            if residual <= tolerance:
-                is_minimum, why = linearisation.is_strict_minimum()
-                status, message = ("solved", "converged") if is_minimum else ("not_a_minimum", why)
+            converged = "solved" if residual <= tolerance else None
+            if converged is None and not system.exact and _acceptable_without_exact_jacobian(linearisation, point, width, radius):
+                converged = "solved_acceptable"
+            if converged is not None:
+                updated = _updated_active_sets(point, linearisation, excluded_c, threshold=LIMIT_TOLERANCE)
+                if updated is not None and active_set_rounds < _ACTIVE_SET_ROUNDS and count < max_iterations:
+                    active_set_rounds += 1
+                    point, linearisation = updated, linearise(updated)
+                    radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+                    continue
+                is_minimum, why = linearisation.is_strict_minimum(system.exact)
+                message = "converged" if converged == "solved" else \
+                    "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
+                status, message = (converged, message) if is_minimum else ("not_a_minimum", why)
                 return NewtonResult(point, status, message, count, residual, linearisation.J_c - linearisation.J_s)
             if count >= max_iterations:
                 break
@@ -336,17 +149,20 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
                 status, message = "max_wall_time", "the wall-time budget ran out"
                 break
             ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-            step = linearisation.step(min(radius, ceiling))
-            trial, trial_linearisation = moved(step)
+            step = linearisation.step(min(radius, ceiling), point)
+            trial, trial_linearisation = moved(point, step)
             if _acceptable(linearisation, trial_linearisation):
                 point, linearisation = trial, trial_linearisation
-                radius = min(2 * radius, ceiling) if np.linalg.norm(step[3]) >= 0.99 * min(radius, ceiling) else radius
+                radius = min(2 * radius, ceiling) if np.linalg.norm(step.goal) >= 0.99 * min(radius, ceiling) else radius
                 continue
-            radius = 0.25 * np.linalg.norm(step[3])
+            radius = 0.25 * np.linalg.norm(step.goal)
             if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
                 status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
                 break
-            inner, inner_linearisation = moved(linearisation.step(0.0))
+            inner_step = linearisation.step(0.0, point)
+            scale = 1.0 if system.exact else _inner_step_length(system, point, inner_step, linearisation, start, observed,
+                                                                 n_o, observed_rows, width)
+            inner, inner_linearisation = moved(point, inner_step, scale)
         except np.linalg.LinAlgError:
             status, message = "failed", "a Newton system was singular (the observation does not pin the torques down)"
             break
@@ -364,7 +180,66 @@ def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
     return after < before or (trial.residual < 0.5 * current.residual and after < before + _ROUNDING * (1 + abs(before)))
 
 
+def _inner_step_length(system: RegretSystem, point: RegretPoint, step: RegretPoint, linearisation: Linearisation,
+                       start, observed, n_o: int, observed_rows: np.ndarray, width: float) -> float:
+    """Step length alpha in (0, 1] for the plans' Newton step at a fixed goal (approximate Jacobian): the
+    first of 1, 1/2, ... that lowers the plans' l1 merits by 1e-4 of the predicted decrease (Armijo), as the
+    planner's SQP does; the shortest tried if none does (or if the step does not descend)."""
+    after = point.plus(step)
+    weights = (2 * np.abs(np.r_[after.lam, after.nu_c]).max(initial=0.0), 2 * np.abs(after.nu_s).max(initial=0.0))
+    n_c = len(point.lam) + len(point.nu_c)
+    # along a step that meets the linearised constraints, d|c|_1/dalpha = -|c|_1
+    slope = (linearisation.grad_c @ step.tau_c - weights[0] * np.abs(linearisation.F2[:n_c]).sum()
+             + linearisation.grad_s @ step.tau_s - weights[1] * np.abs(linearisation.F5).sum())
+    merit = system.merits(point, start, observed, n_o, observed_rows, width, weights)
+    alpha = 1.0
+    while alpha > _SHORTEST_INNER_STEP:
+        trial = system.merits(point.plus(step, alpha), start, observed, n_o, observed_rows, width, weights)
+        if np.isfinite(trial) and trial <= merit + _ARMIJO * alpha * min(slope, 0.0):
+            break
+        alpha *= 0.5
+    return alpha
+
+
+def _acceptable_without_exact_jacobian(linearisation: Linearisation, point: RegretPoint, width: float, radius: float) -> bool:
+    """Stop criterion for an approximate Jacobian (module docstring): both plans stationary and their
+    constraints met to acceptable levels, and either the Newton goal step is short or the trust region has
+    shrunk below that length (no longer goal step lowers the regret as far as the approximation can tell)."""
+    stationarity, constraints = linearisation.inner_residuals
+    if stationarity > _ACCEPTABLE_GRADIENT or constraints > _ACCEPTABLE_CONSTRAINT_ERROR:
+        return False
+    short = _ACCEPTABLE_GOAL_STEP * width
+    return radius <= short or np.linalg.norm(linearisation.step(np.inf, point).goal) <= short
+
+
+def _updated_active_sets(point: RegretPoint, linearisation: Linearisation, excluded_c: np.ndarray,
+                         threshold: float) -> RegretPoint | None:
+    """``point`` with the path limits c > threshold added to the plans' active sets and those with a
+    negative multiplier dropped (the constrained plan never holds ``excluded_c``, the limits on the observed
+    state itself); None when nothing changes."""
+    active_c, nu_c = _updated_active_set(point.active_c, point.nu_c, linearisation.limits_c, threshold, excluded_c)
+    active_s, nu_s = _updated_active_set(point.active_s, point.nu_s, linearisation.limits_s, threshold, np.zeros(0, dtype=int))
+    if np.array_equal(active_c, point.active_c) and np.array_equal(active_s, point.active_s):
+        return None
+    return replace(point, active_c=active_c, nu_c=nu_c, active_s=active_s, nu_s=nu_s)
+
+
+def _updated_active_set(active, nu, limits, threshold, excluded) -> tuple[np.ndarray, np.ndarray]:
+    keep = nu >= -_MULTIPLIER_TOLERANCE
+    added = np.setdiff1d(np.flatnonzero(limits > threshold), np.r_[active[keep], excluded])
+    return np.r_[active[keep], added].astype(int), np.r_[nu[keep], np.zeros(len(added))]
+
+
 #: A goal step shorter than this fraction of the goal width means the iteration has stalled.
 _SHORTEST_GOAL_STEP = 1e-7
 #: Relative change of the (normalised) regret below which it no longer tells steps apart.
 _ROUNDING = 1e-10
+#: Inner steps (approximate Jacobian) are halved down to this fraction, until they achieve this fraction of
+#: the linearly predicted decrease of the merit.
+_SHORTEST_INNER_STEP, _ARMIJO = 1.0 / 64, 1e-4
+#: 'solved_acceptable' (approximate Jacobian): plan stationarity, constraint error (state units), goal step (goal widths).
+_ACCEPTABLE_GRADIENT, _ACCEPTABLE_CONSTRAINT_ERROR, _ACCEPTABLE_GOAL_STEP = 1e-3, 1e-4, 1e-2
+#: Limits within this distance of binding at the start (rad, rad/s) are held from the first step.
+_INITIAL_MARGIN = 1e-4
+#: A multiplier below -this leaves the active set; at most this many active-set updates per solve.
+_MULTIPLIER_TOLERANCE, _ACTIVE_SET_ROUNDS = 1e-9, 5
