@@ -10,7 +10,7 @@ from comanip.objectives import discount_weights, goal_covariance, reach_objectiv
 
 def test_objective_gradient_matches_finite_differences(planar_planner, rng):
     """The gradient the planner's solver uses (compiled C) against central differences of the SPEC §4 J."""
-    problem, curvature = planar_planner.problem, planar_planner._curvature
+    problem, curvature = planar_planner.problem, planar_planner.curvature
     p = np.r_[np.zeros(4), 0.3, 0.0, 0.02]
     x = planar_planner.solve(np.zeros(4), [0.3, 0.0], 0.02).torque.ravel() + rng.normal(scale=0.5, size=60)
     _, g, _ = curvature.evaluate(x, p)
