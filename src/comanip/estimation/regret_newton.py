@@ -148,17 +148,21 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
             if expired():
                 status, message = "max_wall_time", "the wall-time budget ran out"
                 break
-            ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-            step = linearisation.step(min(radius, ceiling), point)
-            trial, trial_linearisation = moved(point, step)
-            if _acceptable(linearisation, trial_linearisation):
-                point, linearisation = trial, trial_linearisation
-                radius = min(2 * radius, ceiling) if np.linalg.norm(step.goal) >= 0.99 * min(radius, ceiling) else radius
-                continue
-            radius = 0.25 * np.linalg.norm(step.goal)
-            if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
-                status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
-                break
+            # with an approximate Jacobian, once no goal step longer than the acceptable one lowers the
+            # regret, the goal has settled as far as the approximation can tell: only the plans move on
+            settled = not system.exact and radius <= _ACCEPTABLE_GOAL_STEP * width
+            if not settled:
+                ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+                step = linearisation.step(min(radius, ceiling), point)
+                trial, trial_linearisation = moved(point, step)
+                if _acceptable(linearisation, trial_linearisation):
+                    point, linearisation = trial, trial_linearisation
+                    radius = min(2 * radius, ceiling) if np.linalg.norm(step.goal) >= 0.99 * min(radius, ceiling) else radius
+                    continue
+                radius = 0.25 * np.linalg.norm(step.goal)
+                if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
+                    status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
+                    break
             inner_step = linearisation.step(0.0, point)
             scale = 1.0 if system.exact else _inner_step_length(system, point, inner_step, linearisation, start, observed,
                                                                  n_o, observed_rows, width)

@@ -177,7 +177,7 @@ class RegretSystem:
             F2=np.r_[(mu - observed)[observed_rows], limits_c[point.active_c]],
             F3=s.grad + rows_s.T @ point.nu_s, F5=limits_s[point.active_s],
             F4=c.grad_g - s.grad_g + pull, Hc_tau_g=c.cross, Hs_tau_g=s.cross, Hc_gg=c.hess_gg, Hs_gg=s.hess_gg,
-            P=P, A_c=A_c, A_s=rows_s, limits_c=limits_c, limits_s=limits_s)
+            P=P, A_c=A_c, A_s=rows_s, limits_c=limits_c, limits_s=limits_s, regularise=not self.exact)
 
 
 @dataclass
@@ -212,6 +212,9 @@ class Linearisation:
     limits_c: np.ndarray
     """All path-limit values c(tau_c) and c(tau_s) (≤ 0 when they hold), for updating the active sets."""
     limits_s: np.ndarray
+    regularise: bool = False
+    """Shift an indefinite H_c or H_s by a multiple of I until it is positive definite before solving (for
+    approximate Hessians, as the planner does); otherwise solve the KKT systems as they are (exact Newton)."""
 
     @property
     def residual(self) -> float:
@@ -225,7 +228,9 @@ class Linearisation:
 
     @cached_property
     def _cholesky(self) -> tuple[tuple | None, tuple | None]:
-        """Cholesky factors of H_c and H_s, None where one is not positive definite."""
+        """Cholesky factors of H_c and H_s (shifted if ``regularise``), None where one is not positive definite."""
+        if self.regularise:
+            return _shifted_cholesky(self.H_c), _shifted_cholesky(self.H_s)
         return _cholesky_or_none(self.H_c), _cholesky_or_none(self.H_s)
 
     @cached_property
@@ -322,6 +327,17 @@ def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
         return True
     Z = scipy.linalg.null_space(A) if A.shape[0] else np.eye(H.shape[0])
     return _cholesky_or_none(Z.T @ H @ Z) is not None
+
+
+def _shifted_cholesky(matrix: np.ndarray):
+    """Cholesky factor of matrix + delta·s·I, s = max |diag|, for the least delta in 0, 1e-8, 1e-7, ... that works."""
+    scale = max(float(np.abs(np.diag(matrix)).max()), 1e-300)
+    delta = 0.0
+    while True:
+        factor = _cholesky_or_none(matrix + delta * scale * np.eye(len(matrix)))
+        if factor is not None or delta > 1e6:
+            return factor
+        delta = 1e-8 if delta == 0.0 else 10 * delta
 
 
 def _cholesky_or_none(matrix: np.ndarray):
