@@ -151,6 +151,43 @@ def test_observation_between_steps_uses_the_earlier_step(planar_estimator):
     assert observation_step(model, 0.0201, allow_start=True) == 1  # a posterior may score step 1 (and 0)
 
 
+def test_observation_at_step_one_holds_the_velocity_and_reports_the_position(planar_estimator):
+    """At step 1 the position q_1 = q_0 + h qdot_0 is fixed by the start: the estimate meets the observed
+    velocity, reports the position's mismatch, and a position the start cannot produce changes nothing."""
+    model = planar_estimator.model
+    goal = np.array([0.1, 0.25])
+    plan = hidden_plan(planar_estimator, goal)
+    t_obs = 1.5 * model.h
+    assert observation_step(model, t_obs) == 1
+    exact = planar_estimator.estimate(plan.start, plan.mean[1], t_obs)
+    assert exact.success, exact.message
+    assert np.linalg.norm(exact.goal - goal) < 1e-3 * np.linalg.norm(goal)  # a plan's own step-1 state gives its goal back
+    offset = np.array([0.002, -0.001])
+    observed = plan.mean[1] + np.r_[offset, 0.0, 0.0]
+    shifted = planar_estimator.estimate(plan.start, observed, t_obs, warm_start=exact)
+    assert shifted.success, shifted.message
+    np.testing.assert_allclose(shifted.goal, exact.goal, atol=1e-9)
+    np.testing.assert_allclose(shifted.extras["observation_residual"][:2], -offset, atol=1e-12)
+    np.testing.assert_allclose(shifted.extras["observation_residual"][2:], 0.0, atol=1e-9)
+
+
+def test_observation_at_step_zero_gives_the_plan_to_the_prior(planar_estimator):
+    """Before h the observed state is the start itself: no information about the goal, so the estimate is
+    the prior goal with its plan, flagged 'uninformative' (not a success: nothing was estimated)."""
+    model = planar_estimator.model
+    start, prior = np.zeros(4), np.array([0.25, -0.1])
+    observed = np.array([0.001, 0.0, 0.0, 0.0])
+    estimate = planar_estimator.estimate(start, observed, 0.5 * model.h, prior_goal=prior)
+    assert estimate.status == "uninformative" and not estimate.success
+    np.testing.assert_array_equal(estimate.goal, prior)
+    np.testing.assert_array_equal(estimate.extras["estimated_goal"], prior)
+    assert estimate.extras["observed_step"] == 0
+    np.testing.assert_allclose(estimate.extras["observation_residual"], start - observed)
+    plan = planar_estimator.planner.solve(start, prior)
+    np.testing.assert_allclose(estimate.ee_mean, plan.ee_mean, atol=1e-9)
+    assert np.linalg.norm(estimate.ee_mean[-1] - prior) < model.width
+
+
 def test_joint_state_covariance_matches_monte_carlo(planar_planner, rng):
     """Cross-covariances of the states at several steps (the posterior's likelihood) against samples."""
     model = planar_planner.model

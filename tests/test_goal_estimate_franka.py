@@ -7,6 +7,7 @@ import pytest
 import comanip
 from comanip.estimation import GoalEstimator
 from comanip.estimation.observation import observation_step
+from comanip.planning.path_limits import PathLimits
 
 T_OBS = 0.2
 
@@ -52,8 +53,7 @@ def test_franka_estimate_from_the_hidden_plan_is_exact(franka_estimator):
     home = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     goal = home + [0.0, -0.25, 0.0]
     hidden = franka_estimator.planner.solve(start, goal)
-    limits = franka_estimator._regret.path_limits
-    assert np.max(limits.constraints(hidden.mean)) > -1e-6  # a limit binds in this reach
+    assert np.max(PathLimits.of(model).constraints(hidden.mean)) > -1e-6  # a limit binds in this reach
     n_o = observation_step(model, T_OBS)
     estimate = franka_estimator.estimate(start, hidden.mean[n_o], T_OBS, warm_start=hidden)
     assert estimate.success, estimate.message
