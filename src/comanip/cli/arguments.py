@@ -16,6 +16,16 @@ def add_model_arguments(parser: argparse.ArgumentParser, default_preset: str = "
                         help=f"built-in preset ({', '.join(presets.names())}) or a model YAML file (default: %(default)s)")
 
 
+def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out_default: str, figures: str) -> None:
+    """Arguments of the subcommands that solve one reach and write it: --start (whose default is described
+    by ``start_default``), --width, --max-wall-time, --out (default ``out_default``) and --png (``figures``)."""
+    parser.add_argument("--start", type=vector, help=f"start state [q; qdot], comma-separated (default: {start_default})")
+    parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
+    parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
+    parser.add_argument("--out", default=out_default, help="output folder (default: %(default)s)")
+    parser.add_argument("--png", action="store_true", help=f"also save {figures}")
+
+
 def load_model(args: argparse.Namespace) -> ReachingModel:
     return presets.load(args.preset)
 

@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, add_reach_arguments, load_model, output_dir, vector
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 
@@ -23,18 +23,14 @@ from comanip.estimation.goal_estimate import METHODS
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("estimate", help="estimate a reach's goal from an observed state", description=__doc__)
     add_model_arguments(parser)
-    parser.add_argument("--start", type=vector, help="start state [q; qdot], comma-separated (default: the CSV's t = 0 row, "
-                                                     "else at rest at the body's home position)")
+    add_reach_arguments(parser, "the CSV's t = 0 row, else at rest at the body's home position", "out/estimate", "figures")
     parser.add_argument("--observed", type=vector, help="observed state [q; qdot], comma-separated")
     parser.add_argument("--observations", type=Path, help="CSV of timestamped states (header t_s, q0.., qdot0..)")
-    parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, the paper's)")
+    parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, "
+                        "the paper's); before the model's step h it says nothing about the goal and needs --prior")
     parser.add_argument("--prior", type=vector, help="prior goal g_bar (m), comma-separated (default: no regulariser)")
-    parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
     parser.add_argument("--method", choices=METHODS, default="regret", help="'regret' (default) or 'paper' (eq. 11 as printed)")
     parser.add_argument("--candidates", type=candidate_list, help="candidate goals for a posterior, e.g. '0.3,0;0.2,0.2' (m)")
-    parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
-    parser.add_argument("--out", default="out/estimate", help="output folder (default: %(default)s)")
-    parser.add_argument("--png", action="store_true", help="also save figures")
     parser.set_defaults(func=run)
 
 

@@ -6,20 +6,16 @@ import json
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, add_reach_arguments, load_model, output_dir, vector
 from comanip.planning.planner import Planner
 
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("plan", help="plan one reach", description=__doc__)
     add_model_arguments(parser)
-    parser.add_argument("--start", type=vector, help="start state [q; qdot], comma-separated (default: at rest at the body's home position: "
-                        "the origin for a point mass, the ready pose for the Panda)")
+    add_reach_arguments(parser, "at rest at the body's home position: the origin for a point mass, the ready pose for the Panda",
+                        "out/plan", "a figure")
     parser.add_argument("--goal", type=vector, help="goal position (m), comma-separated (default: 0.3 m along x from the start)")
-    parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
-    parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
-    parser.add_argument("--out", default="out/plan", help="output folder (default: %(default)s)")
-    parser.add_argument("--png", action="store_true", help="also save a figure")
     parser.set_defaults(func=run)
 
 
