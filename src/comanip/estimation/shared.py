@@ -9,7 +9,7 @@ import casadi as ca
 
 from comanip.belief.propagation import linearised_step_function
 from comanip.model import ReachingModel
-from comanip.planning.planner import Planner
+from comanip.planning.planner import Planner, SolverOptions
 
 #: How many models keep a built planner at once (least recently used dropped first).
 CACHE_SIZE = 4
@@ -26,12 +26,18 @@ def model_key(model: ReachingModel) -> str:
 
 
 def shared_planner(model: ReachingModel | Planner) -> Planner:
-    """The planner of ``model``, built on first use; a Planner passed in is returned as it is."""
+    """The planner of ``model``, built on first use; a Planner passed in is returned as it is.
+
+    Its terms are compiled to C (``SolverOptions(compile=True)``, cached on disk; a first build costs
+    2–9 s for a point mass): an estimate evaluates them some fifteen times, and compiled they make a warm
+    Cartesian estimate about a third faster (benchmarks/README.md), where the planner's own default
+    leaves point masses uncompiled for sweeps over many models.
+    """
     if isinstance(model, Planner):
         return model
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel or Planner (e.g. comanip.presets.planar()), got {type(model).__name__}")
-    return cached_per_model(_planners, model, Planner)
+    return cached_per_model(_planners, model, lambda m: Planner(m, SolverOptions(compile=True)))
 
 
 def shared_step_jacobians(model: ReachingModel) -> ca.Function:
