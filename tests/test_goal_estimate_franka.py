@@ -58,3 +58,10 @@ def test_franka_estimate_from_the_hidden_plan_is_exact(franka_estimator):
     estimate = franka_estimator.estimate(start, hidden.mean[n_o], T_OBS, warm_start=hidden)
     assert estimate.success, estimate.message
     assert np.linalg.norm(estimate.goal - goal) < 1e-5
+
+
+def test_franka_rejects_the_paper_method_before_any_solve(franka_estimator):
+    """Eq. 11 by IPOPT needs CasADi's exact Hessian of the expanded Panda problem: refused up front."""
+    start = np.r_[franka_estimator.model.body.home_position, np.zeros(7)]
+    with pytest.raises(ValueError, match="method 'paper'"):
+        franka_estimator.estimate(start, start, T_OBS, method="paper")

@@ -10,9 +10,15 @@ Two methods:
 - ``"regret"`` (default): min over g of Jc(g) - V*(g) + (g - g_bar)^T W^-1 (g - g_bar), the paper's
   constrained objective minus the value of the unconstrained plan to the same goal, which makes an exact
   observation of a plan give back its goal (:mod:`comanip.estimation.regret_newton` explains why eq. 11 as
-  printed does not, with numbers). Solved by Newton's method from a plan (IPOPT).
+  printed does not, with numbers). Solved by Newton's method on the planner's structured Hessians, from a
+  plan or a previous estimate. Point masses and the Panda (whose plans keep the joint limits, held here
+  too; approximate Hessian, so estimates end 'solved_acceptable' at a goal settled to 1e-2 goal widths).
 - ``"paper"``: eq. 11 as printed, one IPOPT solve over (tau, g) with the observation as a constraint.
-  Biased towards goals near the observation; kept to reproduce the paper and to compare.
+  Biased towards goals near the observation; kept to reproduce the paper and to compare. Point masses
+  only (IPOPT needs CasADi's exact Hessian of the expanded problem, far too expensive for the Panda).
+
+Observations before 2h: at step 1 only the velocity is held, at step 0 the estimate is the prior's plan
+(status 'uninformative'); :mod:`comanip.estimation.observation` says why.
 
 The regulariser (g - g_bar)^T W^-1 (g - g_bar), W from the width as the model says (W = w² I by default), is
 the paper's; without a prior goal (``prior_goal=None``) it is left out.
@@ -131,6 +137,9 @@ class GoalEstimator:
         prior = None if prior_goal is None else as_vector("prior_goal", prior_goal, model.d, "task-space position, m")
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        if method == "paper" and not model.body.is_linear:
+            raise ValueError(f"method 'paper' (IPOPT with CasADi's exact Hessian of the expanded problem) is for point "
+                             f"masses; the {model.body.name!r} body needs method 'regret'")
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         rows = observed_rows(model, n_o)
         if n_o == 0:
