@@ -38,25 +38,24 @@ reaches): the binding ones are held as equalities with their own multipliers, so
 the planner's plan, and the active sets are updated once F is solved (a violated limit joins, one with a
 negative multiplier leaves) until they settle (:mod:`comanip.estimation.regret_system` writes F out). Only second derivatives of J appear,
 the Hessians a plan's solver uses anyway: Newton's method on F costs two of them per iteration. No NLP
-solver takes a value function as an objective, so the iteration is written out here; IPOPT (through the
-planner) provides its starting point. Block elimination reduces each Newton step to a d×d system in the
+solver takes a value function as an objective, so the iteration is written out here; the planner
+provides its starting point. Block elimination reduces each Newton step to a d×d system in the
 goal whose matrix is the regret's Hessian d²R/dg²; where that is not positive definite (far from the
 optimum) its eigenvalues are mirrored so the step still descends. A trust region on the goal step, judged
 by the regret the inner problems' quadratic models predict, keeps the iteration from overshooting where
 the regret is flat (:func:`newton_solve`). The returned point is checked to be a strict local minimum.
 
 **Arms.** The Panda's Hessian of J is an approximation (:mod:`comanip.planning.linearised_curvature`), so
-F's Jacobian is too: the iteration converges linearly, its inner steps are shortened until the residual
-falls, and it stops ('solved_acceptable') once the Newton goal step is below 1e-2 goal widths with both
-plans stationary to 1e-4 (the planner's own acceptable gradient) and the constraints met to 1e-6; the
-second-order check is then made on the regret's d×d Hessian only. Secant (SR1) corrections of the two
-Hessians, which the planner uses, were tried here and made the iteration worse (3 of 4 warm estimates
-stalled against 0 of 4 without): the regret's curvature in g is a small difference of the two plans'
-curvatures, and corrections learned from steps of both plans and the goal at once unsettle it.
-
-The regret is measured against the plan the iteration tracks (tau_s), a local optimum of J: started from
-a poor local optimum it can be zero at a wrong goal, which is why starting points come from the planner's
-multi-start solves or from a previous estimate.
+F's Jacobian is too, and the iteration converges linearly. Indefinite plan Hessians are shifted by a
+multiple of I before the KKT solves (as the planner does), the inner steps at a fixed goal take the
+first of 1, 1/2, ... that lowers the plans' l1 merits, and the iteration stops ('solved_acceptable') when
+both plans are stationary to 1e-3 with their constraints met to 1e-4 and either the Newton goal step is
+below 1e-2 goal widths or no goal step that long lowers the regret any more (the goal has settled as far
+as the approximation can tell; from then on only the plans move). The second-order check is then made on
+the regret's d×d Hessian only. Secant (SR1) corrections of the two Hessians, which the planner uses, were
+tried and made things worse (none of 4 warm estimates converged in 30 iterations with them, 3 of 4 did in
+2–3 without): the regret's curvature in g is a small difference of the two plans' curvatures, and
+corrections learned from steps of both plans and the goal at once unsettle it.
 """
 
 from __future__ import annotations
