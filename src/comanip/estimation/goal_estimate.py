@@ -49,7 +49,8 @@ from comanip.estimation.shared import cached_per_model, shared_planner, shared_s
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
 from comanip.planning.plan import Plan
-from comanip.planning.planner import IPOPT_STATUS, IpoptDeadline, Planner
+from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
+from comanip.planning.planner import Planner
 
 METHODS = ("regret", "paper")
 

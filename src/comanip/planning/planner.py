@@ -39,6 +39,7 @@ from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_v
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
+from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
@@ -46,15 +47,6 @@ from comanip.planning.plan import Plan
 from comanip.planning.reach_problem import ReachProblem
 
 SOLVER_METHODS = ("newton", "ipopt")
-
-#: IPOPT return_status -> (comanip status, success); shared by every IPOPT-solved problem (planner, eq. 11).
-IPOPT_STATUS = {
-    "Solve_Succeeded": ("solved", True),
-    "Solved_To_Acceptable_Level": ("solved_acceptable", True),
-    "Maximum_Iterations_Exceeded": ("max_iterations", False),
-    "Maximum_WallTime_Exceeded": ("max_wall_time", False),
-    "Maximum_CpuTime_Exceeded": ("max_wall_time", False),
-}
 
 
 @dataclass(frozen=True)
@@ -313,38 +305,6 @@ class Planner:
             status = "max_wall_time"
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return torque, float(result["f"]), status, success, stats["return_status"], int(stats.get("iter_count", 0))
-
-
-class IpoptDeadline(ca.Callback):
-    """IPOPT iteration callback that asks the solver to stop once ``time`` (perf_counter, s) has passed."""
-
-    def __init__(self, n_x: int, n_p: int, n_g: int = 0):
-        ca.Callback.__init__(self)
-        self.time = np.inf
-        self._sizes = {"x": n_x, "f": 1, "g": n_g, "lam_x": n_x, "lam_g": n_g, "lam_p": n_p}
-        self.construct("deadline", {})
-
-    @property
-    def expired(self) -> bool:
-        return time.perf_counter() > self.time
-
-    def get_n_in(self):
-        return ca.nlpsol_n_out()
-
-    def get_n_out(self):
-        return 1
-
-    def get_name_in(self, i):
-        return ca.nlpsol_out(i)
-
-    def get_name_out(self, i):
-        return "ret"
-
-    def get_sparsity_in(self, i):
-        return ca.Sparsity.dense(self._sizes[ca.nlpsol_out(i)], 1)
-
-    def eval(self, arg):
-        return [1 if self.expired else 0]
 
 
 def plan_reach(model: ReachingModel, start, goal, width: float | None = None, **solve_options) -> Plan:

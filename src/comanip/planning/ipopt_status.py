@@ -1,0 +1,53 @@
+"""What IPOPT says, in comanip's terms: its return status mapped to a plan status, and a wall-time deadline.
+
+Shared by every problem comanip hands to IPOPT (the planner's reference solver, the paper's eq. 11 goal
+estimate).
+"""
+
+from __future__ import annotations
+
+import time
+
+import casadi as ca
+import numpy as np
+
+#: IPOPT return_status -> (comanip status, success); a status not listed maps to ("failed", False).
+IPOPT_STATUS = {
+    "Solve_Succeeded": ("solved", True),
+    "Solved_To_Acceptable_Level": ("solved_acceptable", True),
+    "Maximum_Iterations_Exceeded": ("max_iterations", False),
+    "Maximum_WallTime_Exceeded": ("max_wall_time", False),
+    "Maximum_CpuTime_Exceeded": ("max_wall_time", False),
+}
+
+
+class IpoptDeadline(ca.Callback):
+    """IPOPT iteration callback that asks the solver to stop once ``time`` (perf_counter, s) has passed."""
+
+    def __init__(self, n_x: int, n_p: int, n_g: int = 0):
+        ca.Callback.__init__(self)
+        self.time = np.inf
+        self._sizes = {"x": n_x, "f": 1, "g": n_g, "lam_x": n_x, "lam_g": n_g, "lam_p": n_p}
+        self.construct("deadline", {})
+
+    @property
+    def expired(self) -> bool:
+        return time.perf_counter() > self.time
+
+    def get_n_in(self):
+        return ca.nlpsol_n_out()
+
+    def get_n_out(self):
+        return 1
+
+    def get_name_in(self, i):
+        return ca.nlpsol_out(i)
+
+    def get_name_out(self, i):
+        return "ret"
+
+    def get_sparsity_in(self, i):
+        return ca.Sparsity.dense(self._sizes[ca.nlpsol_out(i)], 1)
+
+    def eval(self, arg):
+        return [1 if self.expired else 0]
