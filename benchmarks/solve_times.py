@@ -30,6 +30,13 @@ class Case:
     paper_time: float | None = None
 
 
+def timed(build: Callable[[], object]) -> tuple[object, float]:
+    """(build(), its wall time in s): a case's one-off set-up, reported apart from the solves."""
+    t0 = time.perf_counter()
+    built = build()
+    return built, time.perf_counter() - t0
+
+
 def reach_case(preset: str, paper_time: float, options: SolverOptions | None = None, label: str = "",
                reach=(0.3, 0.0, 0.0)) -> Callable[[], Case]:
     """Warm solves to goals drawn uniformly within ±5 cm (per axis) of a base goal, each warm-started from
@@ -38,9 +45,7 @@ def reach_case(preset: str, paper_time: float, options: SolverOptions | None = N
 
     def make() -> Case:
         model = comanip.presets.load(preset)
-        t0 = time.perf_counter()
-        planner = comanip.Planner(model, options)
-        build = time.perf_counter() - t0
+        planner, build = timed(lambda: comanip.Planner(model, options))
         rng = np.random.default_rng(0)
         home = model.body.home_position
         start = np.concatenate([home, np.zeros(model.n)])
@@ -65,9 +70,7 @@ def closed_loop_reach_case() -> Case:
     from comanip.execution import execute_receding_horizon
 
     model = comanip.presets.planar()
-    t0 = time.perf_counter()
-    planner = comanip.Planner(model)
-    build = time.perf_counter() - t0
+    planner, build = timed(lambda: comanip.Planner(model))
     rng = np.random.default_rng(0)
 
     def solve(k: int) -> tuple[float, bool]:
@@ -86,9 +89,7 @@ def franka_replan_case() -> Case:
     from comanip.execution import execute_receding_horizon
 
     model = comanip.presets.load("franka")
-    t0 = time.perf_counter()
-    planner = comanip.Planner(model)
-    build = time.perf_counter() - t0
+    planner, build = timed(lambda: comanip.Planner(model))
     home = model.body.home_position
     start = np.concatenate([home, np.zeros(model.n)])
     goal = np.asarray(model.body.kinematics_function(home)[0]).ravel() + np.array([0.15, 0.1, -0.1])
@@ -122,9 +123,7 @@ def estimate_case(preset: str, reach=(0.3, 0.0, 0.0)) -> Callable[[], Case]:
         from comanip.estimation import GoalEstimator
 
         model = comanip.presets.load(preset)
-        t0 = time.perf_counter()
-        estimator = GoalEstimator(model)
-        build = time.perf_counter() - t0
+        estimator, build = timed(lambda: GoalEstimator(model))
         rng = np.random.default_rng(0)
         home = model.body.home_position
         start = np.concatenate([home, np.zeros(model.n)])
@@ -157,9 +156,7 @@ def posterior_case(preset: str, new_start: bool) -> Callable[[], Case]:
         from comanip.estimation.shared import shared_planner
 
         model = comanip.presets.load(preset)
-        t0 = time.perf_counter()
-        planner = shared_planner(model)
-        build = time.perf_counter() - t0
+        planner, build = timed(lambda: shared_planner(model))
         rng = np.random.default_rng(0)
         offsets = np.array([[0, 0, 0], [0, 1, 0], [0, -1, 0], [1, 0, 0], [-1, 0, 0]])[:, : model.d]
         candidates = 0.3 * np.eye(model.d)[0] + 0.15 * offsets
