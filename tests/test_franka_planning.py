@@ -83,8 +83,38 @@ def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(f
         assert np.all(np.abs(qdot) <= body.qdot_max + LIMIT_TOLERANCE)
         assert np.all(np.abs(plan.torque) <= body.tau_max + 1e-9)
         fastest_joint = max(fastest_joint, float(np.max(np.abs(qdot) / body.qdot_max)))
-    # the reaches are fast enough for the velocity limits to bind: the augmented Lagrangian was exercised
+    # the reaches are fast enough for the velocity limits to bind: the working set was exercised
     assert fastest_joint > 0.99
+
+
+@pytest.mark.parametrize("drop", [0.2, 0.25])
+def test_cold_reach_along_a_joint_limit_converges(franka_planner, drop):
+    """Reaching down from the ready pose, joint 4 runs along its lower limit for the second half of the
+    reach. The solver once stalled there (a limit met to 3e-8 kept in the working set against a negative
+    multiplier; the merit's penalty blocking every step) or kept the zero-reward plan of another start,
+    570 mm from the goal, as its 'success'."""
+    model = franka_planner.model
+    body = model.body
+    start = np.r_[body.home_position, np.zeros(7)]
+    goal = np.asarray(body.kinematics_function(body.home_position)[0]).ravel() - [0.0, 0.0, drop]
+    plan = franka_planner.solve(start, goal)
+    assert plan.success, (plan.status, plan.message)
+    assert plan.final_error < model.width
+    assert np.min(plan.mean[1:, 3] - body.q_min[3]) < 1e-3  # the limit binds
+    assert np.all(plan.mean[1:, :7] >= body.q_min - LIMIT_TOLERANCE)
+
+
+def test_closed_loop_franka_replans_converge(franka_planner):
+    """A closed-loop reach replans at every step from the noisy state, warm-started with the shifted plan:
+    the real-time use. Before the solver's recovery steps a quarter of these replans ended 'failed'."""
+    from comanip.execution import execute_receding_horizon
+
+    body = franka_planner.model.body
+    start = np.r_[body.home_position, np.zeros(7)]
+    goal = np.asarray(body.kinematics_function(body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
+    run = execute_receding_horizon(franka_planner, start, goal, steps=40, rng=np.random.default_rng(0))
+    assert run.failed_replans <= 2
+    assert np.linalg.norm(run.ee[-1] - goal) < franka_planner.model.width
 
 
 @pytest.mark.parametrize("goal", [[1.5, 0.0, 0.3], [0.0, 0.0, -0.9]])
