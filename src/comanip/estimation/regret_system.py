@@ -114,7 +114,7 @@ class RegretSystem:
         """(mu_no (2n,), A = dmu_no/dtau (2n, H·n)) at torques tau; ``data`` from the same evaluation."""
         if not self.linear:
             A = self.curvature.mean_sensitivities(data)[n_o].reshape(2 * self.n, -1)
-            return self.curvature.trajectory(data)[0][n_o], A
+            return self.curvature.mean_path(data)[n_o], A
         if n_o not in self._observed:
             p = self.problem
             tau_symbol = ca.vec(p.tau)
@@ -136,12 +136,18 @@ class RegretSystem:
         """l1 merit of the two plans at the point's goal: J(tau_c) + mu_c |c_c|_1 + J(tau_s) + mu_s |c_s|_1,
         (mu_c, mu_s) = ``weights``, c the constraints each holds (observed rows and active limits)."""
         total = 0.0
+        params = np.r_[start, point.goal, width]
         for tau, active, mu, observe in ((point.tau_c, point.active_c, weights[0], True),
                                          (point.tau_s, point.active_s, weights[1], False)):
-            f, _, data = self.curvature.evaluate(np.asarray(tau, dtype=float), np.r_[start, point.goal, width])
+            tau = np.asarray(tau, dtype=float)
+            if self.linear:
+                f, _, data = self.curvature.evaluate(tau, params)
+            else:  # the forward rollout alone: a sixth of the derivatives' cost on the Panda
+                f, data = self.curvature.value_and_mean(tau, params)
             violation = np.abs(self.limits(tau, data, _NO_INDICES)[0][active]).sum()
             if observe:
-                violation += np.abs((self.observed_mean(n_o, tau, start, data)[0] - observed)[observed_rows]).sum()
+                mean = self.observed_mean(n_o, tau, start, data)[0] if self.linear else self.curvature.mean_path(data)[n_o]
+                violation += np.abs((mean - observed)[observed_rows]).sum()
             total += f + mu * violation
         return total
 
