@@ -144,7 +144,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             H = H + correction
             previous = (x, g)
         # after a failed line search, a stronger shift turns the step towards steepest descent
-        factor, delta_last = _regularised_cholesky(H, delta_last, least=_RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0)
+        least = _RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
+        factor, delta_last = _regularised_cholesky(H, delta_last, least)
         if factor is None:
             return result("failed", "no positive definite regularised Hessian", np.inf)
         step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin, constraint_tolerance)

@@ -285,12 +285,14 @@ class Planner:
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
+        # an arm's value-only rollout is a sixth of the terms' cost; a point mass computes everything at once
+        value = (lambda x: curvature.value_and_mean(x, params)) if isinstance(curvature, LinearisedCurvature) else None
         result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                                  *self._torque_bounds, tolerance=self.options.tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                                  constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
-                                 value=(lambda x: curvature.value_and_mean(x, params)) if hasattr(curvature, "value_and_mean") else None)
+                                 value=value)
         success = result.status in ("solved", "solved_acceptable")
         return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
                 result.message, result.iterations)
