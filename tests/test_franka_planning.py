@@ -63,6 +63,47 @@ def test_structured_hessian_is_close_to_the_exact_one(short_franka, rng):
         assert np.linalg.norm(H - H_exact, 2) < 0.1 * np.linalg.norm(H_exact, 2)
 
 
+@pytest.mark.parametrize("noise", ["isotropic", "per_channel", "rank_one"])
+def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
+    """The assembly (backward recursion for the state cost, contracted noise rows) against the plain sum
+    Σ_i Z_iᵀ ∇²phi_i Z_i + T_iᵀ W_i T_i over explicit rows Z_i, the noise rows built one torque at a time
+    from central differences of N(tau) (exact: N is quadratic), plus the noise's own curvature and effort."""
+    from comanip.belief.noise import noise_covariance
+
+    model = comanip.presets.load("franka").replace(H=6, noise=noise)
+    curvature = LinearisedCurvature(ReachProblem(model), compile=False)
+    tau, p = _point(model, rng)
+    data = curvature.evaluate(tau, p)[2]
+    n, d, H = 7, 3, model.H
+    J, Q, phi_grad, W, dvech = data[6], data[7], data[8], data[9], data[10]
+    T = curvature.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
+    triangle = [(a, b) for b in range(d) for a in range(b + 1)]
+    vech = lambda S: np.array([S[a, b] for a, b in triangle])  # noqa: E731
+    taus = tau.reshape(H, n)
+    E = [[(noise_covariance(t + e, model.kappa, noise) - noise_covariance(t - e, model.kappa, noise)) / 2
+          for e in np.eye(n)] for t in taus]
+    expected = np.zeros((H * n, H * n))
+    for i in range(H + 1):
+        J_i, Q_i = J[:, i * n:(i + 1) * n], Q[:, i * 9:(i + 1) * 9]
+        G = J_i @ T[i]
+        N = np.array([vech(G[:, k * n:(k + 1) * n] @ E[k][j] @ G[:, k * n:(k + 1) * n].T)
+                      for k in range(H) for j in range(n)]).T
+        Z = np.vstack([G, dvech[:, i * n:(i + 1) * n] @ T[i] + N])
+        expected += Z.T @ Q_i @ Z + T[i].T @ W[:, i * n:(i + 1) * n] @ T[i]
+        Lambda = np.zeros((d, d))
+        for (a, b), g in zip(triangle, phi_grad[d:, i]):
+            Lambda[a, b] = Lambda[b, a] = g if a == b else g / 2
+        for k in range(H):
+            G_k = G[:, k * n:(k + 1) * n]
+            for j in range(n):
+                for m in range(n):
+                    second = (noise_covariance(np.eye(n)[j] + np.eye(n)[m], model.kappa, noise)
+                              - noise_covariance(np.eye(n)[j] - np.eye(n)[m], model.kappa, noise)) / 2
+                    expected[k * n + j, k * n + m] += np.sum(Lambda * (G_k @ second @ G_k.T))
+    expected += 2 * model.nu / curvature.normaliser(p[-1]) * np.eye(H * n)
+    np.testing.assert_allclose(curvature.hessian(data), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
 def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(franka_planner):
     """Ten goals around the ready pose (up to 0.2 m along each axis), visited in a tour and each
     warm-started from the plan to the one before, as a robot tracking a person would."""
