@@ -83,30 +83,6 @@ def test_newton_matches_scipy_on_a_bounded_rosenbrock():
     assert result.f <= reference.fun + 1e-12
 
 
-def test_newton_lookahead_takes_constraints_the_step_would_break_into_the_working_set():
-    """min ½|x - t|² s.t. x_0 + x_1 ≤ 1 from 0, where the constraint starts 1 away (outside the working-set
-    margin) and the target t = (2, 2) lies beyond it. Watching it (lookahead 2), the first step lands on its
-    linearisation, which here is exact: the QP's solution (0.5, 0.5) in one step. Without lookahead the full
-    step breaks it and the line search has to back off, so more iterations are needed."""
-    target = np.array([2.0, 2.0])
-
-    def evaluate(x):
-        return 0.5 * float((x - target) @ (x - target)), x - target, x
-
-    def constraints(x, data):
-        return np.array([x[0] + x[1] - 1.0]), lambda rows: np.ones((len(rows), 2))
-
-    free = np.full(2, np.inf)
-    runs = {lookahead: newton_minimize(evaluate, lambda x: np.eye(2), np.zeros(2), -free, free, tolerance=1e-10,
-                                       max_iterations=50, constraints=constraints, lookahead=lookahead)
-            for lookahead in (0.0, 2.0)}
-    watched, unwatched = runs[2.0], runs[0.0]
-    np.testing.assert_allclose(watched.x, [0.5, 0.5], atol=1e-12)
-    assert watched.status == "solved" and watched.iterations == 2  # one step, then the optimality check
-    np.testing.assert_allclose(unwatched.x, [0.5, 0.5], atol=1e-6)
-    assert unwatched.iterations > watched.iterations
-
-
 def test_newton_stops_at_the_deadline():
     calls = []
 

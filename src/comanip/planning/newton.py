@@ -78,7 +78,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
                     hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
                     tolerance: float, max_iterations: int, secant: bool = False,
                     constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
-                    constraint_tolerance: float = 1e-6, margin: float = 1e-3, lookahead: float = 0.0,
+                    constraint_tolerance: float = 1e-6, margin: float = 1e-3,
                     expired: Callable[[], bool] = lambda: False,
                     value: Callable[[np.ndarray], tuple[float, Any]] | None = None) -> NewtonResult:
     """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0.
@@ -94,8 +94,6 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             for none. Entries of c may be -inf (no constraint).
         constraint_tolerance: largest violation a solution may keep (units of c).
         margin: constraints with c > -margin are in the working set.
-        lookahead: constraints with c > -lookahead join the working set too when the step's linearisation
-            would violate them (0: none are watched).
         expired: called between evaluations; True stops with status 'max_wall_time'.
         value: x -> (f, data) without the gradient, for line-search trials when that is much cheaper than
             ``evaluate`` (``data`` then only needs what ``constraints`` reads); ``evaluate`` runs once a trial
@@ -150,7 +148,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         factor, delta_last = _regularised_cholesky(H, delta_last, least)
         if factor is None:
             return result("failed", "no positive definite regularised Hessian", np.inf)
-        step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin, constraint_tolerance, lookahead)
+        step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin, constraint_tolerance)
         lagrangian_gradient = float(np.max(np.abs(g + A(working).T @ multipliers)))
         violation = problem.violation(c)
         if lagrangian_gradient <= tolerance and violation <= constraint_tolerance:
@@ -268,52 +266,33 @@ class _Constraints:
         return float(max(0.0, np.max(c, initial=0.0)))
 
 
-def _constrained_step(factor, g, c, A, margin: float, tolerance: float, lookahead: float = 0.0):
+def _constrained_step(factor, g, c, A, margin: float, tolerance: float):
     """Newton step under the working set's linearised constraints.
 
     A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row with a negative
     multiplier is dropped and the step recomputed unless it is violated by more than ``tolerance`` (then
     the step must restore it). (Keeping a row met to within the tolerance, say at 3e-8 past a joint limit,
     held the Panda's plans on the limit while the objective pulled them off it: the step vanished and
-    the solve stalled with a large Lagrangian gradient.) Rows with -lookahead < c_j ≤ -margin that the
-    step's linearisation c_j + A_j p would violate join the working set, the most violated five at a time,
-    and the step is recomputed: otherwise the line search finds them one backtrack at a time. Returns
-    (step, multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
+    the solve stalled with a large Lagrangian gradient.) Returns (step,
+    multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
     """
     Hg = scipy.linalg.cho_solve(factor, g, check_finite=False)
     working = np.flatnonzero(c > -margin)
-    watched = np.flatnonzero((c > -lookahead) & (c <= -margin))
-    watched_rows = A(watched) if len(watched) else None
-    dropped = np.zeros(0, dtype=int)  # rows left for a negative multiplier do not come back
-    while True:
-        if len(working):
-            rows = A(working)
-            HA = scipy.linalg.cho_solve(factor, rows.T, check_finite=False)
-            schur = rows @ HA
-            multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
-            dropping = (multipliers < 0) & (c[working] <= tolerance)
-            if dropping.any():
-                dropped = np.union1d(dropped, working[dropping])
-                working = working[~dropping]
-                continue
+    while len(working):
+        rows = A(working)
+        HA = scipy.linalg.cho_solve(factor, rows.T, check_finite=False)
+        schur = rows @ HA
+        multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
+        dropping = (multipliers < 0) & (c[working] <= tolerance)
+        if not dropping.any():
             multipliers = np.maximum(multipliers, 0.0)
-            step = -(Hg + HA @ multipliers)
-        else:
-            step, multipliers = -Hg, np.zeros(0)
-        if watched_rows is not None:
-            predicted = c[watched] + watched_rows @ step
-            outside = ~np.isin(watched, working) & ~np.isin(watched, dropped)
-            hit = np.flatnonzero(outside & (predicted > 0.5 * tolerance))
-            if len(hit):
-                working = np.union1d(working, watched[hit[np.argsort(-predicted[hit])][:5]])
-                continue
-        if not len(working):
-            return step, multipliers, working, None
 
-        def correct(c_working, HA=HA, schur=schur):
-            return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
+            def correct(c_working, HA=HA, schur=schur):
+                return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
 
-        return step, multipliers, working, correct
+            return -(Hg + HA @ multipliers), multipliers, working, correct
+        working = working[~dropping]
+    return -Hg, np.zeros(0), working, None
 
 
 def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> None:

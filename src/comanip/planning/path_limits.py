@@ -19,10 +19,6 @@ import numpy as np
 
 LIMIT_TOLERANCE = 1e-6
 """Largest violation (rad or rad/s, m or m/s) a plan may keep."""
-LIMIT_LOOKAHEAD = 1.0
-"""Limits (and torque bounds) closer than this (rad, rad/s, N·m) are checked against each Newton step's
-linearisation and join the working set when the step would break them: on warm Panda solves 10–25 % fewer
-iterations than discovering them by backtracking (benchmarks/README.md)."""
 
 
 @dataclass(frozen=True)

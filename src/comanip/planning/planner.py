@@ -42,7 +42,7 @@ from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques
 from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
-from comanip.planning.path_limits import LIMIT_LOOKAHEAD, LIMIT_TOLERANCE, PathLimits
+from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
 from comanip.planning.reach_problem import ReachProblem
 
@@ -291,8 +291,7 @@ class Planner:
                                  *self._torque_bounds, tolerance=self.options.tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
-                                 constraint_tolerance=LIMIT_TOLERANCE, lookahead=LIMIT_LOOKAHEAD,
-                                 expired=lambda: time.perf_counter() > deadline,
+                                 constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
                                  value=value)
         success = result.status in ("solved", "solved_acceptable")
         return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
