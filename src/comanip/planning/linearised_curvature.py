@@ -224,7 +224,7 @@ class LinearisedCurvature:
         G (H+1, d, H, n); Q_cc (H+1, nv, nv) the reward's curvature in vech Sigma_x; R (H+1, nv, H·n) the
         cross terms Q_cz X_i T_i. With E_kj = dN/dtau_j at tau_k, row (k, j) of N_i is vech(G_ik E_kj G_ikᵀ).
         For isotropic noise E_kj = 2 kappa tau_kj I, so the row is 2 kappa tau_kj v_ik with
-        v_ik = vech(G_ik G_ikᵀ): the sums contract v (H+1, nv, H) instead of N (H+1, nv, H·n), seven times
+        v_ik = vech(G_ik G_ikᵀ): the sums contract v (H+1, nv, H) instead of N (H+1, nv, H·n), n times
         fewer columns.
         """
         a, b = self._triangle.T
