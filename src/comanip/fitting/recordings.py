@@ -1,0 +1,143 @@
+"""Recorded reaches read from CSV: one file, or a folder of files, of hand positions over time.
+
+A recordings file has the columns ``t, x, y`` (and ``z`` for 3-D reaches): t in s from the movement's
+start, positions in m. A ``trial`` column names the trial of each row (rows of one trial in time order);
+without it the whole file is one trial, named after the file. The first sample of a trial is its start,
+where the hand is taken to be at rest. Each trial's goal and width come from columns
+``goal_x, goal_y[, goal_z], width`` (m) repeated on its rows, or from a separate trials table with the
+columns ``trial, goal_x, goal_y[, goal_z], width``. See docs/fitting.md.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from comanip.arguments import as_positive
+from comanip.fitting.csv_table import read_table
+
+AXES = ("x", "y", "z")
+GOAL_COLUMNS = tuple(f"goal_{a}" for a in AXES)
+
+
+@dataclass(frozen=True)
+class Trial:
+    """One recorded reach: K samples of the hand in d task dimensions."""
+
+    name: str
+    """Trial identifier (the ``trial`` column, or the file name without extension)."""
+    t: np.ndarray
+    """Sample times (K,), s from the movement's start, strictly increasing, ≥ 0."""
+    position: np.ndarray
+    """Hand positions (K, d), m."""
+    goal: np.ndarray
+    """Goal position (d,), m."""
+    width: float
+    """Goal width w (m)."""
+
+    @property
+    def start(self) -> np.ndarray:
+        """The first sample (d,), m: where the hand rests before the reach."""
+        return self.position[0]
+
+
+def load_recordings(path: str | Path, trials: str | Path | None = None) -> list[Trial]:
+    """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name).
+
+    Args:
+        path: a recordings file, or a folder of recordings files.
+        trials: a trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal and
+            width columns; a file of that name inside the folder is not read as recordings.
+
+    Returns:
+        The trials, in file order and then in order of first appearance.
+
+    Raises:
+        ValueError (one line) for a missing or empty path, missing columns, non-numeric or non-finite
+        values, times that do not increase within a trial, a goal or width that changes within a trial,
+        a trial without goal and width, or the same trial name twice.
+    """
+    path = Path(path)
+    if path.is_dir():
+        skip = None if trials is None else Path(trials).resolve()
+        files = [f for f in sorted(path.glob("*.csv")) if f.resolve() != skip]
+        if not files:
+            raise ValueError(f"recordings folder {str(path)!r} holds no .csv files")
+    elif path.is_file():
+        files = [path]
+    else:
+        raise ValueError(f"recordings path {str(path)!r} does not exist (give a CSV file or a folder of them)")
+    targets = None if trials is None else read_trials_table(trials)
+    result: list[Trial] = []
+    for file in files:
+        result += _trials_in_file(file, targets)
+    names = [trial.name for trial in result]
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise ValueError(f"recordings: trial names {repeated[:5]} appear in more than one file; name trials uniquely")
+    dimensions = {trial.position.shape[1] for trial in result}
+    if len(dimensions) > 1:
+        raise ValueError(f"recordings mix {sorted(dimensions)}-D trials; every file needs the same position columns")
+    return result
+
+
+def read_trials_table(path: str | Path) -> dict[str, tuple[np.ndarray, float]]:
+    """{trial name: (goal (d,) m, width m)} from a CSV with columns trial, goal_x, goal_y[, goal_z], width."""
+    table = read_table(path, "trials table", ("trial", "goal_x", "goal_y", "width"), GOAL_COLUMNS + ("width",))
+    goal = np.column_stack([table[c] for c in GOAL_COLUMNS if c in table])
+    names = list(table["trial"])
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        raise ValueError(f"trials table {str(path)!r} lists trials {repeated[:5]} more than once")
+    return {name: (goal[k], as_positive(f"width of trial {name!r}", table["width"][k], "m")) for k, name in enumerate(names)}
+
+
+def _trials_in_file(path: Path, targets: dict | None) -> list[Trial]:
+    """The trials of one recordings file; goal and width from its columns or from ``targets``."""
+    table = read_table(path, "recordings", ("t", "x", "y"), ("t",) + AXES + GOAL_COLUMNS + ("width",))
+    d = 3 if "z" in table else 2
+    has_targets = "width" in table
+    if has_targets and not all(c in table for c in GOAL_COLUMNS[:d]):
+        raise ValueError(f"recordings file {str(path)!r} has a width column but not all of {list(GOAL_COLUMNS[:d])}")
+    if not has_targets and targets is None:
+        raise ValueError(f"recordings file {str(path)!r} has no goal_x/goal_y/width columns; add them or give a trials table")
+    labels = table["trial"] if "trial" in table else np.full(len(table["t"]), path.stem)
+    position = np.column_stack([table[a] for a in AXES[:d]])
+    trials = []
+    for name in dict.fromkeys(labels):
+        rows = np.flatnonzero(labels == name)
+        where = f"recordings file {str(path)!r}, trial {name!r}"
+        if has_targets:
+            goal, width = _constant_targets(table, rows, d, where)
+        elif name not in targets:
+            raise ValueError(f"{where} is not in the trials table")
+        else:
+            goal, width = targets[name]
+        trials.append(_checked_trial(str(name), table["t"][rows], position[rows], goal, width, where))
+    return trials
+
+
+def _constant_targets(table: dict, rows: np.ndarray, d: int, where: str) -> tuple[np.ndarray, float]:
+    goal = np.column_stack([table[c][rows] for c in GOAL_COLUMNS[:d]])
+    width = table["width"][rows]
+    if np.ptp(goal, axis=0).max() > 0 or np.ptp(width) > 0:
+        raise ValueError(f"{where}: the goal or width changes within the trial; each trial has one goal and width")
+    return goal[0], width[0]
+
+
+def _checked_trial(name: str, t: np.ndarray, position: np.ndarray, goal, width, where: str) -> Trial:
+    if len(t) < 3:
+        raise ValueError(f"{where} has {len(t)} samples; a trial needs at least 3")
+    if t[0] < 0:
+        raise ValueError(f"{where} starts at t = {t[0]} s; t counts seconds from the movement's start (≥ 0)")
+    steps = np.diff(t)
+    if np.any(steps <= 0):
+        k = int(np.argmax(steps <= 0))
+        raise ValueError(f"{where}: t must increase from sample to sample, but goes {t[k]} -> {t[k + 1]} s at sample {k + 1}")
+    goal = np.asarray(goal, dtype=float)
+    if goal.shape != (position.shape[1],):
+        raise ValueError(f"{where}: the goal has {goal.size} coordinates, the positions {position.shape[1]}")
+    width = as_positive(f"width of {where}", width, "m")
+    return Trial(name, t, position, goal, width)
