@@ -43,6 +43,13 @@ def as_positive_array(name: str, value, unit: str) -> np.ndarray:
     return array
 
 
+def as_count(name: str, value, minimum: int = 1) -> int:
+    """value as an integer ≥ minimum (bool refused), else ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
+        raise ValueError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
+    return int(value)
+
+
 def as_optional_positive(name: str, value, unit: str) -> float | None:
     return None if value is None else as_positive(name, value, unit)
 

@@ -1,0 +1,86 @@
+"""Planning every condition of a fit for one model configuration, here or on a Dask cluster.
+
+Tasks carry the model as its JSON config (plain data), never a Planner: each process builds a Planner once
+per configuration (:func:`cached_planner`) and reuses it for every condition.
+
+Every solve is cold (the planner's multi-start from minimum-jerk guesses), not warm-started from the
+previous evaluation's plan, so that the objective is a function of the parameters alone and the fitted
+model predicts what ``Planner(model).solve`` gives. Warm starts were tried and measured: the planning
+problem has several local optima, and a solve warm-started from another parameter value's plan can stay in
+a different one (at gamma = 0.95 a reach of 0.3 m to a 1 cm goal took 0.355 s warm-started from the
+gamma = 0.99 plan, 0.374 s cold), which made the objective depend on the optimiser's path. A cold solve
+costs about 35 ms against 6 ms warm for the planar preset, next to 80 ms for building the Planner.
+"""
+
+from __future__ import annotations
+
+import json
+import threading
+from functools import lru_cache
+
+import numpy as np
+
+from comanip.model import ReachingModel
+from comanip.planning.plan import Plan
+from comanip.planning.planner import Planner
+
+
+@lru_cache(maxsize=2)
+def cached_planner(model_config: str) -> tuple[Planner, threading.Lock]:
+    """The Planner of a model given as the JSON of ``model.config()``, built once per process, and the lock
+    that serialises its solves (a Planner is not thread-safe, and a Dask worker may run tasks in threads)."""
+    return Planner(ReachingModel.from_config(json.loads(model_config))), threading.Lock()
+
+
+def plan_condition(model_config: str, start: np.ndarray, goal: np.ndarray, width: float) -> Plan:
+    """One reach, solved cold: start state (2n,), goal (d,) m, width m."""
+    planner, lock = cached_planner(model_config)
+    with lock:
+        return planner.solve(start, goal, width)
+
+
+class ConditionPlanner:
+    """Plans a fixed list of reaches for any model configuration; use as a context manager.
+
+    Args:
+        reaches: (start state (2n,), goal (d,) m, width m) per condition.
+        scheduler: None plans in this process; a Dask scheduler address ("tcp://host:8786") or a
+            ``dask.distributed.Client`` maps the conditions onto that cluster (an address's client is
+            closed on exit, a given client is left open).
+    """
+
+    def __init__(self, reaches: list[tuple[np.ndarray, np.ndarray, float]], scheduler=None):
+        self.reaches = reaches
+        self._client, self._owned = _client(scheduler)
+
+    def __enter__(self) -> "ConditionPlanner":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self._owned:
+            self._client.close()
+
+    def plans(self, model: ReachingModel) -> list[Plan]:
+        """One plan per reach for this model, in the order of ``reaches``; never raises on a failed solve."""
+        config = json.dumps(model.config())
+        tasks = [(config, start, goal, width) for start, goal, width in self.reaches]
+        if self._client is None:
+            return [plan_condition(*task) for task in tasks]
+        return self._client.gather(self._client.map(plan_condition, *zip(*tasks), pure=False))
+
+
+def _client(scheduler):
+    """(Dask client or None, whether this object owns it) for a scheduler argument."""
+    if scheduler is None:
+        return None, False
+    from dask.distributed import Client
+
+    if isinstance(scheduler, Client):
+        return scheduler, False
+    if not isinstance(scheduler, str) or "://" not in scheduler:
+        raise ValueError(f"scheduler must be None, a Dask scheduler address such as 'tcp://host:8786' or a "
+                         f"dask.distributed.Client, got {scheduler!r}")
+    try:
+        return Client(scheduler, timeout="10s"), True
+    except (OSError, TimeoutError) as error:
+        raise ValueError(f"could not connect to the Dask scheduler at {scheduler!r} ({type(error).__name__})") from None
