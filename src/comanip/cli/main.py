@@ -15,6 +15,7 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.handover_command",
     "comanip.cli.estimate_command",
     "comanip.cli.simulate_command",
+    "comanip.cli.fit_command",
 ]
 
 

@@ -1,0 +1,58 @@
+"""``comanip fit``: fit a model's parameters to recorded reaches (maximum likelihood) or to movement times
+per condition (least squares); write fit.json (values, standard errors, residuals, status), model.yaml
+(readable by ``comanip plan --preset``) and fit.png. The formats and the method: docs/fitting.md."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from comanip.cli.arguments import add_model_arguments, load_model, output_dir
+from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
+from comanip.fitting.movement_times import fit_movement_times
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser("fit", help="fit model parameters to recordings or movement times", description=__doc__)
+    data = parser.add_mutually_exclusive_group(required=True)
+    data.add_argument("--recordings", type=Path, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
+    data.add_argument("--mt-table", type=Path, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
+    parser.add_argument("--trials", type=Path, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
+    add_model_arguments(parser)
+    parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
+                        f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, kappa,gamma for an MT table)")
+    parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
+    parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings, 100 for an MT table)")
+    parser.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
+    parser.add_argument("--out", default="out/fit", help="output folder (default: %(default)s)")
+    parser.add_argument("--no-progress", action="store_true", help="no progress line")
+    parser.set_defaults(func=run)
+
+
+def names(text: str) -> tuple[str, ...]:
+    """'kappa, gamma' -> ('kappa', 'gamma')."""
+    return tuple(name.strip() for name in text.split(",") if name.strip())
+
+
+def run(args) -> int:
+    model = load_model(args)
+    options = {"scheduler": args.scheduler, "progress": not args.no_progress}
+    if args.max_evaluations is not None:
+        options["max_evaluations"] = args.max_evaluations
+    if args.parameters is not None:
+        options["parameters"] = args.parameters
+    if args.recordings is not None:
+        result = fit_model(model, args.recordings, trials=args.trials, sigma_obs=args.sigma_obs, **options)
+    else:
+        if args.trials is not None:
+            raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
+        result = fit_movement_times(model, args.mt_table, **options)
+    out = output_dir(args.out)
+    written = [result.save_json(out / "fit.json"), result.save_yaml(out / "model.yaml")]
+    if result.conditions:
+        from comanip.plots.fit_figure import plot_fit
+
+        written.append(plot_fit(result, out / "fit.png"))
+    summary = {key: value for key, value in result.to_dict().items() if key not in ("model", "conditions", "trials")}
+    print(json.dumps(summary | {"files": [str(p) for p in written]}, indent=1))
+    return 0 if result.success else 1
