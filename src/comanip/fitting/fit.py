@@ -25,7 +25,7 @@ from comanip.fitting.parameters import ParameterSpace
 from comanip.fitting.recordings import Trial, load_recordings
 from comanip.fitting.residuals import condition_curves, condition_residuals, trial_residuals
 from comanip.fitting.progress import ProgressBar
-from comanip.fitting.result import FitResult, failed_result, fitted_model
+from comanip.fitting.result import FitResult, failed_result, fitted_model, outcome_message
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
 
@@ -61,14 +61,14 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         A :class:`FitResult`. Input errors raise ValueError before any planning; a fit that fails later
         returns a result with status 'failed'.
     """
-    trials, conditions = _grouped(model, recordings, trials, start_tolerance)
+    data, conditions = _grouped(model, recordings, trials, start_tolerance)
     space = ParameterSpace(model, parameters, sigma_obs, bounds)
     max_evaluations = as_count("max_evaluations", max_evaluations)
     step = as_positive("step", step, "transformed units")
     t_begin = time.perf_counter()
     reaches = [(c.start_state(model), c.goal, c.width) for c in conditions]
     with ConditionPlanner(reaches, scheduler) as planner, ProgressBar("fit", progress) as bar:
-        objective = RecordingsObjective(trials, conditions, space, planner, on_evaluation=bar.record)
+        objective = RecordingsObjective(data, conditions, space, planner, on_evaluation=bar.record)
         try:
             u, status, message = _minimise(objective, space, max_evaluations)
             spread = curvature(objective.per_trial, u, step)
@@ -76,12 +76,12 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         except Exception as error:  # the fit never raises once planning started: report it as failed
             return failed_result(model, space, f"{type(error).__name__}: {error}", objective.evaluations,
                                  time.perf_counter() - t_begin, NLL_KIND)
-    fitted = fitted_model(space.model_for(u), model, f"{len(trials)} recorded trials in {len(conditions)} conditions")
-    curves = [condition_curves(trials, c, plan) for c, plan in zip(conditions, plans)]
-    trial_rows = trial_residuals(trials, conditions, plans)
+    fitted = fitted_model(space.model_for(u), model, f"{len(data)} recorded trials in {len(conditions)} conditions")
+    curves = [condition_curves(data, c, plan) for c, plan in zip(conditions, plans)]
+    trial_rows = trial_residuals(data, conditions, plans)
     return FitResult(
-        success=status == "converged" and all(plan.success for plan in plans), status=status, message=message,
-        model=fitted, values=space.values(u), initial_values=space.values(space.initial),
+        success=status == "converged" and all(plan.success for plan in plans), status=status,
+        message=outcome_message(message, space, u), model=fitted, values=space.values(u), initial_values=space.start_values,
         std_errors=space.natural_std_errors(u, spread.robust_std()),
         laplace_std_errors=space.natural_std_errors(u, spread.laplace_std()),
         objective=objective(u), objective_kind=NLL_KIND, evaluations=objective.evaluations,
@@ -92,10 +92,10 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
 def recordings_nll(model: ReachingModel, recordings: str | Path | Sequence[Trial], *, trials: str | Path | None = None,
                    sigma_obs: float = 1e-3, start_tolerance: float = 0.005, scheduler=None) -> float:
     """The negative log-likelihood (nats) :func:`fit_model` minimises, at the model as given."""
-    trials, conditions = _grouped(model, recordings, trials, start_tolerance)
+    data, conditions = _grouped(model, recordings, trials, start_tolerance)
     space = ParameterSpace(model, ("sigma_obs",), sigma_obs)
     with ConditionPlanner([(c.start_state(model), c.goal, c.width) for c in conditions], scheduler) as planner:
-        return RecordingsObjective(trials, conditions, space, planner)(space.initial)
+        return RecordingsObjective(data, conditions, space, planner)(space.initial)
 
 
 def _grouped(model, recordings, trials_table, start_tolerance) -> tuple[list[Trial], list[Condition]]:

@@ -39,8 +39,10 @@ class ParameterSpace:
         self.model = model
         self.names = tuple(names)
         self.sigma_obs = as_positive("sigma_obs", sigma_obs, "m, standard deviation of the measurement noise")
-        start = [self.sigma_obs if name == "sigma_obs" else read_parameter(model, name) for name in self.names]
-        self.initial = np.array([_to_transformed(name, value) for name, value in zip(self.names, start)])
+        self.start_values = {name: self.sigma_obs if name == "sigma_obs" else read_parameter(model, name) for name in self.names}
+        """{name: start value}, natural units."""
+        self.initial = np.array([_to_transformed(name, value) for name, value in self.start_values.items()])
+        """Transformed start vector (p,)."""
         self.bounds = [self._bound(name, u, (bounds or {}).get(name)) for name, u in zip(self.names, self.initial)]
         unknown = set(bounds or {}) - set(self.names)
         if unknown:
@@ -52,7 +54,7 @@ class ParameterSpace:
             return (-half, half) if name in UNIT_INTERVAL else (u0 - half, u0 + half)
         low, high = (_to_transformed(name, v) for v in natural)
         if not low <= u0 <= high:
-            raise ValueError(f"bounds of {name} are {tuple(natural)}, which exclude its start value {self.values(self.initial)[name]}")
+            raise ValueError(f"bounds of {name} are {tuple(natural)}, which exclude its start value {self.start_values[name]}")
         return low, high
 
     def values(self, u) -> dict[str, float]:
@@ -71,10 +73,18 @@ class ParameterSpace:
         """Measurement noise std (m) at u."""
         return self.values(u).get("sigma_obs", self.sigma_obs)
 
+    def at_bounds(self, u, tolerance: float = 0.1) -> list[str]:
+        """Names of the parameters within tolerance (transformed units: 0.1 is 10 % for a log parameter) of a
+        search bound at u. Along a direction the data hardly constrain, Nelder-Mead stops anywhere near the
+        bound once the objective changes by less than its tolerance."""
+        return [name for name, x, (low, high) in zip(self.names, u, self.bounds) if min(x - low, high - x) <= tolerance]
+
     def natural_std_errors(self, u, transformed_std) -> dict[str, float]:
-        """Standard errors in natural units by the delta method: se(theta) = |dtheta/du| se(u)."""
-        values = self.values(u)
-        return {name: float(_slope(name, values[name]) * s) for name, s in zip(self.names, transformed_std)}
+        """Standard errors in natural units by the delta method: se(theta) = |dtheta/du| se(u); NaN for a
+        parameter at a search bound, where the curvature says nothing about the uncertainty."""
+        values, bounded = self.values(u), self.at_bounds(u)
+        return {name: np.nan if name in bounded else float(_slope(name, values[name]) * s)
+                for name, s in zip(self.names, transformed_std)}
 
 
 def read_parameter(model: ReachingModel, name: str) -> float:

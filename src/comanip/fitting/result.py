@@ -76,6 +76,15 @@ class FitResult:
         return f"{self.status}: {values}; {self.objective_kind} {self.objective:.6g} after {self.evaluations} evaluations in {self.fit_time:.1f} s"
 
 
+def outcome_message(optimiser: str, space: ParameterSpace, u) -> str:
+    """The optimiser's message, plus the parameters that ended at a search bound (if any)."""
+    bounded = space.at_bounds(u)
+    if not bounded:
+        return optimiser
+    return (f"{optimiser} {bounded} ended at a search bound: the data hardly constrain them there or the bounds are "
+            f"too tight (their standard errors are NaN)")
+
+
 def fitted_model(fitted: ReachingModel, start: ReachingModel, data: str) -> ReachingModel:
     """The fitted model, named '<start name>-fit', its description saying what it was fitted to."""
     return fitted.replace(name=f"{start.name}-fit", description=f"Fitted by comanip to {data}, starting from the {start.name!r} model.")
@@ -85,8 +94,8 @@ def failed_result(model: ReachingModel, space: ParameterSpace, message: str, eva
                   kind: str) -> FitResult:
     """A result with status 'failed': the start model and values, NaN errors and objective."""
     nan = {name: np.nan for name in space.names}
-    return FitResult(success=False, status="failed", message=message, model=model, values=space.values(space.initial),
-                     initial_values=space.values(space.initial), std_errors=nan, laplace_std_errors=dict(nan),
+    return FitResult(success=False, status="failed", message=message, model=model, values=dict(space.start_values),
+                     initial_values=space.start_values, std_errors=nan, laplace_std_errors=dict(nan),
                      objective=np.nan, objective_kind=kind, evaluations=evaluations, fit_time=fit_time)
 
 
