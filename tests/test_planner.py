@@ -5,7 +5,7 @@ import pytest
 
 import comanip
 from comanip.belief import end_effector_belief, propagate_belief
-from comanip.objectives import discount_weights, goal_covariance, reach_objective
+from comanip.objectives import GoalReward, discount_weights, reach_objective
 
 
 def test_objective_gradient_matches_finite_differences(planar_planner, rng):
@@ -25,7 +25,8 @@ def test_plan_objective_is_the_spec_objective(planar_planner):
     plan = planar_planner.solve(np.zeros(4), [0.3, 0.0], 0.02)
     mean, cov = propagate_belief(model.body, model.h, model.kappa, plan.start, plan.torque, model.noise)
     ee_mean, ee_cov = end_effector_belief(model.body, mean, cov)
-    J = reach_objective(ee_mean, ee_cov, plan.torque, plan.goal, goal_covariance(0.02, 2), discount_weights(model.gamma, model.H), model.nu)
+    J = reach_objective(ee_mean, ee_cov, plan.torque, plan.goal, 0.02, discount_weights(model.gamma, model.H), model.nu,
+                        GoalReward.of(model))
     assert plan.objective == pytest.approx(J, rel=1e-9)
     np.testing.assert_allclose(plan.mean, mean, atol=1e-12)
 

@@ -12,9 +12,9 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from comanip.belief.noise import check_noise_form
-from comanip.bodies import Body, body_from_config
+from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
-from comanip.objectives.reward import check_goal_covariance_form
+from comanip.objectives.reward import check_goal_covariance_form, check_reward_form
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,22 @@ class ReachingModel:
     noise: str = "isotropic"
     """Noise covariance form: 'isotropic' (default), 'per_channel' or 'rank_one' (SPEC §2)."""
     goal_covariance: str = "std"
-    """How W is built from w: 'std' W = w² I (default) or 'cov' W = w I (SPEC §3)."""
+    """How W is built from w: 'std' W = w² I (default), 'cov' W = w I (SPEC §3), or 'effective'
+    W = (2w / effective_k)² I (the goal's full width 2w read as effective_k standard deviations)."""
+    effective_k: float = 4.133
+    """Standard deviations spanned by the full width 2w under goal_covariance 'effective', > 0; 4.133 is the
+    effective-width convention of Fitts studies (2w = 4.133 sigma: 96 % of a 1-D normal inside the target)."""
+    reward: str = "gaussian"
+    """'gaussian' (default, paper eq. 7): the overlap density of N(mu_x, Sigma_x) and N(g, W), in m^-d;
+    'hit': the probability of a hand inside the goal ball of radius w (paper eq. 1), in closed form through
+    a flat-topped kernel (comanip.objectives.reward); it saturates once the hand is surely inside."""
+    activation: tuple = ()
+    """Time constants (s) of the muscle activation stages between command and force, each > 0 (e.g.
+    (0.04, 0.04), Todorov 2005); () (default, the paper) applies the command as the force. The motor noise
+    enters at the command. See comanip.bodies.muscle."""
+    stop_weight: float = 0.0
+    """Weight of the terminal stopping cost stop_weight · E||qdot_H||² (reward units per (m/s)² or
+    (rad/s)²), ≥ 0: asks the hand to be still at the end of the horizon. 0 (default, the paper): none."""
     discount: str = "exponential"
     """'exponential' gamma^i (default) or 'hyperbolic' 1/(1 + (1/gamma - 1) i)."""
     name: str = "custom"
@@ -50,6 +65,7 @@ class ReachingModel:
     def __post_init__(self):
         if not isinstance(self.body, Body):
             raise ValueError(f"body must be a comanip.bodies.Body, got {type(self.body).__name__}")
+        self._attach_activation()
         _check_positive("h", self.h, "s")
         if isinstance(self.H, bool) or not isinstance(self.H, (int, np.integer)) or self.H < 1:
             raise ValueError(f"H must be an integer ≥ 1 (horizon in steps), got {self.H!r}")
@@ -61,7 +77,23 @@ class ReachingModel:
         _check_positive("width", self.width, "m")
         check_noise_form(self.noise)
         check_goal_covariance_form(self.goal_covariance)
+        check_reward_form(self.reward)
         check_discount_form(self.discount)
+        _check_positive("effective_k", self.effective_k, "standard deviations")
+        _check_nonnegative("stop_weight", self.stop_weight, "reward per (m/s)²")
+
+    def _attach_activation(self) -> None:
+        """Make ``body`` the plant: the bare body, or the bare body behind the activation stages."""
+        body = self.body
+        if isinstance(body, MuscleActuatedBody) and not self.activation:
+            object.__setattr__(self, "activation", body.time_constants)
+        bare = body.inner if isinstance(body, MuscleActuatedBody) else body
+        try:
+            activation = tuple(float(t) for t in self.activation)
+        except (TypeError, ValueError):
+            raise ValueError(f"activation must be a list of time constants in s, e.g. [0.04, 0.04], got {self.activation!r}") from None
+        object.__setattr__(self, "activation", activation)
+        object.__setattr__(self, "body", MuscleActuatedBody(bare, activation) if activation else bare)
 
     @property
     def n(self) -> int:
@@ -72,6 +104,18 @@ class ReachingModel:
     def d(self) -> int:
         """Task-space dimension of the end effector."""
         return self.body.d
+
+    @property
+    def state_size(self) -> int:
+        """Length of the state s = [q; qdot] (2n), plus n per activation stage."""
+        return self.body.state_size
+
+    def full_state(self, state) -> np.ndarray:
+        """A state (state_size,) from [q; qdot] (2n,) with the activation stages at zero force, or unchanged."""
+        state = np.asarray(state, dtype=float)
+        if state.shape == (2 * self.n,) and self.state_size != 2 * self.n:
+            return np.concatenate([state, np.zeros(self.state_size - 2 * self.n)])
+        return state
 
     @property
     def M(self):
@@ -91,7 +135,9 @@ class ReachingModel:
         return self.H * self.h
 
     def replace(self, **changes) -> "ReachingModel":
-        """A copy with some fields changed (checked again)."""
+        """A copy with some fields changed (checked again); ``activation=()`` removes the activation stages."""
+        if "activation" in changes and "body" not in changes and isinstance(self.body, MuscleActuatedBody):
+            changes["body"] = self.body.inner
         return replace(self, **changes)
 
     def config(self) -> dict:
@@ -108,6 +154,10 @@ class ReachingModel:
             "width": self.width,
             "noise": self.noise,
             "goal_covariance": self.goal_covariance,
+            "effective_k": self.effective_k,
+            "reward": self.reward,
+            "activation": list(self.activation),
+            "stop_weight": self.stop_weight,
             "discount": self.discount,
         }
 

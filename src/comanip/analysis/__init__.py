@@ -3,6 +3,7 @@ and executions that return numbers (dataclasses), which :mod:`comanip.plots` dra
 reports."""
 
 from comanip.analysis.arm_reaches import ArmReach, LimitUsage, arm_reaches, joint_limit_usage, summarise_reaches
+from comanip.analysis.ball_probability import ball_probability
 from comanip.analysis.calibration import (
     CalibrationResult,
     Configuration,
@@ -12,22 +13,38 @@ from comanip.analysis.calibration import (
 )
 from comanip.analysis.dispersion import EndpointDispersion, endpoint_dispersion
 from comanip.analysis.fitts import FITTS_FORMS, FittsFit, fit_fitts, index_of_difficulty, trend_fraction
+from comanip.analysis.human_targets import (
+    TARGET_DISTANCES,
+    TARGET_WIDTHS,
+    ConditionTargets,
+    HumanTargetsResult,
+    condition_targets,
+    measure_human_targets,
+)
 from comanip.analysis.minimum_jerk_baseline import (
     minimum_jerk_asymmetry,
     minimum_jerk_settling_fraction,
+    minimum_jerk_speed_fraction,
     minimum_jerk_velocity,
 )
 from comanip.analysis.phase import PhaseCurve, phase_curves
+from comanip.analysis.profile_shape import ProfileShape, profile_shape
 from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, home_start, open_loop_grid, unit_direction
 from comanip.analysis.speed_profile import SETTLING_FRACTION, SpeedMetrics, speed_metrics
+from comanip.analysis.target_verdicts import HumanTargets, TargetVerdict, target_verdicts
 
 __all__ = [
     "ArmReach", "LimitUsage", "arm_reaches", "joint_limit_usage", "summarise_reaches",
+    "ball_probability",
     "CalibrationResult", "Configuration", "measure_grid", "run_calibration", "study_configurations",
     "EndpointDispersion", "endpoint_dispersion",
     "FITTS_FORMS", "FittsFit", "fit_fitts", "index_of_difficulty", "trend_fraction",
-    "minimum_jerk_asymmetry", "minimum_jerk_settling_fraction", "minimum_jerk_velocity",
+    "TARGET_DISTANCES", "TARGET_WIDTHS", "ConditionTargets", "HumanTargetsResult", "condition_targets",
+    "measure_human_targets",
+    "minimum_jerk_asymmetry", "minimum_jerk_settling_fraction", "minimum_jerk_speed_fraction", "minimum_jerk_velocity",
     "PhaseCurve", "phase_curves",
+    "ProfileShape", "profile_shape",
     "ReachOutcome", "closed_loop_grid", "home_start", "open_loop_grid", "unit_direction",
     "SETTLING_FRACTION", "SpeedMetrics", "speed_metrics",
+    "HumanTargets", "TargetVerdict", "target_verdicts",
 ]

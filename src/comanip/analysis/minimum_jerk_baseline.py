@@ -42,3 +42,12 @@ def minimum_jerk_velocity(start, goal, movement_time: float, t, start_velocity=N
     duration = movement_time / minimum_jerk_settling_fraction(settling_fraction)
     _, velocity, _ = minimum_jerk(start, v0, goal, duration, t)
     return velocity
+
+
+def minimum_jerk_speed_fraction(t, movement_time: float, settling_fraction: float = SETTLING_FRACTION) -> np.ndarray:
+    """Speed over peak speed, 16 s²(1 − s)² with s = t/T clipped to [0, 1], at times t (s, any shape) of the
+    rest-to-rest minimum-jerk reach whose SPEC §6 movement time is movement_time (s), T = movement_time/s_f."""
+    if not (np.isfinite(movement_time) and movement_time > 0):
+        raise ValueError(f"movement_time must be a finite number > 0 (s), got {movement_time!r}")
+    s = np.clip(np.asarray(t, dtype=float) * minimum_jerk_settling_fraction(settling_fraction) / movement_time, 0.0, 1.0)
+    return 16.0 * s**2 * (1.0 - s) ** 2

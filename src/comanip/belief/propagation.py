@@ -7,7 +7,9 @@ s_i ~ N(mu_i, Sigma_i), mu_0 = s_0, Sigma_0 = 0, and for i = 0..H-1, with f the 
 
 For a point mass f is linear and A, B are the paper's matrices. The same step is offered as a CasADi
 function (for the optimiser) and as a NumPy rollout (for analysis and as an independent check).
-Shapes: s, mu (2n,); Sigma (2n, 2n); tau (n,); trajectories stack steps on the first axis.
+Shapes: s, mu (nx,); Sigma (nx, nx); tau (n,); trajectories stack steps on the first axis. nx is the
+body's state size: 2n for [q; qdot], plus n per muscle activation stage (comanip.bodies.muscle), where the
+noise enters at the command and reaches the force through the filter.
 """
 
 from __future__ import annotations
@@ -20,8 +22,8 @@ from comanip.bodies.body import Body
 
 
 def linearised_step_function(body: Body, h: float) -> ca.Function:
-    """``(s (2n,), tau (n,)) -> (f(s, tau) (2n,), A (2n, 2n), B (2n, n))``: one step and its Jacobians."""
-    s = ca.SX.sym("s", 2 * body.n)
+    """``(s (nx,), tau (n,)) -> (f(s, tau) (nx,), A (nx, nx), B (nx, n))``: one step and its Jacobians."""
+    s = ca.SX.sym("s", body.state_size)
     tau = ca.SX.sym("tau", body.n)
     s_next = body.discrete_step(s, tau, h)
     A = ca.jacobian(s_next, s)
@@ -30,11 +32,11 @@ def linearised_step_function(body: Body, h: float) -> ca.Function:
 
 
 def belief_step_function(body: Body, h: float, kappa: float, noise: str = "isotropic") -> ca.Function:
-    """``(mu (2n,), Sigma (2n, 2n), tau (n,)) -> (mu+ (2n,), Sigma+ (2n, 2n))`` as a CasADi function."""
+    """``(mu (nx,), Sigma (nx, nx), tau (n,)) -> (mu+ (nx,), Sigma+ (nx, nx))`` as a CasADi function."""
     check_noise_form(noise)
     step = linearised_step_function(body, h)
-    mu = ca.SX.sym("mu", 2 * body.n)
-    Sigma = ca.SX.sym("Sigma", 2 * body.n, 2 * body.n)
+    mu = ca.SX.sym("mu", body.state_size)
+    Sigma = ca.SX.sym("Sigma", body.state_size, body.state_size)
     tau = ca.SX.sym("tau", body.n)
     mu_next, A, B = step(mu, tau)
     Sigma_next = ca.mtimes([A, Sigma, A.T]) + ca.mtimes([B, noise_covariance(tau, kappa, noise), B.T])
@@ -42,9 +44,9 @@ def belief_step_function(body: Body, h: float, kappa: float, noise: str = "isotr
 
 
 def end_effector_belief_function(body: Body) -> ca.Function:
-    """``(mu (2n,), Sigma (2n, 2n)) -> (mu_x (d,), Sigma_x (d, d))``: mu_x = x_ee(mu_q), Sigma_x = J Sigma_qq J^T."""
-    mu = ca.SX.sym("mu", 2 * body.n)
-    Sigma = ca.SX.sym("Sigma", 2 * body.n, 2 * body.n)
+    """``(mu (nx,), Sigma (nx, nx)) -> (mu_x (d,), Sigma_x (d, d))``: mu_x = x_ee(mu_q), Sigma_x = J Sigma_qq J^T."""
+    mu = ca.SX.sym("mu", body.state_size)
+    Sigma = ca.SX.sym("Sigma", body.state_size, body.state_size)
     q = mu[: body.n]
     J = body.jacobian(q)
     Sigma_x = ca.mtimes([J, Sigma[: body.n, : body.n], J.T])
@@ -52,12 +54,12 @@ def end_effector_belief_function(body: Body) -> ca.Function:
 
 
 def propagate_belief(body: Body, h: float, kappa: float, s0, torque, noise: str = "isotropic"):
-    """NumPy rollout of the belief: s0 (2n,), torque (H, n) -> mean (H+1, 2n), cov (H+1, 2n, 2n)."""
+    """NumPy rollout of the belief: s0 (nx,), torque (H, n) -> mean (H+1, nx), cov (H+1, nx, nx)."""
     check_noise_form(noise)
     step = linearised_step_function(body, h)
     torque = np.atleast_2d(np.asarray(torque, dtype=float))
-    mean = np.zeros((len(torque) + 1, 2 * body.n))
-    cov = np.zeros((len(torque) + 1, 2 * body.n, 2 * body.n))
+    mean = np.zeros((len(torque) + 1, body.state_size))
+    cov = np.zeros((len(torque) + 1, body.state_size, body.state_size))
     mean[0] = s0
     for i, tau in enumerate(torque):
         s_next, A, B = (np.asarray(v) for v in step(mean[i], tau))
@@ -67,7 +69,7 @@ def propagate_belief(body: Body, h: float, kappa: float, s0, torque, noise: str 
 
 
 def end_effector_belief(body: Body, mean, cov):
-    """Task-space belief of a state trajectory: mean (T, 2n), cov (T, 2n, 2n) -> (T, d), (T, d, d)."""
+    """Task-space belief of a state trajectory: mean (T, nx), cov (T, nx, nx) -> (T, d), (T, d, d)."""
     f = end_effector_belief_function(body)
     pairs = [f(m, c) for m, c in zip(mean, cov)]
     return np.array([np.asarray(x).ravel() for x, _ in pairs]), np.array([np.asarray(S) for _, S in pairs])
@@ -76,14 +78,14 @@ def end_effector_belief(body: Body, mean, cov):
 def sample_trajectories(body: Body, h: float, kappa: float, s0, torque, n_samples: int, rng, noise: str = "isotropic"):
     """Monte Carlo of the noisy discrete dynamics s+ = f(s, (I + E) tau), open loop.
 
-    s0 (2n,), torque (H, n) -> states (n_samples, H+1, 2n). Each sample draws its own E at every step.
+    s0 (nx,), torque (H, n) -> states (n_samples, H+1, nx). Each sample draws its own E at every step.
     """
     check_noise_form(noise)
-    s = ca.SX.sym("s", 2 * body.n)
+    s = ca.SX.sym("s", body.state_size)
     tau = ca.SX.sym("tau", body.n)
     step = ca.Function("step", [s, tau], [body.discrete_step(s, tau, h)]).map(n_samples)
     torque = np.atleast_2d(np.asarray(torque, dtype=float))
-    states = np.zeros((n_samples, len(torque) + 1, 2 * body.n))
+    states = np.zeros((n_samples, len(torque) + 1, body.state_size))
     states[:, 0] = s0
     for i, tau_i in enumerate(torque):
         executed = tau_i + sample_torque_error(np.broadcast_to(tau_i, (n_samples, body.n)), kappa, noise, rng)

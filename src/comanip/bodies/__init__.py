@@ -3,6 +3,7 @@
 from importlib import import_module
 
 from comanip.bodies.body import Body
+from comanip.bodies.muscle import MuscleActuatedBody
 from comanip.bodies.point_mass import PointMass
 
 #: body ``type`` in a config -> "module:class"; imported on use so heavy bodies cost nothing until asked for.
@@ -22,4 +23,4 @@ def body_from_config(config: dict) -> Body:
     return getattr(import_module(module), cls)(**config)
 
 
-__all__ = ["Body", "PointMass", "body_from_config", "BODY_TYPES"]
+__all__ = ["Body", "MuscleActuatedBody", "PointMass", "body_from_config", "BODY_TYPES"]

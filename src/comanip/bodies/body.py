@@ -56,6 +56,15 @@ class Body(ABC):
         qddot = ca.solve(self.mass_matrix(q), tau - ca.mtimes(self.damping, qdot) - self.gravity(q))
         return ca.vertcat(q + h * qdot, qdot + h * qddot)
 
+    def command_for_force(self, force: np.ndarray, h: float) -> np.ndarray:
+        """Commands (H, n) under which the body feels the torques ``force`` (H, n): the same, for a bare body."""
+        return np.asarray(force, dtype=float)
+
+    @property
+    def state_size(self) -> int:
+        """Length of the state s: 2n, [q; qdot], for a rigid body (bodies with actuator states add theirs)."""
+        return 2 * self.n
+
     @property
     def is_linear(self) -> bool:
         """True when M is constant and x_ee is linear, so the belief dynamics are exactly LTI."""

@@ -1,7 +1,8 @@
-"""``comanip validate``: the paper's validation analyses (Section IV-D, Fig. 3–5) and the calibration study on
-a point-mass preset, and the Franka section (Section V-B: Panda reaches from the ready pose, hand speed, joint
-trajectories against their limits, solve times), written as PNG figures, CSV files, ``report.json`` (every
-number) and ``report.md`` (tables). With an arm preset (``--preset franka``) the run is the Franka section alone."""
+"""``comanip validate``: the paper's validation analyses (Section IV-D, Fig. 3–5), the calibration study and the
+human-likeness targets (issue 11, beside the paper's planar preset) on a point-mass preset, and the Franka
+section (Section V-B: Panda reaches from the ready pose, hand speed, joint trajectories against their limits,
+solve times), written as PNG figures, CSV files, ``report.json`` (every number) and ``report.md`` (tables).
+With an arm preset (``--preset franka``) the run is the Franka section alone."""
 
 from __future__ import annotations
 
@@ -23,6 +24,9 @@ def add_parser(subparsers) -> None:
                              "functions are compiled and cached)")
     parser.add_argument("--no-franka", dest="franka", action="store_false",
                         help="skip the Franka section (no Panda planner is built)")
+    parser.add_argument("--targets-reference", default="planar", metavar="PRESET",
+                        help="point-mass preset or model YAML scored beside --preset on the human-likeness targets "
+                             "(default: %(default)s)")
     parser.add_argument("--workers", type=int, help="processes for the calibration study (default: the CPU count)")
     parser.add_argument("--seed", type=int, default=0, help="seed of every random draw (default: %(default)s)")
     parser.set_defaults(func=run)
@@ -30,7 +34,7 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     model = load_model(args)
-    options = {"workers": args.workers, "seed": args.seed, "franka": args.franka}
+    options = {"workers": args.workers, "seed": args.seed, "franka": args.franka, "human_reference": args.targets_reference}
     settings = ValidationSettings.quick_run(**options) if args.quick else ValidationSettings(**options)
     out = Path(args.out)
     report = run_validation(model, out, settings)  # checks the model against the settings before creating out
@@ -39,6 +43,8 @@ def run(args) -> int:
         grid = report["fitts_grid"]
         summary |= {"fitts_r2": grid["fits"]["fitts"]["r2"], "shannon_r2": grid["fits"]["shannon"]["r2"],
                     "calibration_both": report["calibration"]["both"]}
+    if "human_targets" in report:
+        summary["human_targets_passed"] = {m["model"]: f"{m['passed']}/{m['targets']}" for m in report["human_targets"]["models"]}
     if "franka" in report:
         summary["franka"] = report["franka"]["summary"]
     files = ["report.json", "report.md", *report["figures"], *report.get("franka", {}).get("files", [])]

@@ -28,7 +28,8 @@ import casadi as ca
 import numpy as np
 
 from comanip.belief.noise import noise_covariance
-from comanip.objectives.reward import expected_reward, goal_covariance
+from comanip.objectives.reach_objective import stopping_cost
+from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
 from comanip.planning.reach_problem import ReachProblem
 
@@ -62,6 +63,7 @@ class ReachCurvature:
         self._last_normaliser = (None, 1.0)
         self._noise_hessian = _noise_second_derivatives(model)
         self._G = _constant_sensitivities(model)
+        self._stop_hessian = _stopping_hessian(problem)
         self._build_constant_products()
 
     # -- the compiled per-solve function -------------------------------------------------------------
@@ -145,6 +147,8 @@ class ReachCurvature:
         steps = np.arange(H)
         hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks.reshape(H, n, n)
         hessian[np.diag_indices(H * n)] += self._effort / self.normaliser(width)
+        if self._stop_hessian is not None:
+            hessian += self._stop_hessian / self.normaliser(width)
         return hessian
 
     def goal_derivatives(self, data: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -179,7 +183,7 @@ class ReachCurvature:
         return Z.reshape(H + 1, d + self._U.shape[2], H * n)
 
     def _split(self, params):
-        n2, d = 2 * self.model.n, self.model.d
+        n2, d = self.model.state_size, self.model.d
         return params[:n2], params[n2:n2 + d], params[-1]
 
 
@@ -194,7 +198,7 @@ def _reward_derivatives_function(model) -> ca.Function:
     for e, (a, b) in enumerate(triangle):
         Sigma_x[a, b] = Sigma_x[b, a] = vech[e]
     goal, width, weight = ca.SX.sym("goal", d), ca.SX.sym("width"), ca.SX.sym("weight")
-    phi = -weight * expected_reward(mu_x, Sigma_x, goal, goal_covariance(width, d, model.goal_covariance))
+    phi = -weight * GoalReward.of(model).expected(mu_x, Sigma_x, goal, width)
     z = ca.vertcat(mu_x, vech)
     hess, grad = ca.hessian(phi, z)
     return ca.Function("reward_derivatives", [mu_x, vech, goal, width, weight], [hess, grad])
@@ -212,15 +216,28 @@ def _noise_second_derivatives(model) -> np.ndarray:
     return D
 
 
+def _stopping_hessian(problem: ReachProblem) -> np.ndarray | None:
+    """∇² of the stopping cost (H·n, H·n), constant for a linear body (it is quadratic in tau); None without one."""
+    model = problem.model
+    if model.stop_weight == 0:
+        return None
+    n = model.n
+    x = ca.vec(problem.tau)
+    cost = stopping_cost(problem.means[-1][n:2 * n], problem.covs[-1][n:2 * n, n:2 * n], model.stop_weight)
+    hessian = ca.Function("stop_hessian", [x, problem.s0], [ca.hessian(cost, x)[0]])
+    return np.asarray(hessian(np.zeros(x.numel()), np.zeros(problem.s0.numel())))
+
+
 def _constant_sensitivities(model) -> np.ndarray:
     """G[i, k] = d mu_x,i / d tau_k (H+1, H, d, n) of a linear body (the same at every torque)."""
     body, n, H = model.body, model.n, model.H
-    s, tau = ca.SX.sym("s", 2 * n), ca.SX.sym("tau", n)
+    nx = model.state_size
+    s, tau = ca.SX.sym("s", nx), ca.SX.sym("tau", n)
     step = body.discrete_step(s, tau, model.h)
     A = np.asarray(ca.evalf(ca.jacobian(step, s)))
     B = np.asarray(ca.evalf(ca.jacobian(step, tau)))
     J = np.asarray(body.kinematics_function(np.zeros(n))[1])
-    state_sensitivity = np.zeros((H + 1, H, 2 * n, n))  # d s_i / d tau_k
+    state_sensitivity = np.zeros((H + 1, H, nx, n))  # d s_i / d tau_k
     for i in range(H):
         state_sensitivity[i + 1, :i] = A @ state_sensitivity[i, :i]
         state_sensitivity[i + 1, i] = B

@@ -34,14 +34,15 @@ def minimum_jerk(x0, v0, x1, duration: float, t) -> tuple[np.ndarray, np.ndarray
 
 
 def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration: float) -> np.ndarray:
-    """Torques (H, n) that make the mean follow a joint-space minimum-jerk reach from start (2n,) to goal_q (n,)."""
+    """Commands (H, n) that make the mean follow a joint-space minimum-jerk reach from start (nx,) to goal_q (n,)
+    (through the body's activation stages, if it has them)."""
     t = h * np.arange(H)
-    q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n :], goal_q, duration, t)
+    q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n:2 * body.n], goal_q, duration, t)
     if body.is_linear:  # constant M and G: inverse dynamics of all steps at once
         M = np.asarray(body.mass_matrix_function(q[0]))
         G = np.asarray(body.gravity_function(q[0])).ravel()
-        return qddot @ M.T + qdot @ body.damping.T + G
-    return np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(H)])
+        return body.command_for_force(qddot @ M.T + qdot @ body.damping.T + G, h)
+    return body.command_for_force(np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(H)]), h)
 
 
 def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations,
@@ -68,7 +69,7 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
         # x(t) = shift_q (10 s³ - 15 s⁴ + 6 s⁵): Flash–Hogan from rest to rest
         speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / T
         acceleration = (60 * s - 180 * s**2 + 120 * s**3) / T**2
-        results.append(torque + acceleration[:, None] * push + np.outer(speed, body.damping @ shift_q))
+        results.append(torque + body.command_for_force(acceleration[:, None] * push + np.outer(speed, body.damping @ shift_q), h))
     return results
 
 

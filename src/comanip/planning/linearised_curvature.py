@@ -27,7 +27,7 @@ import casadi as ca
 import numpy as np
 
 from comanip.belief.propagation import belief_step_function, linearised_step_function
-from comanip.objectives.reward import expected_reward, goal_covariance
+from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
 from comanip.planning.curvature import _causal_gram, _noise_second_derivatives, _reward_derivatives_function
 from comanip.planning.reach_problem import ReachProblem
@@ -255,8 +255,7 @@ def _stage_cost_function(model) -> ca.Function:
     goal, width, weight = ca.SX.sym("goal", d), ca.SX.sym("width"), ca.SX.sym("weight")
     q = mu[:n]
     J = body.jacobian(q)
-    R = expected_reward(body.end_effector(q), ca.mtimes([J, Sigma[:n, :n], J.T]), goal,
-                        goal_covariance(width, d, model.goal_covariance))
+    R = GoalReward.of(model).expected(body.end_effector(q), ca.mtimes([J, Sigma[:n, :n], J.T]), goal, width)
     return ca.Function("stage_cost", [mu, Sigma, goal, width, weight], [-weight * R])
 
 

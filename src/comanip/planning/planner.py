@@ -100,6 +100,9 @@ class Planner:
             raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")
         self.model = model
         self.options = options or SolverOptions()
+        if not model.body.is_linear and (model.activation or model.stop_weight > 0):
+            raise ValueError(f"activation stages and stop_weight are supported for point-mass bodies; the {model.body.name!r} "
+                             f"body needs activation=() and stop_weight=0")
         if self.options.method == "ipopt" and not model.body.is_linear:
             raise ValueError(f"method 'ipopt' (exact Hessian of the expanded problem) is for point masses; the "
                              f"{model.body.name!r} body needs method 'newton'")
@@ -151,9 +154,14 @@ class Planner:
         return self._ipopt
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
-        """Validated (start (2n,), goal (d,), width) or ValueError naming the argument."""
+        """Validated (start (nx,), goal (d,), width) or ValueError naming the argument.
+
+        A start of [q; qdot] (2n,) for a model with activation stages gets them at zero force."""
         model = self.model
-        start = as_vector("start", start, 2 * model.n, "state [q; qdot] in m and m/s, or rad and rad/s")
+        size = 2 * model.n if np.shape(start) == (2 * model.n,) else model.state_size
+        start = model.full_state(as_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
+                                           + (f", optionally followed by the {model.state_size - 2 * model.n} activation states"
+                                              if size != 2 * model.n else "")))
         goal = as_vector("goal", goal, model.d, "task-space position, m")
         width = model.width if width is None else as_positive("width", width, "m")
         return start, goal, width
@@ -162,7 +170,8 @@ class Planner:
         """Plan a reach.
 
         Args:
-            start: start state s_0 = [q; qdot] (2n,), m and m/s (rad, rad/s for joints).
+            start: start state s_0 = [q; qdot] (2n,), m and m/s (rad, rad/s for joints); a model with activation
+                stages also takes the full state (nx,), else they start at zero force.
             goal: goal position (d,), m, in task space.
             width: goal width w (m) > 0; the model's default when None.
             warm_start: a previous :class:`Plan` or torques (H, n) to start from; cold multi-start when None.
@@ -190,7 +199,7 @@ class Planner:
         model, body = self.model, self.model.body
         if body.is_linear:
             return None
-        seed = warm_start.mean[-1, : model.n] if isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, 2 * model.n) \
+        seed = warm_start.mean[-1, : model.n] if isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size) \
             else start[: model.n]
         q = body.inverse_kinematics(goal, seed)
         residual = float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - goal))
@@ -236,7 +245,7 @@ class Planner:
         """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
         if self._curvature is not None:
             return self._curvature.value(np.ravel(torque), params)
-        n2, d = 2 * self.model.n, self.model.d
+        n2, d = self.model.state_size, self.model.d
         return self.problem.objective_value(torque, params[:n2], params[n2:n2 + d], params[-1])
 
     def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None) -> Plan:
@@ -268,7 +277,7 @@ class Planner:
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
     def _make_plan(self, torque, params, **fields) -> Plan:
-        n2, d = 2 * self.model.n, self.model.d
+        n2, d = self.model.state_size, self.model.d
         start, goal, width = params[:n2], params[n2:n2 + d], params[-1]
         curvature = self._curvature
         if curvature is None or curvature.exact:  # a point mass's expanded rollout is cheap

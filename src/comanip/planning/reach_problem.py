@@ -1,7 +1,7 @@
 """The reaching problem as CasADi expressions, shared by the planner and the goal estimator.
 
-Symbols: tau (n, H) torques, s0 (2n,) start state, goal (d,) m, width (scalar) m. From them, by single
-shooting through the belief dynamics: means[i] (2n,), covs[i] (2n, 2n), ee_means[i] (d,),
+Symbols: tau (n, H) torques, s0 (nx,) start state (nx = 2n, plus n per activation stage), goal (d,) m,
+width (scalar) m. From them, by single shooting through the belief dynamics: means[i] (nx,), covs[i] (nx, nx), ee_means[i] (d,),
 ee_covs[i] (d, d) for i = 0..H, and the SPEC §4 objective J. Which symbols are decision variables and
 which are parameters is the caller's choice (the estimator makes the goal a decision variable).
 """
@@ -14,8 +14,8 @@ import numpy as np
 from comanip.belief.propagation import belief_step_function, end_effector_belief_function
 from comanip.model import ReachingModel
 from comanip.objectives.discounting import discount_weights
-from comanip.objectives.reach_objective import reach_objective
-from comanip.objectives.reward import goal_covariance
+from comanip.objectives.reach_objective import reach_objective, stopping_cost
+from comanip.objectives.reward import GoalReward
 from comanip.planning.plan import Plan
 
 
@@ -24,15 +24,15 @@ class ReachProblem:
 
     def __init__(self, model: ReachingModel):
         self.model = model
-        body, n, d, H = model.body, model.n, model.d, model.H
+        body, n, d, H, nx = model.body, model.n, model.d, model.H, model.state_size
         self.tau = ca.SX.sym("tau", n, H)
-        self.s0 = ca.SX.sym("s0", 2 * n)
+        self.s0 = ca.SX.sym("s0", nx)
         self.goal = ca.SX.sym("goal", d)
         self.width = ca.SX.sym("width")
 
         step = belief_step_function(body, model.h, model.kappa, model.noise)
         ee = end_effector_belief_function(body)
-        self.means, self.covs = [self.s0], [ca.SX.zeros(2 * n, 2 * n)]
+        self.means, self.covs = [self.s0], [ca.SX.zeros(nx, nx)]
         for i in range(H):
             mu, Sigma = step(self.means[-1], self.covs[-1], self.tau[:, i])
             self.means.append(mu)
@@ -42,12 +42,14 @@ class ReachProblem:
         self.ee_covs = [S for _, S in ee_beliefs]
         self.weights = weights = discount_weights(model.gamma, H, model.discount)
         """Discount weights w_i (H+1,) of the reward terms."""
-        self.W = goal_covariance(self.width, d, model.goal_covariance)
+        self.reward = GoalReward.of(model)
         self.objective = reach_objective(self.ee_means, self.ee_covs, [self.tau[:, i] for i in range(H)],
-                                         self.goal, self.W, weights, model.nu)
+                                         self.goal, self.width, weights, model.nu, self.reward)
+        if model.stop_weight > 0:
+            self.objective += stopping_cost(self.means[-1][n:2 * n], self.covs[-1][n:2 * n, n:2 * n], model.stop_weight)
         # The best objective attainable (hand on the goal with no noise at every step, no effort), used to
         # normalise J for the solver so its tolerances mean the same for every width; the minimiser is unchanged.
-        self.best_objective = -float(np.sum(weights)) / ca.sqrt(ca.det(2 * ca.pi * self.W))
+        self.best_objective = -float(np.sum(weights)) * self.reward.peak(self.width)
 
         self.trajectory = ca.Function(
             "trajectory", [ca.vec(self.tau), self.s0, self.goal, self.width],
@@ -70,7 +72,7 @@ class ReachProblem:
         torques skip the rollout (for the Panda the expanded rollout costs about 9 ms).
         """
         model = self.model
-        n2, d, H = 2 * model.n, model.d, model.H
+        n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
         if belief is None:
             mean, cov, ee_mean, ee_cov, J = (np.asarray(v) for v in self.trajectory(torque.ravel(), start, goal, width))
@@ -79,7 +81,7 @@ class ReachProblem:
             mean, cov = belief
             ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
             J = np.asarray(objective, dtype=float)
-        ee_velocity = np.asarray(self._ee_velocity(mean[:, : model.n].T, mean[:, model.n :].T)).T
+        ee_velocity = np.asarray(self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)).T
         return Plan(
             success=bool(success), status=status, message=message, objective=float(J.item()),
             solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),

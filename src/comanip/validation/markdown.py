@@ -1,4 +1,7 @@
-"""``report.md``: the validation report dictionary of :func:`comanip.validation.run.run_validation` as tables."""
+"""``report.md``: the validation report dictionary of :func:`comanip.validation.run.run_validation` as tables.
+
+The human-likeness section's verdict table (:func:`verdict_table`) is also what ``docs/make_calibration_table.py``
+writes into the README."""
 
 from __future__ import annotations
 
@@ -6,6 +9,7 @@ import math
 
 from comanip.analysis.arm_reaches import LIMIT_KINDS
 from comanip.analysis.calibration import EARLY_PEAK_MAX, FITTS_R2_MIN
+from comanip.analysis.minimum_jerk_baseline import minimum_jerk_asymmetry
 
 
 def report_markdown(report: dict) -> str:
@@ -17,6 +21,8 @@ def report_markdown(report: dict) -> str:
              f"{_num(report['wall_time_s'], 1)} s.", ""]
     if "fitts_grid" in report:
         lines += _point_mass_sections(report)
+    if "human_targets" in report:
+        lines += human_targets_markdown(report["human_targets"])
     if "franka" in report:
         lines += _franka_section(report["franka"], report["model"])
     lines += ["Figures: " + ", ".join(f"`{f}`" for f in report["figures"]), ""]
@@ -128,6 +134,74 @@ def _calibration_section(calibration: dict, settings: dict) -> list[str]:
                  _num(r["distance_trend"], 2), r["all_solves_converged"], "yes" if r["fitts_law"] else "no",
                  "yes" if r["early_peak"] else "no", _num(r["effective_id_at_half_bits"], 2)] for r in rows]),
     ]
+
+
+def human_targets_markdown(section: dict) -> list[str]:
+    """Lines of the report section."""
+    models = section["models"]
+    samples = models[0]["conditions"][0]["samples"]
+    lines = ["## Human-likeness targets (issue 11; `human_targets.png`)", "",
+             f"Open-loop plans from rest, measured on the plan's mean; {section['definition']}. MT: first time after the "
+             "peak with speed below 5 % of the peak (SPEC §6; minimum jerk then has t_peak/MT = "
+             f"{minimum_jerk_asymmetry():.3f}). The hand is scored at the first step at or after MT: hit rate in closed "
+             f"form (Gaussian with the plan's predicted mean and covariance, integrated over the ball) and over {samples} "
+             "open-loop Monte Carlo executions of the planned torques under the model's noise. 'Onset': speed 50 ms "
+             "after the start over the peak speed (the column 'min-jerk' gives a minimum-jerk reach with the same MT, "
+             "for reference). The endpoint-SD target uses the closed-form SD along and across the reach.", "",
+             verdict_table(section), ""]
+    for model in models:
+        lines += [f"### {model['model']}: per condition", "", _condition_table(model["conditions"]), ""]
+    return lines
+
+
+def verdict_table(section: dict) -> str:
+    """The targets as rows, each model's measured value (range over conditions) and pass/fail as columns."""
+    models = section["models"]
+    header = ["target", "threshold"]
+    for model in models:
+        header += [f"{model['model']}: measured", f"{model['model']}: verdict"]
+    rows = []
+    for k, first in enumerate(models[0]["verdicts"]):
+        row = [first["target"] + (f" ({first['unit']})" if first["unit"] else ""), first["threshold"]]
+        for model in models:
+            verdict = model["verdicts"][k]
+            row += [_range(verdict["low"], verdict["high"]), _pass(verdict)]
+        rows.append(row)
+    totals = ["**targets passed**", ""]
+    for model in models:
+        totals += ["", f"**{model['passed']} / {model['targets']}**"]
+    return _table(header, rows + [totals])
+
+
+def _condition_table(conditions: list[dict]) -> str:
+    header = ["D (m)", "w (m)", "ID (bits)", "MT (s)", "t_peak/MT", "peak speed / (D/MT)", "onset", "onset min-jerk",
+              "peaks", "reversal", "end speed", "hit rate closed form", "hit rate Monte Carlo", "SD along / across (mm)",
+              "SD along / across closed form (mm)", "converged"]
+    rows = [[c["distance"], c["width"], _num(c["index_of_difficulty"], 2), _num(c["movement_time"], 3),
+             _num(c["asymmetry"], 3), _num(c["peak_speed_ratio"], 2), _num(c["onset"], 3), _num(c["onset_minimum_jerk"], 3),
+             c["peaks"], _num(c["reversal"], 3), _significant(c["end_speed"]), _num(c["hit_rate_closed_form"], 3),
+             _num(c["hit_rate_monte_carlo"], 3), f"{_num(1e3 * c['sd_along'], 1)} / {_num(1e3 * c['sd_across'], 1)}",
+             f"{_num(1e3 * c['sd_along_predicted'], 1)} / {_num(1e3 * c['sd_across_predicted'], 1)}", c["success"]]
+            for c in conditions]
+    return _table(header, rows)
+
+
+def _range(low, high) -> str:
+    """'low … high' with three significant digits; one number when both read the same."""
+    low, high = _significant(low), _significant(high)
+    return low if low == high else f"{low} … {high}"
+
+
+def _pass(verdict: dict) -> str:
+    if verdict["passed"]:
+        return "pass"
+    failing = verdict["failing"]
+    return f"**fail** ({len(failing)}/{verdict['checked']})" if failing else "**fail**"
+
+
+def _significant(value) -> str:
+    """Three significant digits; '–' for a missing (None) or non-finite value."""
+    return f"{value:.3g}" if value is not None and math.isfinite(value) else "–"
 
 
 def _table(header: list[str], rows: list[list]) -> str:

@@ -1,8 +1,9 @@
 """A validation run: every analysis of the paper's Section IV-D on one model, its figures, the calibration
-study and the Franka section (Section V-B), written as PNGs, CSV files, ``report.json`` (every number) and
-``report.md`` (the same, as tables).
+study, the human-likeness targets (issue 11) and the Franka section (Section V-B), written as PNGs, CSV files,
+``report.json`` (every number) and ``report.md`` (the same, as tables).
 
-A point-mass model gets the Section IV-D analyses and, unless ``settings.franka`` is False, the Franka
+A point-mass model gets the Section IV-D analyses, the human-likeness targets beside a reference preset
+(``settings.human_targets``, ``settings.human_reference``) and, unless ``settings.franka`` is False, the Franka
 section planned with the built-in ``franka`` preset. An arm model (the Panda) gets the Franka section alone:
 the point-mass grids (a dozen cold solves, hundreds of closed-loop replans) are not what its section shows.
 """
@@ -31,7 +32,7 @@ from comanip.analysis import (
     study_configurations,
 )
 from comanip.analysis.calibration import HUMAN_MT_RANGE, TREND_TOLERANCE
-from comanip.analysis.reach_grid import home_start, unit_direction
+from comanip.analysis.reach_grid import ReachOutcome, home_start, unit_direction
 from comanip.model import ReachingModel
 from comanip.planning.planner import Planner
 from comanip.plots.asymmetry_figure import plot_asymmetry_against_difficulty
@@ -41,6 +42,7 @@ from comanip.plots.fitts_figure import plot_fitts
 from comanip.plots.phase_figure import plot_phase
 from comanip.plots.velocity_profiles import plot_velocity_profiles
 from comanip.validation.arm_section import run_arm_section
+from comanip.validation.human_section import run_human_section
 from comanip.validation.markdown import report_markdown
 from comanip.validation.settings import ValidationSettings
 
@@ -49,7 +51,8 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
                    progress: bool = True) -> dict:
     """Run every analysis on model, write figures and reports into out; returns the report dictionary.
 
-    Raises ValueError, before any work, for an arm model with ``settings.franka`` False (nothing to run).
+    Raises ValueError, before any work, for an arm model with ``settings.franka`` False (nothing to run) and
+    for a human-likeness reference that is not a point-mass model.
     """
     settings = settings or ValidationSettings()
     point_mass = model.body.is_linear
@@ -57,14 +60,21 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
         raise ValueError(f"franka is False (--no-franka) but the model {model.name!r} is an arm ({model.body.name}), whose "
                          "validation is the Franka section alone: nothing to run (the other analyses need a point-mass "
                          "preset such as planar)")
+    reference = presets.load(settings.human_reference) if point_mass and settings.human_targets else None
+    if reference is not None and not reference.body.is_linear:
+        raise ValueError(f"the human-likeness reference {settings.human_reference!r} must be a point-mass model, "
+                         f"got an arm ({reference.body.name})")
     out = Path(out)
     out.mkdir(parents=True, exist_ok=True)
     began = time.perf_counter()
     report = {"model": model.config(), "settings": settings.to_dict()}
     figures = []
     if point_mass:
-        sections, figures = _point_mass_sections(model, out, settings, progress)
+        sections, figures, grid = _point_mass_sections(model, out, settings, progress)
         report |= sections
+        if reference is not None:
+            report["human_targets"], human_figures = run_human_section(model, reference, grid, out, settings, progress)
+            figures += human_figures
     if settings.franka:
         arm = model if not point_mass else presets.load("franka")
         report["franka"], arm_figures = run_arm_section(arm, out, settings, progress)
@@ -76,8 +86,9 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
 
 
 def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSettings,
-                         progress: bool) -> tuple[dict, list[Path]]:
-    """The Section IV-D analyses and the calibration study: report entries and figure paths."""
+                         progress: bool) -> tuple[dict, list[Path], list[ReachOutcome]]:
+    """The Section IV-D analyses and the calibration study: report entries, figure paths and the open-loop
+    outcomes (with plans) of the distances × widths grid."""
     planner = Planner(model)
     rng = np.random.default_rng(settings.seed)
     n_grid = len(settings.distances) * len(settings.widths)
@@ -148,7 +159,7 @@ def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSe
             **{f"cov_reading_{form}_r2_if_log_linear": _r2_if_log_linear_in_d_over_sqrt_w(grid, form) for form in ("fitts", "shannon")},
         },
     }
-    return report, figures
+    return report, figures, grid
 
 
 def _r2_if_log_linear_in_d_over_sqrt_w(grid, form: str) -> float:

@@ -1,5 +1,5 @@
-"""What ``comanip validate`` measures: the grids of the paper's Section IV-D, the calibration study and the
-Franka section (Section V-B)."""
+"""What ``comanip validate`` measures: the grids of the paper's Section IV-D, the calibration study, the
+human-likeness targets (issue 11) and the Franka section (Section V-B)."""
 
 from __future__ import annotations
 
@@ -45,6 +45,13 @@ class ValidationSettings:
     """Processes for the calibration study (default: the CPU count)."""
     seed: int = 0
     """Seed of every random draw (Monte Carlo and closed-loop noise)."""
+    human_targets: bool = True
+    """Score a point-mass model on the human-likeness targets over the distances × widths grid, beside
+    human_reference (:mod:`comanip.validation.human_section`)."""
+    human_reference: str = "planar"
+    """Preset name or YAML path of the model shown beside the run's model in that section."""
+    human_samples: int = 2000
+    """Open-loop Monte Carlo executions per condition for the targets' hit rate and endpoint SD."""
     franka: bool = True
     """Run the Franka section: Panda reaches from the ready pose. A point-mass model's run plans with the
     built-in ``franka`` preset; an arm model's run is this section alone."""
@@ -69,12 +76,15 @@ class ValidationSettings:
                 raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}")
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.phase_initial_velocities):
             raise ValueError(f"phase_initial_velocities must be finite numbers (m/s), got {self.phase_initial_velocities!r}")
-        for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0)):
+        for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0), ("human_samples", 2)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < least:
                 raise ValueError(f"{name} must be an integer ≥ {least}, got {value!r}")
-        if not isinstance(self.franka, bool):
-            raise ValueError(f"franka must be True or False, got {self.franka!r}")
+        for name in ("franka", "human_targets"):
+            if not isinstance(getattr(self, name), bool):
+                raise ValueError(f"{name} must be True or False, got {getattr(self, name)!r}")
+        if not isinstance(self.human_reference, str) or not self.human_reference:
+            raise ValueError(f"human_reference must be a preset name or a YAML path, got {self.human_reference!r}")
         offsets = self.franka_goal_offsets
         if len(offsets) == 0 or not all(len(o) == 3 and all(isinstance(v, (int, float)) and math.isfinite(v) for v in o)
                                         for o in offsets):

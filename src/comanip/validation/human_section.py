@@ -1,0 +1,48 @@
+"""The human-likeness section of a validation run (issue 11): the run's model scored on the targets
+(:mod:`comanip.analysis.human_targets`) beside a reference preset (the paper's ``planar`` by default), their
+figure, and the section's report dictionary (rendered by :func:`comanip.validation.markdown.human_targets_markdown`).
+
+The run's model is scored on the open-loop grid the run already planned; the reference's grid is planned
+here (over the same distances and widths) unless the reference is the run's model itself.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from pathlib import Path
+
+from tqdm import tqdm
+
+from comanip.analysis.human_targets import HumanTargetsResult, measure_human_targets
+from comanip.analysis.reach_grid import ReachOutcome
+from comanip.analysis.target_verdicts import HumanTargets
+from comanip.model import ReachingModel
+from comanip.plots.human_targets_figure import plot_human_targets
+from comanip.validation.settings import ValidationSettings
+
+#: Figure file of the section.
+HUMAN_FIGURE = "human_targets.png"
+#: The one definition of w and ID the section states.
+DEFINITION = "w is the goal radius: a reach hits when ‖x − g‖ ≤ w at MT (2w is the full width), and ID = log2(2D/w) bits"
+
+
+def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list[ReachOutcome], out: Path,
+                      settings: ValidationSettings, progress: bool = True) -> tuple[dict, list[Path]]:
+    """Score model on grid (its open-loop outcomes over settings.distances × settings.widths, with plans)
+    and reference; write the figure into out. Returns the section's report dictionary and the figure path."""
+    same = reference.config() == model.config()
+    options = {"n_samples": settings.human_samples, "seed": settings.seed, "distances": settings.distances,
+               "widths": settings.widths}
+    with tqdm(total=len(grid) * (1 if same else 3), desc="human-likeness targets", unit="reach",
+              disable=not progress) as bar:
+        results = [measure_human_targets(model, grid, progress=bar.update, **options)]
+        if not same:
+            results.append(measure_human_targets(reference, progress=bar.update, **options))
+    names = " vs ".join(r.model_name for r in results)
+    figure = plot_human_targets(results, out / HUMAN_FIGURE, title=f"human-likeness targets: {names}")
+    return human_section(results), [figure]
+
+
+def human_section(results: list[HumanTargetsResult], targets: HumanTargets = HumanTargets()) -> dict:
+    """The report dictionary of scored models (the first is the one the report is about)."""
+    return {"definition": DEFINITION, "thresholds": asdict(targets), "models": [r.to_dict() for r in results]}
