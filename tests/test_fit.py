@@ -13,7 +13,7 @@ import comanip
 from comanip.analysis import speed_metrics
 from comanip.belief.propagation import sample_trajectories
 from comanip.cli.main import main
-from comanip.fitting import MovementTimeTable, fit_model, fit_movement_times, load_recordings, recordings_nll
+from comanip.fitting import MovementTimeTable, Trial, fit_model, fit_movement_times, load_recordings, recordings_nll
 from comanip.fitting.condition_plans import ConditionPlanner
 
 TRUE_KAPPA = 2e-2
@@ -116,6 +116,21 @@ def test_dask_scheduler_gives_the_local_likelihood(synthetic):
     with LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster, Client(cluster) as client:
         remote = recordings_nll(model, synthetic[0], scheduler=client)
     assert remote == pytest.approx(local, rel=1e-10, abs=1e-8)
+
+
+def test_fit_recovers_an_activation_time_constant_named_by_index(tmp_path):
+    # a tuple field's entry is a parameter ('activation.0'); data from a one-stage muscle model, tau = 40 ms
+    truth = true_model().replace(activation=(0.04,))
+    rng, planner, trials = np.random.default_rng(3), comanip.Planner(truth), []
+    for c, (goal, width) in enumerate(CONDITIONS[:2]):
+        plan = planner.solve(np.zeros(4), goal, width)
+        states = sample_trajectories(truth.body, truth.h, truth.kappa, truth.full_state(np.zeros(4)), plan.torque, 10, rng)
+        trials += [Trial(f"{c}-{k}", plan.t, path[:, :2] + MEASUREMENT_NOISE * rng.standard_normal(path[:, :2].shape),
+                         np.array(goal), width) for k, path in enumerate(states)]
+    fit = fit_model(truth.replace(activation=(0.08,)), trials, ["activation.0"], progress=False)
+    value, se = fit.values["activation.0"], fit.std_errors["activation.0"]
+    assert fit.success and value == pytest.approx(0.04, rel=0.1) and abs(value - 0.04) < 3 * se
+    assert comanip.presets.load(fit.save_yaml(tmp_path / "muscle.yaml")).activation == (value,)
 
 
 def movement_time_table(model, distances, widths):
