@@ -53,8 +53,10 @@ class ReachingModel:
     (0.04, 0.04), Todorov 2005); () (default, the paper) applies the command as the force. The motor noise
     enters at the command. See comanip.bodies.muscle."""
     stop_weight: float = 0.0
-    """Weight of the terminal stopping cost stop_weight · E||qdot_H||² (reward units per (m/s)² or
-    (rad/s)²), ≥ 0: asks the hand to be still at the end of the horizon. 0 (default, the paper): none."""
+    """Weight of the terminal stopping cost |J_best(w)| · stop_weight · E||qdot_H||², in (s/m)² or (s/rad)², ≥ 0:
+    asks the hand to be still at the end of the horizon. Relative to the best attainable reward |J_best|, so a
+    final RMS speed of 1/sqrt(stop_weight) costs as much as the whole reward, whatever the width.
+    0 (default, the paper): none."""
     discount: str = "exponential"
     """'exponential' gamma^i (default) or 'hyperbolic' 1/(1 + (1/gamma - 1) i)."""
     name: str = "custom"

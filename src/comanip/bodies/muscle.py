@@ -74,8 +74,11 @@ class MuscleActuatedBody(Body):
         return ca.vertcat(body_next, *filtered)
 
     def command_for_force(self, force: np.ndarray, h: float) -> np.ndarray:
-        """Commands (H, n) whose filtered output is ``force`` (H, n) one step later at every step (each stage
-        inverted, last to first: input_k = (a_{k+1} - alpha a_k) / (1 - alpha), the last value held)."""
+        """Commands (H, n) under which the last stage's output at step k is ``force[k]`` (H, n) at every step k,
+        each stage inverted, last to first: input_k = (a_{k+1} - alpha a_k) / (1 - alpha), the last force held.
+
+        Exact when the first m forces are zero (m stages from rest cannot feel a command sooner); otherwise
+        the force lags there, which an initial guess tolerates."""
         signal = np.asarray(force, dtype=float)
         for t in reversed(self.time_constants):
             alpha = math.exp(-h / t)

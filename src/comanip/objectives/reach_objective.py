@@ -26,7 +26,8 @@ def reach_objective(ee_means, ee_covs, torques, goal, width, weights, nu, reward
 
 def stopping_cost(mean_velocity, velocity_cov, stop_weight: float):
     """stop_weight · E||qdot||² = stop_weight (||mu_qdot||² + tr Sigma_qdot) of the final state (the
-    model's stopping requirement): mean_velocity (n,), velocity_cov (n, n), CasADi or NumPy."""
+    model's stopping requirement, which the planner scales by |J_best|): mean_velocity (n,), velocity_cov (n, n),
+    CasADi or NumPy."""
     if isinstance(mean_velocity, (ca.SX, ca.MX)):
         return stop_weight * (ca.sumsqr(mean_velocity) + ca.trace(velocity_cov))
     return stop_weight * float(np.sum(np.square(mean_velocity)) + np.trace(velocity_cov))

@@ -147,8 +147,8 @@ class ReachCurvature:
         steps = np.arange(H)
         hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks.reshape(H, n, n)
         hessian[np.diag_indices(H * n)] += self._effort / self.normaliser(width)
-        if self._stop_hessian is not None:
-            hessian += self._stop_hessian / self.normaliser(width)
+        if self._stop_hessian is not None:  # the stopping cost is scaled by |J_best| already
+            hessian += self._stop_hessian
         return hessian
 
     def goal_derivatives(self, data: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -217,7 +217,8 @@ def _noise_second_derivatives(model) -> np.ndarray:
 
 
 def _stopping_hessian(problem: ReachProblem) -> np.ndarray | None:
-    """∇² of the stopping cost (H·n, H·n), constant for a linear body (it is quadratic in tau); None without one."""
+    """∇² of the stopping cost over |J_best| (H·n, H·n), constant for a linear body (it is quadratic in tau);
+    None without one."""
     model = problem.model
     if model.stop_weight == 0:
         return None

@@ -45,11 +45,12 @@ class ReachProblem:
         self.reward = GoalReward.of(model)
         self.objective = reach_objective(self.ee_means, self.ee_covs, [self.tau[:, i] for i in range(H)],
                                          self.goal, self.width, weights, model.nu, self.reward)
-        if model.stop_weight > 0:
-            self.objective += stopping_cost(self.means[-1][n:2 * n], self.covs[-1][n:2 * n, n:2 * n], model.stop_weight)
         # The best objective attainable (hand on the goal with no noise at every step, no effort), used to
         # normalise J for the solver so its tolerances mean the same for every width; the minimiser is unchanged.
         self.best_objective = -float(np.sum(weights)) * self.reward.peak(self.width)
+        if model.stop_weight > 0:  # relative to the best reward, so it means the same for every width
+            self.objective += -self.best_objective * stopping_cost(self.means[-1][n:2 * n], self.covs[-1][n:2 * n, n:2 * n],
+                                                                   model.stop_weight)
 
         self.trajectory = ca.Function(
             "trajectory", [ca.vec(self.tau), self.s0, self.goal, self.width],

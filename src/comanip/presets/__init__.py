@@ -54,6 +54,16 @@ def cartesian() -> ReachingModel:
     return load("cartesian")
 
 
+def human() -> ReachingModel:
+    """Human-like planar reaching (n = d = 2): the planar preset with muscle activation stages and arm viscosity."""
+    return load("human")
+
+
+def human_cartesian() -> ReachingModel:
+    """The human preset in 3-D (n = d = 3), for the collaborative scenarios and 3-D recordings."""
+    return load("human_cartesian")
+
+
 def franka() -> ReachingModel:
     """Franka Emika Panda (n = 7 joints, d = 3), H = 50, h = 0.035 s; start from ``model.body.home_position``."""
     return load("franka")
