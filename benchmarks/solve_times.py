@@ -64,6 +64,30 @@ def reach_case(preset: str, paper_time: float, options: SolverOptions | None = N
     return make
 
 
+def cold_case(preset: str, paper_time: float | None = None) -> Callable[[], Case]:
+    """Cold solves (no warm start: the model's multi-start guesses) from rest at the home position to goals
+    0.1–0.4 m away in uniformly drawn directions, a new goal each time (a user's first plan for a goal)."""
+
+    def make() -> Case:
+        model = comanip.presets.load(preset)
+        planner, build = timed(lambda: comanip.Planner(model))
+        rng = np.random.default_rng(1)
+        home = model.body.home_position
+        start = np.concatenate([home, np.zeros(model.n)])
+        origin = np.asarray(model.body.kinematics_function(home)[0]).ravel()
+        planner.solve(start, origin + 0.2 * np.eye(model.d)[0], model.width)  # any one-off work, untimed
+
+        def solve(k: int) -> tuple[float, bool]:
+            direction = rng.normal(size=model.d)
+            goal = origin + rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+            plan = planner.solve(start, goal, model.width)
+            return plan.solve_time, plan.success
+
+        return Case(f"{preset} cold (H={model.H}, n={model.n})", build, solve, paper_time)
+
+    return make
+
+
 def closed_loop_reach_case() -> Case:
     """One closed-loop reach of the transition-data person (planar, 2H = 60 replans, D = 0.3 m, w = 0.02 m):
     the unit of `comanip transition generate` (conditions × trials reaches, spread over the workers)."""
@@ -187,6 +211,12 @@ CASES: dict[str, Callable[[], Case]] = {
     "planar_ipopt": reach_case("planar", 0.04, SolverOptions(method="ipopt"), " IPOPT"),
     "cartesian_ipopt": reach_case("cartesian", 0.20, SolverOptions(method="ipopt"), " IPOPT"),
     "franka": reach_case("franka", 1.3, reach=(0.15, 0.1, -0.1)),
+    "planar_cold": cold_case("planar", 0.04),
+    "cartesian_cold": cold_case("cartesian", 0.20),
+    "human": reach_case("human", None),
+    "human_cold": cold_case("human"),
+    "human_cartesian": reach_case("human_cartesian", None),
+    "human_cartesian_cold": cold_case("human_cartesian"),
     "closed_loop": closed_loop_reach_case,
     "franka_replan": franka_replan_case,
     "estimate_planar": estimate_case("planar"),
