@@ -55,10 +55,11 @@ class ReachOutcome:
 
 
 def home_start(model: ReachingModel) -> tuple[np.ndarray, np.ndarray]:
-    """Start state at rest at the body's home position (2n,), and its end-effector position (d,), m."""
+    """Start state at rest at the body's home position (nx,; activation stages at zero force), and its
+    end-effector position (d,), m."""
     q0 = model.body.home_position
     x0 = np.asarray(model.body.kinematics_function(q0)[0]).ravel()
-    return np.concatenate([q0, np.zeros(model.n)]), x0
+    return model.full_state(np.concatenate([q0, np.zeros(model.n)])), x0
 
 
 def unit_direction(model: ReachingModel, direction=None) -> np.ndarray:
@@ -101,7 +102,7 @@ def closed_loop_grid(planner: Planner, distances, widths, n_trials: int, rng: np
 
 
 def _over_grid(model, distances, widths, direction, progress, reach) -> list[ReachOutcome]:
-    """reach(start (2n,), goal (d,), distance, width) for every pair, distances outer; progress(1) after each."""
+    """reach(start (nx,), goal (d,), distance, width) for every pair, distances outer; progress(1) after each."""
     start, x0 = home_start(model)
     u = unit_direction(model, direction)
     outcomes = []

@@ -24,7 +24,7 @@ class Execution:
     t: np.ndarray
     """Times (K+1,), s."""
     states: np.ndarray
-    """Actual states [q; qdot] (K+1, 2n)."""
+    """Actual states [q; qdot] (K+1, nx), nx = model.state_size (2n, plus n per activation stage)."""
     commanded: np.ndarray
     """Commanded torques (K, n)."""
     executed: np.ndarray
@@ -48,7 +48,7 @@ def execute_receding_horizon(planner: Planner, start, goal, width: float | None 
 
     Args:
         planner: a built :class:`Planner` (its model sets h, H, kappa and the noise form).
-        start: start state (2n,); goal: (d,) m; width: m (model default when None).
+        start: start state [q; qdot] (2n,) or the full state (nx,); goal: (d,) m; width: m (model default when None).
         steps: steps to execute (default H).
         rng: random generator for the motor noise (default: a fresh unseeded one).
         noise: False executes the commands exactly (a deterministic closed loop).
@@ -61,11 +61,11 @@ def execute_receding_horizon(planner: Planner, start, goal, width: float | None 
         raise ValueError(f"steps must be ≥ 1, got {steps}")
     rng = rng if rng is not None else np.random.default_rng()
     body, n = model.body, model.n
-    s_sym, tau_sym = ca.SX.sym("s", 2 * n), ca.SX.sym("tau", n)
+    s_sym, tau_sym = ca.SX.sym("s", model.state_size), ca.SX.sym("tau", n)
     step = ca.Function("step", [s_sym, tau_sym], [body.discrete_step(s_sym, tau_sym, model.h)])
-    velocity = ca.Function("ee_velocity", [s_sym], [ca.mtimes(body.jacobian(s_sym[:n]), s_sym[n:])])
+    velocity = ca.Function("ee_velocity", [s_sym], [ca.mtimes(body.jacobian(s_sym[:n]), s_sym[n:2 * n])])
 
-    states = np.zeros((steps + 1, 2 * n))
+    states = np.zeros((steps + 1, model.state_size))
     states[0] = start
     commanded = np.zeros((steps, n))
     executed = np.zeros((steps, n))

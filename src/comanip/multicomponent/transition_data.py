@@ -49,7 +49,7 @@ def simulate_paths(planner: Planner, distance: float, width: float, n_trials: in
     model = planner.model
     goal = np.zeros(model.d)
     goal[0] = distance
-    start = np.zeros(2 * model.n)
+    start = np.zeros(model.state_size)
     paths, settled, failed = [], 0, 0
     for _ in range(n_trials):
         run = execute_receding_horizon(planner, start, goal, width, steps=steps, rng=rng)
