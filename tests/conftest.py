@@ -17,3 +17,9 @@ def cartesian_planner():
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+@pytest.fixture(scope="session")
+def activation_planner():
+    """The planar preset with two 40 ms muscle activation stages: state [q; qdot; a_1; a_2] (8,)."""
+    return comanip.Planner(comanip.presets.planar().replace(activation=(0.04, 0.04)))

@@ -65,6 +65,29 @@ def test_generated_rows_do_not_depend_on_the_number_of_workers(tmp_path):
     assert json.loads(path.with_suffix(".json").read_text()) == {"seed": 7}
 
 
+def test_generate_and_fit_with_a_preset_yaml_of_a_model_with_activation_stages(tmp_path, capsys):
+    # the person of --preset (here planar with two 40 ms activation stages, state (8,)) makes the data, the JSON
+    # records it and fit names it; w ≥ 0.04 because at H = 30 this model stays still for w ≤ 0.02
+    preset = comanip.presets.save(comanip.presets.planar().replace(activation=(0.04, 0.04), name="planar_activation"),
+                                  tmp_path / "planar_activation.yaml")
+    csv = tmp_path / "data.csv"
+    assert main(["transition", "generate", "--preset", str(preset), "--distances", "0.3,0.43", "--widths", "0.04,0.05",
+                 "--trials", "3", "--steps", "30", "--workers", "1", "--out", str(csv)]) == 0
+    capsys.readouterr()
+    metadata = json.loads(csv.with_suffix(".json").read_text())
+    assert metadata["model"]["activation"] == [0.04, 0.04] and metadata["model"]["name"] == "planar_activation"
+    rows = read_transition_csv(csv)
+    assert len(rows["width_m"]) == 4 and np.all(rows["failed_replans"] == 0)
+    assert np.all((rows["transition_distance_m"] > 0) & (rows["transition_distance_m"] < 0.43 * 0.7))
+    assert main(["transition", "fit", "--data", str(csv), "--out", str(tmp_path / "fit")]) == 0
+    assert json.loads(capsys.readouterr().out)["data_made_by"]["model"] == "planar_activation"
+
+
+def test_generate_rejects_an_arm_before_any_work():
+    with pytest.raises(ValueError, match="must be a point-mass model .* an arm"):
+        generate_transition_data([0.3], [0.02], 3, model=comanip.presets.franka(), progress=False)
+
+
 # ---- the Gaussian process ------------------------------------------------------------------------------------
 
 def _known_function(ratio, width):
@@ -175,6 +198,8 @@ def test_transition_commands_fit_save_and_plot(tmp_path, capsys):
     assert main(["transition", "fit", "--out", str(tmp_path)]) == 0
     printed = json.loads(capsys.readouterr().out)
     assert printed["rows"] == len(read_transition_csv(shipped_dataset_path())["width_m"])
+    assert printed["data_made_by"] == {"model": "planar",
+                                       "command": "comanip transition generate --out src/comanip/data/transition_planar.csv"}
     saved = TransitionModel.load(tmp_path / "model.json")
     assert saved.predict(0.3, 0.02) == comanip.TransitionModel().predict(0.3, 0.02)
     assert json.loads((tmp_path / "trends.json").read_text()) == printed["trends"]

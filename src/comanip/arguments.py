@@ -30,6 +30,13 @@ def as_positive(name: str, value, unit: str) -> float:
     return float(value)
 
 
+def as_nonnegative(name: str, value, unit: str) -> float:
+    """value as a finite float ≥ 0, else ValueError."""
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not math.isfinite(value) or value < 0:
+        raise ValueError(f"{name} must be a finite number ≥ 0 ({unit}), got {value!r}")
+    return float(value)
+
+
 def as_positive_array(name: str, value, unit: str) -> np.ndarray:
     """value (a number or an array of any shape) as a float array, all finite and > 0, else ValueError."""
     try:

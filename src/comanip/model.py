@@ -6,11 +6,11 @@ CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from comanip.arguments import as_nonnegative, as_positive
 from comanip.belief.noise import check_noise_form
 from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
@@ -68,21 +68,21 @@ class ReachingModel:
         if not isinstance(self.body, Body):
             raise ValueError(f"body must be a comanip.bodies.Body, got {type(self.body).__name__}")
         self._attach_activation()
-        _check_positive("h", self.h, "s")
+        as_positive("h", self.h, "s")
         if isinstance(self.H, bool) or not isinstance(self.H, (int, np.integer)) or self.H < 1:
             raise ValueError(f"H must be an integer ≥ 1 (horizon in steps), got {self.H!r}")
         object.__setattr__(self, "H", int(self.H))
         if not (isinstance(self.gamma, (int, float)) and 0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1] (discount per step), got {self.gamma!r}")
-        _check_nonnegative("nu", self.nu, "reward per N²")
-        _check_nonnegative("kappa", self.kappa, "dimensionless variance")
-        _check_positive("width", self.width, "m")
+        as_nonnegative("nu", self.nu, "reward per N²")
+        as_nonnegative("kappa", self.kappa, "dimensionless variance")
+        as_positive("width", self.width, "m")
         check_noise_form(self.noise)
         check_goal_covariance_form(self.goal_covariance)
         check_reward_form(self.reward)
         check_discount_form(self.discount)
-        _check_positive("effective_k", self.effective_k, "standard deviations")
-        _check_nonnegative("stop_weight", self.stop_weight, "reward per (m/s)²")
+        as_positive("effective_k", self.effective_k, "standard deviations")
+        as_nonnegative("stop_weight", self.stop_weight, "reward per (m/s)²")
 
     def _attach_activation(self) -> None:
         """Make ``body`` the plant: the bare body, or the bare body behind the activation stages."""
@@ -175,12 +175,3 @@ class ReachingModel:
         config["body"] = body_from_config(config["body"])
         return cls(**config)
 
-
-def _check_positive(name, value, unit):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}")
-
-
-def _check_nonnegative(name, value, unit):
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating)) or not math.isfinite(value) or value < 0:
-        raise ValueError(f"{name} must be a finite number ≥ 0 ({unit}), got {value!r}")

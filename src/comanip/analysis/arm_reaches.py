@@ -55,7 +55,7 @@ class LimitUsage:
 def joint_limit_usage(model, plan: Plan) -> LimitUsage:
     """Limit usage (see the module docstring) of plan, a plan of model's arm."""
     body, n = model.body, model.n
-    q, qdot = plan.mean[1:, :n], plan.mean[1:, n:]
+    q, qdot = plan.mean[1:, :n], plan.mean[1:, n:2 * n]
     middle, half_range = (body.q_max + body.q_min) / 2, (body.q_max - body.q_min) / 2
     position = np.max(np.abs(q - middle), axis=0) / half_range
     velocity = np.max(np.abs(qdot), axis=0) / body.qdot_max
@@ -70,7 +70,7 @@ def _velocity_usage_after(model, plan: Plan, time: float) -> float:
     after = plan.t > time  # False everywhere for a NaN time
     if not after.any():
         return float("nan")
-    return float(np.max(np.abs(plan.mean[after, model.n:]) / model.body.qdot_max))
+    return float(np.max(np.abs(plan.mean[after, model.n:2 * model.n]) / model.body.qdot_max))
 
 
 @dataclass

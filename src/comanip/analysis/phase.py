@@ -54,7 +54,7 @@ def phase_curves(planner: Planner, distances, initial_velocities, width: float, 
     for distance in distances:
         for v0 in initial_velocities:
             s0 = start.copy()
-            s0[model.n :] = np.linalg.lstsq(J, float(v0) * u, rcond=None)[0]
+            s0[model.n : 2 * model.n] = np.linalg.lstsq(J, float(v0) * u, rcond=None)[0]
             plan = planner.solve(s0, x0 + float(distance) * u, width)
             curves.append(PhaseCurve(float(distance), float(v0), float(width), plan.t, (plan.ee_mean - x0) @ u,
                                      plan.ee_velocity @ u, speed_metrics(plan.t, plan.ee_speed), plan.success,

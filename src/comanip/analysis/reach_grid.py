@@ -3,7 +3,8 @@
 Every reach starts at rest at the body's home position and aims at a goal ``distance`` metres away along
 ``direction`` (default: the first task axis, x). An open-loop outcome is the plan's mean; a closed-loop
 outcome is the mean over trials of the executed end-effector velocity (replanning every step from the
-noisy state, :func:`comanip.execution.execute_receding_horizon`).
+noisy state, or from the person's estimate of it under an observation model,
+:func:`comanip.execution.execute_receding_horizon`).
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import Callable
 import numpy as np
 
 from comanip.analysis.speed_profile import SpeedMetrics, speed_metrics
-from comanip.execution import execute_receding_horizon
+from comanip.execution import Observation, execute_receding_horizon
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
@@ -55,10 +56,11 @@ class ReachOutcome:
 
 
 def home_start(model: ReachingModel) -> tuple[np.ndarray, np.ndarray]:
-    """Start state at rest at the body's home position (2n,), and its end-effector position (d,), m."""
+    """Start state at rest at the body's home position (nx,; activation stages at zero force), and its
+    end-effector position (d,), m."""
     q0 = model.body.home_position
     x0 = np.asarray(model.body.kinematics_function(q0)[0]).ravel()
-    return np.concatenate([q0, np.zeros(model.n)]), x0
+    return model.full_state(np.concatenate([q0, np.zeros(model.n)])), x0
 
 
 def unit_direction(model: ReachingModel, direction=None) -> np.ndarray:
@@ -83,14 +85,17 @@ def open_loop_grid(planner: Planner, distances, widths, direction=None,
 
 def closed_loop_grid(planner: Planner, distances, widths, n_trials: int, rng: np.random.Generator,
                      steps: int | None = None, direction=None,
-                     progress: Callable[[int], object] | None = None) -> list[ReachOutcome]:
-    """Closed-loop executions (n_trials per condition, steps each; default 2H so slow reaches finish)."""
+                     progress: Callable[[int], object] | None = None,
+                     observation: Observation | None = None) -> list[ReachOutcome]:
+    """Closed-loop executions (n_trials per condition, steps each; default 2H so slow reaches finish), replanned
+    from the actual state (observation None) or from the estimate made with the observation's noise and delay."""
     if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:
         raise ValueError(f"n_trials must be an integer ≥ 1, got {n_trials!r}")
     steps = 2 * planner.model.H if steps is None else steps
 
     def reach(start, goal, distance, width):
-        runs = [execute_receding_horizon(planner, start, goal, width, steps=steps, rng=rng) for _ in range(n_trials)]
+        runs = [execute_receding_horizon(planner, start, goal, width, steps=steps, rng=rng, observation=observation)
+                for _ in range(n_trials)]
         velocity = np.mean([run.ee_velocity for run in runs], axis=0)
         final = np.mean([run.ee[-1] for run in runs], axis=0)
         return ReachOutcome(distance, width, runs[0].t, velocity, speed_metrics(runs[0].t, np.linalg.norm(velocity, axis=1)),
@@ -101,7 +106,7 @@ def closed_loop_grid(planner: Planner, distances, widths, n_trials: int, rng: np
 
 
 def _over_grid(model, distances, widths, direction, progress, reach) -> list[ReachOutcome]:
-    """reach(start (2n,), goal (d,), distance, width) for every pair, distances outer; progress(1) after each."""
+    """reach(start (nx,), goal (d,), distance, width) for every pair, distances outer; progress(1) after each."""
     start, x0 = home_start(model)
     u = unit_direction(model, direction)
     outcomes = []

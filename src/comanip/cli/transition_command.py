@@ -1,7 +1,9 @@
 """``comanip transition generate|fit|plot``: the transition-point data, its Gaussian-process model, Fig. 2.
 
     comanip transition generate --out data.csv      # simulate the two-component person over a (D/L, w) grid
-    comanip transition fit [--data data.csv]        # fit the GP (default: the shipped data), check the trends
+        [--preset NAME_OR_YAML]                     # ... made by any point-mass model (default: planar)
+    comanip transition fit [--data data.csv]        # fit the GP (default: the shipped data), check the trends;
+                                                    # prints the model that made the data (from the JSON beside it)
     comanip transition plot [--model model.json]    # Fig. 2: predicted transition distance over (D/L, w)
 """
 
@@ -16,7 +18,7 @@ import time
 from pathlib import Path
 
 from comanip.cli.arguments import add_model_arguments, load_model, vector
-from comanip.multicomponent.transition_csv import shipped_dataset_path, write_transition_csv
+from comanip.multicomponent.transition_csv import read_transition_metadata, shipped_dataset_path, write_transition_csv
 from comanip.multicomponent.transition_data import ARM_LENGTH, default_steps, generate_transition_data
 
 DEFAULT_DISTANCES = "0.2,0.3,0.4,0.5,0.6,0.7,0.8"
@@ -89,7 +91,10 @@ def run_fit(args) -> int:
     model.save(out / "model.json")
     report = trend_report(model)
     (out / "trends.json").write_text(json.dumps(report, indent=1))
-    print(json.dumps({"data": str(data), "rows": len(model.training_data["width_m"]), "kernel": model.kernel_description,
+    made = read_transition_metadata(data)
+    made_by = None if made is None else {"model": made.get("model", {}).get("name"), "command": made.get("command")}
+    print(json.dumps({"data": str(data), "data_made_by": made_by, "rows": len(model.training_data["width_m"]),
+                      "kernel": model.kernel_description,
                       "trends": report, "files": [str(out / "model.json"), str(out / "trends.json")]}, indent=1))
     return 0
 

@@ -31,13 +31,7 @@ from functools import cached_property
 
 import numpy as np
 
-from comanip.arguments import as_vector
-
-
-def _check_nonnegative(name: str, value, unit: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not np.isfinite(value) or value < 0:
-        raise ValueError(f"{name} must be a finite number ≥ 0 ({unit}), got {value!r}")
-    return float(value)
+from comanip.arguments import as_nonnegative, as_vector
 
 
 @dataclass(frozen=True)
@@ -60,10 +54,10 @@ class ImpedanceGains:
         if np.any(stiffness < 0):
             raise ValueError(f"translational_stiffness must be ≥ 0 N/m on every axis, got {stiffness.tolist()}")
         object.__setattr__(self, "translational_stiffness", tuple(stiffness.tolist()))
-        _check_nonnegative("rotational_stiffness", self.rotational_stiffness, "N·m/rad")
-        _check_nonnegative("damping_ratio", self.damping_ratio, "dimensionless")
-        _check_nonnegative("nullspace_stiffness", self.nullspace_stiffness, "N·m/rad")
-        _check_nonnegative("nullspace_damping_ratio", self.nullspace_damping_ratio, "dimensionless")
+        as_nonnegative("rotational_stiffness", self.rotational_stiffness, "N·m/rad")
+        as_nonnegative("damping_ratio", self.damping_ratio, "dimensionless")
+        as_nonnegative("nullspace_stiffness", self.nullspace_stiffness, "N·m/rad")
+        as_nonnegative("nullspace_damping_ratio", self.nullspace_damping_ratio, "dimensionless")
 
 
 @dataclass
@@ -115,7 +109,7 @@ class CartesianImpedanceController:
         self.rest_posture = np.array(rest_posture, dtype=float)
         n = self.rest_posture.size
         self.torque_limit = None if torque_limit is None else as_vector("torque_limit", torque_limit, n, "N·m")
-        self.redesign_angle = _check_nonnegative("redesign_angle", redesign_angle, "rad")
+        self.redesign_angle = as_nonnegative("redesign_angle", redesign_angle, "rad")
         self._stiffness = np.r_[gains.translational_stiffness, np.full(3, gains.rotational_stiffness)]
         self._damping = None
         self._designed_at = np.full(n, np.inf)

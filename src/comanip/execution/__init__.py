@@ -1,5 +1,8 @@
-"""Executing plans on the noisy arm: open loop (sampled motor noise) and closed loop (receding horizon)."""
+"""Executing plans on the noisy arm: open loop (sampled motor noise) and closed loop (receding horizon), the
+latter from the actual state or from a Kalman estimate made from noisy, delayed feedback."""
 
+from comanip.execution.kalman_filter import DelayedKalmanFilter
+from comanip.execution.observation import Observation
 from comanip.execution.receding_horizon import Execution, execute_receding_horizon
 
-__all__ = ["Execution", "execute_receding_horizon"]
+__all__ = ["DelayedKalmanFilter", "Execution", "Observation", "execute_receding_horizon"]

@@ -50,6 +50,13 @@ def write_transition_csv(rows: list[dict], path: str | Path, metadata: dict | No
     return path
 
 
+def read_transition_metadata(path: str | Path) -> dict | None:
+    """The JSON written beside a transition CSV by :func:`write_transition_csv` (command, seed, model, ...), or
+    None when there is none (e.g. a lab's own CSV)."""
+    metadata = Path(path).with_suffix(".json")
+    return json.loads(metadata.read_text()) if metadata.is_file() else None
+
+
 def read_transition_csv(path: str | Path) -> dict[str, np.ndarray]:
     """Columns of a transition CSV as float arrays (N,), checked by :func:`check_transition_columns`."""
     path = Path(path)

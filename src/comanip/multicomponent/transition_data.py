@@ -6,7 +6,9 @@ torque with signal-dependent noise (SPEC §2). The fast first part of the reach 
 path; the replanning then corrects it, so the perpendicular dispersion rises and falls, and its peak marks
 the transition (Peternel & Babič 2019; SPEC §8).
 
-A condition is a goal at distance D = (D/L)·L along x from rest at the origin, with width w (m). N trials
+The person is any point-mass model (default the planar preset; with activation stages the state
+[q; qdot; a_1..a_m] starts at rest with zero force). A condition is a goal at distance D = (D/L)·L along x
+from rest at the origin, with width w (m). N trials
 per condition give one row of the transition CSV (:mod:`comanip.multicomponent.transition_csv`). The sweep
 runs conditions in parallel on a Dask ``LocalCluster`` (one single-threaded worker process per core; each
 builds its planner once), with a tqdm progress bar.
@@ -42,14 +44,15 @@ def default_steps(model: ReachingModel) -> int:
 
 def simulate_paths(planner: Planner, distance: float, width: float, n_trials: int, steps: int,
                    rng: np.random.Generator) -> tuple[np.ndarray, int, int]:
-    """Hand paths of n_trials closed-loop reaches from rest at the origin to a goal distance (m) along x.
+    """Hand paths of n_trials closed-loop reaches from rest at the origin (the full state (nx,) at zero) to a
+    goal distance (m) along x.
 
     Returns (paths (n_trials, steps+1, d) m, trials that settled in the goal, failed replans in total).
     """
     model = planner.model
     goal = np.zeros(model.d)
     goal[0] = distance
-    start = np.zeros(2 * model.n)
+    start = np.zeros(model.state_size)
     paths, settled, failed = [], 0, 0
     for _ in range(n_trials):
         run = execute_receding_horizon(planner, start, goal, width, steps=steps, rng=rng)
@@ -91,7 +94,7 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
         distances_over_arm_length: goal distances D/L (> 0), dimensionless.
         widths: goal widths w (> 0), m.
         n_trials: closed-loop reaches per condition (≥ 3).
-        model: the person (default ``presets.planar()``; a 2-D point mass reaching along x).
+        model: the person, any point-mass model (default ``presets.planar()``, a 2-D point mass), reaching along x.
         arm_length: L (m) that turns D/L into metres.
         steps: executed steps per reach (default :func:`default_steps`, 2H).
         seed: seeds every condition's generator (one child of ``SeedSequence(seed)`` per condition, so the
@@ -103,6 +106,9 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
     model = presets.planar() if model is None else model
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel, got {type(model).__name__}")
+    if not model.body.is_linear:
+        raise ValueError(f"model must be a point-mass model (the person starts at rest at the origin and reaches along x), "
+                         f"got {model.name!r}, an arm ({model.body.name})")
     distances = np.ravel(as_positive_array("distances_over_arm_length", distances_over_arm_length, "D/L"))
     widths = np.ravel(as_positive_array("widths", widths, "goal width, m"))
     if distances.size == 0 or widths.size == 0:
