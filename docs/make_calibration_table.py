@@ -18,7 +18,7 @@ import time
 from pathlib import Path
 
 from comanip import presets
-from comanip.analysis import measure_human_targets
+from comanip.analysis import measure_closed_loop_targets, measure_human_targets
 from comanip.validation.human_section import human_section
 from comanip.validation.markdown import verdict_table
 
@@ -35,15 +35,21 @@ def replace_block(text: str, block: str) -> str:
     return f"{head}{BEGIN}\n{block.strip()}\n{END}{tail}"
 
 
-def measured_block(names: list[str], samples: int, seed: int) -> str:
+def measured_block(names: list[str], samples: int, seed: int, trials: int) -> str:
     """The block's markdown: how it was measured, the definition of w and ID, and the verdict table."""
     began = time.perf_counter()
-    results = [measure_human_targets(presets.load(name), n_samples=samples, seed=seed) for name in names]
+    results = []
+    for name in names:
+        model = presets.load(name)
+        results.append(measure_human_targets(model, n_samples=samples, seed=seed))
+        if model.observation:  # a model with feedback is scored on its closed loop too
+            results.append(measure_closed_loop_targets(model, trials, seed=seed))
     section = human_section(results)
-    command = " ".join(["docs/make_calibration_table.py", *names])
-    return (f"Measured by `{command}` ({samples} Monte Carlo executions per condition, seed {seed}; "
-            f"{time.perf_counter() - began:.0f} s for planning and scoring): {section['definition']}.\n\n"
-            f"{verdict_table(section)}")
+    command = " ".join(["docs/make_calibration_table.py", *names, f"--trials {trials}"])
+    return (f"Measured by `{command}` ({samples} open-loop Monte Carlo executions per condition; {trials} closed-loop "
+            f"executions per condition for a model with feedback (`observation`), scored on their mean velocity and "
+            f"their hands at MT; seed {seed}; {time.perf_counter() - began:.0f} s for planning, executing and scoring): "
+            f"{section['definition']}.\n\n{verdict_table(section)}")
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -52,10 +58,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--readme", type=Path, default=Path(__file__).resolve().parent.parent / "README.md")
     parser.add_argument("--samples", type=int, default=2000, help="Monte Carlo executions per condition (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the Monte Carlo draws (default: %(default)s)")
+    parser.add_argument("--trials", type=int, default=20,
+                        help="closed-loop executions per condition of a model with feedback (default: %(default)s)")
     args = parser.parse_args(argv)
     names = args.presets or [name for name in ("human", "planar") if name in presets.names()]
     text = args.readme.read_text()
-    args.readme.write_text(replace_block(text, measured_block(names, args.samples, args.seed)))
+    args.readme.write_text(replace_block(text, measured_block(names, args.samples, args.seed, args.trials)))
     print(f"{args.readme}: human-likeness table rewritten for {', '.join(names)}")
     return 0
 

@@ -130,3 +130,30 @@ def test_model_options_round_trip_through_yaml(tmp_path):
         comanip.presets.planar().replace(activation=(0.04, -1.0))
     with pytest.raises(ValueError, match="reward"):
         comanip.presets.planar().replace(reward="box")
+
+
+def test_feedback_shrinks_the_endpoint_spread_the_plan_predicts():
+    """Closed loop (replanning from the state every step) ends far tighter than the open-loop plan's spread."""
+    from comanip.analysis import measure_closed_loop_targets, measure_human_targets
+
+    model = comanip.presets.planar()
+    grid = dict(distances=(0.3,), widths=(0.01, 0.04))
+    open_loop = measure_human_targets(model, n_samples=200, **grid)
+    closed = measure_closed_loop_targets(model, n_trials=5, **grid)
+    assert closed.model_name == "planar closed loop" and len(closed.rows) == 2
+    for plan_row, run_row in zip(open_loop.rows, closed.rows):
+        assert run_row.samples == 5 and 0 <= run_row.hit_rate_monte_carlo <= 1
+        assert max(run_row.sd_along, run_row.sd_across) < 0.5 * min(plan_row.sd_along_predicted, plan_row.sd_across_predicted)
+
+
+def test_model_observation_drives_the_closed_loop_estimate():
+    from comanip.execution import Observation, execute_receding_horizon
+
+    model = comanip.presets.planar().replace(observation=(0.004, 0.04, 0.1))
+    assert Observation.of(model) == Observation(0.004, 0.04, 0.1) and Observation.of(comanip.presets.planar()) is None
+    run = execute_receding_horizon(comanip.Planner(model), np.zeros(4), [0.2, 0.0], 0.02, steps=8, rng=np.random.default_rng(0))
+    assert run.estimates is not None and not np.allclose(run.estimates[1:, :2], run.states[1:, :2])
+    with pytest.raises(ValueError, match="observation"):
+        comanip.presets.planar().replace(observation=(0.004, 0.04))
+    with pytest.raises(ValueError, match=r"observation\[2\]"):
+        comanip.presets.planar().replace(observation=(0.004, 0.04, -0.1))

@@ -57,6 +57,10 @@ class ReachingModel:
     asks the hand to be still at the end of the horizon. Relative to the best attainable reward |J_best|, so a
     final RMS speed of 1/sqrt(stop_weight) costs as much as the whole reward, whatever the width.
     0 (default, the paper): none."""
+    observation: tuple = ()
+    """What the person sees when executing in closed loop (comanip.execution): (position SD in m, velocity
+    SD in m/s, delay in s), each finite and ≥ 0; the replans then start from a Kalman estimate made from those
+    noisy, delayed observations. () (default): the replans start from the true state. Plans do not use it."""
     discount: str = "exponential"
     """'exponential' gamma^i (default) or 'hyperbolic' 1/(1 + (1/gamma - 1) i)."""
     name: str = "custom"
@@ -82,7 +86,11 @@ class ReachingModel:
         check_reward_form(self.reward)
         check_discount_form(self.discount)
         as_positive("effective_k", self.effective_k, "standard deviations")
-        as_nonnegative("stop_weight", self.stop_weight, "reward per (m/s)²")
+        as_nonnegative("stop_weight", self.stop_weight, "(s/m)²")
+        if len(self.observation) not in (0, 3):
+            raise ValueError(f"observation must be () or (position SD m, velocity SD m/s, delay s), got {self.observation!r}")
+        object.__setattr__(self, "observation", tuple(as_nonnegative(f"observation[{i}]", v, unit)
+                                                      for i, (v, unit) in enumerate(zip(self.observation, ("m", "m/s", "s")))))
 
     def _attach_activation(self) -> None:
         """Make ``body`` the plant: the bare body, or the bare body behind the activation stages."""
@@ -160,6 +168,7 @@ class ReachingModel:
             "reward": self.reward,
             "activation": list(self.activation),
             "stop_weight": self.stop_weight,
+            "observation": list(self.observation),
             "discount": self.discount,
         }
 

@@ -12,6 +12,7 @@ from comanip.analysis.calibration import (
     study_configurations,
 )
 from comanip.analysis.dispersion import EndpointDispersion, endpoint_dispersion
+from comanip.analysis.closed_loop_targets import measure_closed_loop_targets
 from comanip.analysis.fitts import FITTS_FORMS, FittsFit, fit_fitts, index_of_difficulty, trend_fraction
 from comanip.analysis.human_targets import (
     TARGET_DISTANCES,
@@ -41,6 +42,7 @@ __all__ = [
     "FITTS_FORMS", "FittsFit", "fit_fitts", "index_of_difficulty", "trend_fraction",
     "TARGET_DISTANCES", "TARGET_WIDTHS", "ConditionTargets", "HumanTargetsResult", "condition_targets",
     "measure_human_targets",
+    "measure_closed_loop_targets",
     "minimum_jerk_asymmetry", "minimum_jerk_settling_fraction", "minimum_jerk_speed_fraction", "minimum_jerk_velocity",
     "PhaseCurve", "phase_curves",
     "ProfileShape", "profile_shape",

@@ -93,7 +93,7 @@ class HumanTargetsResult:
     model_name: str
     rows: list[ConditionTargets]
     outcomes: list[ReachOutcome]
-    """The scored open-loop outcomes, in the order of rows."""
+    """The scored outcomes (open-loop plans, or closed-loop executions), in the order of rows."""
     fitts: FittsFit
     """MT = a + b·log2(2D/w) over the rows with a finite MT."""
     asymmetry_slope: float
@@ -131,13 +131,19 @@ def measure_human_targets(model: ReachingModel, outcomes: list[ReachOutcome] | N
         rows.append(condition_targets(model, outcome, n_samples, rng, targets))
         if progress:
             progress(1)
+    return score_rows(model.name, rows, outcomes, targets, began)
+
+
+def score_rows(model_name: str, rows: list[ConditionTargets], outcomes: list[ReachOutcome], targets: HumanTargets,
+               began: float) -> HumanTargetsResult:
+    """The grid's Fitts fit, t_peak/MT slope and verdicts from its per-condition rows; began: perf_counter at the start."""
     D, w, mt, ratio = (np.array([getattr(r, k) for r in rows], dtype=float)
                        for k in ("distance", "width", "movement_time", "asymmetry"))
     fit = fit_fitts(D, w, mt, "fitts")
     ids, finite = index_of_difficulty(D, w), np.isfinite(ratio)
     slope = (float(linregress(ids[finite], ratio[finite]).slope)
              if finite.sum() >= 3 and np.ptp(ids[finite]) > 0 else float("nan"))
-    return HumanTargetsResult(model.name, rows, outcomes, fit, slope, target_verdicts(rows, fit, slope, targets),
+    return HumanTargetsResult(model_name, rows, outcomes, fit, slope, target_verdicts(rows, fit, slope, targets),
                               time.perf_counter() - began)
 
 

@@ -34,6 +34,11 @@ class Observation:
         object.__setattr__(self, "velocity_std", as_nonnegative("velocity_std", self.velocity_std, "m/s"))
         object.__setattr__(self, "delay", as_nonnegative("delay", self.delay, "s"))
 
+    @classmethod
+    def of(cls, model) -> "Observation | None":
+        """The observation a :class:`comanip.ReachingModel` asks for (its ``observation`` field), None without one."""
+        return cls(*model.observation) if model.observation else None
+
     def delay_steps(self, h: float) -> int:
         """The delay in whole steps of h (s): delay / h rounded to the nearest integer, halves up."""
         # relative slack so that a delay of k.5 steps up to rounding (0.03 / 0.02) rounds up as stated

@@ -60,10 +60,12 @@ def execute_receding_horizon(planner: Planner, start, goal, width: float | None 
         rng: random generator for the motor (and sensory) noise (default: a fresh unseeded one).
         noise: False executes the commands exactly (a deterministic closed loop).
         max_wall_time: budget per replan (s); a late replan still yields its best plan so far.
-        observation: None replans from the actual state; an Observation replans from the Kalman estimate made
-            from measurements of [q; qdot] with its noise and delay (the start is known exactly).
+        observation: an Observation replans from the Kalman estimate made from measurements of [q; qdot] with
+            its noise and delay (the start is known exactly); None uses the model's ``observation``, and replans
+            from the actual state when the model has none. ``Observation(0, 0)`` forces the exact state.
     """
     model = planner.model
+    observation = Observation.of(model) if observation is None else observation
     start, goal, width = planner.check_inputs(start, goal, width)
     steps = model.H if steps is None else int(steps)
     if steps < 1:

@@ -2,8 +2,9 @@
 (:mod:`comanip.analysis.human_targets`) beside a reference preset (the paper's ``planar`` by default), their
 figure, and the section's report dictionary (rendered by :func:`comanip.validation.markdown.human_targets_markdown`).
 
-The run's model is scored on the open-loop grid the run already planned; the reference's grid is planned
-here (over the same distances and widths) unless the reference is the run's model itself.
+The run's model is scored on the open-loop grid the run already planned (what a robot predicts) and, when the
+model has an ``observation`` (feedback), on its closed-loop executions (what the person does); the reference's
+grid is planned here (over the same distances and widths) unless the reference is the run's model itself.
 """
 
 from __future__ import annotations
@@ -13,6 +14,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from comanip.analysis.closed_loop_targets import measure_closed_loop_targets
 from comanip.analysis.human_targets import HumanTargetsResult, measure_human_targets
 from comanip.analysis.reach_grid import ReachOutcome
 from comanip.analysis.target_verdicts import HumanTargets
@@ -31,13 +33,16 @@ def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list
     """Score model on grid (its open-loop outcomes over settings.distances × settings.widths, with plans)
     and reference; write the figure into out. Returns the section's report dictionary and the figure path."""
     same = reference.config() == model.config()
-    options = {"n_samples": settings.human_samples, "seed": settings.seed, "distances": settings.distances,
-               "widths": settings.widths}
-    with tqdm(total=len(grid) * (1 if same else 3), desc="human-likeness targets", unit="reach",
+    grid_options = {"seed": settings.seed, "distances": settings.distances, "widths": settings.widths}
+    feedback = bool(model.observation)
+    with tqdm(total=len(grid) * (1 + (0 if same else 2) + feedback), desc="human-likeness targets", unit="condition",
               disable=not progress) as bar:
-        results = [measure_human_targets(model, grid, progress=bar.update, **options)]
+        results = [measure_human_targets(model, grid, n_samples=settings.human_samples, progress=bar.update, **grid_options)]
+        if feedback:
+            results.append(measure_closed_loop_targets(model, settings.human_trials, progress=bar.update, **grid_options))
         if not same:
-            results.append(measure_human_targets(reference, progress=bar.update, **options))
+            results.append(measure_human_targets(reference, n_samples=settings.human_samples, progress=bar.update,
+                                                 **grid_options))
     names = " vs ".join(r.model_name for r in results)
     figure = plot_human_targets(results, out / HUMAN_FIGURE, title=f"human-likeness targets: {names}")
     return human_section(results), [figure]

@@ -52,6 +52,9 @@ class ValidationSettings:
     """Preset name or YAML path of the model shown beside the run's model in that section."""
     human_samples: int = 2000
     """Open-loop Monte Carlo executions per condition for the targets' hit rate and endpoint SD."""
+    human_trials: int = 20
+    """Closed-loop executions per condition when the model has an ``observation`` (feedback): its closed loop
+    is scored on the targets too (:mod:`comanip.analysis.closed_loop_targets`)."""
     franka: bool = True
     """Run the Franka section: Panda reaches from the ready pose. A point-mass model's run plans with the
     built-in ``franka`` preset; an arm model's run is this section alone."""
@@ -76,7 +79,8 @@ class ValidationSettings:
                 raise ValueError(f"{name} must be a finite number > 0 ({unit}), got {value!r}")
         if not all(isinstance(v, (int, float)) and math.isfinite(v) for v in self.phase_initial_velocities):
             raise ValueError(f"phase_initial_velocities must be finite numbers (m/s), got {self.phase_initial_velocities!r}")
-        for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0), ("human_samples", 2)):
+        for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0), ("human_samples", 2),
+                            ("human_trials", 2)):
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, int) or value < least:
                 raise ValueError(f"{name} must be an integer ≥ {least}, got {value!r}")
@@ -96,7 +100,7 @@ class ValidationSettings:
     @classmethod
     def quick_run(cls, **changes) -> "ValidationSettings":
         """The ``--quick`` settings: the same grids, fewer samples and configurations, three Franka goals."""
-        return cls(**({"dispersion_samples": 500, "calibration_trials": 2, "quick": True,
+        return cls(**({"dispersion_samples": 500, "calibration_trials": 2, "quick": True, "human_trials": 6,
                        "franka_goal_offsets": FRANKA_GOAL_OFFSETS[:3]} | changes))
 
     def to_dict(self) -> dict:
