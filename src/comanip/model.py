@@ -7,7 +7,7 @@ CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import MISSING, dataclass, field, replace
 
 import numpy as np
 
@@ -170,8 +170,11 @@ class ReachingModel:
         unknown = set(config) - allowed
         if unknown:
             raise ValueError(f"unknown model fields {sorted(unknown)}; allowed: {sorted(allowed)}")
-        if "body" not in config:
-            raise ValueError("a model config needs a 'body' entry, e.g. {type: point_mass, n: 2, mass: 2.0}")
+        required = [name for name, f in cls.__dataclass_fields__.items() if f.default is MISSING and f.default_factory is MISSING]
+        missing = [name for name in required if name not in config]
+        if missing:
+            raise ValueError(f"model config lacks the required fields {missing} (required: {required}; the body e.g. "
+                             "{type: point_mass, n: 2, mass: 2.0})")
         config["body"] = body_from_config(config["body"])
         return cls(**config)
 

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import numpy as np
@@ -27,7 +28,36 @@ def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out
 
 
 def load_model(args: argparse.Namespace) -> ReachingModel:
-    return presets.load(args.preset)
+    """The model named by --preset; a ValueError names the argument."""
+    try:
+        return presets.load(args.preset)
+    except ValueError as error:
+        raise ValueError(f"--preset: {error}") from None
+
+
+def input_file(text: str) -> Path:
+    """An argparse type: a path to an existing, readable, non-empty file (not a directory)."""
+    return _readable(Path(text), folders=False)
+
+
+def input_file_or_folder(text: str) -> Path:
+    """An argparse type: a path to an existing, readable, non-empty file, or to a folder."""
+    return _readable(Path(text), folders=True)
+
+
+def _readable(path: Path, folders: bool) -> Path:
+    wanted = "a file or a folder" if folders else "a file"
+    if not path.exists():
+        raise argparse.ArgumentTypeError(f"{str(path)!r} does not exist; expected {wanted}")
+    if path.is_dir():
+        if folders:
+            return path
+        raise argparse.ArgumentTypeError(f"{str(path)!r} is a directory; expected a file")
+    if not os.access(path, os.R_OK):
+        raise argparse.ArgumentTypeError(f"{str(path)!r} is not readable (permissions)")
+    if path.stat().st_size == 0:
+        raise argparse.ArgumentTypeError(f"{str(path)!r} is empty")
+    return path
 
 
 def vector(text: str) -> np.ndarray:

@@ -5,9 +5,8 @@ per condition (least squares); write fit.json (values, standard errors, residual
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
-from comanip.cli.arguments import add_model_arguments, load_model, output_dir
+from comanip.cli.arguments import add_model_arguments, input_file, input_file_or_folder, load_model, output_dir
 from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
 from comanip.fitting.movement_times import fit_movement_times
 
@@ -15,9 +14,9 @@ from comanip.fitting.movement_times import fit_movement_times
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("fit", help="fit model parameters to recordings or movement times", description=__doc__)
     data = parser.add_mutually_exclusive_group(required=True)
-    data.add_argument("--recordings", type=Path, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
-    data.add_argument("--mt-table", type=Path, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
-    parser.add_argument("--trials", type=Path, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
+    data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
+    data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
+    parser.add_argument("--trials", type=input_file, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
                         f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, kappa,gamma for an MT table)")

@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 
 from comanip.arguments import as_positive
-from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, input_file, load_model, output_dir, vector
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH
 from comanip.planning.planner import Planner
@@ -37,7 +37,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--stiffness", type=float, default=LEADING_STIFFNESS,
                         help="translational stiffness while the robot leads (N/m) (default: %(default)s)")
     parser.add_argument("--rate", type=float, help="resample the schedule at this controller rate (Hz), e.g. 1000")
-    parser.add_argument("--transition-model", help="a model JSON from 'comanip transition fit' (default: fit on the shipped data)")
+    parser.add_argument("--transition-model", type=input_file, help="a model JSON from 'comanip transition fit' (default: fit on the shipped data)")
     parser.add_argument("--arm-length", type=float,
                         help=f"arm length L (m) that normalises the goal distance (default: the model's, {ARM_LENGTH} for the shipped one)")
     parser.add_argument("--max-wall-time", type=float, help="planning budget per goal (s)")

@@ -15,7 +15,7 @@ import sys
 import time
 from pathlib import Path
 
-from comanip.cli.arguments import add_model_arguments, load_model, vector
+from comanip.cli.arguments import add_model_arguments, input_file, load_model, vector
 from comanip.multicomponent.transition_csv import shipped_dataset_path, write_transition_csv
 from comanip.multicomponent.transition_data import ARM_LENGTH, default_steps, generate_transition_data
 
@@ -43,14 +43,14 @@ def add_parser(subparsers) -> None:
     generate.set_defaults(func=run_generate)
 
     fit = actions.add_parser("fit", help="fit the transition model and report the published trends")
-    fit.add_argument("--data", help="transition CSV (default: the shipped dataset)")
+    fit.add_argument("--data", type=input_file, help="transition CSV (default: the shipped dataset)")
     fit.add_argument("--arm-length", type=float, default=ARM_LENGTH, help="arm length L (m) for queries in metres (default: %(default)s)")
     fit.add_argument("--out", default="out/transition", help="output folder for model.json and trends.json (default: %(default)s)")
     fit.set_defaults(func=run_fit)
 
     plot = actions.add_parser("plot", help="Fig. 2: the predicted transition distance over (D/L, w) with the data")
-    plot.add_argument("--model", help="a model JSON written by 'fit' (default: fit on --data)")
-    plot.add_argument("--data", help="transition CSV to fit when no --model is given (default: the shipped dataset)")
+    plot.add_argument("--model", type=input_file, help="a model JSON written by 'fit' (default: fit on --data)")
+    plot.add_argument("--data", type=input_file, help="transition CSV to fit when no --model is given (default: the shipped dataset)")
     plot.add_argument("--out", default="out/transition/transition_model.png", help="PNG to write (default: %(default)s)")
     plot.set_defaults(func=run_plot)
 
