@@ -12,11 +12,7 @@ GOOD_MODEL = "name: mine\nbody: {type: point_mass, n: 2}\nh: 0.02\nH: 30\ngamma:
 
 def run_cli(argv, capsys) -> tuple[int, str]:
     """Exit status and stderr of ``comanip argv`` run in this process."""
-    try:
-        code = main(argv)
-    except SystemExit as stop:
-        code = stop.code
-    return code, capsys.readouterr().err
+    return main(argv), capsys.readouterr().err
 
 
 def assert_one_line_error(code: int, err: str, *fragments: str) -> None:
@@ -90,3 +86,9 @@ def test_debug_shows_the_traceback(tmp_path):
     path.write_text("name: [unclosed\n")
     with pytest.raises(ValueError, match="not valid YAML"):
         main(["--debug", "plan", "--preset", str(path)])
+
+
+def test_help_has_no_literal_double_backticks(capsys):
+    for argv in (["--help"], ["fit", "--help"], ["transition", "--help"], ["estimate", "--help"]):
+        assert main(argv) == 0
+        assert "``" not in capsys.readouterr().out

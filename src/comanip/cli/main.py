@@ -30,7 +30,11 @@ USER_ERRORS = (ValueError, OSError, yaml.YAMLError)
 
 
 class OneLineParser(argparse.ArgumentParser):
-    """An ArgumentParser whose errors are one line (no usage block), exit status 2; subparsers inherit it."""
+    """An ArgumentParser whose errors are one line (no usage block), exit status 2, and whose help shows the
+    docstrings' reStructuredText literals (``x``) as plain quotes; subparsers inherit it."""
+
+    def format_help(self) -> str:
+        return super().format_help().replace("``", "'")
 
     def error(self, message: str):
         self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')\n")
@@ -55,7 +59,11 @@ def one_line(error) -> str:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run ``comanip argv``; returns the exit status (2 for a user mistake, after one line on stderr)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help, or an argument error already printed
+        return stop.code if isinstance(stop.code, int) else 2
     try:
         return int(args.func(args) or 0)
     except USER_ERRORS as error:
