@@ -40,5 +40,5 @@ def run(args) -> int:
     print(json.dumps({"model": model.name, "goal": np.asarray(plan.goal).tolist(), "width": plan.width,
                       "success": plan.success, "status": plan.status, "objective": plan.objective,
                       "solve_time_s": plan.solve_time, "iterations": plan.iterations,
-                      "final_error_m": plan.final_error, "files": [str(p) for p in written]}, indent=1))
+                      "final_error_m": plan.final_error, "reaches_goal": plan.reaches_goal, "files": [str(p) for p in written]}, indent=1))
     return 0 if plan.success else 1
