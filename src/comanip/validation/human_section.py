@@ -11,13 +11,12 @@ from __future__ import annotations
 from dataclasses import asdict
 from pathlib import Path
 
-from tqdm import tqdm
-
 from comanip.analysis.human_targets import HumanTargetsResult, measure_human_targets
 from comanip.analysis.reach_grid import ReachOutcome
 from comanip.analysis.target_verdicts import HumanTargets
 from comanip.model import ReachingModel
 from comanip.plots.human_targets_figure import plot_human_targets
+from comanip.progress import progress_bar
 from comanip.validation.settings import ValidationSettings
 
 #: Figure file of the section.
@@ -33,8 +32,7 @@ def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list
     same = reference.config() == model.config()
     options = {"n_samples": settings.human_samples, "seed": settings.seed, "distances": settings.distances,
                "widths": settings.widths}
-    with tqdm(total=len(grid) * (1 if same else 3), desc="human-likeness targets", unit="reach",
-              disable=not progress) as bar:
+    with progress_bar("human-likeness targets", len(grid) * (1 if same else 3), "reach", progress) as bar:
         results = [measure_human_targets(model, grid, progress=bar.update, **options)]
         if not same:
             results.append(measure_human_targets(reference, progress=bar.update, **options))
