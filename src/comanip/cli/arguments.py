@@ -9,6 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from comanip import presets
+from comanip.cli.outputs import add_output_arguments
 from comanip.model import ReachingModel
 
 
@@ -19,11 +20,11 @@ def add_model_arguments(parser: argparse.ArgumentParser, default_preset: str = "
 
 def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out_default: str, figures: str) -> None:
     """Arguments of the subcommands that solve one reach and write it: --start (whose default is described
-    by ``start_default``), --width, --max-wall-time, --out (default ``out_default``) and --png (``figures``)."""
+    by ``start_default``), --width, --max-wall-time, --out (default ``out_default``), --force and --png (``figures``)."""
     parser.add_argument("--start", type=vector, help=f"start state [q; qdot], comma-separated (default: {start_default})")
     parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
     parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
-    parser.add_argument("--out", default=out_default, help="output folder (default: %(default)s)")
+    add_output_arguments(parser, out_default)
     parser.add_argument("--png", action="store_true", help=f"also save {figures}")
 
 
@@ -66,9 +67,3 @@ def vector(text: str) -> np.ndarray:
         return np.array([float(v) for v in text.replace(",", " ").split()])
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
-
-
-def output_dir(path: str) -> Path:
-    out = Path(path)
-    out.mkdir(parents=True, exist_ok=True)
-    return out

@@ -16,7 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, add_reach_arguments, input_file, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, add_reach_arguments, input_file, load_model, vector
+from comanip.cli.outputs import output_dir, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 
@@ -79,9 +80,9 @@ def run(args) -> int:
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+    out = output_dir(args.out, "estimate", args.force)
 
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, method=args.method, max_wall_time=args.max_wall_time)
-    out = output_dir(args.out)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
                "t_obs_s": float(t_obs), "observed_step": estimate.extras["observed_step"], "method": args.method,
@@ -107,5 +108,6 @@ def run(args) -> int:
         if posterior is not None:
             written.append(plot_posterior(posterior, out / "posterior.png"))
     summary["files"] = [str(p) for p in written]
+    write_manifest(out, "estimate", written)
     print(json.dumps(summary, indent=1))
     return 0 if estimate.success else 1
