@@ -17,3 +17,12 @@ def cartesian_planner():
 @pytest.fixture
 def rng():
     return np.random.default_rng(12345)
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Report how many generated inputs the fuzz suite (tests/test_fuzz.py) tried, when it ran."""
+    import sys
+
+    fuzz = sys.modules.get("test_fuzz") or sys.modules.get("tests.test_fuzz")
+    if fuzz is not None and fuzz.FUZZ_COUNT["inputs"]:
+        terminalreporter.write_line(f"fuzz: {fuzz.FUZZ_COUNT['inputs']} generated inputs tried")

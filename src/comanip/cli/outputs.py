@@ -50,9 +50,10 @@ def add_output_arguments(parser: argparse.ArgumentParser, default: str, what: st
     parser.add_argument("--force", action="store_true", help="write into an output folder that holds another command's results")
 
 
-def output_dir(path: str | Path, command: str, force: bool = False) -> Path:
-    """The folder ``path``, created; ValueError when it is a file, or holds another command's results (its
-    manifest names another command) and ``force`` is False."""
+def output_dir(path: str | Path, command: str, force: bool = False, create: bool = True) -> Path:
+    """The folder ``path``, created unless ``create`` is False (the caller creates it after further checks);
+    ValueError when it is a file, or holds another command's results (its manifest names another command) and
+    ``force`` is False."""
     out = Path(path)
     if out.exists() and not out.is_dir():
         raise ValueError(f"--out {str(out)!r} is a file; expected a folder")
@@ -60,7 +61,8 @@ def output_dir(path: str | Path, command: str, force: bool = False) -> Path:
     if owner not in (None, command) and not force:
         raise ValueError(f"--out {str(out)!r} holds the results of 'comanip {owner}'; give another --out, or --force "
                          "to write into it anyway")
-    out.mkdir(parents=True, exist_ok=True)
+    if create:
+        out.mkdir(parents=True, exist_ok=True)
     return out
 
 

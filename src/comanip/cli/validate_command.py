@@ -36,7 +36,7 @@ def run(args) -> int:
     model = load_model(args)
     options = {"workers": args.workers, "seed": args.seed, "franka": args.franka, "human_reference": args.targets_reference}
     settings = ValidationSettings.quick_run(**options) if args.quick else ValidationSettings(**options)
-    out = output_dir(args.out, "validate", args.force)
+    out = output_dir(args.out, "validate", args.force, create=False)
     report = run_validation(model, out, settings)  # checks the model against the settings before creating out
     summary = {"model": model.name, "out": str(out)}
     if "fitts_grid" in report:
