@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 import comanip
 from comanip.cli.main import main
+from comanip.estimation import GoalEstimator
 
 FUZZ_COUNT = {"inputs": 0}
 FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None)
@@ -107,3 +108,19 @@ def test_cli_never_tracebacks(tmp_path_factory, capsys, command, argv):
     assert "Traceback" not in err
     if code == 2:
         assert err.count("\n") == 1 and "error:" in err, err
+
+
+@pytest.fixture(scope="module")
+def small_estimator():
+    return GoalEstimator(comanip.presets.planar().replace(H=8))
+
+
+@FAST
+@given(observed=vectors, t_obs=numbers, prior=st.one_of(st.none(), vectors), width=st.one_of(st.none(), numbers))
+def test_goal_estimate(small_estimator, observed, t_obs, prior, width):
+    check_plan_or_value_error(lambda: small_estimator.estimate(np.zeros(4), observed, t_obs, prior, width, max_wall_time=2.0))
+
+
+def test_found_by_fuzzing_a_huge_activation_time_constant_is_refused():
+    with pytest.raises(ValueError, match="activation time constants must be ≤ 1000 h"):
+        comanip.presets.planar().replace(activation=[3.6e14])

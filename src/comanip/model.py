@@ -16,6 +16,10 @@ from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
 from comanip.objectives.reward import check_goal_covariance_form, check_reward_form
 
+#: the slowest activation stage allowed, in time steps h (slower ones make the plant unresponsive and the
+#: activation inverse divide by zero)
+MAX_ACTIVATION_STEPS = 1000
+
 
 @dataclass(frozen=True)
 class ReachingModel:
@@ -69,6 +73,10 @@ class ReachingModel:
             raise ValueError(f"body must be a comanip.bodies.Body, got {type(self.body).__name__}")
         self._attach_activation()
         _check_positive("h", self.h, "s")
+        slow = [t for t in self.activation if t > MAX_ACTIVATION_STEPS * self.h]
+        if slow:
+            raise ValueError(f"activation time constants must be ≤ {MAX_ACTIVATION_STEPS} h = {MAX_ACTIVATION_STEPS * self.h:g} s "
+                             f"(a slower stage never responds within a plan), got {slow}")
         if isinstance(self.H, bool) or not isinstance(self.H, (int, np.integer)) or self.H < 1:
             raise ValueError(f"H must be an integer ≥ 1 (horizon in steps), got {self.H!r}")
         object.__setattr__(self, "H", int(self.H))
