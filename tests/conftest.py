@@ -23,3 +23,12 @@ def rng():
 def activation_planner():
     """The planar preset with two 40 ms muscle activation stages: state [q; qdot; a_1; a_2] (8,)."""
     return comanip.Planner(comanip.presets.planar().replace(activation=(0.04, 0.04)))
+
+
+def pytest_terminal_summary(terminalreporter):
+    """Report how many generated inputs the fuzz suite (tests/test_fuzz.py) tried, when it ran."""
+    import sys
+
+    fuzz = sys.modules.get("test_fuzz") or sys.modules.get("tests.test_fuzz")
+    if fuzz is not None and fuzz.FUZZ_COUNT["inputs"]:
+        terminalreporter.write_line(f"fuzz: {fuzz.FUZZ_COUNT['inputs']} generated inputs tried")

@@ -6,7 +6,7 @@ CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, replace
+from dataclasses import MISSING, dataclass, field, replace
 
 import numpy as np
 
@@ -15,6 +15,10 @@ from comanip.belief.noise import check_noise_form
 from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
 from comanip.objectives.reward import check_goal_covariance_form, check_reward_form
+
+#: the slowest activation stage allowed, in time steps h (slower ones make the plant unresponsive and the
+#: activation inverse divide by zero)
+MAX_ACTIVATION_STEPS = 1000
 
 
 @dataclass(frozen=True)
@@ -73,6 +77,10 @@ class ReachingModel:
             raise ValueError(f"body must be a comanip.bodies.Body, got {type(self.body).__name__}")
         self._attach_activation()
         as_positive("h", self.h, "s")
+        slow = [t for t in self.activation if t > MAX_ACTIVATION_STEPS * self.h]
+        if slow:
+            raise ValueError(f"activation time constants must be ≤ {MAX_ACTIVATION_STEPS} h = {MAX_ACTIVATION_STEPS * self.h:g} s "
+                             f"(a slower stage never responds within a plan), got {slow}")
         if isinstance(self.H, bool) or not isinstance(self.H, (int, np.integer)) or self.H < 1:
             raise ValueError(f"H must be an integer ≥ 1 (horizon in steps), got {self.H!r}")
         object.__setattr__(self, "H", int(self.H))
@@ -179,8 +187,11 @@ class ReachingModel:
         unknown = set(config) - allowed
         if unknown:
             raise ValueError(f"unknown model fields {sorted(unknown)}; allowed: {sorted(allowed)}")
-        if "body" not in config:
-            raise ValueError("a model config needs a 'body' entry, e.g. {type: point_mass, n: 2, mass: 2.0}")
+        required = [name for name, f in cls.__dataclass_fields__.items() if f.default is MISSING and f.default_factory is MISSING]
+        missing = [name for name in required if name not in config]
+        if missing:
+            raise ValueError(f"model config lacks the required fields {missing} (required: {required}; the body e.g. "
+                             "{type: point_mass, n: 2, mass: 2.0})")
         config["body"] = body_from_config(config["body"])
         return cls(**config)
 

@@ -1,5 +1,6 @@
 """Body models: inertia, damping and kinematics as CasADi expressions behind one interface."""
 
+import inspect
 from importlib import import_module
 
 from comanip.bodies.body import Body
@@ -14,13 +15,25 @@ BODY_TYPES = {
 
 
 def body_from_config(config: dict) -> Body:
-    """Build a body from its :meth:`Body.config` dictionary (``{"type": ..., **parameters}``)."""
+    """Build a body from its :meth:`Body.config` dictionary (``{"type": ..., **parameters}``); ValueError naming
+    the type, the unknown or missing parameters and the allowed ones for a config that does not fit."""
+    if not isinstance(config, dict):
+        raise ValueError(f"body must be a mapping such as {{type: point_mass, n: 2, mass: 2.0}}, got {config!r}")
     config = dict(config)
     kind = config.pop("type", None)
-    if kind not in BODY_TYPES:
+    if not isinstance(kind, str) or kind not in BODY_TYPES:
         raise ValueError(f"body type must be one of {sorted(BODY_TYPES)}, got {kind!r}")
     module, cls = BODY_TYPES[kind].split(":")
-    return getattr(import_module(module), cls)(**config)
+    body_class = getattr(import_module(module), cls)
+    signature = inspect.signature(body_class)
+    parameters = signature.parameters
+    try:
+        signature.bind(**config)
+    except TypeError:
+        required = [p for p, v in parameters.items() if v.default is inspect.Parameter.empty]
+        raise ValueError(f"body of type {kind!r} takes the parameters {list(parameters)} ({required} required), "
+                         f"got {sorted(config)}") from None
+    return body_class(**config)
 
 
 __all__ = ["Body", "MuscleActuatedBody", "PointMass", "body_from_config", "BODY_TYPES"]

@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 
 import numpy as np
 
 from comanip import presets
+from comanip.cli.outputs import add_output_arguments
 from comanip.model import ReachingModel
 
 
@@ -18,16 +20,45 @@ def add_model_arguments(parser: argparse.ArgumentParser, default_preset: str = "
 
 def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out_default: str, figures: str) -> None:
     """Arguments of the subcommands that solve one reach and write it: --start (whose default is described
-    by ``start_default``), --width, --max-wall-time, --out (default ``out_default``) and --png (``figures``)."""
+    by ``start_default``), --width, --max-wall-time, --out (default ``out_default``), --force and --png (``figures``)."""
     parser.add_argument("--start", type=vector, help=f"start state [q; qdot], comma-separated (default: {start_default})")
     parser.add_argument("--width", type=float, help="goal width (m) (default: the preset's)")
     parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
-    parser.add_argument("--out", default=out_default, help="output folder (default: %(default)s)")
+    add_output_arguments(parser, out_default)
     parser.add_argument("--png", action="store_true", help=f"also save {figures}")
 
 
 def load_model(args: argparse.Namespace) -> ReachingModel:
-    return presets.load(args.preset)
+    """The model named by --preset; a ValueError names the argument."""
+    try:
+        return presets.load(args.preset)
+    except ValueError as error:
+        raise ValueError(f"--preset: {error}") from None
+
+
+def input_file(text: str) -> Path:
+    """An argparse type: a path to an existing, readable, non-empty file (not a directory)."""
+    return _readable(Path(text), folders=False)
+
+
+def input_file_or_folder(text: str) -> Path:
+    """An argparse type: a path to an existing, readable, non-empty file, or to a folder."""
+    return _readable(Path(text), folders=True)
+
+
+def _readable(path: Path, folders: bool) -> Path:
+    wanted = "a file or a folder" if folders else "a file"
+    if not path.exists():
+        raise argparse.ArgumentTypeError(f"{str(path)!r} does not exist; expected {wanted}")
+    if path.is_dir():
+        if folders:
+            return path
+        raise argparse.ArgumentTypeError(f"{str(path)!r} is a directory; expected a file")
+    if not os.access(path, os.R_OK):
+        raise argparse.ArgumentTypeError(f"{str(path)!r} is not readable (permissions)")
+    if path.stat().st_size == 0:
+        raise argparse.ArgumentTypeError(f"{str(path)!r} is empty")
+    return path
 
 
 def vector(text: str) -> np.ndarray:
@@ -36,9 +67,3 @@ def vector(text: str) -> np.ndarray:
         return np.array([float(v) for v in text.replace(",", " ").split()])
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected comma-separated numbers, got {text!r}") from None
-
-
-def output_dir(path: str) -> Path:
-    out = Path(path)
-    out.mkdir(parents=True, exist_ok=True)
-    return out

@@ -9,13 +9,15 @@ to the horizon feeds the posterior.
 
 from __future__ import annotations
 
+import argparse
 import csv
 import json
 from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, add_reach_arguments, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, add_reach_arguments, input_file, load_model, vector
+from comanip.cli.outputs import output_dir, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 
@@ -25,7 +27,7 @@ def add_parser(subparsers) -> None:
     add_model_arguments(parser)
     add_reach_arguments(parser, "the CSV's t = 0 row, else at rest at the body's home position", "out/estimate", "figures")
     parser.add_argument("--observed", type=vector, help="observed state [q; qdot], comma-separated")
-    parser.add_argument("--observations", type=Path, help="CSV of timestamped states (header t_s, q0.., qdot0..)")
+    parser.add_argument("--observations", type=input_file, help="CSV of timestamped states (header t_s, q0.., qdot0..)")
     parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, "
                         "the paper's); before the model's step h it says nothing about the goal and needs --prior")
     parser.add_argument("--prior", type=vector, help="prior goal g_bar (m), comma-separated (default: no regulariser)")
@@ -35,17 +37,15 @@ def add_parser(subparsers) -> None:
 
 
 def candidate_list(text: str) -> np.ndarray:
-    """Parse '0.3,0; 0.2,0.2' into an array (C, d)."""
+    """Parse '0.3,0; 0.2,0.2' into an array (C, d); an argparse type."""
     rows = [vector(part) for part in text.split(";") if part.strip()]
     if not rows or len({len(r) for r in rows}) != 1:
-        raise ValueError(f"--candidates must be goals of equal length separated by ';', got {text!r}")
+        raise argparse.ArgumentTypeError(f"expected goals of equal length (m) separated by ';', e.g. '0.3,0;0.2,0.2', got {text!r}")
     return np.array(rows)
 
 
 def read_observations(path: Path, n: int) -> tuple[np.ndarray, np.ndarray]:
     """Times (K,) s and states (K, 2n) from a CSV with columns t_s, q0..q{n-1}, qdot0..qdot{n-1}, sorted by time."""
-    if not path.exists():
-        raise ValueError(f"--observations file {str(path)!r} does not exist")
     columns = ["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
@@ -80,9 +80,9 @@ def run(args) -> int:
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+    out = output_dir(args.out, "estimate", args.force)
 
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, method=args.method, max_wall_time=args.max_wall_time)
-    out = output_dir(args.out)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
                "t_obs_s": float(t_obs), "observed_step": estimate.extras["observed_step"], "method": args.method,
@@ -108,5 +108,6 @@ def run(args) -> int:
         if posterior is not None:
             written.append(plot_posterior(posterior, out / "posterior.png"))
     summary["files"] = [str(p) for p in written]
+    write_manifest(out, "estimate", written)
     print(json.dumps(summary, indent=1))
     return 0 if estimate.success else 1

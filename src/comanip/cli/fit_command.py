@@ -5,9 +5,9 @@ per condition (least squares); write fit.json (values, standard errors, residual
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
-from comanip.cli.arguments import add_model_arguments, load_model, output_dir
+from comanip.cli.arguments import add_model_arguments, input_file, input_file_or_folder, load_model
+from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
 from comanip.fitting.movement_times import fit_movement_times
 
@@ -15,16 +15,16 @@ from comanip.fitting.movement_times import fit_movement_times
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("fit", help="fit model parameters to recordings or movement times", description=__doc__)
     data = parser.add_mutually_exclusive_group(required=True)
-    data.add_argument("--recordings", type=Path, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
-    data.add_argument("--mt-table", type=Path, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
-    parser.add_argument("--trials", type=Path, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
+    data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
+    data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
+    parser.add_argument("--trials", type=input_file, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
                         f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, kappa,gamma for an MT table)")
     parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
     parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings, 100 for an MT table)")
     parser.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
-    parser.add_argument("--out", default="out/fit", help="output folder (default: %(default)s)")
+    add_output_arguments(parser, "out/fit")
     parser.add_argument("--no-progress", action="store_true", help="no progress line")
     parser.set_defaults(func=run)
 
@@ -36,6 +36,7 @@ def names(text: str) -> tuple[str, ...]:
 
 def run(args) -> int:
     model = load_model(args)
+    out = output_dir(args.out, "fit", args.force)
     options = {"scheduler": args.scheduler, "progress": not args.no_progress}
     if args.max_evaluations is not None:
         options["max_evaluations"] = args.max_evaluations
@@ -47,12 +48,12 @@ def run(args) -> int:
         if args.trials is not None:
             raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
         result = fit_movement_times(model, args.mt_table, **options)
-    out = output_dir(args.out)
     written = [result.save_json(out / "fit.json"), result.save_yaml(out / "model.yaml")]
     if result.conditions:
         from comanip.plots.fit_figure import plot_fit
 
         written.append(plot_fit(result, out / "fit.png"))
+    write_manifest(out, "fit", written)
     summary = {key: value for key, value in result.to_dict().items() if key not in ("model", "conditions", "trials")}
     print(json.dumps(summary | {"files": [str(p) for p in written]}, indent=1))
     return 0 if result.success else 1

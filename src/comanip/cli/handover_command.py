@@ -15,7 +15,8 @@ import warnings
 import numpy as np
 
 from comanip.arguments import as_positive
-from comanip.cli.arguments import add_model_arguments, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, input_file, load_model, vector
+from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH
 from comanip.planning.planner import Planner
@@ -37,11 +38,11 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--stiffness", type=float, default=LEADING_STIFFNESS,
                         help="translational stiffness while the robot leads (N/m) (default: %(default)s)")
     parser.add_argument("--rate", type=float, help="resample the schedule at this controller rate (Hz), e.g. 1000")
-    parser.add_argument("--transition-model", help="a model JSON from 'comanip transition fit' (default: fit on the shipped data)")
+    parser.add_argument("--transition-model", type=input_file, help="a model JSON from 'comanip transition fit' (default: fit on the shipped data)")
     parser.add_argument("--arm-length", type=float,
                         help=f"arm length L (m) that normalises the goal distance (default: the model's, {ARM_LENGTH} for the shipped one)")
     parser.add_argument("--max-wall-time", type=float, help="planning budget per goal (s)")
-    parser.add_argument("--out", default="out/handover", help="output folder (default: %(default)s)")
+    add_output_arguments(parser, "out/handover")
     parser.add_argument("--no-plot", action="store_true", help="skip the figure")
     parser.set_defaults(func=run)
 
@@ -58,7 +59,7 @@ def run(args) -> int:
     planner = Planner(model)
     start = np.zeros(2 * model.n) if args.start is None else args.start
     goals = args.goal or [vector(g) for g in DEFAULT_GOALS]
-    out = output_dir(args.out)
+    out = output_dir(args.out, "handover", args.force)
     plans, schedules, report = [], [], []
     for k, goal in enumerate(goals):
         plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)
@@ -76,5 +77,6 @@ def run(args) -> int:
 
         figure = plot_handover(plans, schedules, out / "handover.png")
         report.append({"figure": str(figure)})
+    write_manifest(out, "handover", [f for entry in report for f in entry.get("files", [entry.get("figure")]) if f])
     print(json.dumps(report, indent=1))
     return 0 if all(p.success for p in plans) else 1

@@ -1,11 +1,18 @@
 """Entry point of the ``comanip`` command. Each subcommand lives in its own module with
-``add_parser(subparsers)``, which registers the subcommand and sets ``func(args) -> int``."""
+``add_parser(subparsers)``, which registers the subcommand and sets ``func(args) -> int``.
+
+Every user mistake ends the command with one line on stderr, ``comanip <command>: error: ...``, and exit
+status 2: argparse's own errors (through :class:`OneLineParser`) and the ValueError, OSError and YAML errors
+raised while loading and checking inputs (through :func:`main`). ``comanip --debug <command>`` shows the traceback.
+"""
 
 from __future__ import annotations
 
 import argparse
 import sys
 from importlib import import_module
+
+import yaml
 
 #: subcommand modules, in the order ``comanip --help`` lists them
 SUBCOMMAND_MODULES = [
@@ -18,21 +25,51 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.fit_command",
 ]
 
+#: errors that mean the user gave something wrong (an argument, a file): one line, exit status 2
+USER_ERRORS = (ValueError, OSError, yaml.YAMLError)
+
+
+class OneLineParser(argparse.ArgumentParser):
+    """An ArgumentParser whose errors are one line (no usage block), exit status 2, and whose help shows the
+    docstrings' reStructuredText literals (``x``) as plain quotes; subparsers inherit it."""
+
+    def format_help(self) -> str:
+        return super().format_help().replace("``", "'")
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')\n")
+
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="comanip", description="Human reaching prediction and co-manipulation planning.")
+    parser = OneLineParser(prog="comanip", description="Human reaching prediction and co-manipulation planning.")
+    parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     subparsers = parser.add_subparsers(dest="command", required=True)
     for module in SUBCOMMAND_MODULES:
         import_module(module).add_parser(subparsers)
     return parser
 
 
+def one_line(error) -> str:
+    """An error (or message) as one line: an OSError as 'strerror: filename', newlines folded into '; '."""
+    if isinstance(error, OSError) and error.strerror:
+        text = f"{error.strerror}: {error.filename!r}" if error.filename else error.strerror
+    else:
+        text = str(error) or type(error).__name__
+    return "; ".join(line.strip() for line in text.splitlines() if line.strip())
+
+
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    """Run ``comanip argv``; returns the exit status (2 for a user mistake, after one line on stderr)."""
+    try:
+        args = build_parser().parse_args(argv)
+    except SystemExit as stop:  # --help, or an argument error already printed
+        return stop.code if isinstance(stop.code, int) else 2
     try:
         return int(args.func(args) or 0)
-    except ValueError as error:
-        print(f"comanip {args.command}: error: {error}", file=sys.stderr)
+    except USER_ERRORS as error:
+        if args.debug:
+            raise
+        print(f"comanip {args.command}: error: {one_line(error)}", file=sys.stderr)
         return 2
 
 

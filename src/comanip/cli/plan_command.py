@@ -6,7 +6,8 @@ import json
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, add_reach_arguments, load_model, output_dir, vector
+from comanip.cli.arguments import add_model_arguments, add_reach_arguments, load_model, vector
+from comanip.cli.outputs import output_dir, write_manifest
 from comanip.planning.planner import Planner
 
 
@@ -21,6 +22,7 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     model = load_model(args)
+    out = output_dir(args.out, "plan", args.force)
     planner = Planner(model)
     start = np.concatenate([model.body.home_position, np.zeros(model.n)]) if args.start is None else args.start
     if args.goal is None:
@@ -29,7 +31,6 @@ def run(args) -> int:
     else:
         goal = args.goal
     plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)
-    out = output_dir(args.out)
     plan.save_json(out / "plan.json")
     plan.save_csv(out / "plan.csv")
     written = [out / "plan.json", out / "plan.csv"]
@@ -37,8 +38,9 @@ def run(args) -> int:
         from comanip.plots.plan_figure import plot_plan
 
         written.append(plot_plan(plan, out / "plan.png"))
+    write_manifest(out, "plan", written)
     print(json.dumps({"model": model.name, "goal": np.asarray(plan.goal).tolist(), "width": plan.width,
                       "success": plan.success, "status": plan.status, "objective": plan.objective,
                       "solve_time_s": plan.solve_time, "iterations": plan.iterations,
-                      "final_error_m": plan.final_error, "files": [str(p) for p in written]}, indent=1))
+                      "final_error_m": plan.final_error, "reaches_goal": plan.reaches_goal, "files": [str(p) for p in written]}, indent=1))
     return 0 if plan.success else 1

@@ -7,7 +7,7 @@ from __future__ import annotations
 import json
 import time
 
-from comanip.cli.arguments import output_dir
+from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 
 
 def add_parser(subparsers) -> None:
@@ -21,7 +21,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--kappa", type=float, help="the person's motor-noise variance (default: the preset's)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial (default: %(default)s)")
     parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
-    parser.add_argument("--out", default="out/simulate", help="output folder (default: %(default)s)")
+    add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
     parser.set_defaults(func=run)
@@ -36,7 +36,7 @@ def run(args) -> int:
     # every setting is checked here, before any solver or model is built
     all_settings = {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in goals}
     setup = ScenarioSetup(next(iter(all_settings.values())))
-    out = output_dir(args.out)
+    out = output_dir(args.out, "simulate", args.force)
 
     results, timing = {}, {}
     for label, settings in all_settings.items():
@@ -87,6 +87,7 @@ def run(args) -> int:
         print(replay_in_viewer(setup.world.model, record.t, record.qpos))
     print(json.dumps({label: {"summary": _headline(goals_out[label]["summary"]), "timing": timing[label]}
                       for label in goals_out}, indent=1, default=float))
+    write_manifest(out, "simulate", files)
     print(f"wrote {len(files)} files to {out}")
     return 0
 

@@ -17,7 +17,8 @@ import sys
 import time
 from pathlib import Path
 
-from comanip.cli.arguments import add_model_arguments, load_model, vector
+from comanip.cli.arguments import add_model_arguments, input_file, load_model, vector
+from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.multicomponent.transition_csv import read_transition_metadata, shipped_dataset_path, write_transition_csv
 from comanip.multicomponent.transition_data import ARM_LENGTH, default_steps, generate_transition_data
 
@@ -41,25 +42,26 @@ def add_parser(subparsers) -> None:
     generate.add_argument("--steps", type=int, help="executed steps per reach (default: 2H)")
     generate.add_argument("--seed", type=int, default=0, help="random seed (default: %(default)s)")
     generate.add_argument("--workers", type=int, default=2, help="worker processes (default: %(default)s)")
-    generate.add_argument("--out", default="out/transition/transition_data.csv", help="CSV to write (default: %(default)s)")
+    add_output_arguments(generate, "out/transition/transition_data.csv", "CSV to write")
     generate.set_defaults(func=run_generate)
 
     fit = actions.add_parser("fit", help="fit the transition model and report the published trends")
-    fit.add_argument("--data", help="transition CSV (default: the shipped dataset)")
+    fit.add_argument("--data", type=input_file, help="transition CSV (default: the shipped dataset)")
     fit.add_argument("--arm-length", type=float, default=ARM_LENGTH, help="arm length L (m) for queries in metres (default: %(default)s)")
-    fit.add_argument("--out", default="out/transition", help="output folder for model.json and trends.json (default: %(default)s)")
+    add_output_arguments(fit, "out/transition", "output folder for model.json and trends.json")
     fit.set_defaults(func=run_fit)
 
     plot = actions.add_parser("plot", help="Fig. 2: the predicted transition distance over (D/L, w) with the data")
-    plot.add_argument("--model", help="a model JSON written by 'fit' (default: fit on --data)")
-    plot.add_argument("--data", help="transition CSV to fit when no --model is given (default: the shipped dataset)")
-    plot.add_argument("--out", default="out/transition/transition_model.png", help="PNG to write (default: %(default)s)")
+    plot.add_argument("--model", type=input_file, help="a model JSON written by 'fit' (default: fit on --data)")
+    plot.add_argument("--data", type=input_file, help="transition CSV to fit when no --model is given (default: the shipped dataset)")
+    add_output_arguments(plot, "out/transition/transition_model.png", "PNG to write")
     plot.set_defaults(func=run_plot)
 
 
 def run_generate(args) -> int:
     model = load_model(args)
     steps = default_steps(model) if args.steps is None else args.steps
+    folder = output_dir(Path(args.out).parent, "transition", args.force)
     began = time.perf_counter()
     rows = generate_transition_data(args.distances, args.widths, args.trials, model=model, arm_length=args.arm_length,
                                     steps=steps, seed=args.seed, workers=args.workers)
@@ -73,6 +75,7 @@ def run_generate(args) -> int:
                   "at the origin, goal D along x",
     }
     path = write_transition_csv(rows, args.out, metadata)
+    write_manifest(folder, "transition", [path, path.with_suffix(".json")])
     unsettled = sum(r["n_trials"] - r["settled_trials"] for r in rows)
     print(json.dumps({"rows": len(rows), "csv": str(path), "metadata": str(path.with_suffix(".json")),
                       "wall_time_s": metadata["wall_time_s"], "unsettled_trials": unsettled,
@@ -86,11 +89,11 @@ def run_fit(args) -> int:
 
     data = args.data or shipped_dataset_path()
     model = TransitionModel(data, arm_length=args.arm_length)
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    out = output_dir(args.out, "transition", args.force)
     model.save(out / "model.json")
     report = trend_report(model)
     (out / "trends.json").write_text(json.dumps(report, indent=1))
+    write_manifest(out, "transition", [out / "model.json", out / "trends.json"])
     made = read_transition_metadata(data)
     made_by = None if made is None else {"model": made.get("model", {}).get("name"), "command": made.get("command")}
     print(json.dumps({"data": str(data), "data_made_by": made_by, "rows": len(model.training_data["width_m"]),
@@ -104,7 +107,9 @@ def run_plot(args) -> int:
     from comanip.plots.transition_figure import plot_transition_model
 
     model = TransitionModel.load(args.model) if args.model else TransitionModel(args.data or shipped_dataset_path())
-    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-    print(json.dumps({"figure": str(plot_transition_model(model, args.out))}))
+    folder = output_dir(Path(args.out).parent, "transition", args.force)
+    figure = plot_transition_model(model, args.out)
+    write_manifest(folder, "transition", [figure])
+    print(json.dumps({"figure": str(figure)}))
     return 0
 

@@ -7,9 +7,9 @@ With an arm preset (``--preset franka``) the run is the Franka section alone."""
 from __future__ import annotations
 
 import json
-from pathlib import Path
 
 from comanip.cli.arguments import add_model_arguments, load_model
+from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.validation import ValidationSettings, run_validation
 
 
@@ -17,7 +17,7 @@ def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("validate", help="run the validation analyses, the calibration study and the Franka section",
                                    description=__doc__)
     add_model_arguments(parser)
-    parser.add_argument("--out", default="out/validate", help="output folder (default: %(default)s)")
+    add_output_arguments(parser, "out/validate")
     parser.add_argument("--quick", action="store_true",
                         help="fewer Monte Carlo samples, closed-loop trials and calibration configurations, three Franka "
                              "goals instead of six (about 30 s; about 110 s the first time, when the Panda's "
@@ -36,7 +36,7 @@ def run(args) -> int:
     model = load_model(args)
     options = {"workers": args.workers, "seed": args.seed, "franka": args.franka, "human_reference": args.targets_reference}
     settings = ValidationSettings.quick_run(**options) if args.quick else ValidationSettings(**options)
-    out = Path(args.out)
+    out = output_dir(args.out, "validate", args.force, create=False)
     report = run_validation(model, out, settings)  # checks the model against the settings before creating out
     summary = {"model": model.name, "out": str(out)}
     if "fitts_grid" in report:
@@ -48,5 +48,6 @@ def run(args) -> int:
     if "franka" in report:
         summary["franka"] = report["franka"]["summary"]
     files = ["report.json", "report.md", *report["figures"], *report.get("franka", {}).get("files", [])]
+    write_manifest(out, "validate", [out / f for f in files])
     print(json.dumps(summary | {"files": files, "wall_time_s": round(report["wall_time_s"], 1)}, indent=1))
     return 0

@@ -66,11 +66,11 @@ class GoalPosterior:
     @property
     def success(self) -> bool:
         """True when every candidate's plan converged (a posterior over unconverged plans is less trustworthy)."""
-        return all(plan.success for plan in self.plans)
+        return all(plan.converged for plan in self.plans)
 
     @property
     def status(self) -> str:
-        failed = [i for i, plan in enumerate(self.plans) if not plan.success]
+        failed = [i for i, plan in enumerate(self.plans) if not plan.converged]
         return "solved" if not failed else f"plans of candidates {failed} did not converge"
 
     @property

@@ -90,7 +90,7 @@ def execute_receding_horizon(planner: Planner, start, goal, width: float | None 
     for k in range(steps):
         warm = None if plan is None else np.vstack([plan.torque[1:], plan.torque[-1:]])
         plan = planner.solve(estimates[k], goal, width, warm_start=warm, max_wall_time=max_wall_time)
-        failed += not plan.success
+        failed += not plan.converged
         commanded[k] = plan.torque[0]
         error = sample_torque_error(commanded[k], model.kappa, model.noise, rng) if noise else 0.0
         executed[k] = commanded[k] + error

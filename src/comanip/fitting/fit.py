@@ -80,7 +80,7 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
     curves = [condition_curves(data, c, plan) for c, plan in zip(conditions, plans)]
     trial_rows = trial_residuals(data, conditions, plans)
     return FitResult(
-        success=status == "converged" and all(plan.success for plan in plans), status=status,
+        success=status == "converged" and all(plan.converged for plan in plans), status=status,
         message=outcome_message(message, space, u), model=fitted, values=space.values(u), initial_values=space.start_values,
         std_errors=space.natural_std_errors(u, spread.robust_std()),
         laplace_std_errors=space.natural_std_errors(u, spread.laplace_std()),

@@ -98,7 +98,7 @@ def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTab
              "mt_predicted_s": movement_time(plan.t, plan.ee_speed), "plan_status": plan.status, "plan_success": plan.success}
             for c, (D, w, mt, plan) in enumerate(zip(table.distance, table.width, table.mt, plans))]
     return FitResult(
-        success=status == "converged" and all(plan.success for plan in plans), status=status,
+        success=status == "converged" and all(plan.converged for plan in plans), status=status,
         message=outcome_message(str(result.message), space, result.x),
         model=fitted_model(space.model_for(result.x), model, f"movement times of {len(table.mt)} conditions"),
         values=space.values(result.x), initial_values=space.start_values,

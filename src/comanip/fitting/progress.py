@@ -5,13 +5,15 @@ from __future__ import annotations
 import numpy as np
 from tqdm import tqdm
 
+from comanip.progress import progress_options
+
 
 class ProgressBar(tqdm):
-    """tqdm over objective evaluations (no total: the optimiser decides when to stop). When stderr is not a
-    terminal tqdm still redraws one line; ``enabled=False`` silences it."""
+    """tqdm over objective evaluations (no total: the optimiser decides when to stop), redrawn in a terminal
+    and one line per update in a log (:mod:`comanip.progress`); ``enabled=False`` silences it."""
 
     def __init__(self, description: str, enabled: bool):
-        super().__init__(desc=description, unit="evaluation", disable=not enabled, mininterval=0.5)
+        super().__init__(desc=description, unit="evaluation", **progress_options(enabled))
         self.best = np.inf
 
     def record(self, value: float) -> None:

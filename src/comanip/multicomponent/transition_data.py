@@ -28,6 +28,7 @@ from comanip.execution import execute_receding_horizon
 from comanip.model import ReachingModel
 from comanip.multicomponent.dispersion import bootstrap_transition_std, first_passage_deviations, profile_from_deviations
 from comanip.planning.planner import Planner
+from comanip.progress import progress_bar
 
 #: Default arm length L (m) that normalises the goal distance.
 ARM_LENGTH = 0.7
@@ -123,7 +124,7 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
     seeds = np.random.SeedSequence(seed).spawn(len(conditions))
     config = json.dumps(model.config())
     tasks = [(config, r, w, n_trials, arm_length, steps, s) for (r, w), s in zip(conditions, seeds)]
-    bar = tqdm(total=len(tasks), desc="transition conditions", unit="condition", disable=not progress)
+    bar = progress_bar("transition conditions", len(tasks), "condition", progress)
     if workers == 1:
         rows = []
         for task in tasks:

@@ -9,7 +9,8 @@ The cache key is a SHA-256 of the generated C source (which holds every model co
 command and the CasADi version, so a changed model, a changed formulation or a new CasADi builds a new
 library; stale files are simply never looked up again. The folder is ``$COMANIP_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/comanip`` or ``~/.cache/comanip``. Without a working C compiler (``$CC``, default
-``gcc``) the uncompiled function is returned with a warning: same numbers, slower.
+``gcc``) the uncompiled function is returned with a warning: same numbers, slower. Each compile shows a
+progress line with its elapsed time (:mod:`comanip.progress`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,8 @@ from pathlib import Path
 
 import casadi as ca
 import numpy as np
+
+from comanip.progress import elapsed
 
 COMPILE_FLAGS = ("-O1", "-fPIC", "-shared")
 """Flags for the C compiler: -O1 runs the straight-line SX code as fast as -O2 (measured on the Panda's
@@ -53,7 +56,8 @@ def compiled(function: ca.Function) -> ca.Function:
     library = cache_dir() / f"{name}_{key}.so"
     if not library.exists():
         try:
-            _build(source, compiler, library)
+            with elapsed(f"compiling {name} to C (first use of this model; cached in {cache_dir()})"):
+                _build(source, compiler, library)
         except (OSError, subprocess.CalledProcessError) as error:
             detail = getattr(error, "stderr", "") or error
             warnings.warn(f"could not compile {name} with {' '.join(compiler)} ({str(detail)[:300]}); "

@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import csv
 import json
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
+
+
+#: statuses of a solver that converged (to its tolerance, or to an acceptable level)
+CONVERGED_STATUSES = ("solved", "solved_acceptable")
 
 
 @dataclass
@@ -18,10 +22,14 @@ class Plan:
     """
 
     success: bool
-    """True when the solver converged (to its tolerance or an acceptable level) to a finite plan."""
+    """True when the solver converged (to its tolerance or an acceptable level) to a finite plan whose mean
+    end effector ends within the goal width w of the goal."""
     status: str
-    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'unreachable' (goal out of the arm's
-    reach), 'constraints_violated' (joint limits could not be met) or 'failed'."""
+    """'solved', 'solved_acceptable' (converged and reaching), 'goal_not_reached' (converged, but the mean end
+    effector ends farther than w from the goal: e.g. a goal too far for the horizon, or not worth the effort;
+    ``extras['solver_status']`` keeps the solver's word), 'max_iterations', 'max_wall_time', 'unreachable'
+    (goal out of the arm's reach), 'constraints_violated' (joint limits could not be met) or 'failed'.
+    The README's status table says the same."""
     message: str
     """What the solver said, in words."""
     objective: float
@@ -69,6 +77,16 @@ class Plan:
         """Distance of the final mean end effector from the goal (m)."""
         return float(np.linalg.norm(self.ee_mean[-1] - self.goal))
 
+    @property
+    def reaches_goal(self) -> bool:
+        """True when the final mean end effector is within the goal width of the goal (final_error ≤ w)."""
+        return self.final_error <= self.width
+
+    @property
+    def converged(self) -> bool:
+        """True when the solver converged, whether or not the plan reaches the goal (see ``success``)."""
+        return self.status in CONVERGED_STATUSES or self.status == "goal_not_reached"
+
     def to_dict(self) -> dict:
         """JSON-ready dictionary (arrays as nested lists)."""
         out = {}
@@ -102,3 +120,15 @@ class Plan:
     def summary(self) -> str:
         return (f"{self.status} ({'success' if self.success else 'no success'}) objective {self.objective:.4g}, "
                 f"{self.iterations} iterations in {1e3 * self.solve_time:.1f} ms; final error {1e3 * self.final_error:.1f} mm")
+
+
+def with_reach_check(plan: Plan) -> Plan:
+    """The plan, or, when the solver converged but the mean end effector ends farther than the goal width from
+    the goal, a copy with status 'goal_not_reached', success False and the solver's status in
+    ``extras['solver_status']``."""
+    if plan.status not in CONVERGED_STATUSES or plan.reaches_goal:
+        return plan
+    message = (f"the plan ends {plan.final_error:.4g} m from the goal, beyond the goal width {plan.width:g} m "
+               f"(solver: {plan.status}, {plan.message})")
+    return replace(plan, success=False, status="goal_not_reached", message=message,
+                   extras={**plan.extras, "solver_status": plan.status})

@@ -43,7 +43,7 @@ from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
-from comanip.planning.plan import Plan
+from comanip.planning.plan import Plan, with_reach_check
 from comanip.planning.reach_problem import ReachProblem
 
 SOLVER_METHODS = ("newton", "ipopt")
@@ -179,7 +179,7 @@ class Planner:
                 status 'max_wall_time' when it runs out.
 
         Returns:
-            A :class:`Plan`; never raises on a failed solve (check ``plan.success``).
+            A :class:`Plan`; never raises on a failed solve (check ``plan.success``: converged and reaching).
         """
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
@@ -188,7 +188,7 @@ class Planner:
         if unreachable is not None:
             return unreachable
         guesses = self._initial_guesses(start, goal, width, warm_start)
-        return self._solve_from(guesses, start, goal, width, t_begin, max_wall_time)
+        return with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time))
 
     def _unreachable_plan(self, start, goal, width, warm_start, t_begin: float) -> Plan | None:
         """A plan with status 'unreachable' when no joint position within the limits puts the end effector

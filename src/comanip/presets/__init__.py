@@ -23,17 +23,43 @@ def names() -> list[str]:
 
 
 def load(name_or_path: str | Path) -> ReachingModel:
-    """A built-in preset by name, or a model from a YAML file written by :func:`save`."""
-    path = PRESET_DIR / f"{name_or_path}.yaml"
-    if not path.exists():
-        path = Path(name_or_path)
-        if path.suffix not in (".yaml", ".yml") or not path.exists():
-            raise ValueError(f"preset must be one of {names()} or an existing .yaml file, got {str(name_or_path)!r}")
-    with open(path) as f:
-        config = yaml.safe_load(f)
+    """A built-in preset by name, or a model from a YAML file written by :func:`save`.
+
+    Raises ValueError with a one-line message for an unknown name, a path that is not a readable, non-empty
+    YAML file, a YAML syntax error (with its line), and missing, unknown or mistyped model fields.
+    """
+    path = _preset_path(name_or_path)
+    try:
+        text = path.read_text()
+    except (OSError, UnicodeDecodeError) as error:
+        raise ValueError(f"cannot read {str(path)!r}: {getattr(error, 'strerror', None) or error}") from None
+    try:
+        config = yaml.safe_load(text)
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" at line {mark.line + 1}, column {mark.column + 1}" if mark is not None else ""
+        problem = getattr(error, "problem", None) or str(error).splitlines()[0]
+        raise ValueError(f"{str(path)!r} is not valid YAML{where}: {problem}") from None
+    if config is None:
+        raise ValueError(f"{str(path)!r} is empty; a model YAML is a mapping such as the one `comanip.presets.save` writes")
     if not isinstance(config, dict):
-        raise ValueError(f"{path} does not hold a model mapping (got {type(config).__name__})")
+        raise ValueError(f"{str(path)!r} does not hold a model mapping (got a {type(config).__name__})")
     return ReachingModel.from_config(config)
+
+
+def _preset_path(name_or_path: str | Path) -> Path:
+    """The YAML file of a built-in preset name, or the given path if it is a .yaml/.yml file; else ValueError."""
+    if isinstance(name_or_path, str) and name_or_path in names():
+        return PRESET_DIR / f"{name_or_path}.yaml"
+    path = Path(name_or_path)
+    allowed = f"one of {names()} or a model .yaml file"
+    if path.suffix not in (".yaml", ".yml"):
+        raise ValueError(f"preset must be {allowed}, got {str(name_or_path)!r}")
+    if path.is_dir():
+        raise ValueError(f"{str(path)!r} is a directory; the preset must be {allowed}")
+    if not path.is_file():
+        raise ValueError(f"{str(path)!r} does not exist; the preset must be {allowed}")
+    return path
 
 
 def save(model: ReachingModel, path: str | Path) -> Path:

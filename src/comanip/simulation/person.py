@@ -81,11 +81,11 @@ def solve_to_convergence(planner: Planner, start, goal, width: float, warm_start
     """Solve with a planner whose iteration limit is small, continuing from each result until it converges.
 
     Lets one planner (built once, with a per-replan iteration cap) also deliver fully converged plans.
-    Returns the last plan (check ``plan.success``); at most ``rounds`` solves.
+    Returns the last plan (check ``plan.converged`` and ``plan.success``); at most ``rounds`` solves.
     """
     plan = planner.solve(start, goal, width, warm_start=warm_start)
     for _ in range(rounds - 1):
-        if plan.success:
+        if plan.converged:
             break
         plan = planner.solve(start, goal, width, warm_start=plan)
     return plan

@@ -232,7 +232,7 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
             world.step(state, force, rest_position, rest_velocity)
     replans = person.plans[1:]      # the first plan is made before the trial (shared by trials alike)
     return TrialRecord(t=t, goal=person.goal.copy(), qpos=qpos, replans=len(person.plans),
-                       failed_replans=sum(not plan.success for plan in replans), wall_time=time.perf_counter() - begin,
+                       failed_replans=sum(not plan.converged for plan in replans), wall_time=time.perf_counter() - begin,
                        replan_time=sum(plan.solve_time for plan in replans), **record)
 
 

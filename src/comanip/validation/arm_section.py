@@ -8,18 +8,16 @@ cached on disk; :mod:`comanip.planning.compiled`), so the build gets its own pro
 from __future__ import annotations
 
 import csv
-import threading
 import time
-from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from comanip.analysis.arm_reaches import arm_reaches, summarise_reaches
 from comanip.model import ReachingModel
 from comanip.planning.compiled import cache_dir
 from comanip.planning.planner import Planner
+from comanip.progress import elapsed, progress_bar
 from comanip.plots.arm_figure import plot_arm_paths, plot_arm_speed_profiles, plot_joint_trajectories
 from comanip.validation.settings import ValidationSettings
 
@@ -32,7 +30,7 @@ def run_arm_section(model: ReachingModel, out: Path, settings: ValidationSetting
     into out; returns the section's report dictionary and the figure paths."""
     planner, build_time, compiled_now = build_arm_planner(model, progress)
     offsets = np.array(settings.franka_goal_offsets, dtype=float)
-    with tqdm(total=len(offsets), desc=f"franka: planning reaches ({model.name})", unit="reach", disable=not progress) as bar:
+    with progress_bar(f"franka: planning reaches ({model.name})", len(offsets), "reach", progress) as bar:
         reaches = arm_reaches(planner, offsets, settings.franka_width, settings.franka_max_wall_time, progress=bar.update)
     body = model.body
     name = model.name
@@ -72,7 +70,7 @@ def build_arm_planner(model: ReachingModel, progress: bool = True) -> tuple[Plan
     before = _cached_libraries()
     began = time.perf_counter()
     description = f"franka: building the {model.body.name.capitalize()}'s compiled functions (first use ~1 min, cached after)"
-    with tqdm(desc=description, bar_format="{desc}: {elapsed}", disable=not progress) as bar, _ticking(bar):
+    with elapsed(description, progress):
         planner = Planner(model)
     return planner, time.perf_counter() - began, bool(_cached_libraries() - before)
 
@@ -80,24 +78,6 @@ def build_arm_planner(model: ReachingModel, progress: bool = True) -> tuple[Plan
 def _cached_libraries() -> set[Path]:
     folder = cache_dir()
     return set(folder.glob("*.so")) if folder.is_dir() else set()
-
-
-@contextmanager
-def _ticking(bar: tqdm, every: float = 1.0):
-    """Redraw bar every ``every`` seconds while the block runs, so its elapsed time moves during a long call."""
-    stop = threading.Event()
-
-    def tick():
-        while not stop.wait(every):
-            bar.refresh()
-
-    thread = threading.Thread(target=tick, daemon=True)
-    thread.start()
-    try:
-        yield
-    finally:
-        stop.set()
-        thread.join()
 
 
 def _write_csv(rows: list[dict], path: Path) -> None:

@@ -12,14 +12,13 @@ from __future__ import annotations
 from dataclasses import asdict
 from pathlib import Path
 
-from tqdm import tqdm
-
 from comanip.analysis.closed_loop_targets import measure_closed_loop_targets
 from comanip.analysis.human_targets import HumanTargetsResult, measure_human_targets
 from comanip.analysis.reach_grid import ReachOutcome
 from comanip.analysis.target_verdicts import HumanTargets
 from comanip.model import ReachingModel
 from comanip.plots.human_targets_figure import plot_human_targets
+from comanip.progress import progress_bar
 from comanip.validation.settings import ValidationSettings
 
 #: Figure file of the section.
@@ -35,8 +34,7 @@ def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list
     same = reference.config() == model.config()
     grid_options = {"seed": settings.seed, "distances": settings.distances, "widths": settings.widths}
     feedback = bool(model.observation)
-    with tqdm(total=len(grid) * (1 + (0 if same else 2) + feedback), desc="human-likeness targets", unit="condition",
-              disable=not progress) as bar:
+    with progress_bar("human-likeness targets", len(grid) * (1 + (0 if same else 2) + feedback), "condition", progress) as bar:
         results = [measure_human_targets(model, grid, n_samples=settings.human_samples, progress=bar.update, **grid_options)]
         if feedback:
             results.append(measure_closed_loop_targets(model, settings.human_trials, progress=bar.update, **grid_options))

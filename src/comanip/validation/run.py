@@ -16,7 +16,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-from tqdm import tqdm
 
 from comanip import presets
 from comanip.analysis import (
@@ -41,6 +40,7 @@ from comanip.plots.dispersion_figure import plot_dispersion
 from comanip.plots.fitts_figure import plot_fitts
 from comanip.plots.phase_figure import plot_phase
 from comanip.plots.velocity_profiles import plot_velocity_profiles
+from comanip.progress import progress_bar
 from comanip.validation.arm_section import run_arm_section
 from comanip.validation.human_section import run_human_section
 from comanip.validation.markdown import report_markdown
@@ -93,8 +93,7 @@ def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSe
     rng = np.random.default_rng(settings.seed)
     n_grid = len(settings.distances) * len(settings.widths)
     n_phase = len(settings.phase_distances) + len(settings.phase_initial_velocities)
-    with tqdm(total=n_grid + len(settings.dispersion_widths) + n_phase, desc="validation", unit="reach",
-              disable=not progress) as bar:
+    with progress_bar("validation", n_grid + len(settings.dispersion_widths) + n_phase, "reach", progress) as bar:
         grid = open_loop_grid(planner, settings.distances, settings.widths, progress=bar.update)
         start, x0 = home_start(model)
         dispersion_goal = x0 + settings.dispersion_distance * unit_direction(model)

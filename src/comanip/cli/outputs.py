@@ -1,0 +1,101 @@
+"""Output folders of the subcommands: each command has its own default folder (``out/<command>``), a folder
+holding another command's results is written into only with ``--force``, and every folder gets a
+``manifest.json`` saying which command wrote it, when, and what each file is."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import shlex
+import sys
+import time
+from fnmatch import fnmatch
+from pathlib import Path
+
+MANIFEST = "manifest.json"
+
+#: (file-name pattern, what the file is), first match wins
+FILE_KINDS = (
+    ("plan.json", "the plan: status, success, objective, times, state and end-effector mean and covariance, torques"),
+    ("plan.csv", "the plan, one row per step: t, q, qdot, hand position, velocity and std, torque"),
+    ("estimate.json", "the goal estimate: estimated goal (extras), status, and the plan through the observation"),
+    ("estimate.csv", "the estimate's predicted trajectory, one row per step (columns as a plan CSV)"),
+    ("posterior.json", "posterior over the candidate goals after each observation prefix, with entropies"),
+    ("posterior.png", "figure: posterior probability of each candidate goal over time"),
+    ("fit.json", "fitted values, standard errors, residuals per condition and the fit's status"),
+    ("model.yaml", "the fitted model, readable by 'comanip plan --preset model.yaml'"),
+    ("model.json", "the fitted transition model (Gaussian process), readable by --transition-model"),
+    ("handover_*.json", "handover schedule for one goal: transition time and position, stiffness over time"),
+    ("handover_*.csv", "handover schedule for one goal, one row per time: rest position and stiffness"),
+    ("*_trial*.csv", "one simulated trial, one row per time step: handle, rest position, stiffness, person's force"),
+    ("*_summary.json", "settings, per-trial metrics and their summaries for every goal"),
+    ("*_frames.png", "rendered frame strip of the first trial"),
+    ("report.json", "every number of the validation run"),
+    ("report.md", "the validation run's tables, readable"),
+    ("franka_plans/*.csv", "one Panda reach's plan, one row per step"),
+    ("franka_reaches.csv", "one row per Panda reach: goal, status, timing, joint-limit usage"),
+    ("transition_data.csv", "transition distances over the (D/L, w) grid, one row per condition"),
+    ("transition_data.json", "how transition_data.csv was generated: command, seed, model, wall time"),
+    ("trends.json", "the published trends checked on the fitted transition model"),
+    ("transition_model.png", "Fig. 2: the predicted transition distance over (D/L, w) with the data"),
+    ("*.png", "figure"),
+    ("*.csv", "table (CSV with a header row)"),
+    ("*.json", "results (JSON)"),
+)
+
+
+def add_output_arguments(parser: argparse.ArgumentParser, default: str, what: str = "output folder") -> None:
+    """--out (default ``default``) and --force."""
+    parser.add_argument("--out", default=default, help=f"{what} (default: %(default)s)")
+    parser.add_argument("--force", action="store_true", help="write into an output folder that holds another command's results")
+
+
+def output_dir(path: str | Path, command: str, force: bool = False, create: bool = True) -> Path:
+    """The folder ``path``, created unless ``create`` is False (the caller creates it after further checks);
+    ValueError when it is a file, or holds another command's results (its manifest names another command) and
+    ``force`` is False."""
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {str(out)!r} is a file; expected a folder")
+    owner = _owner(out)
+    if owner not in (None, command) and not force:
+        raise ValueError(f"--out {str(out)!r} holds the results of 'comanip {owner}'; give another --out, or --force "
+                         "to write into it anyway")
+    if create:
+        out.mkdir(parents=True, exist_ok=True)
+    return out
+
+
+def write_manifest(out: Path, command: str, files) -> Path:
+    """Write ``out/manifest.json``: the command, its arguments, the time, and a description of each of ``files``
+    (paths in out); the entries of an earlier run of the same command are kept."""
+    path = Path(out) / MANIFEST
+    entries = _read(path).get("files", {}) if _owner(Path(out)) == command else {}
+    for file in files:
+        name = Path(file).resolve().relative_to(Path(out).resolve()).as_posix()
+        entries[name] = _describe(name, command)
+    manifest = {"command": command, "arguments": shlex.join(sys.argv[1:]), "written": time.strftime("%Y-%m-%d %H:%M:%S"),
+                "files": dict(sorted(entries.items()))}
+    path.write_text(json.dumps(manifest, indent=1))
+    return path
+
+
+def _describe(name: str, command: str) -> str:
+    """What the file ``name`` (relative to its output folder) is, from :data:`FILE_KINDS`."""
+    for pattern, text in FILE_KINDS:
+        if fnmatch(name, pattern):
+            return text
+    return f"see 'comanip {command} --help'"
+
+
+def _owner(out: Path) -> str | None:
+    """The command named by out's manifest, or None (no folder, no manifest, or an unreadable one)."""
+    return _read(out / MANIFEST).get("command")
+
+
+def _read(path: Path) -> dict:
+    try:
+        data = json.loads(path.read_text())
+    except (OSError, ValueError):
+        return {}
+    return data if isinstance(data, dict) else {}

@@ -1,0 +1,94 @@
+"""Every user mistake on the command line is one line on stderr naming the argument, with exit status 2."""
+
+import os
+
+import pytest
+
+from comanip import presets
+from comanip.cli.main import main
+
+GOOD_MODEL = "name: mine\nbody: {type: point_mass, n: 2}\nh: 0.02\nH: 30\ngamma: 0.98\nnu: 1.0e-4\nkappa: 0.02\nwidth: 0.01\n"
+
+
+def run_cli(argv, capsys) -> tuple[int, str]:
+    """Exit status and stderr of ``comanip argv`` run in this process."""
+    return main(argv), capsys.readouterr().err
+
+
+def assert_one_line_error(code: int, err: str, *fragments: str) -> None:
+    assert code == 2, err
+    assert err.count("\n") == 1 and "Traceback" not in err, err
+    assert "error:" in err
+    for fragment in fragments:
+        assert fragment in err, (fragment, err)
+
+
+@pytest.mark.parametrize("text, fragments", [
+    ("name: [unclosed\n", ["--preset", "not valid YAML", "line 2"]),
+    ("name: mine\nbody: {type: point_mass, n: 2}\nh: 0.02\nH: 30\n", ["--preset", "'gamma'", "'nu'", "'kappa'", "'width'"]),
+    (GOOD_MODEL + "speed: 3\n", ["--preset", "unknown model fields ['speed']", "allowed"]),
+    (GOOD_MODEL.replace("h: 0.02", "h: fast"), ["--preset", "h must be a finite number > 0", "'fast'"]),
+    (GOOD_MODEL.replace("H: 30", "H: 2.5"), ["--preset", "H must be an integer"]),
+    (GOOD_MODEL.replace("n: 2}", "n: 2, size: 3}"), ["--preset", "body of type 'point_mass' takes the parameters", "size"]),
+    (GOOD_MODEL.replace("{type: point_mass, n: 2}", "rocket"), ["--preset", "body must be a mapping"]),
+    ("- 1\n- 2\n", ["--preset", "does not hold a model mapping"]),
+    ("", ["--preset", "is empty"]),
+])
+def test_bad_model_yaml_is_one_line(tmp_path, capsys, text, fragments):
+    path = tmp_path / "model.yaml"
+    path.write_text(text)
+    assert_one_line_error(*run_cli(["plan", "--preset", str(path), "--out", str(tmp_path / "out")], capsys), *fragments)
+    assert not (tmp_path / "out").exists()
+
+
+def test_presets_load_raises_value_errors_naming_the_problem(tmp_path):
+    (tmp_path / "folder.yaml").mkdir()
+    with pytest.raises(ValueError, match="is a directory"):
+        presets.load(tmp_path / "folder.yaml")
+    with pytest.raises(ValueError, match="does not exist"):
+        presets.load(tmp_path / "absent.yaml")
+    with pytest.raises(ValueError, match="must be one of"):
+        presets.load("plannar")
+
+
+@pytest.mark.skipif(os.geteuid() == 0, reason="root reads every file")
+def test_unreadable_files_are_one_line(tmp_path, capsys):
+    for name in ("model.yaml", "observed.csv"):
+        (tmp_path / name).write_text(GOOD_MODEL)
+        (tmp_path / name).chmod(0)
+    assert_one_line_error(*run_cli(["plan", "--preset", str(tmp_path / "model.yaml")], capsys), "--preset", "cannot read")
+    assert_one_line_error(*run_cli(["estimate", "--observations", str(tmp_path / "observed.csv")], capsys),
+                          "--observations", "not readable")
+
+
+@pytest.mark.parametrize("argv, fragments", [
+    (["estimate", "--candidates", "0.3,0;0.2"], ["--candidates", "equal length", "'0.3,0;0.2'"]),
+    (["estimate", "--observations", "{tmp}"], ["--observations", "is a directory"]),
+    (["estimate", "--observations", "{tmp}/empty.csv"], ["--observations", "is empty"]),
+    (["estimate", "--observations", "{tmp}/absent.csv"], ["--observations", "does not exist"]),
+    (["fit", "--mt-table", "{tmp}"], ["--mt-table", "is a directory"]),
+    (["handover", "--transition-model", "{tmp}/empty.csv"], ["--transition-model", "is empty"]),
+    (["transition", "fit", "--data", "{tmp}"], ["--data", "is a directory"]),
+    (["plan", "--goal", "0.3,abc"], ["--goal", "expected comma-separated numbers"]),
+    (["plan", "--goal", "0.3,0,0"], ["goal must have shape (2,)"]),
+    (["plan", "--width", "-1"], ["width must be a finite number > 0"]),
+    (["plan", "--preset", "plannar"], ["--preset", "must be one of"]),
+    (["estimate"], ["give the observation"]),
+])
+def test_argument_mistakes_are_one_line(tmp_path, capsys, argv, fragments):
+    (tmp_path / "empty.csv").write_text("")
+    argv = [a.format(tmp=tmp_path) for a in argv] + (["--out", str(tmp_path / "out")] if argv[0] in ("plan", "estimate") else [])
+    assert_one_line_error(*run_cli(argv, capsys), *fragments)
+
+
+def test_debug_shows_the_traceback(tmp_path):
+    path = tmp_path / "model.yaml"
+    path.write_text("name: [unclosed\n")
+    with pytest.raises(ValueError, match="not valid YAML"):
+        main(["--debug", "plan", "--preset", str(path)])
+
+
+def test_help_has_no_literal_double_backticks(capsys):
+    for argv in (["--help"], ["fit", "--help"], ["transition", "--help"], ["estimate", "--help"]):
+        assert main(argv) == 0
+        assert "``" not in capsys.readouterr().out

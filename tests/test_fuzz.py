@@ -1,0 +1,126 @@
+"""Fuzz the public API and the CLI with bad and extreme inputs (hypothesis).
+
+Each input must give a ValueError with a message, or a plan with a status and finite arrays: never another
+exception or a silent NaN. The count of inputs tried is printed at the end of the session (conftest.py).
+"""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import comanip
+from comanip.cli.main import main
+from comanip.estimation import GoalEstimator
+
+FUZZ_COUNT = {"inputs": 0}
+FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+
+numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**12, 10**12),
+                    st.sampled_from([0.0, -0.0, 1e-300, 1e300, -1e300]))
+vectors = st.one_of(st.lists(numbers, min_size=0, max_size=6), numbers, st.text(max_size=5), st.none(),
+                    st.lists(st.lists(numbers, min_size=1, max_size=3), min_size=1, max_size=3))
+
+
+@pytest.fixture(scope="module")
+def small_planner():
+    return comanip.Planner(comanip.presets.planar().replace(H=8))
+
+
+def check_plan_or_value_error(call):
+    """call() returns a Plan with a status and finite arrays, or raises ValueError with a message."""
+    FUZZ_COUNT["inputs"] += 1
+    try:
+        plan = call()
+    except ValueError as error:
+        assert str(error), "ValueError without a message"
+        return
+    assert isinstance(plan.status, str) and plan.status
+    for name in ("t", "mean", "cov", "torque", "ee_mean", "ee_cov", "ee_velocity"):
+        assert np.all(np.isfinite(getattr(plan, name))), (name, plan.status)
+    assert math.isfinite(plan.objective) or not plan.success
+
+
+@FAST
+@given(start=vectors, goal=vectors, width=st.one_of(numbers, st.none()), wall=st.one_of(numbers, st.none()))
+def test_planner_solve(small_planner, start, goal, width, wall):
+    check_plan_or_value_error(lambda: small_planner.solve(start, goal, width, max_wall_time=wall if wall is None else
+                                                          (min(wall, 2.0) if isinstance(wall, (int, float)) and wall > 0 else wall)))
+
+
+@FAST
+@given(goal=st.lists(st.floats(-1e6, 1e6), min_size=2, max_size=2), width=st.floats(1e-6, 1e3))
+def test_planner_solve_extreme_but_valid(small_planner, goal, width):
+    check_plan_or_value_error(lambda: small_planner.solve(np.zeros(4), goal, width, max_wall_time=2.0))
+
+
+model_fields = st.fixed_dictionaries({}, optional={
+    "h": numbers, "H": st.one_of(st.integers(-5, 12), numbers), "gamma": numbers, "nu": numbers, "kappa": numbers,
+    "width": numbers, "noise": st.text(max_size=8), "reward": st.sampled_from(["gaussian", "hit", "bogus", ""]),
+    "effective_k": numbers, "stop_weight": numbers, "activation": st.lists(numbers, max_size=2),
+    "discount": st.sampled_from(["exponential", "hyperbolic", "x"])})
+
+
+@FAST
+@given(changes=model_fields)
+def test_model_parameters_then_a_plan(changes):
+    def build_and_plan():
+        model = comanip.presets.planar().replace(H=6).replace(**changes)
+        if model.H > 12:
+            raise ValueError("horizon too long for the fuzz budget")
+        return comanip.Planner(model).solve(np.zeros(4), [0.2, 0.0], max_wall_time=2.0)
+    check_plan_or_value_error(build_and_plan)
+
+
+yaml_texts = st.one_of(st.text(max_size=60), st.sampled_from([
+    "name: [unclosed", "", "- 1", "body: 3", "body: {type: point_mass}", "body: {type: point_mass, n: 7}\nh: 1",
+    "h: 0.02\nH: 30\ngamma: 0.9\nnu: 1\nkappa: 0.1\nwidth: 0.01\nbody: {type: panda, damping: x}",
+    "h: .nan\nH: 30\ngamma: 0.9\nnu: 1\nkappa: 0.1\nwidth: 0.01\nbody: {type: point_mass, n: 2}"]))
+
+
+@FAST
+@given(text=yaml_texts)
+def test_presets_load_any_file(tmp_path_factory, text):
+    FUZZ_COUNT["inputs"] += 1
+    path = tmp_path_factory.mktemp("yaml") / "model.yaml"
+    path.write_text(text)
+    try:
+        comanip.presets.load(path)
+    except ValueError as error:
+        assert str(error) and "\n" not in str(error)
+
+
+arguments = st.lists(st.one_of(st.sampled_from(["--goal", "--start", "--width", "--max-wall-time", "--candidates",
+                                                "--t-obs", "--observed", "--prior", "--preset", "--method"]),
+                               st.text(alphabet="0123456789.,;-e naif", max_size=12)), max_size=6)
+
+
+@settings(max_examples=400, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@given(command=st.sampled_from(["plan", "estimate"]), argv=arguments)
+def test_cli_never_tracebacks(tmp_path_factory, capsys, command, argv):
+    FUZZ_COUNT["inputs"] += 1
+    out = tmp_path_factory.mktemp("out")
+    code = main([command, *argv, "--out", str(out), "--max-wall-time", "1"] + (["--preset", "planar"] if "--preset" not in argv else []))
+    err = capsys.readouterr().err
+    assert code in (0, 1, 2), (argv, code)
+    assert "Traceback" not in err
+    if code == 2:
+        assert err.count("\n") == 1 and "error:" in err, err
+
+
+@pytest.fixture(scope="module")
+def small_estimator():
+    return GoalEstimator(comanip.presets.planar().replace(H=8))
+
+
+@FAST
+@given(observed=vectors, t_obs=numbers, prior=st.one_of(st.none(), vectors), width=st.one_of(st.none(), numbers))
+def test_goal_estimate(small_estimator, observed, t_obs, prior, width):
+    check_plan_or_value_error(lambda: small_estimator.estimate(np.zeros(4), observed, t_obs, prior, width, max_wall_time=2.0))
+
+
+def test_found_by_fuzzing_a_huge_activation_time_constant_is_refused():
+    with pytest.raises(ValueError, match="activation time constants must be ≤ 1000 h"):
+        comanip.presets.planar().replace(activation=[3.6e14])

@@ -1,0 +1,36 @@
+"""Output folders: own defaults, no silent overwrite of another command's results, a manifest in each."""
+
+import json
+
+from comanip.cli.main import build_parser, main
+
+
+def test_every_command_has_its_own_default_folder():
+    parser = build_parser()
+    defaults = {name: parser.parse_args(argv).out for name, argv in {
+        "plan": ["plan"], "estimate": ["estimate"], "fit": ["fit", "--mt-table", __file__], "handover": ["handover"],
+        "simulate": ["simulate", "sync"], "validate": ["validate"], "transition": ["transition", "fit"]}.items()}
+    assert all(out.startswith(f"out/{name}") for name, out in defaults.items()), defaults
+
+
+def test_plan_writes_a_manifest_and_another_command_needs_force(tmp_path, capsys):
+    out = tmp_path / "shared"
+    assert main(["plan", "--out", str(out)]) == 0
+    manifest = json.loads((out / "manifest.json").read_text())
+    assert manifest["command"] == "plan" and set(manifest["files"]) == {"plan.json", "plan.csv"}
+    assert "torques" in manifest["files"]["plan.json"]
+    assert main(["plan", "--goal", "0.2,0.1", "--out", str(out)]) == 0          # the same command rewrites its own
+    capsys.readouterr()
+    argv = ["estimate", "--observed", "0.01,0,0.3,0", "--t-obs", "0.1", "--out", str(out)]
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "holds the results of 'comanip plan'" in err and "--force" in err
+    assert not (out / "estimate.json").exists()
+    assert main(argv + ["--force"]) == 0
+    assert json.loads((out / "manifest.json").read_text())["command"] == "estimate"
+
+
+def test_a_file_given_as_the_output_folder_is_one_line(tmp_path, capsys):
+    (tmp_path / "taken").write_text("x")
+    assert main(["plan", "--out", str(tmp_path / "taken")]) == 2
+    assert "is a file; expected a folder" in capsys.readouterr().err
