@@ -8,10 +8,10 @@ the transition (Peternel & Babič 2019; SPEC §8).
 
 The person is any point-mass model (default the planar preset; with activation stages the state
 [q; qdot; a_1..a_m] starts at rest with zero force). A condition is a goal at distance D = (D/L)·L along x
-from rest at the origin, with width w (m). N trials
-per condition give one row of the transition CSV (:mod:`comanip.multicomponent.transition_csv`). The sweep
-runs conditions in parallel on a Dask ``LocalCluster`` (one single-threaded worker process per core; each
-builds its planner once), with a tqdm progress bar.
+from rest at the origin, with width w (m). N trials per condition give one row of the transition CSV
+(:mod:`comanip.multicomponent.transition_csv`). The sweep runs conditions in parallel on a Dask
+``LocalCluster`` (one single-threaded worker process per core; each builds its planner once), with a tqdm
+progress bar.
 """
 
 from __future__ import annotations
