@@ -157,3 +157,20 @@ def test_model_observation_drives_the_closed_loop_estimate():
         comanip.presets.planar().replace(observation=(0.004, 0.04))
     with pytest.raises(ValueError, match=r"observation\[2\]"):
         comanip.presets.planar().replace(observation=(0.004, 0.04, -0.1))
+
+
+def test_human_preset_trends():
+    """What the human preset is for, as trends over the targets' grid: Fitts' law with a steeper slope than the
+    paper's (a human one, about 80 ms/bit), a smooth onset and a flat t_peak/MT in the plan, and, in its closed
+    loop with feedback,
+    a deceleration phase that lengthens for smaller goals (t_peak/MT falls as w shrinks)."""
+    from comanip.analysis import measure_closed_loop_targets, measure_human_targets
+
+    human, paper = comanip.presets.human(), comanip.presets.planar()
+    plans = {m.name: measure_human_targets(m, n_samples=100) for m in (human, paper)}
+    assert plans["human"].fitts.b > 1.5 * plans["planar"].fitts.b and plans["human"].fitts.r2 >= 0.95
+    assert max(r.onset for r in plans["human"].rows) < 0.15 < max(r.onset for r in plans["planar"].rows)
+    assert plans["human"].asymmetry_slope < 0.5 * plans["planar"].asymmetry_slope
+    closed = measure_closed_loop_targets(human, n_trials=4, distances=(0.3,), widths=(0.005, 0.04))
+    small, large = closed.rows
+    assert small.asymmetry < large.asymmetry - 0.05 and small.movement_time > large.movement_time
