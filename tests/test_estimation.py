@@ -6,11 +6,12 @@ import json
 import numpy as np
 import pytest
 
+import comanip
 from comanip.belief import sample_trajectories
+from comanip.belief.propagation import linearised_step_function
 from comanip.cli.main import main
-from comanip.estimation import GoalEstimator, estimate_goal, goal_posterior
-from comanip.estimation.goal_posterior import joint_state_covariance
-from comanip.estimation.shared import shared_step_jacobians
+from comanip.estimation import EstimatorCache, GoalEstimator, estimate_goal, goal_posterior
+from comanip.estimation.observation import joint_state_covariance
 from comanip.estimation.observation import observation_step
 
 T_OBS = 0.2  # the paper's observation time (s)
@@ -196,7 +197,7 @@ def test_joint_state_covariance_matches_monte_carlo(planar_planner, rng):
     samples = sample_trajectories(model.body, model.h, model.kappa, plan.start, plan.torque, 4000, rng, model.noise)
     stacked = samples[:, steps].reshape(len(samples), -1)
     empirical = np.cov(stacked, rowvar=False)
-    predicted = joint_state_covariance(plan, steps, shared_step_jacobians(model))
+    predicted = joint_state_covariance(plan, steps, linearised_step_function(model.body, model.h))
     scale = np.sqrt(np.outer(np.diag(predicted), np.diag(predicted)))
     assert np.abs(empirical - predicted).max() / scale.max() < 0.08
     np.testing.assert_allclose(np.diag(empirical), np.diag(predicted), rtol=0.1)
@@ -303,3 +304,20 @@ def test_bad_posterior_input_names_the_argument(planar_planner, kwargs, word):
                 candidate_goals=[[0.3, 0.0], [0.0, 0.3]]) | kwargs
     with pytest.raises(ValueError, match=word):
         goal_posterior(planar_planner, **args)
+
+
+def test_estimate_goal_uses_the_planner_it_is_given(planar_planner):
+    """Two planners of one model with different options: each call uses its own (a cache keyed by the
+    model alone once handed the first planner's estimator to the second)."""
+    model = planar_planner.model
+    one_iteration = comanip.Planner(model, comanip.SolverOptions(max_iterations=1))
+    plan = planar_planner.solve(np.zeros(4), [0.3, 0.1])
+    by_a = GoalEstimator(planar_planner).estimate(plan.start, plan.mean[10], T_OBS)
+    by_b = GoalEstimator(one_iteration).estimate(plan.start, plan.mean[10], T_OBS)
+    assert (by_a.iterations, by_a.status) != (by_b.iterations, by_b.status) or not np.array_equal(by_a.goal, by_b.goal)
+    cache = EstimatorCache()
+    for planner, expected in ((planar_planner, by_a), (one_iteration, by_b)):
+        for estimate in (estimate_goal(planner, plan.start, plan.mean[10], T_OBS),
+                         estimate_goal(planner, plan.start, plan.mean[10], T_OBS, cache=cache)):
+            assert (estimate.iterations, estimate.status) == (expected.iterations, expected.status)
+            np.testing.assert_array_equal(estimate.goal, expected.goal)

@@ -93,7 +93,7 @@ def run(args) -> int:
         if times is None:
             times, states = np.array([t_obs]), np.atleast_2d(observed)
         usable = times <= model.duration
-        posterior = goal_posterior(estimator.planner, estimate.start, states[usable], times[usable], args.candidates, args.width)
+        posterior = goal_posterior(estimator, estimate.start, states[usable], times[usable], args.candidates, args.width)
         path = out / "posterior.json"
         path.write_text(json.dumps(posterior.to_dict(), indent=1))
         written.append(path)

@@ -31,6 +31,7 @@ the paper's; without a prior goal (``prior_goal=None``) it is left out.
 from __future__ import annotations
 
 import math
+import threading
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, replace
@@ -40,12 +41,12 @@ import numpy as np
 from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
-from comanip.estimation.goal_posterior import OBSERVATION_STD, observation_covariance
+from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
-from comanip.estimation.observation import observation_step, observed_rows, observed_state
+from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
 from comanip.estimation.regret_newton import newton_solve
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
-from comanip.estimation.shared import cached_per_model, shared_planner, shared_step_jacobians
+from comanip.estimation.shared import checked_model, estimation_planner, model_key
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
 from comanip.planning.plan import Plan
@@ -89,16 +90,19 @@ class EstimatorOptions:
 class GoalEstimator:
     """Goal estimates for one model: functions and solvers built once, reused for every observation.
 
-    The model's planner is shared with :func:`comanip.goal_posterior` (one per model). The 'paper'
-    method's NLP depends on the observed step, so one is built per n_o on first use and kept.
+    Given a model, it builds its own planner (terms compiled to C, :func:`estimation_planner`); given a
+    planner, it uses that one. The 'paper' method's NLP depends on the observed step, so one is built per
+    n_o on first use and kept.
     """
 
     def __init__(self, model: ReachingModel | Planner, options: EstimatorOptions | None = None):
-        self.planner = shared_planner(model)
+        self.planner = estimation_planner(model)
         self.model = self.planner.model
         self.problem = self.planner.problem
         self.options = options or EstimatorOptions()
         self._regret = RegretSystem(self.planner)
+        self.step_jacobians = linearised_step_function(self.model.body, self.model.h)
+        """The body's linearised step ``(s, tau) -> (f, A, B)`` (:func:`comanip.belief.linearised_step_function`)."""
         self._blas = ThreadpoolController()
         self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
 
@@ -238,7 +242,7 @@ class GoalEstimator:
         """Start from the best goal along the observed direction; from the prior (or the hand) if nothing moved."""
         R = observation_covariance(self.options.observation_std, self.model.n)
         found = search_along_observed_direction(self.planner, start, observed, n_o, prior, width, R, self.options.search_distances,
-                                                shared_step_jacobians(self.model), remaining_time)
+                                                self.step_jacobians, remaining_time)
         if found is None:
             goal = prior if prior is not None else task_space_state(self.planner, observed)[0]
             plan = self.planner.solve(start, goal, width, max_wall_time=remaining_time())
@@ -285,21 +289,46 @@ class GoalEstimator:
         return solved, status, stats["return_status"], int(stats.get("iter_count", 0))
 
 
-_estimators: OrderedDict = OrderedDict()
+class EstimatorCache:
+    """Goal estimators kept between calls of :func:`estimate_goal` and :func:`comanip.goal_posterior`.
+
+    One key: a Planner or GoalEstimator is its own (its options are part of what it solves); a
+    ReachingModel is keyed by its parameters (:func:`model_key`, so two loads of a preset share an
+    estimator) and gets an estimator with its own planner. At most ``size`` estimators are kept, the least
+    recently used dropped first. Safe to share between threads; an estimator itself is not (give each
+    thread its own cache or planner).
+    """
+
+    def __init__(self, size: int = 4):
+        self.size = size
+        self._estimators: OrderedDict[object, GoalEstimator] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def estimator(self, model: ReachingModel | Planner | GoalEstimator) -> GoalEstimator:
+        """The estimator for ``model``, built on first use."""
+        if isinstance(model, GoalEstimator):
+            return model
+        key = model if isinstance(model, Planner) else model_key(checked_model(model))
+        with self._lock:
+            if key not in self._estimators:
+                self._estimators[key] = GoalEstimator(model)
+                while len(self._estimators) > self.size:
+                    self._estimators.popitem(last=False)
+            self._estimators.move_to_end(key)
+            return self._estimators[key]
+
+
+DEFAULT_CACHE = EstimatorCache()
+"""The cache :func:`estimate_goal` and :func:`comanip.goal_posterior` use when given none."""
 
 
 def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observed, t_obs, prior_goal=None,
-                  width: float | None = None, **options) -> Plan:
+                  width: float | None = None, *, cache: EstimatorCache | None = None, **options) -> Plan:
     """Estimate a reach's goal from a state observed at t_obs; see :meth:`GoalEstimator.estimate`.
 
-    ``model`` may be a ReachingModel (its estimator is built on first use and kept for later calls), a
-    Planner, or a GoalEstimator. ``options`` go to :meth:`GoalEstimator.estimate` (method, warm_start,
-    max_wall_time).
+    ``model`` may be a ReachingModel or a Planner (its estimator is built on first use and kept in
+    ``cache``, :data:`DEFAULT_CACHE` when None), or a GoalEstimator. ``options`` go to
+    :meth:`GoalEstimator.estimate` (method, warm_start, max_wall_time).
     """
-    if isinstance(model, GoalEstimator):
-        estimator = model
-    elif isinstance(model, Planner):
-        estimator = cached_per_model(_estimators, model.model, lambda m: GoalEstimator(model))
-    else:
-        estimator = cached_per_model(_estimators, shared_planner(model).model, GoalEstimator)
+    estimator = (cache or DEFAULT_CACHE).estimator(model)
     return estimator.estimate(start, observed, t_obs, prior_goal, width, **options)
