@@ -30,6 +30,7 @@ from comanip.planning.compiled import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
 from comanip.planning.planner import Planner
+from comanip.planning.terms import ReachTerms
 
 _NO_INDICES = np.zeros(0, dtype=int)
 
@@ -74,8 +75,8 @@ class Derivatives:
     """d²J/dtau dg (H·n, d)."""
     hess_gg: np.ndarray
     """d²J/dg² (d, d)."""
-    data: tuple
-    """What the curvature object's ``evaluate`` returned (for further terms of the same point)."""
+    data: ReachTerms
+    """What the curvature's ``evaluate`` returned (for further terms of the same point)."""
 
 
 class RegretSystem:
@@ -139,11 +140,7 @@ class RegretSystem:
         params = np.r_[start, point.goal, width]
         for tau, active, mu, observe in ((point.tau_c, point.active_c, weights[0], True),
                                          (point.tau_s, point.active_s, weights[1], False)):
-            tau = np.asarray(tau, dtype=float)
-            if self.linear:
-                f, _, data = self.curvature.evaluate(tau, params)
-            else:  # the forward rollout alone: a sixth of the derivatives' cost on the Panda
-                f, data = self.curvature.value_and_mean(tau, params)
+            f, data = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
             violation = np.abs(self.limits(tau, data, _NO_INDICES)[0][active]).sum()
             if observe:
                 mean = self.observed_mean(n_o, tau, start, data)[0] if self.linear else self.curvature.mean_path(data)[n_o]

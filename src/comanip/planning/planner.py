@@ -45,6 +45,7 @@ from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
 
@@ -119,7 +120,7 @@ class Planner:
         self._ipopt = None
 
     @property
-    def curvature(self) -> ReachCurvature | LinearisedCurvature | None:
+    def curvature(self) -> Curvature | None:
         """The Newton method's objective, gradient and Hessian terms (None for ``method="ipopt"``); the goal
         estimator reuses them."""
         return self._curvature
@@ -280,7 +281,7 @@ class Planner:
         n2, d = self.model.state_size, self.model.d
         start, goal, width = params[:n2], params[n2:n2 + d], params[-1]
         curvature = self._curvature
-        if curvature is None or curvature.exact:  # a point mass's expanded rollout is cheap
+        if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
             return self.problem.make_plan(torque, start, goal, width, **fields)
         f, _, data = curvature.evaluate(np.ravel(torque), params)
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
@@ -294,8 +295,7 @@ class Planner:
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
-        # an arm's value-only rollout is a sixth of the terms' cost; a point mass computes everything at once
-        value = (lambda x: curvature.value_and_mean(x, params)) if isinstance(curvature, LinearisedCurvature) else None
+        value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
         result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                                  *self._torque_bounds, tolerance=self.options.tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
