@@ -49,8 +49,9 @@ from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.shared import checked_model, estimation_planner, model_key
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
+from comanip.optim import CONVERGED, Status
 from comanip.planning.plan import Plan
-from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
+from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.planner import Planner
 
 METHODS = ("regret", "paper")
@@ -177,16 +178,16 @@ class GoalEstimator:
                                         step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
 
             result = newton(point if point is not None else cold_point())
-            iterations = result.iterations
-            if (point is not None and result.status in ("failed", "max_iterations", "not_a_minimum")
+            iterations = result.nit
+            if (point is not None and result.status in (Status.FAILED, Status.MAX_ITERATIONS, Status.NOT_A_MINIMUM)
                     and time.perf_counter() < deadline):
                 # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
                 retry = newton(cold_point())
-                iterations += retry.iterations
-                if retry.status in ("solved", "solved_acceptable") or retry.residual < result.residual:
+                iterations += retry.nit
+                if retry.success or retry.optimality < result.optimality:
                     result = retry
-            point, status, message = result.point, result.status, result.message
-            extras = {"regret": self._regret.normaliser(width) * result.regret, "residual": result.residual,
+            point, status, message = result.x, result.status, result.message
+            extras = {"regret": self._regret.normaliser(width) * result.fun, "residual": result.optimality,
                       "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
         else:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
@@ -194,7 +195,7 @@ class GoalEstimator:
             extras = {}
         extras.update({"estimated_goal": point.goal.copy(), "prior_goal": prior, "t_obs": float(t_obs), "observed_step": n_o,
                        "observed_state": observed, "method": method, "multipliers": point.lam.copy()})
-        success = status in ("solved", "solved_acceptable")
+        success = status in CONVERGED
         estimate = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
                                           success=success, message=message, solve_time=time.perf_counter() - t_begin,
                                           iterations=iterations, extras=extras)
@@ -209,7 +210,7 @@ class GoalEstimator:
         extras = {"estimated_goal": prior.copy(), "prior_goal": prior, "t_obs": t_obs, "observed_step": 0,
                   "observed_state": observed, "method": method, "observation_residual": plan.mean[0] - observed,
                   "plan_status": plan.status}
-        return replace(plan, success=False, status="uninformative", message=message, extras=extras,
+        return replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, extras=extras,
                        solve_time=time.perf_counter() - t_begin)
 
     @property
@@ -277,13 +278,11 @@ class GoalEstimator:
         params = np.r_[start, observed, np.zeros(self.model.d) if prior is None else prior, width, prior is not None]
         result = solver(x0=np.r_[point.tau_c, point.goal], p=params, lbg=0, ubg=0)
         stats = solver.stats()
-        status, _ = IPOPT_STATUS.get(stats["return_status"], ("failed", False))
-        if stats["return_status"] == "User_Requested_Stop" and deadline.expired:
-            status = "max_wall_time"
+        status = ipopt_status(stats, deadline)
         x = np.asarray(result["x"]).ravel()
         Hn = self.model.H * self.model.n
         if not np.all(np.isfinite(x)):
-            status, x = "failed", np.r_[point.tau_c, point.goal]
+            status, x = Status.FAILED, np.r_[point.tau_c, point.goal]
         lam = np.asarray(result["lam_g"]).ravel()
         solved = RegretPoint(x[:Hn], lam if np.all(np.isfinite(lam)) else np.zeros_like(lam), point.tau_s, x[Hn:])
         return solved, status, stats["return_status"], int(stats.get("iter_count", 0))

@@ -28,6 +28,7 @@ from scipy.special import logsumexp
 from comanip.arguments import as_matrix, as_optional_positive
 from comanip.estimation.goal_estimate import DEFAULT_CACHE, EstimatorCache
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observed_sequence, prefix_log_likelihoods
+from comanip.optim import Status
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 
@@ -64,9 +65,14 @@ class GoalPosterior:
         return all(plan.success for plan in self.plans)
 
     @property
-    def status(self) -> str:
+    def status(self) -> Status:
+        """'solved' when every candidate's plan converged, else 'plans_not_converged' (:attr:`message` says which)."""
+        return Status.SOLVED if self.success else Status.PLANS_NOT_CONVERGED
+
+    @property
+    def message(self) -> str:
         failed = [i for i, plan in enumerate(self.plans) if not plan.success]
-        return "solved" if not failed else f"plans of candidates {failed} did not converge"
+        return "every candidate's plan converged" if not failed else f"plans of candidates {failed} did not converge"
 
     @property
     def entropy(self) -> np.ndarray:
@@ -85,7 +91,7 @@ class GoalPosterior:
                 "probabilities": self.probabilities.tolist(), "log_likelihoods": self.log_likelihoods.tolist(),
                 "prior": self.prior.tolist(), "entropy": self.entropy.tolist(), "most_likely": self.most_likely.tolist(),
                 "width": self.width, "observation_std": list(self.observation_std), "success": self.success,
-                "status": self.status, "solve_time": self.solve_time}
+                "status": self.status, "message": self.message, "solve_time": self.solve_time}
 
 
 def goal_posterior(model, start, observed_states, times, candidate_goals, width: float | None = None, *,

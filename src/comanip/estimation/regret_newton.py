@@ -60,33 +60,18 @@ corrections learned from steps of both plans and the goal at once unsettle it.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 import numpy as np
 
 from comanip.estimation.regret_system import Linearisation, RegretPoint, RegretSystem
+from comanip.optim import SolverResult, Status, backtrack
 from comanip.planning.path_limits import LIMIT_TOLERANCE
-
-
-@dataclass
-class NewtonResult:
-    """Where :func:`newton_solve` stopped and why."""
-
-    point: RegretPoint
-    status: str
-    """'solved', 'solved_acceptable' (approximate Jacobian, see the module docstring), 'max_iterations',
-    'max_wall_time', 'not_a_minimum' or 'failed'."""
-    message: str
-    iterations: int
-    residual: float
-    """max |F| at the returned point (normalised gradient units; m, m/s or rad, rad/s for F2)."""
-    regret: float
-    """J(tau_c) - J(tau_s) at the returned point, normalised (without the regulariser)."""
 
 
 def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, prior,
                  width: float, *, observed_position: np.ndarray, tolerance: float, max_iterations: int, step_fraction: float,
-                 expired) -> NewtonResult:
+                 expired) -> SolverResult[RegretPoint]:
     """Newton's method on F from ``point`` until max |F| ≤ tolerance, then the second-order check.
 
     Globalised by a trust region on the goal step, judged by the regret itself: a trial point is kept when
@@ -99,8 +84,13 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
     (the observed end effector, m). ``observed_rows`` are the entries of the state s_o (2n,) the
     constrained plan must meet. ``expired()`` is asked before every step (wall-time budget).
     ``max_iterations`` bounds the number of linearisations (two Hessians of J each), which the result
-    reports as iterations. Never raises: when the iteration does not converge, the last accepted iterate
-    is returned with a status.
+    reports as ``nit``. Never raises: when the iteration does not converge, the last accepted iterate
+    is returned with a status ('solved', 'solved_acceptable' (approximate Jacobian, see the module
+    docstring), 'max_iterations', 'max_wall_time', 'not_a_minimum' or 'failed').
+
+    Returns:
+        A :class:`~comanip.optim.SolverResult`: x the point, fun the normalised regret J(tau_c) - J(tau_s)
+        (without the regulariser), optimality max |F| (normalised gradient units; m, m/s or rad, rad/s for F2).
     """
     count = 0
     excluded_c = system.limits_at_step(n_o) if system.path_limits.active else np.zeros(0, dtype=int)
@@ -120,16 +110,16 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
     if updated is not None:
         point, linearisation = updated, linearise(updated)
     radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-    status, message = "max_iterations", f"no convergence in {max_iterations} Newton iterations"
+    status, message = Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations"
     active_set_rounds = 0
     while True:
         residual = linearisation.residual
         if not np.isfinite(residual):
-            return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual, np.nan)
+            return SolverResult(point, np.nan, Status.FAILED, "J is not finite at the starting point", count, residual)
         try:
-            converged = "solved" if residual <= tolerance else None
+            converged = Status.SOLVED if residual <= tolerance else None
             if converged is None and not system.exact and _acceptable_without_exact_jacobian(linearisation, point, width, radius):
-                converged = "solved_acceptable"
+                converged = Status.SOLVED_ACCEPTABLE
             if converged is not None:
                 updated = _updated_active_sets(point, linearisation, excluded_c, threshold=LIMIT_TOLERANCE)
                 if updated is not None and active_set_rounds < _ACTIVE_SET_ROUNDS and count < max_iterations:
@@ -138,14 +128,14 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
                     radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
                     continue
                 is_minimum, why = linearisation.is_strict_minimum(system.exact)
-                message = "converged" if converged == "solved" else \
+                message = "converged" if converged == Status.SOLVED else \
                     "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
-                status, message = (converged, message) if is_minimum else ("not_a_minimum", why)
-                return NewtonResult(point, status, message, count, residual, linearisation.J_c - linearisation.J_s)
+                status, message = (converged, message) if is_minimum else (Status.NOT_A_MINIMUM, why)
+                return SolverResult(point, linearisation.J_c - linearisation.J_s, status, message, count, residual)
             if count >= max_iterations:
                 break
             if expired():
-                status, message = "max_wall_time", "the wall-time budget ran out"
+                status, message = Status.MAX_WALL_TIME, "the wall-time budget ran out"
                 break
             # with an approximate Jacobian, once no goal step longer than the acceptable one lowers the
             # regret, the goal has settled as far as the approximation can tell: only the plans move on
@@ -160,18 +150,18 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
                     continue
                 radius = 0.25 * np.linalg.norm(step.goal)
                 if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
-                    status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
+                    status, message = Status.FAILED, "the Newton iteration stalled (no goal step lowers the regret)"
                     break
             inner_step = linearisation.step(0.0, point)
             scale = 1.0 if system.exact else _inner_step_length(system, point, inner_step, linearisation, start, observed,
                                                                  n_o, observed_rows, width)
             inner, inner_linearisation = moved(point, inner_step, scale)
         except np.linalg.LinAlgError:
-            status, message = "failed", "a Newton system was singular (the observation does not pin the torques down)"
+            status, message = Status.FAILED, "a Newton system was singular (the observation does not pin the torques down)"
             break
         if np.isfinite(inner_linearisation.residual):
             point, linearisation = inner, inner_linearisation
-    return NewtonResult(point, status, message, count, linearisation.residual, linearisation.J_c - linearisation.J_s)
+    return SolverResult(point, linearisation.J_c - linearisation.J_s, status, message, count, linearisation.residual)
 
 
 def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
@@ -195,13 +185,12 @@ def _inner_step_length(system: RegretSystem, point: RegretPoint, step: RegretPoi
     slope = (linearisation.grad_c @ step.tau_c - weights[0] * np.abs(linearisation.F2[:n_c]).sum()
              + linearisation.grad_s @ step.tau_s - weights[1] * np.abs(linearisation.F5).sum())
     merit = system.merits(point, start, observed, n_o, observed_rows, width, weights)
-    alpha = 1.0
-    while alpha > _SHORTEST_INNER_STEP:
+
+    def attempt(alpha: float, bound: float) -> bool | None:
         trial = system.merits(point.plus(step, alpha), start, observed, n_o, observed_rows, width, weights)
-        if np.isfinite(trial) and trial <= merit + _ARMIJO * alpha * min(slope, 0.0):
-            break
-        alpha *= 0.5
-    return alpha
+        return True if np.isfinite(trial) and trial <= bound else None
+
+    return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS)[0]
 
 
 def _acceptable_without_exact_jacobian(linearisation: Linearisation, point: RegretPoint, width: float, radius: float) -> bool:
@@ -237,9 +226,8 @@ def _updated_active_set(active, nu, limits, threshold, excluded) -> tuple[np.nda
 _SHORTEST_GOAL_STEP = 1e-7
 #: Relative change of the (normalised) regret below which it no longer tells steps apart.
 _ROUNDING = 1e-10
-#: Inner steps (approximate Jacobian) are halved down to this fraction, until they achieve this fraction of
-#: the linearly predicted decrease of the merit.
-_SHORTEST_INNER_STEP, _ARMIJO = 1.0 / 64, 1e-4
+#: Inner steps (approximate Jacobian) tried: 1, 1/2, ..., 1/32, then 1/64 taken untried.
+_INNER_STEPS = 6
 #: 'solved_acceptable' (approximate Jacobian): plan stationarity, constraint error (state units), goal step (goal widths).
 _ACCEPTABLE_GRADIENT, _ACCEPTABLE_CONSTRAINT_ERROR, _ACCEPTABLE_GOAL_STEP = 1e-3, 1e-4, 1e-2
 #: Limits within this distance of binding at the start (rad, rad/s) are held from the first step.

@@ -26,6 +26,7 @@ import numpy as np
 import scipy.linalg
 
 from comanip.objectives.reward import goal_covariance
+from comanip.optim import decade_shifts, shifted_cholesky
 from comanip.planning.compiled import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
@@ -232,9 +233,8 @@ class Linearisation:
     @cached_property
     def _cholesky(self) -> tuple[tuple | None, tuple | None]:
         """Cholesky factors of H_c and H_s (shifted if ``regularise``), None where one is not positive definite."""
-        if self.regularise:
-            return _shifted_cholesky(self.H_c), _shifted_cholesky(self.H_s)
-        return _cholesky_or_none(self.H_c), _cholesky_or_none(self.H_s)
+        return tuple(shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))[0]
+                     for H in (self.H_c, self.H_s))
 
     @cached_property
     def _solves(self) -> tuple[np.ndarray, np.ndarray]:
@@ -332,20 +332,10 @@ def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
     return _cholesky_or_none(Z.T @ H @ Z) is not None
 
 
-def _shifted_cholesky(matrix: np.ndarray):
-    """Cholesky factor of matrix + delta·s·I, s = max |diag|, for the least delta in 0, 1e-8, 1e-7, ... that works."""
-    scale = max(float(np.abs(np.diag(matrix)).max()), 1e-300)
-    delta = 0.0
-    while True:
-        factor = _cholesky_or_none(matrix + delta * scale * np.eye(len(matrix)))
-        if factor is not None or delta > 1e6:
-            return factor
-        delta = 1e-8 if delta == 0.0 else 10 * delta
-
-
 def _cholesky_or_none(matrix: np.ndarray):
     """scipy's Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
-    try:
-        return scipy.linalg.cho_factor(0.5 * (matrix + matrix.T), check_finite=False)
-    except np.linalg.LinAlgError:
-        return None
+    return shifted_cholesky(_symmetric_part(matrix), (0.0,))[0]
+
+
+def _symmetric_part(matrix: np.ndarray) -> np.ndarray:
+    return 0.5 * (matrix + matrix.T)

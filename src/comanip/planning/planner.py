@@ -28,7 +28,7 @@ mean the same for every width; ``plan.objective`` is always the SPEC §4 J itsel
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import casadi as ca
 import numpy as np
@@ -39,7 +39,8 @@ from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_v
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
-from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
+from comanip.optim import SolverResult, Status
+from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
@@ -210,7 +211,7 @@ class Planner:
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
         params = np.concatenate([start, goal, [width]])
-        return self._make_plan(torque, params, status="unreachable", success=False, message=message,
+        return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
     def _initial_guesses(self, start, goal, width, warm_start) -> list[np.ndarray]:
@@ -261,20 +262,18 @@ class Planner:
             for guess in guesses:
                 if time.perf_counter() > deadline and best is not None:
                     break
-                torque, f, status, success, message, nit = self._run_solver(guess, params, deadline)
-                iterations += nit
-                if not np.all(np.isfinite(torque)) or not np.isfinite(f):
-                    torque, status, success = guess, "failed", False
-                    f = self.problem.objective_value(guess, start, goal, width) / normaliser
-                    message = "solver returned a non-finite plan; returning the initial guess"
+                candidate = self._run_solver(guess, params, deadline)
+                iterations += candidate.nit
+                if not np.all(np.isfinite(candidate.x)) or not np.isfinite(candidate.fun):
+                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width) / normaliser,
+                                             Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
+                                             candidate.nit, np.inf)
                 # The plan within the limits with the lowest objective wins, whatever its status: a start that
                 # stalls short of the tolerances can still be far better than one that converged on the
                 # zero-reward plateau (seen on the Panda), and the status then says it did not converge.
-                candidate = (status == "constraints_violated", f, torque, status, success, message)
-                if best is None or candidate[:2] < best[:2]:
+                if best is None or _rank(candidate) < _rank(best):
                     best = candidate
-        _, _, torque, status, success, message = best
-        return self._make_plan(torque, params, status=status, success=success, message=message,
+        return self._make_plan(best.x, params, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
     def _make_plan(self, torque, params, **fields) -> Plan:
@@ -287,11 +286,9 @@ class Planner:
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float):
-        """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s).
-
-        Returns (torques (H, n), normalised objective, status, success, message, iterations).
-        """
+    def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
+        """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
+        fun the normalised objective."""
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
@@ -302,20 +299,21 @@ class Planner:
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                                  constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
                                  value=value)
-        success = result.status in ("solved", "solved_acceptable")
-        return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
-                result.message, result.iterations)
+        return replace(result, x=result.x.reshape(self.model.H, self.model.n))
 
-    def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float):
+    def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
         solver = self._solver
         self._deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params)
         stats = solver.stats()
-        status, success = IPOPT_STATUS.get(stats["return_status"], ("failed", False))
-        if stats["return_status"] == "User_Requested_Stop" and self._deadline.expired:
-            status = "max_wall_time"
+        status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
-        return torque, float(result["f"]), status, success, stats["return_status"], int(stats.get("iter_count", 0))
+        return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
+
+
+def _rank(candidate: SolverResult) -> tuple[bool, float]:
+    """Order of the starts' results: within the limits first, then the lower normalised objective."""
+    return candidate.status == Status.CONSTRAINTS_VIOLATED, candidate.fun
 
 
 def plan_reach(model: ReachingModel, start, goal, width: float | None = None, **solve_options) -> Plan:
