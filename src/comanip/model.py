@@ -1,7 +1,7 @@
 """A reaching model: a body plus the motor-control parameters of the paper (Table II, SPEC §5).
 
 Every field of :class:`ReachingModel` is checked at construction, so a bad value fails before any
-CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W.
+CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W (``docs/notation.md``).
 """
 
 from __future__ import annotations

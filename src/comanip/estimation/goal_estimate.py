@@ -167,28 +167,8 @@ class GoalEstimator:
             return self._cold_point(start, observed, n_o, len(rows), prior, width, remaining_time)
 
         if method == "regret":
-            x_obs, _ = task_space_state(self.planner, observed)
-
-            def newton(point: RegretPoint):
-                # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
-                # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
-                with self._blas.limit(limits=1, user_api="blas"):
-                    return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
-                                        tolerance=self.options.tolerance, max_iterations=self._max_iterations,
-                                        step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
-
-            result = newton(point if point is not None else cold_point())
-            iterations = result.nit
-            if (point is not None and result.status in (Status.FAILED, Status.MAX_ITERATIONS, Status.NOT_A_MINIMUM)
-                    and time.perf_counter() < deadline):
-                # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
-                retry = newton(cold_point())
-                iterations += retry.nit
-                if retry.success or retry.optimality < result.optimality:
-                    result = retry
-            point, status, message = result.x, result.status, result.message
-            extras = {"regret": self._regret.normaliser(width) * result.fun, "residual": result.optimality,
-                      "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
+            point, status, message, iterations, extras = self._regret_solve(point, cold_point, start, observed, n_o, rows,
+                                                                            prior, width, deadline)
         else:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
                                                                    observed, n_o, rows, prior, width, remaining_time())
@@ -201,6 +181,34 @@ class GoalEstimator:
                                           iterations=iterations, extras=extras)
         estimate.extras["observation_residual"] = estimate.mean[n_o] - observed
         return estimate
+
+    def _regret_solve(self, point: RegretPoint | None, cold_point, start, observed, n_o, rows, prior, width, deadline):
+        """Newton's method on the regret from ``point`` (from ``cold_point()`` when None, or when a warm start
+        fails and time is left); (point, status, message, iterations, extras)."""
+        model = self.model
+        x_obs, _ = task_space_state(self.planner, observed)
+
+        def newton(point: RegretPoint):
+            # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
+            # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
+            with self._blas.limit(limits=1, user_api="blas"):
+                return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
+                                    tolerance=self.options.tolerance, max_iterations=self._max_iterations,
+                                    step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
+
+        result = newton(point if point is not None else cold_point())
+        iterations = result.nit
+        if (point is not None and result.status in (Status.FAILED, Status.MAX_ITERATIONS, Status.NOT_A_MINIMUM)
+                and time.perf_counter() < deadline):
+            # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
+            retry = newton(cold_point())
+            iterations += retry.nit
+            if retry.success or retry.optimality < result.optimality:
+                result = retry
+        point = result.x
+        extras = {"regret": self._regret.normaliser(width) * result.fun, "residual": result.optimality,
+                  "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
+        return point, result.status, result.message, iterations, extras
 
     def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> Plan:
         """The estimate from an observation at step 0: the plan to the prior goal, status 'uninformative'."""

@@ -1,6 +1,6 @@
 """The regret's first-order conditions F and their Jacobian at an iterate (see :mod:`comanip.estimation.regret_newton`).
 
-Notation: torques tau (H·n,), goal g (d,), J normalised by |J_best(w)|; the constrained plan tau_c with
+Notation (``docs/notation.md``): torques tau (H·n,), goal g (d,), J normalised by |J_best(w)|; the constrained plan tau_c with
 multipliers lam of the observation constraint (rows ``observed_rows`` of mu_no(tau_c) = s_o) and nu_c of
 the path limits it holds as equalities (``active_c``); the plan tau_s with multipliers nu_s of its active
 limits (``active_s``). Path limits are those of :mod:`comanip.planning.path_limits` (joint positions and

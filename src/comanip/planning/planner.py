@@ -23,6 +23,8 @@ status 'unreachable' before any solver work.
 
 Both minimise the same objective, normalised by |J_best(w)| (the best attainable J) so that tolerances
 mean the same for every width; ``plan.objective`` is always the SPEC §4 J itself.
+
+Symbols, shapes and units: ``docs/notation.md``.
 """
 
 from __future__ import annotations
