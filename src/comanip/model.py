@@ -11,6 +11,7 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
+from comanip.arguments import as_count
 from comanip.belief.noise import check_noise_form
 from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
@@ -69,9 +70,7 @@ class ReachingModel:
             raise ValueError(f"body must be a comanip.bodies.Body, got {type(self.body).__name__}")
         self._attach_activation()
         _check_positive("h", self.h, "s")
-        if isinstance(self.H, bool) or not isinstance(self.H, (int, np.integer)) or self.H < 1:
-            raise ValueError(f"H must be an integer ≥ 1 (horizon in steps), got {self.H!r}")
-        object.__setattr__(self, "H", int(self.H))
+        object.__setattr__(self, "H", as_count("H", self.H, 1, "horizon in steps"))
         if not (isinstance(self.gamma, (int, float)) and 0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1] (discount per step), got {self.gamma!r}")
         _check_nonnegative("nu", self.nu, "reward per N²")

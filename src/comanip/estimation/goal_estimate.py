@@ -40,7 +40,7 @@ import casadi as ca
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
@@ -77,9 +77,7 @@ class EstimatorOptions:
 
     def __post_init__(self):
         as_positive("tolerance", self.tolerance, "residual")
-        if self.max_iterations is not None and (isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int)
-                                                or self.max_iterations < 1):
-            raise ValueError(f"max_iterations must be None or an integer ≥ 1, got {self.max_iterations!r}")
+        as_count("max_iterations", self.max_iterations, optional=True)
         if not (isinstance(self.step_fraction, (int, float)) and 0 < self.step_fraction <= 10):
             raise ValueError(f"step_fraction must be in (0, 10] (fraction of the remaining reach), got {self.step_fraction!r}")
         low, high = (as_positive(f"search_distances[{k}]", v, "m") for k, v in enumerate(self.search_distances))

@@ -37,7 +37,7 @@ import numpy as np
 
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
@@ -80,12 +80,8 @@ class SolverOptions:
     def __post_init__(self):
         if self.method not in SOLVER_METHODS:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
-        for name in ("max_iterations", "n_starts"):
-            value = getattr(self, name)
-            if name == "max_iterations" and value is None:
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-                raise ValueError(f"{name} must be an integer ≥ 1, got {value!r}")
+        as_count("max_iterations", self.max_iterations, optional=True)
+        as_count("n_starts", self.n_starts)
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
         if self.compile not in (None, True, False):
             raise ValueError(f"compile must be None, True or False, got {self.compile!r}")
