@@ -65,8 +65,12 @@ class EstimatorOptions:
     """Convergence: max |F| of the regret's first-order conditions (normalised objective per N·m or N, and
     state units for the observation constraint); IPOPT's tol for the 'paper' method."""
     max_iterations: int | None = None
-    """Newton iterations ('regret'), or a tenth of IPOPT's ('paper'). None: 30 for point masses (exact
-    Jacobian, quadratic convergence), 100 for arms (approximate Jacobian, linear convergence)."""
+    """Newton iterations ('regret'), or a tenth of IPOPT's ('paper'). None: ``exact_iterations`` for point
+    masses, ``approximate_iterations`` for arms."""
+    exact_iterations: int = 30
+    """The limit for point masses when ``max_iterations`` is None (exact Jacobian, quadratic convergence)."""
+    approximate_iterations: int = 100
+    """The limit for arms when ``max_iterations`` is None (approximate Jacobian, linear convergence)."""
     step_fraction: float = 0.5
     """Largest goal step of one Newton iteration, as a fraction of the distance from the observed hand to
     the current goal (at least one goal width)."""
@@ -78,6 +82,8 @@ class EstimatorOptions:
     def __post_init__(self):
         as_positive("tolerance", self.tolerance, "residual")
         as_count("max_iterations", self.max_iterations, optional=True)
+        as_count("exact_iterations", self.exact_iterations)
+        as_count("approximate_iterations", self.approximate_iterations)
         if not (isinstance(self.step_fraction, (int, float)) and 0 < self.step_fraction <= 10):
             raise ValueError(f"step_fraction must be in (0, 10] (fraction of the remaining reach), got {self.step_fraction!r}")
         low, high = (as_positive(f"search_distances[{k}]", v, "m") for k, v in enumerate(self.search_distances))
@@ -223,7 +229,7 @@ class GoalEstimator:
     def _max_iterations(self) -> int:
         if self.options.max_iterations is not None:
             return self.options.max_iterations
-        return 30 if self._regret.exact else 100
+        return self.options.exact_iterations if self._regret.exact else self.options.approximate_iterations
 
     def _warm_point(self, warm_start: Plan, n_rows: int) -> tuple[RegretPoint, bool]:
         """The iterate a warm start gives, and whether its plan to the goal (tau_s) must still be solved."""

@@ -61,14 +61,23 @@ class SolverOptions:
     """'newton' (damped Newton on the structure-exploiting Hessian, fast) or 'ipopt' (IPOPT with CasADi's
     exact Hessian, the reference)."""
     max_iterations: int | None = None
-    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations). None: 200 for point
-    masses, 1000 for nonlinear bodies, whose approximate Hessian converges linearly."""
+    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations). None:
+    ``point_mass_iterations`` for point masses, ``arm_iterations`` for nonlinear bodies."""
+    point_mass_iterations: int = 200
+    """The iteration limit for point masses when ``max_iterations`` is None (exact Hessian: Newton converges
+    quadratically)."""
+    arm_iterations: int = 1000
+    """The iteration limit for nonlinear bodies when ``max_iterations`` is None (approximate Hessian: linear
+    convergence)."""
     tolerance: float = 1e-8
     """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
     times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``."""
     n_starts: int = 3
     """Minimum-jerk initial guesses tried on a cold solve (durations spread over the horizon); the best
     converged plan is returned. A warm-started solve uses the warm start only."""
+    far_warm_start: float = 3.0
+    """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
+    from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
@@ -81,7 +90,9 @@ class SolverOptions:
         if self.method not in SOLVER_METHODS:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
         as_count("max_iterations", self.max_iterations, optional=True)
-        as_count("n_starts", self.n_starts)
+        for name in ("n_starts", "point_mass_iterations", "arm_iterations"):
+            as_count(name, getattr(self, name))
+        as_positive("far_warm_start", self.far_warm_start, "goal widths")
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
         if self.compile not in (None, True, False):
             raise ValueError(f"compile must be None, True or False, got {self.compile!r}")
@@ -128,7 +139,7 @@ class Planner:
     def _max_iterations(self) -> int:
         if self.options.max_iterations is not None:
             return self.options.max_iterations
-        return 200 if self.model.body.is_linear else 1000
+        return self.options.point_mass_iterations if self.model.body.is_linear else self.options.arm_iterations
 
     def _newton_terms(self):
         """Objective, gradient and Hessian for the Newton method: exact for linear bodies, structured
@@ -227,7 +238,7 @@ class Planner:
         shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
         candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
                                                    guess_durations(model.duration, 4), warm_start.mean)
-        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > 3 * width:
+        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
             # far beyond the goal's reward (it underflows there): fresh reaches compete too
             candidates += self._cold_guesses(start, goal, self.options.n_starts)
         params = np.concatenate([start, goal, [width]])

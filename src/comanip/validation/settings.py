@@ -90,7 +90,7 @@ class ValidationSettings:
                                         for o in offsets):
             raise ValueError("franka_goal_offsets must be a non-empty sequence of (x, y, z) offsets of finite numbers (m), "
                              f"got {offsets!r}")
-        as_count("workers", self.workers, 1, "processes; None: the CPU count", optional=True)
+        as_count("workers", self.workers, 1, "processes", optional=True)
 
     @classmethod
     def quick_run(cls, **changes) -> "ValidationSettings":
