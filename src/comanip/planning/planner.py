@@ -127,7 +127,7 @@ class Planner:
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
         self._blas = ThreadpoolController()
-        self._ipopt = None
+        self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
 
     @property
     def curvature(self) -> Curvature | None:
@@ -149,20 +149,18 @@ class Planner:
             return ReachCurvature(self.problem, compile=bool(compile))
         return LinearisedCurvature(self.problem, compile=compile is not False)
 
-    @property
-    def _solver(self) -> ca.Function:
-        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian (built on first use)."""
-        if self._ipopt is None:
-            problem = self.problem
-            params = ca.vertcat(problem.s0, problem.goal, problem.width)
-            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
-                     "tol": self.options.tolerance, **self.options.ipopt}
-            self._deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])
-            self._ipopt = ca.nlpsol("planner", "ipopt",
-                                    {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
-                                    {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
-                                     "iteration_callback": self._deadline})
-        return self._ipopt
+    def _ipopt_solver(self) -> tuple[ca.Function, IpoptDeadline]:
+        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian, and the deadline its
+        iteration callback watches (set before each solve)."""
+        problem = self.problem
+        params = ca.vertcat(problem.s0, problem.goal, problem.width)
+        ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
+                 "tol": self.options.tolerance, **self.options.ipopt}
+        deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])
+        solver = ca.nlpsol("planner", "ipopt",
+                           {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
+                           {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
+        return solver, deadline
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (nx,), goal (d,), width) or ValueError naming the argument.
@@ -311,7 +309,7 @@ class Planner:
         return replace(result, x=result.x.reshape(self.model.H, self.model.n))
 
     def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
-        solver = self._solver
+        solver = self._ipopt
         self._deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params)
         stats = solver.stats()
