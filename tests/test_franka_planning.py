@@ -10,6 +10,8 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 from comanip.planning.reach_problem import ReachProblem
 
+pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
+
 
 @pytest.fixture(scope="module")
 def franka_planner():

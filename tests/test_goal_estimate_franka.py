@@ -9,6 +9,8 @@ from comanip.estimation import GoalEstimator
 from comanip.estimation.observation import observation_step
 from comanip.planning.path_limits import PathLimits
 
+pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
+
 T_OBS = 0.2
 
 

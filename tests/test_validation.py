@@ -91,6 +91,7 @@ def test_closed_loop_execution_brings_the_peak_earlier_than_the_open_loop_plan(p
     assert executed.metrics.asymmetry < open_loop.metrics.asymmetry - 0.05
 
 
+@pytest.mark.slow
 def test_validate_quick_writes_figures_and_a_complete_report(tmp_path, grid):
     out = tmp_path / "validate"
     # the Franka section has its own tests (test_validation_franka.py); here the flag must skip it

@@ -17,6 +17,8 @@ from comanip.validation import ValidationSettings, run_validation
 from comanip.validation.arm_section import ARM_FIGURES
 from comanip.validation.settings import FRANKA_GOAL_OFFSETS
 
+pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
+
 
 @pytest.fixture(scope="module")
 def franka_run(tmp_path_factory):
