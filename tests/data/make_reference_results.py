@@ -40,7 +40,13 @@ def _plan_entries(name: str, plan) -> dict:
 def _estimate_entries(name: str, estimate) -> dict:
     return {f"{name}/goal": estimate.goal, f"{name}/torque": estimate.torque, f"{name}/status": np.str_(estimate.status),
             f"{name}/iterations": np.int64(estimate.iterations),
-            f"{name}/regret": np.float64(estimate.extras.get("regret", np.nan))}
+            f"{name}/regret": np.float64(_regret(estimate))}
+
+
+def _regret(estimate) -> float:
+    """The estimate's regret (J units); NaN for none (the code before GoalEstimate kept it in ``extras``)."""
+    regret = estimate.extras["regret"] if "regret" in estimate.extras else getattr(estimate, "regret", None)
+    return np.nan if regret is None else regret
 
 
 def _plans(planners: dict) -> dict:

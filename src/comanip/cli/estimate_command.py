@@ -85,9 +85,9 @@ def run(args) -> int:
     out = output_dir(args.out)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
-               "t_obs_s": float(t_obs), "observed_step": estimate.extras["observed_step"], "method": args.method,
+               "t_obs_s": float(t_obs), "observed_step": estimate.observed_step, "method": args.method,
                "width": estimate.width, "success": estimate.success, "status": estimate.status, "message": estimate.message,
-               "solve_time_s": estimate.solve_time, "iterations": estimate.iterations, "regret": estimate.extras.get("regret")}
+               "solve_time_s": estimate.solve_time, "iterations": estimate.iterations, "regret": estimate.regret}
     posterior = None
     if args.candidates is not None:
         if times is None:

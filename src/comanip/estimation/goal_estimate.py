@@ -3,7 +3,8 @@
 The person started at s_0 and was seen in state s_o at time t_o (step n_o = floor(t_o / h), the nearest
 earlier step; :mod:`comanip.estimation.observation`). The estimate is a goal g_hat and the full predicted
 trajectory: the model's reach from s_0 to g_hat through s_o, returned as a :class:`~comanip.Plan` (so it
-plots and exports like any plan), with g_hat in ``plan.goal`` and ``plan.extras["estimated_goal"]``.
+plots and exports like any plan), with g_hat in ``estimate.goal``: a :class:`GoalEstimate`, a Plan with the
+estimate's own fields (observed step, regret, multipliers, ...).
 
 Two methods:
 
@@ -24,8 +25,8 @@ The regulariser (g - g_bar)^T W^-1 (g - g_bar), W from the width as the model sa
 the paper's; without a prior goal (``prior_goal=None``) it is left out.
 
 >>> estimator = GoalEstimator(comanip.presets.cartesian())
->>> plan = estimator.estimate(start=np.zeros(6), observed=s_o, t_obs=0.2)
->>> plan.goal, plan.success, plan.extras["regret"]
+>>> estimate = estimator.estimate(start=np.zeros(6), observed=s_o, t_obs=0.2)
+>>> estimate.goal, estimate.success, estimate.regret
 """
 
 from __future__ import annotations
@@ -42,6 +43,7 @@ from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
+from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
 from comanip.estimation.regret_newton import newton_solve
@@ -112,7 +114,7 @@ class GoalEstimator:
         self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
 
     def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, method: str = "regret",
-                 warm_start: Plan | None = None, max_wall_time: float | None = None) -> Plan:
+                 warm_start: Plan | None = None, max_wall_time: float | None = None) -> GoalEstimate:
         """Estimate the goal of a reach from its start and a state observed at t_obs.
 
         Args:
@@ -133,11 +135,11 @@ class GoalEstimator:
                 status 'max_wall_time' when it runs out.
 
         Returns:
-            A :class:`~comanip.Plan` through the observation to the estimated goal; never raises on a
-            failed solve (check ``plan.success`` and ``plan.status``). ``extras`` hold the estimated goal,
-            the observed step, ``observation_residual`` (mean at n_o minus the observed state, (2n,)) and,
-            for the regret, ``regret`` (J units), ``residual`` (max |F|) and ``unconstrained_torque`` (the
-            plan to the estimated goal, not held to the observation, (H, n)).
+            A :class:`GoalEstimate`: the plan through the observation to the estimated goal, with the observed
+            step, ``observation_residual`` (mean at n_o minus the observed state, (nx,)) and, for the regret,
+            ``regret`` (J units), ``residual`` (max |F|) and ``unconstrained_torque`` (the plan to the
+            estimated goal, not held to the observation, (H, n)); never raises on a failed solve (check
+            ``success`` and ``status``).
         """
         t_begin = time.perf_counter()
         model = self.model
@@ -171,24 +173,22 @@ class GoalEstimator:
             return self._cold_point(start, observed, n_o, len(rows), prior, width, remaining_time)
 
         if method == "regret":
-            point, status, message, iterations, extras = self._regret_solve(point, cold_point, start, observed, n_o, rows,
-                                                                            prior, width, deadline)
+            point, status, message, iterations, details = self._regret_solve(point, cold_point, start, observed, n_o, rows,
+                                                                             prior, width, deadline)
         else:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
                                                                    observed, n_o, rows, prior, width, remaining_time())
-            extras = {}
-        extras.update({"estimated_goal": point.goal.copy(), "prior_goal": prior, "t_obs": float(t_obs), "observed_step": n_o,
-                       "observed_state": observed, "method": method, "multipliers": point.lam.copy()})
-        success = status in CONVERGED
-        estimate = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
-                                          success=success, message=message, solve_time=time.perf_counter() - t_begin,
-                                          iterations=iterations, extras=extras)
-        estimate.extras["observation_residual"] = estimate.mean[n_o] - observed
-        return estimate
+            details = {}
+        plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
+                                      success=status in CONVERGED, message=message,
+                                      solve_time=time.perf_counter() - t_begin, iterations=iterations)
+        return GoalEstimate.of(plan, t_obs=float(t_obs), observed_step=n_o, observed_state=observed,
+                               observation_residual=plan.mean[n_o] - observed, prior_goal=prior, method=method,
+                               multipliers=point.lam.copy(), **details)
 
     def _regret_solve(self, point: RegretPoint | None, cold_point, start, observed, n_o, rows, prior, width, deadline):
         """Newton's method on the regret from ``point`` (from ``cold_point()`` when None, or when a warm start
-        fails and time is left); (point, status, message, iterations, extras)."""
+        fails and time is left); (point, status, message, iterations, the :class:`GoalEstimate` fields it fills)."""
         model = self.model
         x_obs, _ = task_space_state(self.planner, observed)
 
@@ -210,20 +210,19 @@ class GoalEstimator:
             if retry.success or retry.optimality < result.optimality:
                 result = retry
         point = result.x
-        extras = {"regret": self._regret.normaliser(width) * result.fun, "residual": result.optimality,
-                  "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
-        return point, result.status, result.message, iterations, extras
+        details = {"regret": self._regret.normaliser(width) * result.fun, "residual": result.optimality,
+                   "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
+        return point, result.status, result.message, iterations, details
 
-    def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> Plan:
+    def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> GoalEstimate:
         """The estimate from an observation at step 0: the plan to the prior goal, status 'uninformative'."""
         plan = self.planner.solve(start, prior, width, warm_start=warm_start, max_wall_time=max_wall_time)
         message = (f"the observation at t_obs = {t_obs:g} s falls on step 0, the start itself, and says nothing about the goal: "
                    f"the estimate is the prior goal and the trajectory its plan (plan status '{plan.status}')")
-        extras = {"estimated_goal": prior.copy(), "prior_goal": prior, "t_obs": t_obs, "observed_step": 0,
-                  "observed_state": observed, "method": method, "observation_residual": plan.mean[0] - observed,
-                  "plan_status": plan.status}
-        return replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, extras=extras,
-                       solve_time=time.perf_counter() - t_begin)
+        plan = replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
+        return GoalEstimate.of(plan, t_obs=t_obs, observed_step=0, observed_state=observed,
+                               observation_residual=plan.mean[0] - observed, prior_goal=prior, method=method,
+                               plan_status=plan.status)
 
     @property
     def _max_iterations(self) -> int:
@@ -239,17 +238,18 @@ class GoalEstimator:
         shape, unit = (model.H, model.n), "torques, N·m or N"
         tau_c = as_matrix("warm_start.torque", warm_start.torque, shape, unit).ravel()
         goal = as_vector("warm_start.goal", warm_start.goal, model.d, "m")
-        extras = warm_start.extras
+        if not isinstance(warm_start, GoalEstimate):  # a plain plan is a plan to its goal already
+            return RegretPoint(tau_c.copy(), np.zeros(n_rows), tau_c.copy(), goal.copy()), False
         lam = np.zeros(n_rows)
-        if "multipliers" in extras and np.size(extras["multipliers"]) == n_rows:  # from an estimate at a step like this one's
-            lam = as_vector("warm_start.extras['multipliers']", extras["multipliers"], n_rows, "multipliers")
-        if "unconstrained_torque" in extras:
-            tau_s = as_matrix("warm_start.extras['unconstrained_torque']", extras["unconstrained_torque"], shape, unit).ravel()
+        if np.size(warm_start.multipliers) == n_rows:  # from an estimate at a step like this one's
+            lam = as_vector("warm_start.multipliers", warm_start.multipliers, n_rows, "multipliers")
+        if warm_start.unconstrained_torque is not None:
+            tau_s = as_matrix("warm_start.unconstrained_torque", warm_start.unconstrained_torque, shape, unit).ravel()
             return RegretPoint(tau_c.copy(), lam.copy(), tau_s.copy(), goal.copy()), False
         # An estimate by another method holds a trajectory through its observation, not a plan to its goal
         # (and it may even be a poor local optimum of J that passes through it, where the regret is zero):
-        # the plan to its goal is solved afresh. A plain plan is one already.
-        return RegretPoint(tau_c.copy(), lam.copy(), tau_c.copy(), goal.copy()), "observed_step" in extras
+        # the plan to its goal is solved afresh.
+        return RegretPoint(tau_c.copy(), lam.copy(), tau_c.copy(), goal.copy()), True
 
     def _cold_point(self, start, observed, n_o, n_rows, prior, width, remaining_time) -> RegretPoint:
         """Start from the best goal along the observed direction; from the prior (or the hand) if nothing moved."""
@@ -334,7 +334,7 @@ DEFAULT_CACHE = EstimatorCache()
 
 
 def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observed, t_obs, prior_goal=None,
-                  width: float | None = None, *, cache: EstimatorCache | None = None, **options) -> Plan:
+                  width: float | None = None, *, cache: EstimatorCache | None = None, **options) -> GoalEstimate:
     """Estimate a reach's goal from a state observed at t_obs; see :meth:`GoalEstimator.estimate`.
 
     ``model`` may be a ReachingModel or a Planner (its estimator is built on first use and kept in

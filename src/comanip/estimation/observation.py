@@ -12,7 +12,7 @@ What an observation can tell about the goal depends on its step (forward Euler, 
 - n_o ≥ 2 (t_o ≥ 2h): the whole state depends on the torques; an estimate holds its plan to all of it.
 - n_o = 1 (h ≤ t_o < 2h): q_1 = q_0 + h qdot_0 is fixed by the start, and only the velocity qdot_1 (through
   tau_0) depends on the torques: an estimate holds its plan to the observed velocity only, and reports
-  the position's mismatch (``extras["observation_residual"]``).
+  the position's mismatch (``GoalEstimate.observation_residual``).
 - n_o = 0 (0 < t_o < h): the state at step 0 is the start itself; the observation says nothing about the
   goal. An estimate is then the plan to the prior goal (status 'uninformative'), and without a prior goal
   there is nothing to return (ValueError).
