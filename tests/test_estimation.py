@@ -6,11 +6,12 @@ import json
 import numpy as np
 import pytest
 
+import comanip
 from comanip.belief import sample_trajectories
+from comanip.belief.propagation import linearised_step_function
 from comanip.cli.main import main
-from comanip.estimation import GoalEstimator, estimate_goal, goal_posterior
-from comanip.estimation.goal_posterior import joint_state_covariance
-from comanip.estimation.shared import shared_step_jacobians
+from comanip.estimation import EstimatorCache, GoalEstimator, estimate_goal, goal_posterior
+from comanip.estimation.observation import joint_state_covariance
 from comanip.estimation.observation import observation_step
 
 T_OBS = 0.2  # the paper's observation time (s)
@@ -56,7 +57,7 @@ def test_observed_plan_gives_back_its_goal(request, preset, goal, start):
     distance = np.linalg.norm(goal - plan.ee_mean[0])
     assert estimate.success, estimate.message
     assert np.linalg.norm(estimate.goal - goal) < 0.1 * distance
-    np.testing.assert_array_equal(estimate.goal, estimate.extras["estimated_goal"])
+    np.testing.assert_array_equal(estimate.goal, estimate.estimated_goal)
     # the estimate passes through the observation and its predicted remainder follows the hidden plan
     np.testing.assert_allclose(estimate.mean[n_o], plan.mean[n_o], atol=1e-6)
     assert np.abs(estimate.ee_mean[n_o:] - plan.ee_mean[n_o:]).max() < 0.05 * distance
@@ -73,7 +74,7 @@ def test_eq11_as_printed_falls_short_of_the_goal(planar_estimator):
     assert np.linalg.norm(paper.goal) < 0.9 * np.linalg.norm(goal)
     assert np.linalg.norm(regret.goal - goal) < 1e-3 * np.linalg.norm(goal)
     # both honour the observation constraint
-    n_o = paper.extras["observed_step"]
+    n_o = paper.observed_step
     np.testing.assert_allclose(paper.mean[n_o], observed, atol=1e-6)
 
 
@@ -86,7 +87,7 @@ def test_prior_pulls_the_estimate_part_of_the_way(planar_estimator):
     assert estimate.success
     pulled = (estimate.goal - goal) @ offset / np.linalg.norm(offset)
     assert 0.0 < pulled < np.linalg.norm(offset)
-    np.testing.assert_array_equal(estimate.extras["prior_goal"], goal + offset)
+    np.testing.assert_array_equal(estimate.prior_goal, goal + offset)
 
 
 def test_warm_estimate_agrees_with_cold(planar_estimator, rng):
@@ -167,8 +168,8 @@ def test_observation_at_step_one_holds_the_velocity_and_reports_the_position(pla
     shifted = planar_estimator.estimate(plan.start, observed, t_obs, warm_start=exact)
     assert shifted.success, shifted.message
     np.testing.assert_allclose(shifted.goal, exact.goal, atol=1e-9)
-    np.testing.assert_allclose(shifted.extras["observation_residual"][:2], -offset, atol=1e-12)
-    np.testing.assert_allclose(shifted.extras["observation_residual"][2:], 0.0, atol=1e-9)
+    np.testing.assert_allclose(shifted.observation_residual[:2], -offset, atol=1e-12)
+    np.testing.assert_allclose(shifted.observation_residual[2:], 0.0, atol=1e-9)
 
 
 def test_observation_at_step_zero_gives_the_plan_to_the_prior(planar_estimator):
@@ -180,9 +181,9 @@ def test_observation_at_step_zero_gives_the_plan_to_the_prior(planar_estimator):
     estimate = planar_estimator.estimate(start, observed, 0.5 * model.h, prior_goal=prior)
     assert estimate.status == "uninformative" and not estimate.success
     np.testing.assert_array_equal(estimate.goal, prior)
-    np.testing.assert_array_equal(estimate.extras["estimated_goal"], prior)
-    assert estimate.extras["observed_step"] == 0
-    np.testing.assert_allclose(estimate.extras["observation_residual"], start - observed)
+    np.testing.assert_array_equal(estimate.estimated_goal, prior)
+    assert estimate.observed_step == 0
+    np.testing.assert_allclose(estimate.observation_residual, start - observed)
     plan = planar_estimator.planner.solve(start, prior)
     np.testing.assert_allclose(estimate.ee_mean, plan.ee_mean, atol=1e-9)
     assert np.linalg.norm(estimate.ee_mean[-1] - prior) < model.width
@@ -196,7 +197,7 @@ def test_joint_state_covariance_matches_monte_carlo(planar_planner, rng):
     samples = sample_trajectories(model.body, model.h, model.kappa, plan.start, plan.torque, 4000, rng, model.noise)
     stacked = samples[:, steps].reshape(len(samples), -1)
     empirical = np.cov(stacked, rowvar=False)
-    predicted = joint_state_covariance(plan, steps, shared_step_jacobians(model))
+    predicted = joint_state_covariance(plan, steps, linearised_step_function(model.body, model.h))
     scale = np.sqrt(np.outer(np.diag(predicted), np.diag(predicted)))
     assert np.abs(empirical - predicted).max() / scale.max() < 0.08
     np.testing.assert_allclose(np.diag(empirical), np.diag(predicted), rtol=0.1)
@@ -259,7 +260,7 @@ def test_cli_estimate_writes_the_estimate_posterior_and_figures(tmp_path, capsys
     for name in ("estimate.json", "estimate.csv", "estimate.png", "posterior.json", "posterior.png"):
         assert (tmp_path / "out" / name).stat().st_size > 0
     saved = json.loads((tmp_path / "out" / "estimate.json").read_text())
-    assert saved["extras"]["method"] == "regret" and len(saved["mean"]) == 31
+    assert saved["method"] == "regret" and len(saved["mean"]) == 31
 
 
 @pytest.mark.parametrize("kwargs, word", [
@@ -303,3 +304,20 @@ def test_bad_posterior_input_names_the_argument(planar_planner, kwargs, word):
                 candidate_goals=[[0.3, 0.0], [0.0, 0.3]]) | kwargs
     with pytest.raises(ValueError, match=word):
         goal_posterior(planar_planner, **args)
+
+
+def test_estimate_goal_uses_the_planner_it_is_given(planar_planner):
+    """Two planners of one model with different options: each call uses its own (a cache keyed by the
+    model alone once handed the first planner's estimator to the second)."""
+    model = planar_planner.model
+    one_iteration = comanip.Planner(model, comanip.SolverOptions(max_iterations=1))
+    plan = planar_planner.solve(np.zeros(4), [0.3, 0.1])
+    by_a = GoalEstimator(planar_planner).estimate(plan.start, plan.mean[10], T_OBS)
+    by_b = GoalEstimator(one_iteration).estimate(plan.start, plan.mean[10], T_OBS)
+    assert (by_a.iterations, by_a.status) != (by_b.iterations, by_b.status) or not np.array_equal(by_a.goal, by_b.goal)
+    cache = EstimatorCache()
+    for planner, expected in ((planar_planner, by_a), (one_iteration, by_b)):
+        for estimate in (estimate_goal(planner, plan.start, plan.mean[10], T_OBS),
+                         estimate_goal(planner, plan.start, plan.mean[10], T_OBS, cache=cache)):
+            assert (estimate.iterations, estimate.status) == (expected.iterations, expected.status)
+            np.testing.assert_array_equal(estimate.goal, expected.goal)

@@ -80,7 +80,7 @@ def test_newton_matches_scipy_on_a_bounded_rosenbrock():
     assert result.status == "solved"
     assert result.x[-1] == pytest.approx(0.5)  # the bound is active
     np.testing.assert_allclose(result.x, reference.x, atol=1e-6)
-    assert result.f <= reference.fun + 1e-12
+    assert result.fun <= reference.fun + 1e-12
 
 
 def test_newton_stops_at_the_deadline():
@@ -92,7 +92,7 @@ def test_newton_stops_at_the_deadline():
 
     result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(4, -1.2), np.full(4, -np.inf), np.full(4, np.inf),
                              tolerance=1e-12, max_iterations=100, expired=lambda: len(calls) > 3)
-    assert result.status == "max_wall_time" and np.isfinite(result.f)
+    assert result.status == "max_wall_time" and np.isfinite(result.fun)
 
 
 def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(tmp_path, monkeypatch):

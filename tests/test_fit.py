@@ -50,6 +50,7 @@ def kappa_fit(synthetic):
     return fit_model(comanip.presets.planar().replace(kappa=START_KAPPA), synthetic[0], ["kappa"], progress=False)
 
 
+@pytest.mark.slow
 def test_fit_recovers_kappa_within_its_standard_errors(kappa_fit):
     fit = kappa_fit
     kappa, se = fit.values["kappa"], fit.std_errors["kappa"]
@@ -64,6 +65,7 @@ def test_fit_recovers_kappa_within_its_standard_errors(kappa_fit):
     assert len(fit.conditions) == len(CONDITIONS) and len(fit.trials) == len(CONDITIONS) * TRIALS_PER_CONDITION
 
 
+@pytest.mark.slow
 def test_fit_lowers_the_likelihood_below_the_start_and_the_truth(kappa_fit, synthetic):
     at_start = recordings_nll(comanip.presets.planar().replace(kappa=START_KAPPA), synthetic[0])
     at_truth = recordings_nll(true_model(), synthetic[0])
@@ -71,6 +73,7 @@ def test_fit_lowers_the_likelihood_below_the_start_and_the_truth(kappa_fit, synt
     assert at_truth - kappa_fit.objective < 10  # a one-parameter MLE gains little over the truth
 
 
+@pytest.mark.slow
 def test_fitted_model_reaches_take_the_recorded_movement_time(kappa_fit, synthetic):
     planner = comanip.Planner(kappa_fit.model)
     for c, (goal, width) in enumerate(CONDITIONS):
@@ -82,6 +85,7 @@ def test_fitted_model_reaches_take_the_recorded_movement_time(kappa_fit, synthet
         assert kappa_fit.conditions[c]["mt_recorded_s"] == pytest.approx(recorded, rel=0.02)
 
 
+@pytest.mark.slow
 def test_position_errors_match_the_predicted_spread(kappa_fit):
     # mean squared error of the recorded hand about the predicted mean = trace of the predicted covariance
     # plus the measurement noise of the sample and of the start (2 sigma_obs² per axis). Ten trials per
@@ -97,6 +101,7 @@ def test_position_errors_match_the_predicted_spread(kappa_fit):
     assert 0.8 < np.mean(ratios) < 1.25
 
 
+@pytest.mark.slow
 def test_saved_model_loads_and_plans(kappa_fit, tmp_path):
     path = kappa_fit.save_yaml(tmp_path / "fitted.yaml")
     loaded = comanip.presets.load(path)
@@ -118,6 +123,7 @@ def test_dask_scheduler_gives_the_local_likelihood(synthetic):
     assert remote == pytest.approx(local, rel=1e-10, abs=1e-8)
 
 
+@pytest.mark.slow
 def test_fit_recovers_an_activation_time_constant_named_by_index(tmp_path):
     # a tuple field's entry is a parameter ('activation.0'); data from a one-stage muscle model, tau = 40 ms
     truth = true_model().replace(activation=(0.04,))
@@ -143,6 +149,7 @@ MT_DISTANCES = [0.15, 0.3, 0.15, 0.3, 0.45]
 MT_WIDTHS = [0.01, 0.01, 0.03, 0.03, 0.02]
 
 
+@pytest.mark.slow
 def test_movement_time_fit_recovers_gamma():
     truth = comanip.presets.planar().replace(gamma=0.95)
     table = MovementTimeTable(np.array(MT_DISTANCES), np.array(MT_WIDTHS), movement_time_table(truth, MT_DISTANCES, MT_WIDTHS))
@@ -153,6 +160,7 @@ def test_movement_time_fit_recovers_gamma():
         assert row["mt_predicted_s"] == pytest.approx(row["mt_recorded_s"], abs=0.005)
 
 
+@pytest.mark.slow
 def test_cli_fits_kappa_to_a_movement_time_table(tmp_path, capsys):
     mts = movement_time_table(true_model(), MT_DISTANCES, MT_WIDTHS)
     table = tmp_path / "fitts.csv"
@@ -256,6 +264,7 @@ def test_cli_errors_exit_2_with_one_line(argv, synthetic, capsys):
     assert err.startswith("comanip fit: error: ") and err.count("\n") == 1
 
 
+@pytest.mark.slow
 @pytest.mark.slow
 def test_three_parameter_fit_finds_the_likelihood_maximum_and_says_nu_is_unconstrained(synthetic):
     # measured (45 s): kappa 0.0219 ± 0.0029, gamma 0.967 ± 0.005, nu at its lower bound 1e-8 (true 1e-5),

@@ -10,6 +10,8 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 from comanip.planning.reach_problem import ReachProblem
 
+pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
+
 
 @pytest.fixture(scope="module")
 def franka_planner():
@@ -75,7 +77,7 @@ def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
     tau, p = _point(model, rng)
     data = curvature.evaluate(tau, p)[2]
     n, d, H = 7, 3, model.H
-    J, Q, phi_grad, W, dvech = data[6], data[7], data[8], data[9], data[10]
+    J, Q, phi_grad, W, dvech = data.J, data.phi_hess, data.phi_grad, data.kinematic_hessian, data.dvech
     T = curvature.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
     triangle = [(a, b) for b in range(d) for a in range(b + 1)]
     vech = lambda S: np.array([S[a, b] for a, b in triangle])  # noqa: E731

@@ -112,6 +112,7 @@ def _verdict(result, start):
     return next(v for v in result.verdicts if v.target.startswith(start))
 
 
+@pytest.mark.slow
 def test_planar_preset_reproduces_the_known_failures(planar_result):
     # the shipped preset misses the hit-rate band somewhere and peaks late in most conditions (README)
     for name in ("hit rate at MT, closed form", "hit rate at MT, Monte Carlo"):
@@ -126,6 +127,7 @@ def test_planar_preset_reproduces_the_known_failures(planar_result):
     assert len({v.target for v in planar_result.verdicts}) == len(planar_result.verdicts) == 14
 
 
+@pytest.mark.slow
 def test_planar_closed_form_and_monte_carlo_hit_rates_agree(planar_result):
     for row in planar_result.rows:
         p = row.hit_rate_closed_form
@@ -133,6 +135,7 @@ def test_planar_closed_form_and_monte_carlo_hit_rates_agree(planar_result):
         assert row.sd_along == pytest.approx(row.sd_along_predicted, rel=0.1)
 
 
+@pytest.mark.slow
 def test_human_section_reports_the_model_beside_the_reference(planar_grid, tmp_path):
     settings = ValidationSettings(human_samples=200)
     faster = comanip.presets.planar().replace(kappa=3e-3, name="planar_kappa_3e-3")

@@ -13,6 +13,8 @@ from comanip.bodies.panda import Panda
 from comanip.bodies.panda_urdf import panda_urdf_path
 from comanip.planning.initial_guess import minimum_jerk_torques
 
+pytestmark = pytest.mark.slow  # the Panda's dynamics and Monte Carlo of its nonlinear step
+
 pin = pytest.importorskip("pinocchio")
 
 H_FRANKA = 0.035  # the franka preset's step (s)

@@ -1,5 +1,7 @@
 """The planner: gradients, plans from varied starts, status handling, bad input."""
 
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 import pytest
 
@@ -97,3 +99,20 @@ def test_preset_yaml_round_trip(tmp_path):
     assert loaded.config() == model.config()
     assert (loaded.n, loaded.d, loaded.H, loaded.h) == (3, 3, 50, 0.055)
     np.testing.assert_allclose(loaded.M, 2 * np.eye(3))
+
+
+def test_two_threads_with_separate_planners_plan_as_one_thread():
+    """Planners share no state: two threads, each with its own planner, return the plans one thread does."""
+    model = comanip.presets.planar()
+    goals = [np.array([0.3, 0.0]), np.array([0.1, 0.25]), np.array([-0.2, 0.1])]
+
+    def plan_all(planner):
+        return [planner.solve(np.zeros(4), goal, 0.02) for goal in goals]
+
+    expected = plan_all(comanip.Planner(model))
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        results = list(pool.map(plan_all, [comanip.Planner(model), comanip.Planner(model)]))
+    for plans in results:
+        for plan, reference in zip(plans, expected):
+            assert (plan.status, plan.iterations) == (reference.status, reference.iterations)
+            np.testing.assert_array_equal(plan.torque, reference.torque)

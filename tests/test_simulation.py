@@ -29,6 +29,7 @@ def _mean(trials, key):
     return float(np.mean([trial.metrics[key] for trial in trials]))
 
 
+@pytest.mark.slow
 def test_sync_reports_bounded_goal_and_z_tracking_errors(sync_runs):
     """Every trial yields a finite estimate; the estimated goal lies within 0.25 m of the person's; the robot
     (400 N/m in z) keeps the handle within 4 cm RMS of its estimated z from t_o on; the person still lands
@@ -43,6 +44,7 @@ def test_sync_reports_bounded_goal_and_z_tracking_errors(sync_runs):
             assert np.all(np.isfinite(trial.normalised_error))
 
 
+@pytest.mark.slow
 def test_sync_errors_are_larger_in_xy_and_for_the_far_goal(sync_runs):
     """Paper VI-A: the error between the estimated trajectory and the end effector is larger in x–y (led by
     the person) than in z (led by the robot), and larger in x–y when the goal is farther."""
@@ -52,6 +54,7 @@ def test_sync_errors_are_larger_in_xy_and_for_the_far_goal(sync_runs):
     assert _mean(sync_runs["far"], "goal_error_xy_m") > _mean(sync_runs["near"], "goal_error_xy_m")
 
 
+@pytest.mark.slow
 def test_sync_robot_leads_z_only_after_the_observation(sync_runs):
     trial = sync_runs["near"][0]
     record, t_o = trial.record, 0.2
@@ -60,6 +63,7 @@ def test_sync_robot_leads_z_only_after_the_observation(sync_runs):
     np.testing.assert_array_equal(record.stiffness[after], np.tile([0.0, 0.0, 400.0], (after.sum(), 1)))
 
 
+@pytest.mark.slow
 def test_handover_switches_on_time_smoothly_and_the_person_finishes(handover_runs):
     """The stiffness starts to fall within one planning step (h = 0.055 s) of the predicted transition; no
     velocity jump: within any 50 ms of the ramp the handle's velocity changes by less than 0.1 m/s and by at
@@ -78,6 +82,7 @@ def test_handover_switches_on_time_smoothly_and_the_person_finishes(handover_run
             assert stiffness[0] == 400.0 and stiffness[-1] == 0.0
 
 
+@pytest.mark.slow
 def test_handover_profiles_mark_a_transition_farther_out_for_the_far_goal(handover_runs):
     """The predicted transition lies inside the reach and farther from the goal for the far goal (Peternel &
     Babič 2019); the measured spread of the reaches peaks farther out for the far goal too."""

@@ -53,6 +53,7 @@ def test_closed_loop_reacher_has_an_interior_dispersion_peak(planar_planner, rng
     assert profile.dispersion[-1] < 0.75 * profile.peak_dispersion   # and 0.25–0.65 of the peak left at the goal
 
 
+@pytest.mark.slow
 def test_generated_rows_do_not_depend_on_the_number_of_workers(tmp_path):
     kwargs = dict(distances_over_arm_length=[0.3], widths=[0.01, 0.04], n_trials=3, steps=40, seed=7, progress=False)
     serial = generate_transition_data(workers=1, **kwargs)

@@ -4,6 +4,9 @@ Grid: D ∈ {0.15, 0.3, 0.45} m × w ∈ {0.005, 0.01, 0.02, 0.04} m, open-loop 
 """
 
 import json
+import os
+import subprocess
+import sys
 
 import numpy as np
 import pytest
@@ -88,6 +91,7 @@ def test_closed_loop_execution_brings_the_peak_earlier_than_the_open_loop_plan(p
     assert executed.metrics.asymmetry < open_loop.metrics.asymmetry - 0.05
 
 
+@pytest.mark.slow
 def test_validate_quick_writes_figures_and_a_complete_report(tmp_path, grid):
     out = tmp_path / "validate"
     # the Franka section has its own tests (test_validation_franka.py); here the flag must skip it
@@ -119,3 +123,9 @@ def test_validate_rejects_bad_options_before_any_work(tmp_path, capsys, argv, wo
     assert main(["validate", "--quick", "--out", str(tmp_path / "v"), *argv]) == 2
     assert word in capsys.readouterr().err
     assert not (tmp_path / "v").exists()
+
+
+def test_importing_validation_does_not_load_matplotlib():
+    """The settings and the package import without the figure layer (a fresh interpreter: pytest has loaded it)."""
+    code = "import sys, comanip.validation; assert 'matplotlib' not in sys.modules; comanip.validation.ValidationSettings()"
+    subprocess.run([sys.executable, "-c", code], check=True, env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})

@@ -50,10 +50,14 @@ def as_positive_array(name: str, value, unit: str) -> np.ndarray:
     return array
 
 
-def as_count(name: str, value, minimum: int = 1) -> int:
-    """value as an integer ≥ minimum (bool refused), else ValueError."""
+def as_count(name: str, value, minimum: int = 1, unit: str = "", *, optional: bool = False) -> int | None:
+    """value as an integer ≥ minimum (bool refused; None kept when ``optional``), else ValueError naming
+    the argument and, if given, its unit (e.g. "processes")."""
+    if optional and value is None:
+        return None
     if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
+        raise ValueError(f"{name} must be an integer ≥ {minimum}{f' ({unit})' if unit else ''}{' or None' if optional else ''}, "
+                         f"got {value!r}")
     return int(value)
 
 

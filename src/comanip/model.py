@@ -1,7 +1,7 @@
 """A reaching model: a body plus the motor-control parameters of the paper (Table II, SPEC §5).
 
 Every field of :class:`ReachingModel` is checked at construction, so a bad value fails before any
-CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W.
+CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W (``docs/notation.md``).
 """
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ from dataclasses import MISSING, dataclass, field, replace
 
 import numpy as np
 
-from comanip.arguments import as_nonnegative, as_positive
+from comanip.arguments import as_count, as_nonnegative, as_positive
 from comanip.belief.noise import check_noise_form
 from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
@@ -81,9 +81,7 @@ class ReachingModel:
         if slow:
             raise ValueError(f"activation time constants must be ≤ {MAX_ACTIVATION_STEPS} h = {MAX_ACTIVATION_STEPS * self.h:g} s "
                              f"(a slower stage never responds within a plan), got {slow}")
-        if isinstance(self.H, bool) or not isinstance(self.H, (int, np.integer)) or self.H < 1:
-            raise ValueError(f"H must be an integer ≥ 1 (horizon in steps), got {self.H!r}")
-        object.__setattr__(self, "H", int(self.H))
+        object.__setattr__(self, "H", as_count("H", self.H, 1, "horizon in steps"))
         if not (isinstance(self.gamma, (int, float)) and 0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1] (discount per step), got {self.gamma!r}")
         as_nonnegative("nu", self.nu, "reward per N²")

@@ -31,6 +31,7 @@ from tqdm import tqdm
 
 from comanip.analysis.fitts import FittsFit, fit_fitts, trend_fraction
 from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, open_loop_grid
+from comanip.arguments import as_count
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
 from comanip.planning.planner import Planner
@@ -187,14 +188,12 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
     from a generator seeded by (seed, configuration index, condition index), so results do not depend on
     the scheduling. workers: processes (default: the CPU count; 1 runs in this process).
     """
-    if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:
-        raise ValueError(f"n_trials must be an integer ≥ 1, got {n_trials!r}")
+    as_count("n_trials", n_trials)
     distances, widths = np.sort(np.asarray(distances, float)), np.sort(np.asarray(widths, float))
     tasks = [(base.config(), c, float(D), float(w), n_trials, (seed, i, j))
              for i, c in enumerate(configurations) for j, (D, w) in enumerate(product(distances, widths))]
     workers = (os.cpu_count() or 1) if workers is None else workers
-    if isinstance(workers, bool) or not isinstance(workers, (int, np.integer)) or workers < 1:
-        raise ValueError(f"workers must be an integer ≥ 1 (processes), got {workers!r}")
+    as_count("workers", workers, 1, "processes")
     bar = tqdm(total=len(tasks), desc="calibration", unit="reach", disable=not progress)
     results: dict[int, list[ReachOutcome]] = {i: [] for i in range(len(configurations))}
     if workers == 1:

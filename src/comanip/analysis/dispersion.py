@@ -15,6 +15,7 @@ import numpy as np
 from scipy.stats import norm
 
 from comanip.analysis.speed_profile import speed_metrics
+from comanip.arguments import as_count
 from comanip.belief import sample_trajectories
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
@@ -63,8 +64,7 @@ class EndpointDispersion:
 
 def endpoint_dispersion(model: ReachingModel, plan: Plan, n_samples: int, rng: np.random.Generator) -> EndpointDispersion:
     """Open-loop Monte Carlo (n_samples ≥ 2 executions) of plan.torque under model's noise; see the module doc."""
-    if isinstance(n_samples, bool) or not isinstance(n_samples, (int, np.integer)) or n_samples < 2:
-        raise ValueError(f"n_samples must be an integer ≥ 2, got {n_samples!r}")
+    as_count("n_samples", n_samples, 2)
     body = model.body
     states = sample_trajectories(body, model.h, model.kappa, plan.start, plan.torque, n_samples, rng, model.noise)
     kinematics = body.kinematics_function.map(n_samples * states.shape[1])

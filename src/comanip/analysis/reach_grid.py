@@ -15,6 +15,7 @@ from typing import Callable
 import numpy as np
 
 from comanip.analysis.speed_profile import SpeedMetrics, speed_metrics
+from comanip.arguments import as_count
 from comanip.execution import Observation, execute_receding_horizon
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
@@ -89,8 +90,7 @@ def closed_loop_grid(planner: Planner, distances, widths, n_trials: int, rng: np
                      observation: Observation | None = None) -> list[ReachOutcome]:
     """Closed-loop executions (n_trials per condition, steps each; default 2H so slow reaches finish), replanned
     from the actual state (observation None) or from the estimate made with the observation's noise and delay."""
-    if isinstance(n_trials, bool) or not isinstance(n_trials, (int, np.integer)) or n_trials < 1:
-        raise ValueError(f"n_trials must be an integer ≥ 1, got {n_trials!r}")
+    as_count("n_trials", n_trials)
     steps = 2 * planner.model.H if steps is None else steps
 
     def reach(start, goal, distance, width):

@@ -85,15 +85,15 @@ def run(args) -> int:
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, method=args.method, max_wall_time=args.max_wall_time)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
-               "t_obs_s": float(t_obs), "observed_step": estimate.extras["observed_step"], "method": args.method,
+               "t_obs_s": float(t_obs), "observed_step": estimate.observed_step, "method": args.method,
                "width": estimate.width, "success": estimate.success, "status": estimate.status, "message": estimate.message,
-               "solve_time_s": estimate.solve_time, "iterations": estimate.iterations, "regret": estimate.extras.get("regret")}
+               "solve_time_s": estimate.solve_time, "iterations": estimate.iterations, "regret": estimate.regret}
     posterior = None
     if args.candidates is not None:
         if times is None:
             times, states = np.array([t_obs]), np.atleast_2d(observed)
         usable = times <= model.duration
-        posterior = goal_posterior(estimator.planner, estimate.start, states[usable], times[usable], args.candidates, args.width)
+        posterior = goal_posterior(estimator, estimate.start, states[usable], times[usable], args.candidates, args.width)
         path = out / "posterior.json"
         path.write_text(json.dumps(posterior.to_dict(), indent=1))
         written.append(path)

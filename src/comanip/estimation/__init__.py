@@ -1,6 +1,7 @@
 """Estimation from observed reaching: the goal of a reach in progress, and a posterior over candidate goals."""
 
-from comanip.estimation.goal_estimate import EstimatorOptions, GoalEstimator, estimate_goal
+from comanip.estimation.estimate import GoalEstimate
+from comanip.estimation.goal_estimate import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
 from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
 
-__all__ = ["EstimatorOptions", "GoalEstimator", "GoalPosterior", "estimate_goal", "goal_posterior"]
+__all__ = ["EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior", "estimate_goal", "goal_posterior"]

@@ -3,7 +3,8 @@
 The person started at s_0 and was seen in state s_o at time t_o (step n_o = floor(t_o / h), the nearest
 earlier step; :mod:`comanip.estimation.observation`). The estimate is a goal g_hat and the full predicted
 trajectory: the model's reach from s_0 to g_hat through s_o, returned as a :class:`~comanip.Plan` (so it
-plots and exports like any plan), with g_hat in ``plan.goal`` and ``plan.extras["estimated_goal"]``.
+plots and exports like any plan), with g_hat in ``estimate.goal``: a :class:`GoalEstimate`, a Plan with the
+estimate's own fields (observed step, regret, multipliers, ...).
 
 Two methods:
 
@@ -24,13 +25,14 @@ The regulariser (g - g_bar)^T W^-1 (g - g_bar), W from the width as the model sa
 the paper's; without a prior goal (``prior_goal=None``) it is left out.
 
 >>> estimator = GoalEstimator(comanip.presets.cartesian())
->>> plan = estimator.estimate(start=np.zeros(6), observed=s_o, t_obs=0.2)
->>> plan.goal, plan.success, plan.extras["regret"]
+>>> estimate = estimator.estimate(start=np.zeros(6), observed=s_o, t_obs=0.2)
+>>> estimate.goal, estimate.success, estimate.regret
 """
 
 from __future__ import annotations
 
 import math
+import threading
 import time
 from collections import OrderedDict
 from dataclasses import dataclass, replace
@@ -39,17 +41,19 @@ import casadi as ca
 import numpy as np
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
-from comanip.estimation.goal_posterior import OBSERVATION_STD, observation_covariance
+from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.belief.propagation import linearised_step_function
+from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
-from comanip.estimation.observation import observation_step, observed_rows, observed_state
+from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
 from comanip.estimation.regret_newton import newton_solve
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
-from comanip.estimation.shared import cached_per_model, shared_planner, shared_step_jacobians
+from comanip.estimation.shared import checked_model, estimation_planner, model_key
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
+from comanip.optim import CONVERGED, Status
 from comanip.planning.plan import Plan
-from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
+from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.planner import Planner
 
 METHODS = ("regret", "paper")
@@ -63,8 +67,12 @@ class EstimatorOptions:
     """Convergence: max |F| of the regret's first-order conditions (normalised objective per N·m or N, and
     state units for the observation constraint); IPOPT's tol for the 'paper' method."""
     max_iterations: int | None = None
-    """Newton iterations ('regret'), or a tenth of IPOPT's ('paper'). None: 30 for point masses (exact
-    Jacobian, quadratic convergence), 100 for arms (approximate Jacobian, linear convergence)."""
+    """Newton iterations ('regret'), or a tenth of IPOPT's ('paper'). None: ``exact_iterations`` for point
+    masses, ``approximate_iterations`` for arms."""
+    exact_iterations: int = 30
+    """The limit for point masses when ``max_iterations`` is None (exact Jacobian, quadratic convergence)."""
+    approximate_iterations: int = 100
+    """The limit for arms when ``max_iterations`` is None (approximate Jacobian, linear convergence)."""
     step_fraction: float = 0.5
     """Largest goal step of one Newton iteration, as a fraction of the distance from the observed hand to
     the current goal (at least one goal width)."""
@@ -75,9 +83,9 @@ class EstimatorOptions:
 
     def __post_init__(self):
         as_positive("tolerance", self.tolerance, "residual")
-        if self.max_iterations is not None and (isinstance(self.max_iterations, bool) or not isinstance(self.max_iterations, int)
-                                                or self.max_iterations < 1):
-            raise ValueError(f"max_iterations must be None or an integer ≥ 1, got {self.max_iterations!r}")
+        as_count("max_iterations", self.max_iterations, optional=True)
+        as_count("exact_iterations", self.exact_iterations)
+        as_count("approximate_iterations", self.approximate_iterations)
         if not (isinstance(self.step_fraction, (int, float)) and 0 < self.step_fraction <= 10):
             raise ValueError(f"step_fraction must be in (0, 10] (fraction of the remaining reach), got {self.step_fraction!r}")
         low, high = (as_positive(f"search_distances[{k}]", v, "m") for k, v in enumerate(self.search_distances))
@@ -89,21 +97,24 @@ class EstimatorOptions:
 class GoalEstimator:
     """Goal estimates for one model: functions and solvers built once, reused for every observation.
 
-    The model's planner is shared with :func:`comanip.goal_posterior` (one per model). The 'paper'
-    method's NLP depends on the observed step, so one is built per n_o on first use and kept.
+    Given a model, it builds its own planner (terms compiled to C, :func:`estimation_planner`); given a
+    planner, it uses that one. The 'paper' method's NLP depends on the observed step, so one is built per
+    n_o on first use and kept.
     """
 
     def __init__(self, model: ReachingModel | Planner, options: EstimatorOptions | None = None):
-        self.planner = shared_planner(model)
+        self.planner = estimation_planner(model)
         self.model = self.planner.model
         self.problem = self.planner.problem
         self.options = options or EstimatorOptions()
         self._regret = RegretSystem(self.planner)
+        self.step_jacobians = linearised_step_function(self.model.body, self.model.h)
+        """The body's linearised step ``(s, tau) -> (f, A, B)`` (:func:`comanip.belief.linearised_step_function`)."""
         self._blas = ThreadpoolController()
         self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
 
     def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, method: str = "regret",
-                 warm_start: Plan | None = None, max_wall_time: float | None = None) -> Plan:
+                 warm_start: Plan | None = None, max_wall_time: float | None = None) -> GoalEstimate:
         """Estimate the goal of a reach from its start and a state observed at t_obs.
 
         Args:
@@ -124,11 +135,11 @@ class GoalEstimator:
                 status 'max_wall_time' when it runs out.
 
         Returns:
-            A :class:`~comanip.Plan` through the observation to the estimated goal; never raises on a
-            failed solve (check ``plan.success`` and ``plan.status``). ``extras`` hold the estimated goal,
-            the observed step, ``observation_residual`` (mean at n_o minus the observed state, (2n,)) and,
-            for the regret, ``regret`` (J units), ``residual`` (max |F|) and ``unconstrained_torque`` (the
-            plan to the estimated goal, not held to the observation, (H, n)).
+            A :class:`GoalEstimate`: the plan through the observation to the estimated goal, with the observed
+            step, ``observation_residual`` (mean at n_o minus the observed state, (nx,)) and, for the regret,
+            ``regret`` (J units), ``residual`` (max |F|) and ``unconstrained_torque`` (the plan to the
+            estimated goal, not held to the observation, (H, n)); never raises on a failed solve (check
+            ``success`` and ``status``).
         """
         t_begin = time.perf_counter()
         model = self.model
@@ -162,57 +173,62 @@ class GoalEstimator:
             return self._cold_point(start, observed, n_o, len(rows), prior, width, remaining_time)
 
         if method == "regret":
-            x_obs, _ = task_space_state(self.planner, observed)
-
-            def newton(point: RegretPoint):
-                # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
-                # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
-                with self._blas.limit(limits=1, user_api="blas"):
-                    return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
-                                        tolerance=self.options.tolerance, max_iterations=self._max_iterations,
-                                        step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
-
-            result = newton(point if point is not None else cold_point())
-            iterations = result.iterations
-            if (point is not None and result.status in ("failed", "max_iterations", "not_a_minimum")
-                    and time.perf_counter() < deadline):
-                # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
-                retry = newton(cold_point())
-                iterations += retry.iterations
-                if retry.status in ("solved", "solved_acceptable") or retry.residual < result.residual:
-                    result = retry
-            point, status, message = result.point, result.status, result.message
-            extras = {"regret": self._regret.normaliser(width) * result.regret, "residual": result.residual,
-                      "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
+            point, status, message, iterations, details = self._regret_solve(point, cold_point, start, observed, n_o, rows,
+                                                                             prior, width, deadline)
         else:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
                                                                    observed, n_o, rows, prior, width, remaining_time())
-            extras = {}
-        extras.update({"estimated_goal": point.goal.copy(), "prior_goal": prior, "t_obs": float(t_obs), "observed_step": n_o,
-                       "observed_state": observed, "method": method, "multipliers": point.lam.copy()})
-        success = status in ("solved", "solved_acceptable")
-        estimate = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
-                                          success=success, message=message, solve_time=time.perf_counter() - t_begin,
-                                          iterations=iterations, extras=extras)
-        estimate.extras["observation_residual"] = estimate.mean[n_o] - observed
-        return estimate
+            details = {}
+        plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
+                                      success=status in CONVERGED, message=message,
+                                      solve_time=time.perf_counter() - t_begin, iterations=iterations)
+        return GoalEstimate.of(plan, t_obs=float(t_obs), observed_step=n_o, observed_state=observed,
+                               observation_residual=plan.mean[n_o] - observed, prior_goal=prior, method=method,
+                               multipliers=point.lam.copy(), **details)
 
-    def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> Plan:
+    def _regret_solve(self, point: RegretPoint | None, cold_point, start, observed, n_o, rows, prior, width, deadline):
+        """Newton's method on the regret from ``point`` (from ``cold_point()`` when None, or when a warm start
+        fails and time is left); (point, status, message, iterations, the :class:`GoalEstimate` fields it fills)."""
+        model = self.model
+        x_obs, _ = task_space_state(self.planner, observed)
+
+        def newton(point: RegretPoint):
+            # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
+            # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
+            with self._blas.limit(limits=1, user_api="blas"):
+                return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
+                                    tolerance=self.options.tolerance, max_iterations=self._max_iterations,
+                                    step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
+
+        result = newton(point if point is not None else cold_point())
+        iterations = result.nit
+        if (point is not None and result.status in (Status.FAILED, Status.MAX_ITERATIONS, Status.NOT_A_MINIMUM)
+                and time.perf_counter() < deadline):
+            # a warm start too far from the answer (e.g. the plan to a poor prior): search as if cold
+            retry = newton(cold_point())
+            iterations += retry.nit
+            if retry.success or retry.optimality < result.optimality:
+                result = retry
+        point = result.x
+        details = {"regret": self._regret.normaliser(width) * result.fun, "residual": result.optimality,
+                   "unconstrained_torque": point.tau_s.reshape(model.H, model.n).copy()}
+        return point, result.status, result.message, iterations, details
+
+    def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> GoalEstimate:
         """The estimate from an observation at step 0: the plan to the prior goal, status 'uninformative'."""
         plan = self.planner.solve(start, prior, width, warm_start=warm_start, max_wall_time=max_wall_time)
         message = (f"the observation at t_obs = {t_obs:g} s falls on step 0, the start itself, and says nothing about the goal: "
                    f"the estimate is the prior goal and the trajectory its plan (plan status '{plan.status}')")
-        extras = {"estimated_goal": prior.copy(), "prior_goal": prior, "t_obs": t_obs, "observed_step": 0,
-                  "observed_state": observed, "method": method, "observation_residual": plan.mean[0] - observed,
-                  "plan_status": plan.status}
-        return replace(plan, success=False, status="uninformative", message=message, extras=extras,
-                       solve_time=time.perf_counter() - t_begin)
+        plan = replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
+        return GoalEstimate.of(plan, t_obs=t_obs, observed_step=0, observed_state=observed,
+                               observation_residual=plan.mean[0] - observed, prior_goal=prior, method=method,
+                               plan_status=plan.status)
 
     @property
     def _max_iterations(self) -> int:
         if self.options.max_iterations is not None:
             return self.options.max_iterations
-        return 30 if self._regret.exact else 100
+        return self.options.exact_iterations if self._regret.exact else self.options.approximate_iterations
 
     def _warm_point(self, warm_start: Plan, n_rows: int) -> tuple[RegretPoint, bool]:
         """The iterate a warm start gives, and whether its plan to the goal (tau_s) must still be solved."""
@@ -222,23 +238,24 @@ class GoalEstimator:
         shape, unit = (model.H, model.n), "torques, N·m or N"
         tau_c = as_matrix("warm_start.torque", warm_start.torque, shape, unit).ravel()
         goal = as_vector("warm_start.goal", warm_start.goal, model.d, "m")
-        extras = warm_start.extras
+        if not isinstance(warm_start, GoalEstimate):  # a plain plan is a plan to its goal already
+            return RegretPoint(tau_c.copy(), np.zeros(n_rows), tau_c.copy(), goal.copy()), False
         lam = np.zeros(n_rows)
-        if "multipliers" in extras and np.size(extras["multipliers"]) == n_rows:  # from an estimate at a step like this one's
-            lam = as_vector("warm_start.extras['multipliers']", extras["multipliers"], n_rows, "multipliers")
-        if "unconstrained_torque" in extras:
-            tau_s = as_matrix("warm_start.extras['unconstrained_torque']", extras["unconstrained_torque"], shape, unit).ravel()
+        if np.size(warm_start.multipliers) == n_rows:  # from an estimate at a step like this one's
+            lam = as_vector("warm_start.multipliers", warm_start.multipliers, n_rows, "multipliers")
+        if warm_start.unconstrained_torque is not None:
+            tau_s = as_matrix("warm_start.unconstrained_torque", warm_start.unconstrained_torque, shape, unit).ravel()
             return RegretPoint(tau_c.copy(), lam.copy(), tau_s.copy(), goal.copy()), False
         # An estimate by another method holds a trajectory through its observation, not a plan to its goal
         # (and it may even be a poor local optimum of J that passes through it, where the regret is zero):
-        # the plan to its goal is solved afresh. A plain plan is one already.
-        return RegretPoint(tau_c.copy(), lam.copy(), tau_c.copy(), goal.copy()), "observed_step" in extras
+        # the plan to its goal is solved afresh.
+        return RegretPoint(tau_c.copy(), lam.copy(), tau_c.copy(), goal.copy()), True
 
     def _cold_point(self, start, observed, n_o, n_rows, prior, width, remaining_time) -> RegretPoint:
         """Start from the best goal along the observed direction; from the prior (or the hand) if nothing moved."""
         R = observation_covariance(self.options.observation_std, self.model.n)
         found = search_along_observed_direction(self.planner, start, observed, n_o, prior, width, R, self.options.search_distances,
-                                                shared_step_jacobians(self.model), remaining_time)
+                                                self.step_jacobians, remaining_time)
         if found is None:
             goal = prior if prior is not None else task_space_state(self.planner, observed)[0]
             plan = self.planner.solve(start, goal, width, max_wall_time=remaining_time())
@@ -273,33 +290,56 @@ class GoalEstimator:
         params = np.r_[start, observed, np.zeros(self.model.d) if prior is None else prior, width, prior is not None]
         result = solver(x0=np.r_[point.tau_c, point.goal], p=params, lbg=0, ubg=0)
         stats = solver.stats()
-        status, _ = IPOPT_STATUS.get(stats["return_status"], ("failed", False))
-        if stats["return_status"] == "User_Requested_Stop" and deadline.expired:
-            status = "max_wall_time"
+        status = ipopt_status(stats, deadline)
         x = np.asarray(result["x"]).ravel()
         Hn = self.model.H * self.model.n
         if not np.all(np.isfinite(x)):
-            status, x = "failed", np.r_[point.tau_c, point.goal]
+            status, x = Status.FAILED, np.r_[point.tau_c, point.goal]
         lam = np.asarray(result["lam_g"]).ravel()
         solved = RegretPoint(x[:Hn], lam if np.all(np.isfinite(lam)) else np.zeros_like(lam), point.tau_s, x[Hn:])
         return solved, status, stats["return_status"], int(stats.get("iter_count", 0))
 
 
-_estimators: OrderedDict = OrderedDict()
+class EstimatorCache:
+    """Goal estimators kept between calls of :func:`estimate_goal` and :func:`comanip.goal_posterior`.
+
+    One key: a Planner or GoalEstimator is its own (its options are part of what it solves); a
+    ReachingModel is keyed by its parameters (:func:`model_key`, so two loads of a preset share an
+    estimator) and gets an estimator with its own planner. At most ``size`` estimators are kept, the least
+    recently used dropped first. Safe to share between threads; an estimator itself is not (give each
+    thread its own cache or planner).
+    """
+
+    def __init__(self, size: int = 4):
+        self.size = size
+        self._estimators: OrderedDict[object, GoalEstimator] = OrderedDict()
+        self._lock = threading.Lock()
+
+    def estimator(self, model: ReachingModel | Planner | GoalEstimator) -> GoalEstimator:
+        """The estimator for ``model``, built on first use."""
+        if isinstance(model, GoalEstimator):
+            return model
+        key = model if isinstance(model, Planner) else model_key(checked_model(model))
+        with self._lock:
+            if key not in self._estimators:
+                self._estimators[key] = GoalEstimator(model)
+                while len(self._estimators) > self.size:
+                    self._estimators.popitem(last=False)
+            self._estimators.move_to_end(key)
+            return self._estimators[key]
+
+
+DEFAULT_CACHE = EstimatorCache()
+"""The cache :func:`estimate_goal` and :func:`comanip.goal_posterior` use when given none."""
 
 
 def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observed, t_obs, prior_goal=None,
-                  width: float | None = None, **options) -> Plan:
+                  width: float | None = None, *, cache: EstimatorCache | None = None, **options) -> GoalEstimate:
     """Estimate a reach's goal from a state observed at t_obs; see :meth:`GoalEstimator.estimate`.
 
-    ``model`` may be a ReachingModel (its estimator is built on first use and kept for later calls), a
-    Planner, or a GoalEstimator. ``options`` go to :meth:`GoalEstimator.estimate` (method, warm_start,
-    max_wall_time).
+    ``model`` may be a ReachingModel or a Planner (its estimator is built on first use and kept in
+    ``cache``, :data:`DEFAULT_CACHE` when None), or a GoalEstimator. ``options`` go to
+    :meth:`GoalEstimator.estimate` (method, warm_start, max_wall_time).
     """
-    if isinstance(model, GoalEstimator):
-        estimator = model
-    elif isinstance(model, Planner):
-        estimator = cached_per_model(_estimators, model.model, lambda m: GoalEstimator(model))
-    else:
-        estimator = cached_per_model(_estimators, shared_planner(model).model, GoalEstimator)
+    estimator = (cache or DEFAULT_CACHE).estimator(model)
     return estimator.estimate(start, observed, t_obs, prior_goal, width, **options)

@@ -25,16 +25,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.special import logsumexp
 
-from comanip.arguments import as_matrix, as_optional_positive, as_positive
-from comanip.estimation.observation import observed_sequence
-from comanip.estimation.shared import shared_planner, shared_step_jacobians
+from comanip.arguments import as_matrix, as_optional_positive
+from comanip.estimation.goal_estimate import DEFAULT_CACHE, EstimatorCache
+from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observed_sequence, prefix_log_likelihoods
+from comanip.optim import Status
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
-
-#: Default observation-noise floor: standard deviation of a measured position (m or rad) and velocity
-#: (m/s or rad/s). About what motion capture or joint encoders with differentiated velocity deliver.
-OBSERVATION_STD = (1e-3, 1e-2)
-
 
 @dataclass
 class GoalPosterior:
@@ -69,9 +65,14 @@ class GoalPosterior:
         return all(plan.converged for plan in self.plans)
 
     @property
-    def status(self) -> str:
+    def status(self) -> Status:
+        """'solved' when every candidate's plan converged, else 'plans_not_converged' (:attr:`message` says which)."""
+        return Status.SOLVED if self.success else Status.PLANS_NOT_CONVERGED
+
+    @property
+    def message(self) -> str:
         failed = [i for i, plan in enumerate(self.plans) if not plan.converged]
-        return "solved" if not failed else f"plans of candidates {failed} did not converge"
+        return "every candidate's plan converged" if not failed else f"plans of candidates {failed} did not converge"
 
     @property
     def entropy(self) -> np.ndarray:
@@ -90,66 +91,17 @@ class GoalPosterior:
                 "probabilities": self.probabilities.tolist(), "log_likelihoods": self.log_likelihoods.tolist(),
                 "prior": self.prior.tolist(), "entropy": self.entropy.tolist(), "most_likely": self.most_likely.tolist(),
                 "width": self.width, "observation_std": list(self.observation_std), "success": self.success,
-                "status": self.status, "solve_time": self.solve_time}
-
-
-def observation_covariance(observation_std, n: int) -> np.ndarray:
-    """R (2n, 2n) = diag(sigma_q² I_n, sigma_qdot² I_n) from observation_std = (sigma_q, sigma_qdot)."""
-    try:
-        sigma_q, sigma_qdot = observation_std
-    except (TypeError, ValueError):
-        raise ValueError(f"observation_std must be a pair (position std, velocity std) in state units, got {observation_std!r}") from None
-    sigma_q = as_positive("observation_std[0]", sigma_q, "m or rad")
-    sigma_qdot = as_positive("observation_std[1]", sigma_qdot, "m/s or rad/s")
-    return np.diag(np.r_[np.full(n, sigma_q**2), np.full(n, sigma_qdot**2)])
-
-
-def joint_state_covariance(plan: Plan, steps: np.ndarray, step_jacobians) -> np.ndarray:
-    """Covariance (2nK, 2nK) of the states at non-decreasing steps (K,) under the plan's open-loop belief.
-
-    ``step_jacobians(mu_i, tau_i) -> (f, A_i, B_i)`` is the body's linearised step; block (j, k), j ≥ k, is
-    A_{n_j - 1} ⋯ A_{n_k} Sigma_{n_k}.
-    """
-    n2 = plan.mean.shape[1]
-    K = len(steps)
-    A = {}
-    C = np.zeros((K * n2, K * n2))
-    for k, n_k in enumerate(steps):
-        block, at = plan.cov[n_k], n_k
-        C[k * n2:(k + 1) * n2, k * n2:(k + 1) * n2] = block
-        for j in range(k + 1, K):
-            for i in range(at, steps[j]):
-                if i not in A:
-                    A[i] = np.asarray(step_jacobians(plan.mean[i], plan.torque[i])[1])
-                block = A[i] @ block
-            at = steps[j]
-            C[j * n2:(j + 1) * n2, k * n2:(k + 1) * n2] = block
-            C[k * n2:(k + 1) * n2, j * n2:(j + 1) * n2] = block.T
-    return C
-
-
-def prefix_log_likelihoods(plan: Plan, states: np.ndarray, steps: np.ndarray, R: np.ndarray, step_jacobians) -> np.ndarray:
-    """log N(s_1..k; plan belief + R) for every prefix k = 1..K: states (K, 2n), steps (K,) -> (K,)."""
-    n2 = states.shape[1]
-    residual = (states - plan.mean[steps]).ravel()
-    C = joint_state_covariance(plan, steps, step_jacobians) + np.kron(np.eye(len(steps)), R)
-    out = np.zeros(len(steps))
-    for k in range(len(steps)):
-        m = (k + 1) * n2
-        L = np.linalg.cholesky(C[:m, :m])
-        z = np.linalg.solve(L, residual[:m])
-        out[k] = -0.5 * (z @ z) - np.sum(np.log(np.diag(L))) - 0.5 * m * np.log(2 * np.pi)
-    return out
+                "status": self.status, "message": self.message, "solve_time": self.solve_time}
 
 
 def goal_posterior(model, start, observed_states, times, candidate_goals, width: float | None = None, *,
                    prior=None, observation_std=OBSERVATION_STD, warm_start: GoalPosterior | None = None,
-                   max_wall_time: float | None = None) -> GoalPosterior:
+                   max_wall_time: float | None = None, cache: EstimatorCache | None = None) -> GoalPosterior:
     """Probability of each candidate goal given states observed during a reach, after each observation.
 
     Args:
-        model: a :class:`~comanip.ReachingModel` (its planner is built once and reused across calls) or a
-            :class:`~comanip.Planner`.
+        model: a :class:`~comanip.ReachingModel`, a :class:`~comanip.Planner` or a :class:`GoalEstimator`;
+            the planner a model or planner needs is built once and kept in ``cache``.
         start: start state s_0 (2n,) of the reach, m and m/s (rad, rad/s for joints).
         observed_states: observed states [q; qdot] (K, 2n), in time order; a single state may be (2n,).
         times: their times (K,) after the start, s, non-decreasing, in [0, H·h]; each is scored at the
@@ -161,12 +113,14 @@ def goal_posterior(model, start, observed_states, times, candidate_goals, width:
         warm_start: a previous posterior. With the same start, candidates and width its plans are reused
             (a new observation costs no solve); otherwise they warm-start the new plans.
         max_wall_time: planning budget (s) per candidate; a late plan is used as it stands.
+        cache: where the planner is kept between calls; None: the package's default cache
+            (:data:`comanip.estimation.goal_estimate.DEFAULT_CACHE`).
 
     Returns:
         A :class:`GoalPosterior`; ``probabilities[k]`` is the posterior after observations 0..k.
     """
-    planner: Planner = shared_planner(model)
-    model = planner.model
+    estimator = (cache or DEFAULT_CACHE).estimator(model)
+    planner, model = estimator.planner, estimator.model
     t_begin = time.perf_counter()
     start, _, width = planner.check_inputs(start, np.zeros(model.d), width)
     states, times, steps = observed_sequence(model, observed_states, times)
@@ -176,8 +130,7 @@ def goal_posterior(model, start, observed_states, times, candidate_goals, width:
     max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
 
     plans = _candidate_plans(planner, start, candidates, width, warm_start, max_wall_time)
-    step_jacobians = shared_step_jacobians(model)
-    log_likelihoods = np.column_stack([prefix_log_likelihoods(plan, states, steps, R, step_jacobians) for plan in plans])
+    log_likelihoods = np.column_stack([prefix_log_likelihoods(plan, states, steps, R, estimator.step_jacobians) for plan in plans])
     log_posterior = np.log(prior) + log_likelihoods
     probabilities = np.exp(log_posterior - logsumexp(log_posterior, axis=1, keepdims=True))
     return GoalPosterior(candidates=candidates, times=times, steps=steps, probabilities=probabilities,

@@ -9,7 +9,7 @@ infinitely long movement (on the Cartesian preset at 0.165 s the fitted goal lay
 So the model answers itself: goals are tried on the ray from the observed hand position x_o along its
 velocity (for a point mass starting at rest, the very line of the reach) at distances D in
 [D_min, D_max], and each is scored by the log-likelihood of the observed state under its plan's belief
-(:func:`comanip.estimation.goal_posterior.prefix_log_likelihoods`). A bounded Brent search in log D
+(:func:`comanip.estimation.observation.prefix_log_likelihoods`). A bounded Brent search in log D
 (scipy) needs about a dozen plans, each warm-started from the nearest distance already tried.
 """
 
@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 from scipy.optimize import minimize_scalar
 
-from comanip.estimation.goal_posterior import prefix_log_likelihoods
+from comanip.estimation.observation import prefix_log_likelihoods
 from comanip.objectives.reward import goal_covariance
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner

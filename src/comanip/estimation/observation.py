@@ -1,4 +1,5 @@
-"""Observations of a reach in progress: checked states, their times, and the plan steps they belong to.
+"""Observations of a reach in progress: checked states, their times, the plan steps they belong to, and
+their likelihood under a plan's belief.
 
 An observation is a state s_o = [q; qdot] (2n,) measured at a time t_o (s) after the reach started. The plan
 lives on the grid t_i = i·h, so an observation belongs to step n_o = floor(t_o / h), the nearest *earlier*
@@ -11,7 +12,7 @@ What an observation can tell about the goal depends on its step (forward Euler, 
 - n_o ≥ 2 (t_o ≥ 2h): the whole state depends on the torques; an estimate holds its plan to all of it.
 - n_o = 1 (h ≤ t_o < 2h): q_1 = q_0 + h qdot_0 is fixed by the start, and only the velocity qdot_1 (through
   tau_0) depends on the torques: an estimate holds its plan to the observed velocity only, and reports
-  the position's mismatch (``extras["observation_residual"]``).
+  the position's mismatch (``GoalEstimate.observation_residual``).
 - n_o = 0 (0 < t_o < h): the state at step 0 is the start itself; the observation says nothing about the
   goal. An estimate is then the plan to the prior goal (status 'uninformative'), and without a prior goal
   there is nothing to return (ValueError).
@@ -23,8 +24,13 @@ import math
 
 import numpy as np
 
-from comanip.arguments import as_matrix, as_vector
+from comanip.arguments import as_matrix, as_positive, as_vector
 from comanip.model import ReachingModel
+from comanip.planning.plan import Plan
+
+#: Default observation-noise floor: standard deviation of a measured position (m or rad) and velocity
+#: (m/s or rad/s). About what motion capture or joint encoders with differentiated velocity deliver.
+OBSERVATION_STD = (1e-3, 1e-2)
 
 #: Relative slack on t/h so that times on the grid are not floored one step early by rounding.
 _GRID_SLACK = 1e-9
@@ -82,3 +88,52 @@ def observed_sequence(model: ReachingModel, states, times) -> tuple[np.ndarray, 
         raise ValueError(f"times must be non-decreasing (s), got {times.tolist()}")
     steps = np.array([observation_step(model, t, allow_start=True, name="times") for t in times])
     return states, times, steps
+
+
+def observation_covariance(observation_std, n: int) -> np.ndarray:
+    """R (2n, 2n) = diag(sigma_q² I_n, sigma_qdot² I_n) from observation_std = (sigma_q, sigma_qdot)."""
+    try:
+        sigma_q, sigma_qdot = observation_std
+    except (TypeError, ValueError):
+        raise ValueError(f"observation_std must be a pair (position std, velocity std) in state units, got {observation_std!r}") from None
+    sigma_q = as_positive("observation_std[0]", sigma_q, "m or rad")
+    sigma_qdot = as_positive("observation_std[1]", sigma_qdot, "m/s or rad/s")
+    return np.diag(np.r_[np.full(n, sigma_q**2), np.full(n, sigma_qdot**2)])
+
+
+def joint_state_covariance(plan: Plan, steps: np.ndarray, step_jacobians) -> np.ndarray:
+    """Covariance (2nK, 2nK) of the states at non-decreasing steps (K,) under the plan's open-loop belief.
+
+    ``step_jacobians(mu_i, tau_i) -> (f, A_i, B_i)`` is the body's linearised step; block (j, k), j ≥ k, is
+    A_{n_j - 1} ⋯ A_{n_k} Sigma_{n_k}.
+    """
+    n2 = plan.mean.shape[1]
+    K = len(steps)
+    A = {}
+    C = np.zeros((K * n2, K * n2))
+    for k, n_k in enumerate(steps):
+        block, at = plan.cov[n_k], n_k
+        C[k * n2:(k + 1) * n2, k * n2:(k + 1) * n2] = block
+        for j in range(k + 1, K):
+            for i in range(at, steps[j]):
+                if i not in A:
+                    A[i] = np.asarray(step_jacobians(plan.mean[i], plan.torque[i])[1])
+                block = A[i] @ block
+            at = steps[j]
+            C[j * n2:(j + 1) * n2, k * n2:(k + 1) * n2] = block
+            C[k * n2:(k + 1) * n2, j * n2:(j + 1) * n2] = block.T
+    return C
+
+
+def prefix_log_likelihoods(plan: Plan, states: np.ndarray, steps: np.ndarray, R: np.ndarray, step_jacobians) -> np.ndarray:
+    """log N(s_1..k; plan belief + R) for every prefix k = 1..K: states (K, 2n), steps (K,) -> (K,)."""
+    n2 = states.shape[1]
+    residual = (states - plan.mean[steps]).ravel()
+    C = joint_state_covariance(plan, steps, step_jacobians) + np.kron(np.eye(len(steps)), R)
+    out = np.zeros(len(steps))
+    for k in range(len(steps)):
+        m = (k + 1) * n2
+        L = np.linalg.cholesky(C[:m, :m])
+        z = np.linalg.solve(L, residual[:m])
+        out[k] = -0.5 * (z @ z) - np.sum(np.log(np.diag(L))) - 0.5 * m * np.log(2 * np.pi)
+    return out

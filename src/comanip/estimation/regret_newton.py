@@ -1,8 +1,8 @@
 """Goal estimation as inverse planning: the goal whose plan the observed state departs from least.
 
-Notation as in :mod:`comanip.planning.reach_problem`: torques tau (H·n,) stacked step by step, start s_0,
-goal g (d,) m, width w (m), W = W(w) (d, d), the SPEC §4 objective J(tau, g), and the mean state mu_no(tau)
-at the observed step n_o. Objectives are divided by the planner's normaliser |J_best(w)| (the best
+Notation as in :mod:`comanip.planning.reach_problem` and ``docs/notation.md``: torques tau (H·n,) stacked
+step by step, start s_0, goal g (d,) m, width w (m), W = W(w) (d, d), the SPEC §4 objective J(tau, g), and
+the mean state mu_no(tau) at the observed step n_o. Objectives are divided by the planner's normaliser |J_best(w)| (the best
 attainable J), so the numbers the solver sees lie in about [-1, 0] for every width.
 
 **Why not eq. 11 as printed.** The paper (Section V-C, SPEC §7) estimates the goal by
@@ -65,28 +65,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from comanip.estimation.regret_system import Linearisation, RegretPoint, RegretSystem
+from comanip.optim import SolverResult, Status, backtrack
 from comanip.planning.path_limits import LIMIT_TOLERANCE
-
-
-@dataclass
-class NewtonResult:
-    """Where :func:`newton_solve` stopped and why."""
-
-    point: RegretPoint
-    status: str
-    """'solved', 'solved_acceptable' (approximate Jacobian, see the module docstring), 'max_iterations',
-    'max_wall_time', 'not_a_minimum' or 'failed'."""
-    message: str
-    iterations: int
-    residual: float
-    """max |F| at the returned point (normalised gradient units; m, m/s or rad, rad/s for F2)."""
-    regret: float
-    """J(tau_c) - J(tau_s) at the returned point, normalised (without the regulariser)."""
 
 
 def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, prior,
                  width: float, *, observed_position: np.ndarray, tolerance: float, max_iterations: int, step_fraction: float,
-                 expired) -> NewtonResult:
+                 expired) -> SolverResult[RegretPoint]:
     """Newton's method on F from ``point`` until max |F| ≤ tolerance, then the second-order check.
 
     Globalised by a trust region on the goal step, judged by the regret itself: a trial point is kept when
@@ -99,79 +84,134 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
     (the observed end effector, m). ``observed_rows`` are the entries of the state s_o (2n,) the
     constrained plan must meet. ``expired()`` is asked before every step (wall-time budget).
     ``max_iterations`` bounds the number of linearisations (two Hessians of J each), which the result
-    reports as iterations. Never raises: when the iteration does not converge, the last accepted iterate
-    is returned with a status.
+    reports as ``nit``. Never raises: when the iteration does not converge, the last accepted iterate
+    is returned with a status ('solved', 'solved_acceptable' (approximate Jacobian, see the module
+    docstring), 'max_iterations', 'max_wall_time', 'not_a_minimum' or 'failed').
+
+    Returns:
+        A :class:`~comanip.optim.SolverResult`: x the point, fun the normalised regret J(tau_c) - J(tau_s)
+        (without the regulariser), optimality max |F| (normalised gradient units; m, m/s or rad, rad/s for F2).
     """
-    count = 0
+    problem = _Problem(system, start, observed, n_o, observed_rows, prior, width)
+    linearise, moved = problem.linearise, problem.moved
     excluded_c = system.limits_at_step(n_o) if system.path_limits.active else np.zeros(0, dtype=int)
 
-    def linearise(at: RegretPoint) -> Linearisation:
-        return system.linearise(at, start, observed, n_o, observed_rows, prior, width)
-
-    def moved(base: RegretPoint, step: RegretPoint, scale: float = 1.0) -> tuple[RegretPoint, Linearisation]:
-        nonlocal count
-        count += 1
-        at = base.plus(step, scale)
-        return at, linearise(at)
+    def ceiling_at(at: RegretPoint) -> float:
+        return step_fraction * max(np.linalg.norm(at.goal - observed_position), width)
 
     linearisation = linearise(point)
     # the limits binding at the start (within 1e-4) are held from the first step on
     updated = _updated_active_sets(point, linearisation, excluded_c, threshold=-_INITIAL_MARGIN)
     if updated is not None:
         point, linearisation = updated, linearise(updated)
-    radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-    status, message = "max_iterations", f"no convergence in {max_iterations} Newton iterations"
+    radius = ceiling_at(point)
+    status, message = Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations"
     active_set_rounds = 0
     while True:
         residual = linearisation.residual
         if not np.isfinite(residual):
-            return NewtonResult(point, "failed", "J is not finite at the starting point", count, residual, np.nan)
+            return SolverResult(point, np.nan, Status.FAILED, "J is not finite at the starting point", problem.count, residual)
         try:
-            converged = "solved" if residual <= tolerance else None
+            converged = Status.SOLVED if residual <= tolerance else None
             if converged is None and not system.exact and _acceptable_without_exact_jacobian(linearisation, point, width, radius):
-                converged = "solved_acceptable"
+                converged = Status.SOLVED_ACCEPTABLE
             if converged is not None:
                 updated = _updated_active_sets(point, linearisation, excluded_c, threshold=LIMIT_TOLERANCE)
-                if updated is not None and active_set_rounds < _ACTIVE_SET_ROUNDS and count < max_iterations:
+                if updated is not None and active_set_rounds < _ACTIVE_SET_ROUNDS and problem.count < max_iterations:
                     active_set_rounds += 1
                     point, linearisation = updated, linearise(updated)
-                    radius = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
+                    radius = ceiling_at(point)
                     continue
-                is_minimum, why = linearisation.is_strict_minimum(system.exact)
-                message = "converged" if converged == "solved" else \
-                    "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
-                status, message = (converged, message) if is_minimum else ("not_a_minimum", why)
-                return NewtonResult(point, status, message, count, residual, linearisation.J_c - linearisation.J_s)
-            if count >= max_iterations:
+                return _converged_result(converged, point, linearisation, system.exact, problem.count)
+            if problem.count >= max_iterations:
                 break
             if expired():
-                status, message = "max_wall_time", "the wall-time budget ran out"
+                status, message = Status.MAX_WALL_TIME, "the wall-time budget ran out"
                 break
             # with an approximate Jacobian, once no goal step longer than the acceptable one lowers the
             # regret, the goal has settled as far as the approximation can tell: only the plans move on
             settled = not system.exact and radius <= _ACCEPTABLE_GOAL_STEP * width
             if not settled:
-                ceiling = step_fraction * max(np.linalg.norm(point.goal - observed_position), width)
-                step = linearisation.step(min(radius, ceiling), point)
-                trial, trial_linearisation = moved(point, step)
-                if _acceptable(linearisation, trial_linearisation):
-                    point, linearisation = trial, trial_linearisation
-                    radius = min(2 * radius, ceiling) if np.linalg.norm(step.goal) >= 0.99 * min(radius, ceiling) else radius
+                accepted, point, linearisation, radius = _goal_step(problem, point, linearisation, radius, ceiling_at(point))
+                if accepted:
                     continue
-                radius = 0.25 * np.linalg.norm(step.goal)
                 if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
-                    status, message = "failed", "the Newton iteration stalled (no goal step lowers the regret)"
+                    status, message = Status.FAILED, "the Newton iteration stalled (no goal step lowers the regret)"
                     break
             inner_step = linearisation.step(0.0, point)
-            scale = 1.0 if system.exact else _inner_step_length(system, point, inner_step, linearisation, start, observed,
-                                                                 n_o, observed_rows, width)
+            scale = 1.0 if system.exact else problem.inner_step_length(point, inner_step, linearisation)
             inner, inner_linearisation = moved(point, inner_step, scale)
         except np.linalg.LinAlgError:
-            status, message = "failed", "a Newton system was singular (the observation does not pin the torques down)"
+            status, message = Status.FAILED, "a Newton system was singular (the observation does not pin the torques down)"
             break
         if np.isfinite(inner_linearisation.residual):
             point, linearisation = inner, inner_linearisation
-    return NewtonResult(point, status, message, count, linearisation.residual, linearisation.J_c - linearisation.J_s)
+    return SolverResult(point, linearisation.J_c - linearisation.J_s, status, message, problem.count, linearisation.residual)
+
+
+def _goal_step(problem: "_Problem", point: RegretPoint, linearisation: Linearisation, radius: float,
+               ceiling: float) -> tuple[bool, RegretPoint, Linearisation, float]:
+    """One trust-region step on the goal, of length at most min(radius, ceiling) (m): (True, the new point, its
+    linearisation, the radius doubled if the step was that long) when the trial is acceptable; (False, the
+    point, its linearisation, a quarter of the tried goal step) otherwise."""
+    step = linearisation.step(min(radius, ceiling), point)
+    trial, trial_linearisation = problem.moved(point, step)
+    if _acceptable(linearisation, trial_linearisation):
+        grown = min(2 * radius, ceiling) if np.linalg.norm(step.goal) >= 0.99 * min(radius, ceiling) else radius
+        return True, trial, trial_linearisation, grown
+    return False, point, linearisation, 0.25 * np.linalg.norm(step.goal)
+
+
+def _converged_result(converged: Status, point: RegretPoint, linearisation: Linearisation, exact: bool,
+                      count: int) -> SolverResult[RegretPoint]:
+    """The result at a point that meets the convergence test ``converged``, after the second-order check."""
+    is_minimum, why = linearisation.is_strict_minimum(exact)
+    message = "converged" if converged == Status.SOLVED else \
+        "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
+    status, message = (converged, message) if is_minimum else (Status.NOT_A_MINIMUM, why)
+    return SolverResult(point, linearisation.J_c - linearisation.J_s, status, message, count, linearisation.residual)
+
+
+@dataclass
+class _Problem:
+    """One estimate's fixed data (start, observation, prior, width) and the linearisations made so far."""
+
+    system: RegretSystem
+    start: np.ndarray
+    observed: np.ndarray
+    n_o: int
+    observed_rows: np.ndarray
+    prior: np.ndarray | None
+    width: float
+    count: int = 0
+    """Linearisations at moved points (the iterations reported)."""
+
+    def linearise(self, at: RegretPoint) -> Linearisation:
+        return self.system.linearise(at, self.start, self.observed, self.n_o, self.observed_rows, self.prior, self.width)
+
+    def moved(self, base: RegretPoint, step: RegretPoint, scale: float = 1.0) -> tuple[RegretPoint, Linearisation]:
+        self.count += 1
+        at = base.plus(step, scale)
+        return at, self.linearise(at)
+
+    def inner_step_length(self, point: RegretPoint, step: RegretPoint, linearisation: Linearisation) -> float:
+        """Step length alpha in (0, 1] for the plans' Newton step at a fixed goal (approximate Jacobian): the
+        first of 1, 1/2, ... that lowers the plans' l1 merits by 1e-4 of the predicted decrease (Armijo), as
+        the planner's SQP does; 1/64 if none does (or if the step does not descend)."""
+        after = point.plus(step)
+        weights = (2 * np.abs(np.r_[after.lam, after.nu_c]).max(initial=0.0), 2 * np.abs(after.nu_s).max(initial=0.0))
+        n_c = len(point.lam) + len(point.nu_c)
+        # along a step that meets the linearised constraints, d|c|_1/dalpha = -|c|_1
+        slope = (linearisation.grad_c @ step.tau_c - weights[0] * np.abs(linearisation.F2[:n_c]).sum()
+                 + linearisation.grad_s @ step.tau_s - weights[1] * np.abs(linearisation.F5).sum())
+        fixed = (self.start, self.observed, self.n_o, self.observed_rows, self.width, weights)
+        merit = self.system.merits(point, *fixed)
+
+        def attempt(alpha: float, bound: float) -> bool | None:
+            trial = self.system.merits(point.plus(step, alpha), *fixed)
+            return True if np.isfinite(trial) and trial <= bound else None
+
+        return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS)[0]
 
 
 def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
@@ -181,27 +221,6 @@ def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
     if not np.isfinite(after):
         return False
     return after < before or (trial.residual < 0.5 * current.residual and after < before + _ROUNDING * (1 + abs(before)))
-
-
-def _inner_step_length(system: RegretSystem, point: RegretPoint, step: RegretPoint, linearisation: Linearisation,
-                       start, observed, n_o: int, observed_rows: np.ndarray, width: float) -> float:
-    """Step length alpha in (0, 1] for the plans' Newton step at a fixed goal (approximate Jacobian): the
-    first of 1, 1/2, ... that lowers the plans' l1 merits by 1e-4 of the predicted decrease (Armijo), as the
-    planner's SQP does; the shortest tried if none does (or if the step does not descend)."""
-    after = point.plus(step)
-    weights = (2 * np.abs(np.r_[after.lam, after.nu_c]).max(initial=0.0), 2 * np.abs(after.nu_s).max(initial=0.0))
-    n_c = len(point.lam) + len(point.nu_c)
-    # along a step that meets the linearised constraints, d|c|_1/dalpha = -|c|_1
-    slope = (linearisation.grad_c @ step.tau_c - weights[0] * np.abs(linearisation.F2[:n_c]).sum()
-             + linearisation.grad_s @ step.tau_s - weights[1] * np.abs(linearisation.F5).sum())
-    merit = system.merits(point, start, observed, n_o, observed_rows, width, weights)
-    alpha = 1.0
-    while alpha > _SHORTEST_INNER_STEP:
-        trial = system.merits(point.plus(step, alpha), start, observed, n_o, observed_rows, width, weights)
-        if np.isfinite(trial) and trial <= merit + _ARMIJO * alpha * min(slope, 0.0):
-            break
-        alpha *= 0.5
-    return alpha
 
 
 def _acceptable_without_exact_jacobian(linearisation: Linearisation, point: RegretPoint, width: float, radius: float) -> bool:
@@ -237,9 +256,8 @@ def _updated_active_set(active, nu, limits, threshold, excluded) -> tuple[np.nda
 _SHORTEST_GOAL_STEP = 1e-7
 #: Relative change of the (normalised) regret below which it no longer tells steps apart.
 _ROUNDING = 1e-10
-#: Inner steps (approximate Jacobian) are halved down to this fraction, until they achieve this fraction of
-#: the linearly predicted decrease of the merit.
-_SHORTEST_INNER_STEP, _ARMIJO = 1.0 / 64, 1e-4
+#: Inner steps (approximate Jacobian) tried: 1, 1/2, ..., 1/32, then 1/64 taken untried.
+_INNER_STEPS = 6
 #: 'solved_acceptable' (approximate Jacobian): plan stationarity, constraint error (state units), goal step (goal widths).
 _ACCEPTABLE_GRADIENT, _ACCEPTABLE_CONSTRAINT_ERROR, _ACCEPTABLE_GOAL_STEP = 1e-3, 1e-4, 1e-2
 #: Limits within this distance of binding at the start (rad, rad/s) are held from the first step.

@@ -1,6 +1,6 @@
 """The regret's first-order conditions F and their Jacobian at an iterate (see :mod:`comanip.estimation.regret_newton`).
 
-Notation: torques tau (H·n,), goal g (d,), J normalised by |J_best(w)|; the constrained plan tau_c with
+Notation (``docs/notation.md``): torques tau (H·n,), goal g (d,), J normalised by |J_best(w)|; the constrained plan tau_c with
 multipliers lam of the observation constraint (rows ``observed_rows`` of mu_no(tau_c) = s_o) and nu_c of
 the path limits it holds as equalities (``active_c``); the plan tau_s with multipliers nu_s of its active
 limits (``active_s``). Path limits are those of :mod:`comanip.planning.path_limits` (joint positions and
@@ -26,10 +26,12 @@ import numpy as np
 import scipy.linalg
 
 from comanip.objectives.reward import goal_covariance
+from comanip.optim import decade_shifts, shifted_cholesky
 from comanip.planning.compiled import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
 from comanip.planning.planner import Planner
+from comanip.planning.terms import ReachTerms
 
 _NO_INDICES = np.zeros(0, dtype=int)
 
@@ -74,8 +76,8 @@ class Derivatives:
     """d²J/dtau dg (H·n, d)."""
     hess_gg: np.ndarray
     """d²J/dg² (d, d)."""
-    data: tuple
-    """What the curvature object's ``evaluate`` returned (for further terms of the same point)."""
+    data: ReachTerms
+    """What the curvature's ``evaluate`` returned (for further terms of the same point)."""
 
 
 class RegretSystem:
@@ -139,11 +141,7 @@ class RegretSystem:
         params = np.r_[start, point.goal, width]
         for tau, active, mu, observe in ((point.tau_c, point.active_c, weights[0], True),
                                          (point.tau_s, point.active_s, weights[1], False)):
-            tau = np.asarray(tau, dtype=float)
-            if self.linear:
-                f, _, data = self.curvature.evaluate(tau, params)
-            else:  # the forward rollout alone: a sixth of the derivatives' cost on the Panda
-                f, data = self.curvature.value_and_mean(tau, params)
+            f, data = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
             violation = np.abs(self.limits(tau, data, _NO_INDICES)[0][active]).sum()
             if observe:
                 mean = self.observed_mean(n_o, tau, start, data)[0] if self.linear else self.curvature.mean_path(data)[n_o]
@@ -235,9 +233,8 @@ class Linearisation:
     @cached_property
     def _cholesky(self) -> tuple[tuple | None, tuple | None]:
         """Cholesky factors of H_c and H_s (shifted if ``regularise``), None where one is not positive definite."""
-        if self.regularise:
-            return _shifted_cholesky(self.H_c), _shifted_cholesky(self.H_s)
-        return _cholesky_or_none(self.H_c), _cholesky_or_none(self.H_s)
+        return tuple(shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))[0]
+                     for H in (self.H_c, self.H_s))
 
     @cached_property
     def _solves(self) -> tuple[np.ndarray, np.ndarray]:
@@ -335,20 +332,10 @@ def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
     return _cholesky_or_none(Z.T @ H @ Z) is not None
 
 
-def _shifted_cholesky(matrix: np.ndarray):
-    """Cholesky factor of matrix + delta·s·I, s = max |diag|, for the least delta in 0, 1e-8, 1e-7, ... that works."""
-    scale = max(float(np.abs(np.diag(matrix)).max()), 1e-300)
-    delta = 0.0
-    while True:
-        factor = _cholesky_or_none(matrix + delta * scale * np.eye(len(matrix)))
-        if factor is not None or delta > 1e6:
-            return factor
-        delta = 1e-8 if delta == 0.0 else 10 * delta
-
-
 def _cholesky_or_none(matrix: np.ndarray):
     """scipy's Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
-    try:
-        return scipy.linalg.cho_factor(0.5 * (matrix + matrix.T), check_finite=False)
-    except np.linalg.LinAlgError:
-        return None
+    return shifted_cholesky(_symmetric_part(matrix), (0.0,))[0]
+
+
+def _symmetric_part(matrix: np.ndarray) -> np.ndarray:
+    return 0.5 * (matrix + matrix.T)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from comanip.arguments import as_vector
+from comanip.arguments import as_count, as_vector
 
 
 @dataclass
@@ -74,8 +74,7 @@ def first_passage_deviations(paths, goal, n_points: int = 101) -> tuple[np.ndarr
     goal = as_vector("goal", goal, paths.shape[2], "m")
     if not np.allclose(paths[:, 0], paths[0, 0], atol=1e-12):
         raise ValueError("paths must share their first point (the start); they differ at sample 0")
-    if isinstance(n_points, bool) or not isinstance(n_points, (int, np.integer)) or n_points < 3:
-        raise ValueError(f"n_points must be an integer ≥ 3, got {n_points!r}")
+    as_count("n_points", n_points, 3)
     start = paths[0, 0]
     D = float(np.linalg.norm(goal - start))
     if D <= 0:

@@ -179,7 +179,7 @@ def plan_handover(plan: Plan, model: TransitionModel, ramp_time: float = DEFAULT
         raise ValueError("model must be a fitted comanip.TransitionModel (e.g. comanip.TransitionModel())")
     ramp_time, leading_stiffness, rate = check_schedule_arguments(ramp_time, leading_stiffness, rate)
     if not np.all(np.isfinite(plan.ee_mean)):
-        raise ValueError(f"plan holds a non-finite hand path (status {plan.status!r}); replan before handing over")
+        raise ValueError(f"plan holds a non-finite hand path (status '{plan.status}'); replan before handing over")
 
     goal = np.asarray(plan.goal, dtype=float)
     path = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))

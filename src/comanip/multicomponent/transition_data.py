@@ -23,7 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from comanip import presets
-from comanip.arguments import as_positive, as_positive_array
+from comanip.arguments import as_count, as_positive, as_positive_array
 from comanip.execution import execute_receding_horizon
 from comanip.model import ReachingModel
 from comanip.multicomponent.dispersion import bootstrap_transition_std, first_passage_deviations, profile_from_deviations
@@ -115,10 +115,10 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
     if distances.size == 0 or widths.size == 0:
         raise ValueError(f"distances_over_arm_length and widths must not be empty, got {distances.size} and {widths.size} values")
     arm_length = as_positive("arm_length", arm_length, "m")
-    n_trials = _integer_at_least("n_trials", n_trials, 3)
-    steps = default_steps(model) if steps is None else _integer_at_least("steps", steps, 1)
-    workers = _integer_at_least("workers", workers, 1)
-    seed = _integer_at_least("seed", seed, 0)
+    n_trials = as_count("n_trials", n_trials, 3)
+    steps = default_steps(model) if steps is None else as_count("steps", steps, 1)
+    workers = as_count("workers", workers, 1)
+    seed = as_count("seed", seed, 0)
 
     conditions = [(float(r), float(w)) for r in distances for w in widths]
     seeds = np.random.SeedSequence(seed).spawn(len(conditions))
@@ -164,8 +164,3 @@ def _planner_for(model_config: str) -> Planner:
     """One planner per model per process: a worker builds it on its first condition and reuses it."""
     return Planner(ReachingModel.from_config(json.loads(model_config)))
 
-
-def _integer_at_least(name: str, value, minimum: int) -> int:
-    if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < minimum:
-        raise ValueError(f"{name} must be an integer ≥ {minimum}, got {value!r}")
-    return int(value)

@@ -1,6 +1,6 @@
 """Objective, gradient and a structure-exploiting Hessian of the reaching problem, for Newton-type solvers.
 
-Notation (SPEC §2–4): torques tau (H, n), flattened step by step into x (H·n,); the end-effector belief at
+Notation (SPEC §2–4, ``docs/notation.md``): torques tau (H, n), flattened step by step into x (H·n,); the end-effector belief at
 step i as z_i = (mu_x,i (d,), vech Sigma_x,i (d(d+1)/2,)); the per-step reward term
 phi_i(z_i) = -w_i R(mu_x,i, Sigma_x,i). Everything is divided by |J_best(w)| (the planner's normaliser), so
 
@@ -32,10 +32,12 @@ from comanip.objectives.reach_objective import stopping_cost
 from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.terms import ReachTerms
 
 
 class ReachCurvature:
-    """f, its gradient and its Hessian for one model's reaching problem (linear bodies: exact).
+    """f, its gradient and its Hessian for one model's reaching problem (linear bodies: exact); a
+    :class:`~comanip.planning.terms.Curvature`.
 
     Parameters p = [s0 (2n,), goal (d,), width] as in the planner; x = tau flattened (H·n,).
 
@@ -47,6 +49,10 @@ class ReachCurvature:
 
     exact = True
     """The Hessian is exact."""
+    cheap_value = False
+    """One evaluation computes everything at once: there is no cheaper value-only one."""
+    carries_belief = False
+    """The data holds no mean path: a point mass's belief comes from the problem's expanded rollout."""
 
     def __init__(self, problem: ReachProblem, compile: bool = False):
         model = self.model = problem.model
@@ -120,18 +126,23 @@ class ReachCurvature:
             self._last_normaliser = (width, float(self._normaliser(width)))
         return self._last_normaliser[1]
 
-    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, tuple]:
+    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ReachTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
         s0, goal, width = self._split(params)
         f, grad, phi_hess, phi_grad = self._terms(x, s0, goal, width)
-        return float(f.item()), grad.ravel(), (x, width, phi_hess, phi_grad)
+        return float(f.item()), grad.ravel(), ReachTerms(x, width, phi_hess, phi_grad)
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         return self.evaluate(x, params)[0]
 
-    def hessian(self, data: tuple) -> np.ndarray:
+    def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, ReachTerms]:
+        """(f, data) at torques x: :meth:`evaluate` without the gradient (it costs the same)."""
+        f, _, data = self.evaluate(x, params)
+        return f, data
+
+    def hessian(self, data: ReachTerms) -> np.ndarray:
         """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
-        x, width, phi_hess, phi_grad = data
+        x, width, phi_hess, phi_grad = data.x, data.width, data.phi_hess, data.phi_grad
         model = self.model
         n, d, H = model.n, model.d, model.H
         nz = phi_hess.shape[0]
@@ -151,7 +162,7 @@ class ReachCurvature:
             hessian += self._stop_hessian
         return hessian
 
-    def goal_derivatives(self, data: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def goal_derivatives(self, data: ReachTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned, exact.
 
         phi_i depends on the goal only through mu_x,i - g (the reward is a density of their difference), so
@@ -159,7 +170,7 @@ class ReachCurvature:
         columns of the per-step derivatives the Hessian uses anyway. Then ∂f/∂g = Σ_i ∂phi_i/∂g,
         ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
         """
-        x, _, phi_hess, phi_grad = data
+        x, phi_hess, phi_grad = data.x, data.phi_hess, data.phi_grad
         H, d = self.model.H, self.model.d
         nz = phi_hess.shape[0]
         Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)

@@ -11,14 +11,23 @@ import time
 import casadi as ca
 import numpy as np
 
-#: IPOPT return_status -> (comanip status, success); a status not listed maps to ("failed", False).
+from comanip.optim import Status
+
+#: IPOPT return_status -> comanip status; a status not listed maps to 'failed'.
 IPOPT_STATUS = {
-    "Solve_Succeeded": ("solved", True),
-    "Solved_To_Acceptable_Level": ("solved_acceptable", True),
-    "Maximum_Iterations_Exceeded": ("max_iterations", False),
-    "Maximum_WallTime_Exceeded": ("max_wall_time", False),
-    "Maximum_CpuTime_Exceeded": ("max_wall_time", False),
+    "Solve_Succeeded": Status.SOLVED,
+    "Solved_To_Acceptable_Level": Status.SOLVED_ACCEPTABLE,
+    "Maximum_Iterations_Exceeded": Status.MAX_ITERATIONS,
+    "Maximum_WallTime_Exceeded": Status.MAX_WALL_TIME,
+    "Maximum_CpuTime_Exceeded": Status.MAX_WALL_TIME,
 }
+
+
+def ipopt_status(stats: dict, deadline: "IpoptDeadline") -> Status:
+    """The status of a finished IPOPT solve from its ``stats()``; a stop the deadline asked for is 'max_wall_time'."""
+    if stats["return_status"] == "User_Requested_Stop" and deadline.expired:
+        return Status.MAX_WALL_TIME
+    return IPOPT_STATUS.get(stats["return_status"], Status.FAILED)
 
 
 class IpoptDeadline(ca.Callback):

@@ -31,11 +31,12 @@ from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
 from comanip.planning.curvature import _causal_gram, _noise_second_derivatives, _reward_derivatives_function
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.terms import ArmTerms, Rollout
 
 
 class LinearisedCurvature:
-    """f, its exact gradient and an approximate Hessian for a nonlinear body; same interface as
-    :class:`comanip.planning.curvature.ReachCurvature`.
+    """f, its exact gradient and an approximate Hessian for a nonlinear body; a
+    :class:`~comanip.planning.terms.Curvature`, like :class:`comanip.planning.curvature.ReachCurvature`.
 
     Args:
         problem: the model's :class:`ReachProblem` (its weights and normaliser are used).
@@ -45,6 +46,10 @@ class LinearisedCurvature:
 
     exact = False
     """The Hessian is an approximation (the solver adds secant corrections)."""
+    cheap_value = True
+    """:meth:`value_and_data` is the forward rollout alone, a sixth of :meth:`evaluate`'s cost."""
+    carries_belief = True
+    """The data holds the mean path, its sensitivities and the covariances."""
 
     def __init__(self, problem: ReachProblem, compile: bool = True):
         model = self.model = problem.model
@@ -54,7 +59,6 @@ class LinearisedCurvature:
         terms, value = self._functions(problem)
         self._terms = BufferedFunction(compiled(terms) if compile else terms)
         self._value = BufferedFunction(compiled(value) if compile else value)
-        self._sensitivities = (None, None)  # (data, T): the last mean_sensitivities, reused by hessian and limits
         self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
         self._last_normaliser = (None, 1.0)
         self._noise_hessian = _noise_second_derivatives(model)
@@ -62,7 +66,8 @@ class LinearisedCurvature:
     def _functions(self, problem: ReachProblem) -> tuple[ca.Function, ca.Function]:
         """The per-solve functions, both ``(x, s0, goal, width) -> ...`` with per-step outputs stacked horizontally:
 
-        - terms: ``(f, grad, mean, cov, A, B, J, phi_hess, phi_grad, W, dvech/dq)`` (see :meth:`evaluate`);
+        - terms: ``(f, grad, mean, cov, A, B, J, phi_hess, phi_grad, W, dvech/dq)``, the last nine the fields of
+          :class:`~comanip.planning.terms.ArmTerms` (W its ``kinematic_hessian``);
         - value: ``(f, mean)``, the forward rollout alone (0.4 ms against the terms' 2.4 ms on the Panda), for line-search
           trials and comparisons of initial guesses.
         """
@@ -98,45 +103,46 @@ class LinearisedCurvature:
             self._last_normaliser = (width, float(self._normaliser(width)))
         return self._last_normaliser[1]
 
-    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, tuple]:
+    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ArmTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""
         n2, d = 2 * self.model.n, self.model.d
-        out = self._terms(x, params[:n2], params[n2:n2 + d], params[-1])
-        return float(out[0].item()), out[1].ravel(), (np.array(x, dtype=float), params[-1], *out[2:])
+        f, grad, *terms = self._terms(x, params[:n2], params[n2:n2 + d], params[-1])
+        return float(f.item()), grad.ravel(), ArmTerms(x=np.array(x, dtype=float), width=params[-1],
+                                                       **dict(zip(_TERM_FIELDS, terms)))
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
-        return self.value_and_mean(x, params)[0]
+        return self.value_and_data(x, params)[0]
 
-    def value_and_mean(self, x: np.ndarray, params: np.ndarray) -> tuple[float, tuple]:
+    def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, Rollout]:
         """(f, data for :meth:`mean_path`) at torques x: the forward rollout alone, without derivatives."""
         n2, d = 2 * self.model.n, self.model.d
         f, means = self._value(x, params[:n2], params[n2:n2 + d], params[-1])
-        return float(f.item()), (np.array(x, dtype=float), params[-1], means)
+        return float(f.item()), Rollout(np.array(x, dtype=float), params[-1], means)
 
     @staticmethod
-    def mean_path(data: tuple) -> np.ndarray:
-        """Mean state trajectory (H+1, 2n) from the data of :meth:`evaluate` or :meth:`value_and_mean`."""
-        return data[2].T.copy()
+    def mean_path(data: ArmTerms | Rollout) -> np.ndarray:
+        """Mean state trajectory (H+1, 2n) from the data of :meth:`evaluate` or :meth:`value_and_data`."""
+        return data.mean.T.copy()
 
-    def mean_sensitivities(self, data: tuple) -> np.ndarray:
+    def mean_sensitivities(self, data: ArmTerms) -> np.ndarray:
         """T[i, :, k, :] = d mu_i / d tau_k (H+1, 2n, H, n) along the mean of the evaluated torques (exact).
 
-        The last result is kept: the Hessian and the limits' rows ask for the same evaluation's T.
+        Kept in ``data.sensitivities``: the Hessian and the limits' rows ask for the same evaluation's T.
         """
-        if self._sensitivities[0] is data:
-            return self._sensitivities[1]
+        if data.sensitivities is not None:
+            return data.sensitivities
         model = self.model
         n, H = model.n, model.H
-        A = data[4].reshape(2 * n, H, 2 * n).transpose(1, 0, 2)
-        B = data[5].reshape(2 * n, H, n).transpose(1, 0, 2)
+        A = data.A.reshape(2 * n, H, 2 * n).transpose(1, 0, 2)
+        B = data.B.reshape(2 * n, H, n).transpose(1, 0, 2)
         T = np.zeros((H + 1, 2 * n, H, n))
         for i in range(H):
             T[i + 1, :, :i] = (A[i] @ T[i, :, :i].reshape(2 * n, -1)).reshape(2 * n, i, n)
             T[i + 1, :, i] = B[i]
-        self._sensitivities = (data, T)
+        data.sensitivities = T
         return T
 
-    def hessian(self, data: tuple) -> np.ndarray:
+    def hessian(self, data: ArmTerms) -> np.ndarray:
         """Approximate ∇²f (H·n, H·n) from the data :meth:`evaluate` returned.
 
         The rows of step i are Z_i = [X_i T_i; N_i] with X_i = [J_i; d vech/dq_i] acting on the joint
@@ -146,7 +152,8 @@ class LinearisedCurvature:
         (2n, n) blocks) in place of a Gram product over 16 rows per step; the noise rows and their cross terms
         are contracted apart (4.1 → 2.7 ms per Hessian on the Panda, benchmarks/README.md).
         """
-        x, width, _, _, A, B, J, phi_hess, phi_grad, W, dvech = data
+        x, width, A, B, J, phi_hess, phi_grad, W, dvech = (data.x, data.width, data.A, data.B, data.J, data.phi_hess,
+                                                           data.phi_grad, data.kinematic_hessian, data.dvech)
         model = self.model
         n, d, H = model.n, model.d, model.H
         nv, nz = len(self._triangle), phi_hess.shape[0]
@@ -183,7 +190,7 @@ class LinearisedCurvature:
         hessian[np.diag_indices(H * n)] += 2 * model.nu / self.normaliser(width)
         return hessian
 
-    def goal_derivatives(self, data: tuple) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def goal_derivatives(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned.
 
         phi_i depends on the goal only through x_ee(q_i) - g, so ∂phi_i/∂g = -∂phi_i/∂mu_x,i and
@@ -192,7 +199,7 @@ class LinearisedCurvature:
         forming them. ∂f/∂g, ∂²f/∂g² and the mean rows' part of ∂²f/∂x∂g are exact; the covariance rows'
         part carries the Hessian's approximation (A_i, B_i held along the path).
         """
-        x, _, _, _, _, _, J, phi_hess, phi_grad, W, dvech = data
+        x, J, phi_hess, phi_grad, dvech = data.x, data.J, data.phi_hess, data.phi_grad, data.dvech
         model = self.model
         n, d, H = model.n, model.d, model.H
         nv, nz = len(self._triangle), phi_hess.shape[0]
@@ -242,10 +249,14 @@ class LinearisedCurvature:
         gram = _causal_gram(N, (Q_cc @ N.reshape(H + 1, -1, H * n) + 2 * R).reshape(-1, H * n), len(a), n)
         return 0.5 * (gram + gram.T)
 
-    def trajectory(self, data: tuple) -> tuple[np.ndarray, np.ndarray]:
+    def trajectory(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray]:
         """Mean (H+1, 2n) and covariance (H+1, 2n, 2n) of the evaluated torques."""
         n2, H = 2 * self.model.n, self.model.H
-        return data[2].T.copy(), data[3].reshape(n2, H + 1, n2).transpose(1, 0, 2).copy()
+        return data.mean.T.copy(), data.cov.reshape(n2, H + 1, n2).transpose(1, 0, 2).copy()
+
+
+_TERM_FIELDS = ("mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "kinematic_hessian", "dvech")
+"""The per-solve function's outputs after (f, grad), in order, named as the fields of :class:`ArmTerms`."""
 
 
 def _stage_cost_function(model) -> ca.Function:

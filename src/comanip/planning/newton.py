@@ -8,20 +8,25 @@ that bind at a handful of steps at most. A general NLP solver spends more per it
 machinery than the Hessian costs (IPOPT with MUMPS: about 1 ms per iteration for 150 unknowns), so the
 iteration is written out here:
 
-- Working set W: the constraints within ``margin`` of binding (c_j > -margin), bounds included as rows of
+Solver quantities are named as in ``docs/notation.md``: ``hessian`` (∇²f, not the horizon H), the
+``working`` set of constraint rows (not the goal covariance W), ``merit_weight`` (not the mean mu) and
+``multipliers`` (not the effort weight nu). The factorisation, line search, status and result are those
+of :mod:`comanip.optim`.
+
+- Working set: the constraints within ``margin`` of binding (c_j > -margin), bounds included as rows of
   ±I. Without any, the step is the Newton step.
-- Direction: minimise the quadratic model gᵀp + ½ pᵀ(H + delta·s·I)p subject to the linearised working
-  constraints c_W + A_W p = 0, by one Cholesky factorisation and a Schur complement on the few rows of W;
-  a constraint that is not violated beyond ``constraint_tolerance`` and gets a negative multiplier leaves W
-  and the step is recomputed. s = max |diag H|; delta is 0 whenever H is positive definite, otherwise the
-  smallest of delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for which the factorisation succeeds
-  (IPOPT's inertia correction).
-- Step: backtracking, alpha = 1, 1/2, ..., on the l1 merit f + mu Σ max(0, c - constraint_tolerance/2)
-  (mu ≥ 2 max multiplier) until it decreases by 1e-4 of its directional derivative (Armijo); a trial that
-  raises the violation gets a second-order correction first.
+- Direction: minimise the quadratic model gᵀp + ½ pᵀ(hessian + delta·s·I)p subject to the linearised working
+  constraints c_W + A_W p = 0, by one Cholesky factorisation and a Schur complement on the few working rows;
+  a constraint that is not violated beyond ``constraint_tolerance`` and gets a negative multiplier leaves
+  the working set and the step is recomputed. s = max |diag hessian|; delta is 0 whenever the hessian is
+  positive definite, otherwise the smallest of delta_last/3, 8·delta_last/3, ... (1e-4 the first time) for
+  which the factorisation succeeds (IPOPT's inertia correction, :func:`comanip.optim.growing_shifts`).
+- Step: backtracking, alpha = 1, 1/2, ..., on the l1 merit f + merit_weight Σ max(0, c - constraint_tolerance/2)
+  (merit_weight ≥ 2 max multiplier) until it decreases by 1e-4 of its directional derivative (Armijo,
+  :func:`comanip.optim.backtrack`); a trial that raises the violation gets a second-order correction first.
 - Secant correction (``secant=True``, for approximate Hessians): C is updated after every step s with
-  the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (H + C) s, y the change of gradient, and
-  H + C is used in place of H. It learns the curvature the approximation misses along the directions
+  the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (hessian + C) s, y the change of gradient, and
+  hessian + C is used in its place. It learns the curvature the approximation misses along the directions
   the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md).
 - Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
   the violated constraints' linearisation is taken if it halves the violation.
@@ -47,31 +52,14 @@ from typing import Any, Callable
 import numpy as np
 import scipy.linalg
 
-_ARMIJO = 1e-4
-"""Fraction of the linearly predicted decrease a step must achieve."""
+from comanip.optim import SolverResult, Status, backtrack, growing_shifts, shifted_cholesky
+
 _BACKTRACKS = 30
+"""Step lengths tried by one line search."""
 _RECOVERIES, _RECOVERY_SHIFT = 3, 1e-3
 """Attempts after a failed line search, and the least relative shift delta of the first (ten times more each after)."""
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
-
-
-@dataclass
-class NewtonResult:
-    """Outcome of :func:`newton_minimize`."""
-
-    x: np.ndarray
-    """Best point found (N,)."""
-    f: float
-    status: str
-    """'solved', 'solved_acceptable', 'max_iterations', 'max_wall_time', 'constraints_violated' or 'failed'."""
-    message: str
-    iterations: int
-    """Hessian evaluations (one per accepted step)."""
-    projected_gradient: float
-    """max |∇f + A_Wᵀ lambda| (the Lagrangian's gradient over the working set) at x."""
-    violation: float = 0.0
-    """Largest constraint violation max(0, c) at x, bounds included."""
 
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
@@ -80,7 +68,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
                     constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
                     constraint_tolerance: float = 1e-6, margin: float = 1e-3,
                     expired: Callable[[], bool] = lambda: False,
-                    value: Callable[[np.ndarray], tuple[float, Any]] | None = None) -> NewtonResult:
+                    value: Callable[[np.ndarray], tuple[float, Any]] | None = None) -> SolverResult[np.ndarray]:
     """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0.
 
     Args:
@@ -98,133 +86,180 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         value: x -> (f, data) without the gradient, for line-search trials when that is much cheaper than
             ``evaluate`` (``data`` then only needs what ``constraints`` reads); ``evaluate`` runs once a trial
             is accepted. None: trials use ``evaluate``.
+
+    Returns:
+        A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the Hessian
+        evaluations, optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included.
     """
-    def probe(point):
-        """(f, gradient or None, data) at a trial point."""
-        if value is None:
-            return evaluate(point)
-        f_point, data_point = value(point)
-        return f_point, None, data_point
-
-    def penalty(c_point) -> float:
-        """The merit's l1 violation, counted from half the tolerance: violations the solution may keep cost
-        nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
-        return float(np.sum(np.maximum(c_point - 0.5 * constraint_tolerance, 0.0)))
-
-    def finite(f_point, g_point) -> bool:
-        return bool(np.isfinite(f_point)) and (g_point is None or bool(np.all(np.isfinite(g_point))))
-
-    problem = _Constraints(lb, ub, constraints)
+    solver = _ActiveSetNewton(evaluate, hessian, _Constraints(lb, ub, constraints), value, tolerance=tolerance,
+                              constraint_tolerance=constraint_tolerance, margin=margin)
     x = np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
     if not (np.isfinite(f) and np.all(np.isfinite(g))):
-        return NewtonResult(x, f, "failed", "objective or gradient not finite at the start", 0, np.inf)
-    c, A = problem(x, data)
-    delta_last, mu, iterations = 0.0, 0.0, 0
-    correction, previous = None, None  # secant correction; (x, g) before the last step
-    recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
-    history = [f]
+        return SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf)
+    return solver.run(solver.at(x, f, g, data), max_iterations, secant, expired)
 
-    def result(status, message, gradient):
-        return NewtonResult(x, f, status, message, iterations, gradient, problem.violation(c))
 
-    while True:
-        if iterations >= max_iterations:
-            return result("max_iterations", f"{iterations} iterations", np.inf)
-        if expired():
-            return result("max_wall_time", "wall-time budget spent", np.inf)
-        H = hessian(data)
-        iterations += 1
-        if not np.all(np.isfinite(H)):
-            return result("failed", "Hessian not finite", np.inf)
-        if secant:
-            correction = np.zeros_like(H) if correction is None else correction
-            if previous is not None:
-                _symmetric_rank_one_update(correction, H, x - previous[0], g - previous[1])
-            H = H + correction
-            previous = (x, g)
-        # after a failed line search, a stronger shift turns the step towards steepest descent
-        least = _RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
-        factor, delta_last = _regularised_cholesky(H, delta_last, least)
-        if factor is None:
-            return result("failed", "no positive definite regularised Hessian", np.inf)
-        step, multipliers, working, correct = _constrained_step(factor, g, c, A, margin, constraint_tolerance)
-        lagrangian_gradient = float(np.max(np.abs(g + A(working).T @ multipliers)))
-        violation = problem.violation(c)
-        if lagrangian_gradient <= tolerance and violation <= constraint_tolerance:
-            return result("solved", "gradient of the Lagrangian below tolerance", lagrangian_gradient)
-        if len(history) > _STALL_WINDOW and lagrangian_gradient <= _STALL_GRADIENT and violation <= constraint_tolerance \
-                and history[-1 - _STALL_WINDOW] - f <= _STALL_DECREASE * abs(f):
-            return result("solved_acceptable", f"objective unchanged to {_STALL_DECREASE:g} over {_STALL_WINDOW} "
-                          "iterations", lagrangian_gradient)
-        mu = max(mu, 2 * float(np.max(multipliers, initial=0.0)))
-        merit = f + mu * penalty(c)
-        slope = g @ step - mu * penalty(c)  # directional derivative of the merit
-        alpha, accepted = 1.0, False
-        for attempt in range(_BACKTRACKS):
-            if not slope < -1e-16 * max(1.0, abs(merit)):
-                break
-            trial = x + alpha * step
-            f_trial, g_trial, data_trial = probe(trial)
-            if finite(f_trial, g_trial):
-                c_trial, A_trial = problem(trial, data_trial)
-                if len(working) and penalty(c_trial) > penalty(c):
-                    # second-order correction: the step broke the curved constraints; pull it back onto their
-                    # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
-                    # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
-                    corrected = trial + correct(c_trial[working])
-                    f_corr, g_corr, data_corr = probe(corrected)
-                    if finite(f_corr, g_corr):
-                        c_corr, A_corr = problem(corrected, data_corr)
-                        if f_corr + mu * penalty(c_corr) <= merit + _ARMIJO * alpha * slope:
-                            trial, f_trial, g_trial, data_trial, c_trial, A_trial = corrected, f_corr, g_corr, data_corr, c_corr, A_corr
-                if f_trial + mu * penalty(c_trial) <= merit + _ARMIJO * alpha * slope:
-                    if g_trial is None:
-                        f_trial, g_trial, data_trial = evaluate(trial)
-                        c_trial, A_trial = problem(trial, data_trial)
-                    if finite(f_trial, g_trial):
-                        x, f, g, data, c, A = trial, f_trial, g_trial, data_trial, c_trial, A_trial
-                        history.append(f)
-                        accepted = True
-                        break
-            alpha /= 2
-        if accepted:
-            recoveries = 0
-            continue
-        if problem.violation(c) > constraint_tolerance:
-            restored = _restore(evaluate, problem, x, c, A)
-            if restored is not None:
-                x, f, g, data, c, A = restored
-                history.append(f)
+@dataclass
+class _Iterate:
+    """A point x (N,) and what was evaluated there: f, its gradient (None after a value-only trial), the
+    evaluation's data, the constraints c (bounds first) and rows(indices) of their Jacobian."""
+
+    x: np.ndarray
+    f: float
+    g: np.ndarray | None
+    data: Any
+    c: np.ndarray
+    rows: Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass
+class _ActiveSetNewton:
+    """The method of the module docstring for one problem; :meth:`run` iterates from a point."""
+
+    evaluate: Callable
+    hessian: Callable
+    problem: "_Constraints"
+    value: Callable | None
+    tolerance: float
+    constraint_tolerance: float
+    margin: float
+
+    def at(self, x, f, g, data) -> _Iterate:
+        return _Iterate(x, f, g, data, *self.problem(x, data))
+
+    def run(self, point: _Iterate, max_iterations: int, secant: bool, expired) -> SolverResult[np.ndarray]:
+        shift_last, merit_weight, iterations = 0.0, 0.0, 0
+        correction, previous = None, None  # secant correction; (x, g) before the last step
+        recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
+        history = [point.f]
+
+        def result(status, message, optimality):
+            return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c))
+
+        while True:
+            if iterations >= max_iterations:
+                return result(Status.MAX_ITERATIONS, f"{iterations} iterations", np.inf)
+            if expired():
+                return result(Status.MAX_WALL_TIME, "wall-time budget spent", np.inf)
+            hessian = self.hessian(point.data)
+            iterations += 1
+            if not np.all(np.isfinite(hessian)):
+                return result(Status.FAILED, "Hessian not finite", np.inf)
+            if secant:
+                correction = np.zeros_like(hessian) if correction is None else correction
+                if previous is not None:
+                    _symmetric_rank_one_update(correction, hessian, point.x - previous[0], point.g - previous[1])
+                hessian = hessian + correction
+                previous = (point.x, point.g)
+            # after a failed line search, a stronger shift turns the step towards steepest descent
+            least = _RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
+            factor, shift = shifted_cholesky(hessian, growing_shifts(shift_last, least))
+            if factor is None:
+                return result(Status.FAILED, "no positive definite regularised Hessian", np.inf)
+            shift_last = shift if shift > 0 else shift_last
+            step, multipliers, working, correct = _constrained_step(factor, point.g, point.c, point.rows, self.margin,
+                                                                    self.constraint_tolerance)
+            optimality = float(np.max(np.abs(point.g + point.rows(working).T @ multipliers)))
+            converged = self._converged(optimality, point, history)
+            if converged is not None:
+                return result(*converged, optimality)
+            merit_weight = max(merit_weight, 2 * float(np.max(multipliers, initial=0.0)))
+            accepted = self._line_search(point, step, working, correct, merit_weight)
+            if accepted is None and self.problem.violation(point.c) > self.constraint_tolerance:
+                accepted = self._restore(point)
+            elif accepted is not None:
+                recoveries = 0
+            if accepted is not None:
+                point = accepted
+                history.append(point.f)
                 continue
-        if recoveries < _RECOVERIES:
-            # The quadratic model was wrong along this step: forget the secant corrections (they may have
-            # learnt curvature from far away) and regularise harder, then try again from the same point.
-            recoveries += 1
-            correction, previous = None, None
-            continue
-        violation = problem.violation(c)
-        if lagrangian_gradient <= max(100 * tolerance, _STALL_GRADIENT) and violation <= constraint_tolerance:
-            return result("solved_acceptable", "no step decreases the objective any further", lagrangian_gradient)
-        status = "constraints_violated" if violation > constraint_tolerance else "failed"
-        return result(status, f"no step decreases the merit any further (violation {violation:.3g}, gradient "
-                      f"{lagrangian_gradient:.3g})", lagrangian_gradient)
+            if recoveries < _RECOVERIES:
+                # The quadratic model was wrong along this step: forget the secant corrections (they may have
+                # learnt curvature from far away) and regularise harder, then try again from the same point.
+                recoveries += 1
+                correction, previous = None, None
+                continue
+            return result(*self._final_status(optimality, point), optimality)
+
+    def _converged(self, optimality: float, point: _Iterate, history: list[float]) -> tuple[Status, str] | None:
+        """(status, message) when the point is a solution (module docstring, Convergence), else None."""
+        violation = self.problem.violation(point.c)
+        if violation > self.constraint_tolerance:
+            return None
+        if optimality <= self.tolerance:
+            return Status.SOLVED, "gradient of the Lagrangian below tolerance"
+        if len(history) > _STALL_WINDOW and optimality <= _STALL_GRADIENT \
+                and history[-1 - _STALL_WINDOW] - point.f <= _STALL_DECREASE * abs(point.f):
+            return Status.SOLVED_ACCEPTABLE, f"objective unchanged to {_STALL_DECREASE:g} over {_STALL_WINDOW} iterations"
+        return None
+
+    def _final_status(self, optimality: float, point: _Iterate) -> tuple[Status, str]:
+        """(status, message) when no step decreases the merit, even after the recoveries."""
+        violation = self.problem.violation(point.c)
+        if optimality <= max(100 * self.tolerance, _STALL_GRADIENT) and violation <= self.constraint_tolerance:
+            return Status.SOLVED_ACCEPTABLE, "no step decreases the objective any further"
+        status = Status.CONSTRAINTS_VIOLATED if violation > self.constraint_tolerance else Status.FAILED
+        return status, f"no step decreases the merit any further (violation {violation:.3g}, gradient {optimality:.3g})"
+
+    def _penalty(self, c: np.ndarray) -> float:
+        """The merit's l1 violation, counted from half the tolerance: violations the solution may keep cost
+        nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
+        return float(np.sum(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0)))
+
+    def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct, merit_weight: float) -> _Iterate | None:
+        """The accepted point along ``step`` (Armijo on the l1 merit, with second-order corrections), or None."""
+        penalty = self._penalty(point.c)
+        merit = point.f + merit_weight * penalty
+        slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
+        if not slope < -1e-16 * max(1.0, abs(merit)):
+            return None
+
+        def attempt(alpha: float, bound: float) -> _Iterate | None:
+            trial = self._trial(point.x + alpha * step)
+            if trial is None:
+                return None
+            if len(working) and self._penalty(trial.c) > penalty:
+                # second-order correction: the step broke the curved constraints; pull it back onto their
+                # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
+                # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
+                corrected = self._trial(trial.x + correct(trial.c[working]))
+                if corrected is not None and corrected.f + merit_weight * self._penalty(corrected.c) <= bound:
+                    trial = corrected
+            if trial.f + merit_weight * self._penalty(trial.c) > bound:
+                return None
+            if trial.g is None:
+                trial = self.at(trial.x, *self.evaluate(trial.x))
+            return trial if _finite(trial.f, trial.g) else None
+
+        return backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)[1]
+
+    def _trial(self, x: np.ndarray) -> _Iterate | None:
+        """The point x evaluated (value only when a cheaper ``value`` is given); None where not finite."""
+        if self.value is None:
+            f, g, data = self.evaluate(x)
+        else:
+            (f, data), g = self.value(x), None
+        return self.at(x, f, g, data) if _finite(f, g) else None
+
+    def _restore(self, point: _Iterate) -> _Iterate | None:
+        """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over
+        the violated rows V, halved until the largest violation shrinks; None if it does not."""
+        violated = np.flatnonzero(point.c > 0)
+        rows = point.rows(violated)
+        step = -rows.T @ np.linalg.lstsq(rows @ rows.T, point.c[violated], rcond=None)[0]
+        for alpha in (1.0, 0.5, 0.25, 0.125):
+            x = point.x + alpha * step
+            f, g, data = self.evaluate(x)
+            if np.isfinite(f) and np.all(np.isfinite(g)):
+                trial = self.at(x, f, g, data)
+                if self.problem.violation(trial.c) < 0.5 * self.problem.violation(point.c):
+                    return trial
+        return None
 
 
-def _restore(evaluate, problem, x, c, A):
-    """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over the
-    violated rows V, halved until the largest violation shrinks; None if it does not."""
-    violated = np.flatnonzero(c > 0)
-    rows = A(violated)
-    step = -rows.T @ np.linalg.lstsq(rows @ rows.T, c[violated], rcond=None)[0]
-    for alpha in (1.0, 0.5, 0.25, 0.125):
-        trial = x + alpha * step
-        f, g, data = evaluate(trial)
-        if np.isfinite(f) and np.all(np.isfinite(g)):
-            c_trial, A_trial = problem(trial, data)
-            if problem.violation(c_trial) < 0.5 * problem.violation(c):
-                return trial, f, g, data, c_trial, A_trial
-    return None
+def _finite(f: float, g: np.ndarray | None) -> bool:
+    return bool(np.isfinite(f)) and (g is None or bool(np.all(np.isfinite(g))))
 
 
 class _Constraints:
@@ -302,29 +337,3 @@ def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndar
     denominator = r @ s
     if abs(denominator) > 1e-8 * np.linalg.norm(r) * np.linalg.norm(s):
         correction += np.outer(r, r) / denominator
-
-
-def _regularised_cholesky(H: np.ndarray, delta_last: float, least: float = 0.0):
-    """Cholesky factor of H + delta·s·I with the least delta ≥ ``least`` tried that works; returns
-    (factor, delta_last).
-
-    delta = 0 first (unless ``least`` > 0); then delta_last/3 (or 1e-4 if no regularisation was needed
-    before), growing by 8 (by 100 the first time), as IPOPT does. s = max |diag H| makes delta relative.
-    """
-    if least == 0.0:
-        try:
-            return scipy.linalg.cho_factor(H, check_finite=False), delta_last
-        except scipy.linalg.LinAlgError:
-            pass
-    diagonal = np.diag(H)
-    scale = max(float(np.max(np.abs(diagonal))), np.finfo(float).tiny)
-    shifted = H.copy()
-    delta = max(least, 1e-4 if delta_last == 0 else max(delta_last / 3, 1e-20))
-    growth = 100.0 if delta_last == 0 else 8.0
-    while delta < 1e20:
-        np.fill_diagonal(shifted, diagonal + delta * scale)
-        try:
-            return scipy.linalg.cho_factor(shifted, check_finite=False), delta
-        except scipy.linalg.LinAlgError:
-            delta *= growth
-    return None, delta_last

@@ -9,9 +9,10 @@ from pathlib import Path
 
 import numpy as np
 
+from comanip.optim import CONVERGED, Status
+
 
 #: statuses of a solver that converged (to its tolerance, or to an acceptable level)
-CONVERGED_STATUSES = ("solved", "solved_acceptable")
 
 
 @dataclass
@@ -85,7 +86,7 @@ class Plan:
     @property
     def converged(self) -> bool:
         """True when the solver converged, whether or not the plan reaches the goal (see ``success``)."""
-        return self.status in CONVERGED_STATUSES or self.status == "goal_not_reached"
+        return self.status in CONVERGED or self.status == Status.GOAL_NOT_REACHED
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (arrays as nested lists)."""
@@ -126,9 +127,9 @@ def with_reach_check(plan: Plan) -> Plan:
     """The plan, or, when the solver converged but the mean end effector ends farther than the goal width from
     the goal, a copy with status 'goal_not_reached', success False and the solver's status in
     ``extras['solver_status']``."""
-    if plan.status not in CONVERGED_STATUSES or plan.reaches_goal:
+    if plan.status not in CONVERGED or plan.reaches_goal:
         return plan
     message = (f"the plan ends {plan.final_error:.4g} m from the goal, beyond the goal width {plan.width:g} m "
                f"(solver: {plan.status}, {plan.message})")
-    return replace(plan, success=False, status="goal_not_reached", message=message,
+    return replace(plan, success=False, status=Status.GOAL_NOT_REACHED, message=message,
                    extras={**plan.extras, "solver_status": plan.status})

@@ -23,28 +23,32 @@ status 'unreachable' before any solver work.
 
 Both minimise the same objective, normalised by |J_best(w)| (the best attainable J) so that tolerances
 mean the same for every width; ``plan.objective`` is always the SPEC §4 J itself.
+
+Symbols, shapes and units: ``docs/notation.md``.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import casadi as ca
 import numpy as np
 
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
-from comanip.planning.ipopt_status import IPOPT_STATUS, IpoptDeadline
+from comanip.optim import SolverResult, Status
+from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
 
@@ -57,14 +61,23 @@ class SolverOptions:
     """'newton' (damped Newton on the structure-exploiting Hessian, fast) or 'ipopt' (IPOPT with CasADi's
     exact Hessian, the reference)."""
     max_iterations: int | None = None
-    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations). None: 200 for point
-    masses, 1000 for nonlinear bodies, whose approximate Hessian converges linearly."""
+    """Iteration limit per start (Newton: Hessian evaluations; IPOPT: its iterations). None:
+    ``point_mass_iterations`` for point masses, ``arm_iterations`` for nonlinear bodies."""
+    point_mass_iterations: int = 200
+    """The iteration limit for point masses when ``max_iterations`` is None (exact Hessian: Newton converges
+    quadratically)."""
+    arm_iterations: int = 1000
+    """The iteration limit for nonlinear bodies when ``max_iterations`` is None (approximate Hessian: linear
+    convergence)."""
     tolerance: float = 1e-8
     """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
     times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``."""
     n_starts: int = 3
     """Minimum-jerk initial guesses tried on a cold solve (durations spread over the horizon); the best
     converged plan is returned. A warm-started solve uses the warm start only."""
+    far_warm_start: float = 3.0
+    """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
+    from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
@@ -76,12 +89,10 @@ class SolverOptions:
     def __post_init__(self):
         if self.method not in SOLVER_METHODS:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
-        for name in ("max_iterations", "n_starts"):
-            value = getattr(self, name)
-            if name == "max_iterations" and value is None:
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value < 1:
-                raise ValueError(f"{name} must be an integer ≥ 1, got {value!r}")
+        as_count("max_iterations", self.max_iterations, optional=True)
+        for name in ("n_starts", "point_mass_iterations", "arm_iterations"):
+            as_count(name, getattr(self, name))
+        as_positive("far_warm_start", self.far_warm_start, "goal widths")
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
         if self.compile not in (None, True, False):
             raise ValueError(f"compile must be None, True or False, got {self.compile!r}")
@@ -116,10 +127,10 @@ class Planner:
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
         self._blas = ThreadpoolController()
-        self._ipopt = None
+        self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
 
     @property
-    def curvature(self) -> ReachCurvature | LinearisedCurvature | None:
+    def curvature(self) -> Curvature | None:
         """The Newton method's objective, gradient and Hessian terms (None for ``method="ipopt"``); the goal
         estimator reuses them."""
         return self._curvature
@@ -128,7 +139,7 @@ class Planner:
     def _max_iterations(self) -> int:
         if self.options.max_iterations is not None:
             return self.options.max_iterations
-        return 200 if self.model.body.is_linear else 1000
+        return self.options.point_mass_iterations if self.model.body.is_linear else self.options.arm_iterations
 
     def _newton_terms(self):
         """Objective, gradient and Hessian for the Newton method: exact for linear bodies, structured
@@ -138,20 +149,18 @@ class Planner:
             return ReachCurvature(self.problem, compile=bool(compile))
         return LinearisedCurvature(self.problem, compile=compile is not False)
 
-    @property
-    def _solver(self) -> ca.Function:
-        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian (built on first use)."""
-        if self._ipopt is None:
-            problem = self.problem
-            params = ca.vertcat(problem.s0, problem.goal, problem.width)
-            ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
-                     "tol": self.options.tolerance, **self.options.ipopt}
-            self._deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])
-            self._ipopt = ca.nlpsol("planner", "ipopt",
-                                    {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
-                                    {"ipopt": ipopt, "print_time": False, "error_on_fail": False,
-                                     "iteration_callback": self._deadline})
-        return self._ipopt
+    def _ipopt_solver(self) -> tuple[ca.Function, IpoptDeadline]:
+        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian, and the deadline its
+        iteration callback watches (set before each solve)."""
+        problem = self.problem
+        params = ca.vertcat(problem.s0, problem.goal, problem.width)
+        ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
+                 "tol": self.options.tolerance, **self.options.ipopt}
+        deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])
+        solver = ca.nlpsol("planner", "ipopt",
+                           {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
+                           {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
+        return solver, deadline
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (nx,), goal (d,), width) or ValueError naming the argument.
@@ -209,7 +218,7 @@ class Planner:
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
         params = np.concatenate([start, goal, [width]])
-        return self._make_plan(torque, params, status="unreachable", success=False, message=message,
+        return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
     def _initial_guesses(self, start, goal, width, warm_start) -> list[np.ndarray]:
@@ -227,7 +236,7 @@ class Planner:
         shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
         candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
                                                    guess_durations(model.duration, 4), warm_start.mean)
-        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > 3 * width:
+        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
             # far beyond the goal's reward (it underflows there): fresh reaches compete too
             candidates += self._cold_guesses(start, goal, self.options.n_starts)
         params = np.concatenate([start, goal, [width]])
@@ -260,62 +269,58 @@ class Planner:
             for guess in guesses:
                 if time.perf_counter() > deadline and best is not None:
                     break
-                torque, f, status, success, message, nit = self._run_solver(guess, params, deadline)
-                iterations += nit
-                if not np.all(np.isfinite(torque)) or not np.isfinite(f):
-                    torque, status, success = guess, "failed", False
-                    f = self.problem.objective_value(guess, start, goal, width) / normaliser
-                    message = "solver returned a non-finite plan; returning the initial guess"
+                candidate = self._run_solver(guess, params, deadline)
+                iterations += candidate.nit
+                if not np.all(np.isfinite(candidate.x)) or not np.isfinite(candidate.fun):
+                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width) / normaliser,
+                                             Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
+                                             candidate.nit, np.inf)
                 # The plan within the limits with the lowest objective wins, whatever its status: a start that
                 # stalls short of the tolerances can still be far better than one that converged on the
                 # zero-reward plateau (seen on the Panda), and the status then says it did not converge.
-                candidate = (status == "constraints_violated", f, torque, status, success, message)
-                if best is None or candidate[:2] < best[:2]:
+                if best is None or _rank(candidate) < _rank(best):
                     best = candidate
-        _, _, torque, status, success, message = best
-        return self._make_plan(torque, params, status=status, success=success, message=message,
+        return self._make_plan(best.x, params, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
     def _make_plan(self, torque, params, **fields) -> Plan:
         n2, d = self.model.state_size, self.model.d
         start, goal, width = params[:n2], params[n2:n2 + d], params[-1]
         curvature = self._curvature
-        if curvature is None or curvature.exact:  # a point mass's expanded rollout is cheap
+        if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
             return self.problem.make_plan(torque, start, goal, width, **fields)
         f, _, data = curvature.evaluate(np.ravel(torque), params)
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float):
-        """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s).
-
-        Returns (torques (H, n), normalised objective, status, success, message, iterations).
-        """
+    def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
+        """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
+        fun the normalised objective."""
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
-        # an arm's value-only rollout is a sixth of the terms' cost; a point mass computes everything at once
-        value = (lambda x: curvature.value_and_mean(x, params)) if isinstance(curvature, LinearisedCurvature) else None
+        value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
         result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                                  *self._torque_bounds, tolerance=self.options.tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                                  constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
                                  value=value)
-        success = result.status in ("solved", "solved_acceptable")
-        return (result.x.reshape(self.model.H, self.model.n), result.f, result.status, success,
-                result.message, result.iterations)
+        return replace(result, x=result.x.reshape(self.model.H, self.model.n))
 
-    def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float):
-        solver = self._solver
+    def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
+        solver = self._ipopt
         self._deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params)
         stats = solver.stats()
-        status, success = IPOPT_STATUS.get(stats["return_status"], ("failed", False))
-        if stats["return_status"] == "User_Requested_Stop" and self._deadline.expired:
-            status = "max_wall_time"
+        status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
-        return torque, float(result["f"]), status, success, stats["return_status"], int(stats.get("iter_count", 0))
+        return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
+
+
+def _rank(candidate: SolverResult) -> tuple[bool, float]:
+    """Order of the starts' results: within the limits first, then the lower normalised objective."""
+    return candidate.status == Status.CONSTRAINTS_VIOLATED, candidate.fun
 
 
 def plan_reach(model: ReachingModel, start, goal, width: float | None = None, **solve_options) -> Plan:

@@ -63,7 +63,12 @@ class ReachProblem:
 
     def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
         """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
-        return float(np.asarray(self.trajectory(np.ravel(torque), start, goal, width)[4]).item())
+        return float(np.asarray(self._rollout(torque, start, goal, width)["J"]).item())
+
+    def _rollout(self, torque: np.ndarray, start, goal, width) -> dict[str, ca.DM]:
+        """:attr:`trajectory`'s outputs by name: mean (nx, H+1), cov (nx, nx·(H+1)), ee_mean (d, H+1),
+        ee_cov (d, d·(H+1)), J."""
+        return self.trajectory(tau=np.ravel(torque), s0=start, goal=goal, width=width)
 
     def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
                   solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
@@ -76,8 +81,9 @@ class ReachProblem:
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
         if belief is None:
-            mean, cov, ee_mean, ee_cov, J = (np.asarray(v) for v in self.trajectory(torque.ravel(), start, goal, width))
-            mean, cov = mean.T, cov.reshape(n2, H + 1, n2).transpose(1, 0, 2)
+            rollout = {name: np.asarray(value) for name, value in self._rollout(torque, start, goal, width).items()}
+            ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
+            mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
         else:
             mean, cov = belief
             ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))

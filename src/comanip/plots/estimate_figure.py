@@ -17,20 +17,20 @@ _AXES = "xyz"
 
 def plot_estimate(plan: Plan, path: str | Path, observed_points=None, observed_times=None, true_goal=None,
                   title: str | None = None) -> Path:
-    """Save a three-panel PNG of a goal estimate (a Plan from :func:`comanip.estimate_goal`).
+    """Save a three-panel PNG of a goal estimate (a GoalEstimate from :func:`comanip.estimate_goal`).
 
     Panels: the task-space path (first two axes), each axis against time, and the speed. The predicted
     trajectory is solid up to the observed step (the prefix the estimate reproduces) and dashed after it
     (the predicted remainder, with ±2σ circles on the path).
 
     Args:
-        plan: the estimate; its extras give the observed step, the prior goal and the method.
+        plan: the estimate (its observed step, prior goal and method are drawn).
         path: PNG file to write.
         observed_points: measured end-effector positions (K, d), m, drawn as dots (e.g. a CSV's rows).
         observed_times: their times (K,), s.
         true_goal: the goal actually reached (d,), m, when known (simulations).
     """
-    n_o = int(plan.extras.get("observed_step", 0))
+    n_o = plan.observed_step
     x, t, d = plan.ee_mean, plan.t, plan.ee_mean.shape[1]
     y = x[:, 1] if d > 1 else np.zeros(len(x))
     fig, (ax_path, ax_pos, ax_speed) = plt.subplots(1, 3, figsize=(14, 4.3))
@@ -49,7 +49,7 @@ def plot_estimate(plan: Plan, path: str | Path, observed_points=None, observed_t
     goal_y = goal[1] if d > 1 else 0.0
     ax_path.add_patch(Circle((goal[0], goal_y), plan.width, color="C3", alpha=0.2))
     ax_path.plot(goal[0], goal_y, "*", color="C3", ms=14, label="estimated goal (±w)")
-    prior = plan.extras.get("prior_goal")
+    prior = plan.prior_goal
     if prior is not None:
         ax_path.plot(prior[0], prior[1] if d > 1 else 0.0, "x", color="k", ms=9, mew=2, label="prior goal")
     if true_goal is not None:
@@ -79,7 +79,7 @@ def plot_estimate(plan: Plan, path: str | Path, observed_points=None, observed_t
     ax_speed.set(xlabel="t (s)", ylabel="speed (m/s)", title="end-effector speed")
     ax_speed.legend(fontsize=8)
 
-    method = plan.extras.get("method", "")
+    method = plan.method
     return save_figure(fig, path, title or f"{plan.model_name} goal estimate ({method}): goal {np.round(goal, 3).tolist()} m, "
                                            f"{plan.status}, {1e3 * plan.solve_time:.0f} ms")
 

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.interpolate import CubicSpline
 
-from comanip.arguments import as_matrix, as_positive, as_vector
+from comanip.arguments import as_count, as_matrix, as_positive, as_vector
 from comanip.belief.noise import sample_torque_error
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
@@ -68,9 +68,7 @@ class PersonParameters:
         as_positive("stiffness", self.stiffness, "N/m")
         as_positive("damping", self.damping, "N·s/m")
         as_positive("replan_interval", self.replan_interval, "s")
-        if isinstance(self.iterations_per_replan, bool) or not isinstance(self.iterations_per_replan, (int, np.integer)) \
-                or self.iterations_per_replan < 1:
-            raise ValueError(f"iterations_per_replan must be an integer ≥ 1, got {self.iterations_per_replan!r}")
+        as_count("iterations_per_replan", self.iterations_per_replan)
 
     def impedance_force(self, intended_position, intended_velocity, position, velocity) -> np.ndarray:
         """F = K_h (x_d - x) + D_h (xdot_d - xdot), (3,) N, from intended and actual hand states (3,) m, m/s."""

@@ -14,7 +14,7 @@ from typing import Protocol
 
 import numpy as np
 
-from comanip.arguments import as_positive, as_vector
+from comanip.arguments import as_count, as_positive, as_vector
 from comanip.control.impedance import ImpedanceGains, RobotState
 from comanip.simulation.panda_model import TABLE_HEIGHT
 from comanip.simulation.person import PersonParameters, SimulatedPerson
@@ -70,9 +70,7 @@ def check_workspace(goal: np.ndarray, name: str = "goal") -> np.ndarray:
 
 
 def check_trials(trials) -> int:
-    if isinstance(trials, bool) or not isinstance(trials, (int, np.integer)) or trials < 1:
-        raise ValueError(f"trials must be an integer ≥ 1, got {trials!r}")
-    return int(trials)
+    return as_count("trials", trials)
 
 
 @dataclass(frozen=True)
@@ -109,8 +107,7 @@ class ScenarioSettings:
         if self.kappa is not None and not (isinstance(self.kappa, (int, float)) and np.isfinite(self.kappa) and self.kappa >= 0):
             raise ValueError(f"kappa must be a finite number ≥ 0 (dimensionless variance), got {self.kappa!r}")
         check_trials(self.trials)
-        if isinstance(self.seed, bool) or not isinstance(self.seed, (int, np.integer)) or self.seed < 0:
-            raise ValueError(f"seed must be an integer ≥ 0, got {self.seed!r}")
+        as_count("seed", self.seed, 0)
         if self.duration is not None:
             as_positive("duration", self.duration, "s")
         as_positive("robot_stiffness", self.robot_stiffness, "N/m")

@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 from dataclasses import asdict, dataclass
 
+from comanip.arguments import as_count
+
 #: Goals of the Franka section: offsets (m) from the ready pose's end effector (about [0.307, 0, 0.487] m in
 #: the base frame, x forward, z up), 0.15–0.2 m along each axis both ways, all within reach. Ordered so
 #: that the first three (the quick run's) already go forward, sideways and down.
@@ -81,9 +83,7 @@ class ValidationSettings:
             raise ValueError(f"phase_initial_velocities must be finite numbers (m/s), got {self.phase_initial_velocities!r}")
         for name, least in (("dispersion_samples", 2), ("calibration_trials", 1), ("seed", 0), ("human_samples", 2),
                             ("human_trials", 2)):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int) or value < least:
-                raise ValueError(f"{name} must be an integer ≥ {least}, got {value!r}")
+            as_count(name, getattr(self, name), least)
         for name in ("franka", "human_targets"):
             if not isinstance(getattr(self, name), bool):
                 raise ValueError(f"{name} must be True or False, got {getattr(self, name)!r}")
@@ -94,8 +94,7 @@ class ValidationSettings:
                                         for o in offsets):
             raise ValueError("franka_goal_offsets must be a non-empty sequence of (x, y, z) offsets of finite numbers (m), "
                              f"got {offsets!r}")
-        if self.workers is not None and (isinstance(self.workers, bool) or not isinstance(self.workers, int) or self.workers < 1):
-            raise ValueError(f"workers must be an integer ≥ 1 (processes) or None (the CPU count), got {self.workers!r}")
+        as_count("workers", self.workers, 1, "processes", optional=True)
 
     @classmethod
     def quick_run(cls, **changes) -> "ValidationSettings":

@@ -1,0 +1,57 @@
+"""One regularised factorisation: the Cholesky factor of a symmetric matrix shifted towards the identity
+until it is positive definite, with the shift schedule a policy of the caller."""
+
+from __future__ import annotations
+
+from typing import Iterable, Iterator
+
+import numpy as np
+import scipy.linalg
+
+
+def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple | None, float]:
+    """(scipy Cholesky factor of matrix + delta·s·I, delta) for the first relative shift delta in ``shifts``
+    that gives a positive definite matrix, s = max |diag matrix| (so delta is relative); (None, nan) if none.
+
+    ``matrix`` (N, N) is read as symmetric (its upper triangle); delta = 0 factors it as it is.
+    """
+    shifted, diagonal, scale = None, None, None
+    for delta in shifts:
+        if delta == 0.0:
+            candidate = matrix
+        else:
+            if shifted is None:
+                diagonal = np.diag(matrix)
+                scale = max(float(np.max(np.abs(diagonal))), np.finfo(float).tiny)
+                shifted = matrix.copy()
+            np.fill_diagonal(shifted, diagonal + delta * scale)
+            candidate = shifted
+        try:
+            return scipy.linalg.cho_factor(candidate, check_finite=False), delta
+        except scipy.linalg.LinAlgError:
+            continue
+    return None, np.nan
+
+
+def growing_shifts(last: float, least: float = 0.0) -> Iterator[float]:
+    """IPOPT's schedule (Wächter & Biegler 2006, sec. 3.1): 0 first (unless ``least`` > 0), then the last
+    successful shift / 3 (1e-4 if none was needed before), growing 8-fold (100-fold the first time), below
+    1e20; never below ``least``."""
+    if least == 0.0:
+        yield 0.0
+    delta = max(least, 1e-4 if last == 0 else max(last / 3, 1e-20))
+    growth = 100.0 if last == 0 else 8.0
+    while delta < 1e20:
+        yield delta
+        delta *= growth
+
+
+def decade_shifts(first: float = 1e-8, largest: float = 1e6) -> Iterator[float]:
+    """0, then ``first``, 10·first, ... up to the first shift beyond ``largest`` (a memoryless schedule)."""
+    yield 0.0
+    delta = first
+    while True:
+        yield delta
+        if delta > largest:
+            return
+        delta *= 10

@@ -1,0 +1,103 @@
+"""What a Newton-type solver of the reaching problem asks of the problem: the :class:`Curvature` protocol and
+the typed data one evaluation hands from the objective to the Hessian, the limits and the goal derivatives.
+
+Notation as in :mod:`comanip.planning.curvature` and ``docs/notation.md``: x = tau flattened step by step
+(H·n,), parameters p = [s0 (nx,), goal (d,), width]; z_i = (mu_x,i (d,), vech Sigma_x,i (nv,)) with
+nv = d(d+1)/2 and nz = d + nv; phi_i the per-step reward term; f = J / |J_best(w)|. Per-step arrays are
+stacked horizontally, step i = 0..H in columns (as CasADi's ``map`` returns them).
+
+Two implementations: :class:`~comanip.planning.curvature.ReachCurvature` (point masses, exact Hessian,
+data :class:`ReachTerms`) and :class:`~comanip.planning.linearised_curvature.LinearisedCurvature` (arms,
+approximate Hessian, data :class:`ArmTerms`, and :class:`Rollout` from the value-only evaluation).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+
+@dataclass(eq=False)
+class ReachTerms:
+    """One evaluation at torques x: what the Hessian and the goal derivatives need (point masses)."""
+
+    x: np.ndarray
+    """Torques evaluated (H·n,), N·m or N."""
+    width: float
+    """Goal width w (m)."""
+    phi_hess: np.ndarray
+    """∇²_z phi_i stacked (nz, nz·(H+1))."""
+    phi_grad: np.ndarray
+    """∇_z phi_i stacked (nz, H+1)."""
+
+
+@dataclass(eq=False)
+class Rollout:
+    """The forward rollout alone at torques x (an arm's value-only evaluation): enough for the path limits."""
+
+    x: np.ndarray
+    """Torques evaluated (H·n,)."""
+    width: float
+    """Goal width w (m)."""
+    mean: np.ndarray
+    """Mean states mu_i stacked (2n, H+1)."""
+
+
+@dataclass(eq=False)
+class ArmTerms(ReachTerms):
+    """One evaluation at torques x for a nonlinear body: the point-mass terms plus the rollout and the
+    per-step pieces of the approximate Hessian (:mod:`comanip.planning.linearised_curvature`)."""
+
+    mean: np.ndarray
+    """Mean states mu_i stacked (2n, H+1)."""
+    cov: np.ndarray
+    """State covariances Sigma_i stacked (2n, 2n·(H+1))."""
+    A: np.ndarray
+    """Step Jacobians d mu_{i+1}/d mu_i stacked (2n, 2n·H)."""
+    B: np.ndarray
+    """Step Jacobians d mu_{i+1}/d tau_i stacked (2n, n·H)."""
+    J: np.ndarray
+    """Kinematic Jacobians J(q_i) stacked (d, n·(H+1))."""
+    kinematic_hessian: np.ndarray
+    """∇²_q [λ·x_ee(q) + <Λ, J Sigma_qq Jᵀ>] at q_i stacked (n, n·(H+1)) (the kinematics' curvature)."""
+    dvech: np.ndarray
+    """d vech Sigma_x,i / d q_i stacked (nv, n·(H+1))."""
+    sensitivities: np.ndarray | None = field(default=None, repr=False)
+    """d mu_i / d tau_k (H+1, 2n, H, n), computed on first request and kept with the evaluation it belongs to."""
+
+
+class Curvature(Protocol):
+    """Objective, gradient and Hessian terms of one model's reaching problem, normalised by |J_best(w)|.
+
+    ``evaluate`` computes everything one point needs at once and returns it as typed data; the other
+    methods read that data, so a Newton iteration evaluates each point once.
+    """
+
+    exact: bool
+    """The Hessian is exact (Newton converges quadratically); False: an approximation the solver corrects
+    with secant updates."""
+    cheap_value: bool
+    """:meth:`value_and_data` costs much less than :meth:`evaluate` (line-search trials use it then)."""
+    carries_belief: bool
+    """The data holds the mean path and its sensitivities (:meth:`mean_path`, :meth:`mean_sensitivities`,
+    :meth:`trajectory`); False: the belief comes from the problem's expanded rollout."""
+
+    def normaliser(self, width: float) -> float:
+        """|J_best(w)| for width w (m)."""
+
+    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ReachTerms]:
+        """(f, ∇f (H·n,), data) at torques x (H·n,) and parameters p."""
+
+    def value(self, x: np.ndarray, params: np.ndarray) -> float:
+        """f at torques x."""
+
+    def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, ReachTerms | Rollout]:
+        """(f, data enough for the path limits) at torques x, as cheaply as the curvature can."""
+
+    def hessian(self, data: ReachTerms) -> np.ndarray:
+        """∇²f (H·n, H·n), exact or approximate (see :attr:`exact`)."""
+
+    def goal_derivatives(self, data: ReachTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d))."""

@@ -1,0 +1,47 @@
+"""Plans, estimates and posteriors of a fixed set of problems equal those of the stored reference code
+(tests/data/make_reference_results.py wrote them): refactoring the solvers must not change their results.
+
+Objectives and regrets agree to 1e-9 relative, torques to 1e-9 of their largest magnitude, goals to 1e-9 m,
+probabilities to 1e-9; statuses and iteration counts exactly.
+"""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+DATA = Path(__file__).parent / "data"
+TOLERANCE = 1e-9
+
+
+def _reference_module():
+    spec = importlib.util.spec_from_file_location("make_reference_results", DATA / "make_reference_results.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _assert_equal_results(stored, computed: dict) -> None:
+    assert sorted(stored.files) == sorted(computed)
+    for name in stored.files:
+        expected, actual = stored[name], np.asarray(computed[name])
+        quantity = name.rsplit("/", 1)[1]
+        if quantity in ("status", "iterations"):
+            assert actual == expected, name
+        elif quantity in ("objective", "regret"):
+            np.testing.assert_allclose(actual, expected, rtol=TOLERANCE, atol=0, err_msg=name)
+        else:
+            scale = max(1.0, float(np.max(np.abs(expected)))) if quantity == "torque" else 1.0
+            np.testing.assert_allclose(actual, expected, rtol=0, atol=TOLERANCE * scale, err_msg=name)
+
+
+def test_point_mass_results_equal_the_reference():
+    module = _reference_module()
+    _assert_equal_results(np.load(module.PATH), module.reference_results())
+
+
+@pytest.mark.slow
+def test_franka_results_equal_the_reference():
+    module = _reference_module()
+    _assert_equal_results(np.load(module.FRANKA_PATH), module.franka_reference_results())
