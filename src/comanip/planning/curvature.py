@@ -65,8 +65,6 @@ class ReachCurvature:
         function = self._terms_function(problem)
         self._terms = BufferedFunction(compiled(function) if compile else function)
         self._effort = 2 * model.nu
-        self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
-        self._last_normaliser = (None, 1.0)
         self._noise_hessian = _noise_second_derivatives(model)
         self._G = _constant_sensitivities(model)
         self._stop_hessian = _stopping_hessian(problem)
@@ -122,9 +120,7 @@ class ReachCurvature:
     # -- evaluation ----------------------------------------------------------------------------------
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: the objective is divided by it."""
-        if self._last_normaliser[0] != width:
-            self._last_normaliser = (width, float(self._normaliser(width)))
-        return self._last_normaliser[1]
+        return self.problem.normaliser(width)
 
     def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ReachTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""

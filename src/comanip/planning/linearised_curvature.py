@@ -59,8 +59,6 @@ class LinearisedCurvature:
         terms, value = self._functions(problem)
         self._terms = BufferedFunction(compiled(terms) if compile else terms)
         self._value = BufferedFunction(compiled(value) if compile else value)
-        self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
-        self._last_normaliser = (None, 1.0)
         self._noise_hessian = _noise_second_derivatives(model)
 
     def _functions(self, problem: ReachProblem) -> tuple[ca.Function, ca.Function]:
@@ -75,7 +73,7 @@ class LinearisedCurvature:
         n, d, H = model.n, model.d, model.H
         x = ca.MX.sym("x", n * H)
         s0, goal, width = ca.MX.sym("s0", 2 * n), ca.MX.sym("goal", d), ca.MX.sym("width")
-        scale = ca.Function("normaliser", [problem.width], [-problem.best_objective])(width)
+        scale = problem.normaliser_function(width)
         weights = ca.DM(problem.weights).T / scale
         tau = ca.reshape(x, n, H)
         step = belief_step_function(body, model.h, model.kappa, model.noise)
@@ -99,9 +97,7 @@ class LinearisedCurvature:
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: the objective is divided by it."""
-        if self._last_normaliser[0] != width:
-            self._last_normaliser = (width, float(self._normaliser(width)))
-        return self._last_normaliser[1]
+        return self.problem.normaliser(width)
 
     def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ArmTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""

@@ -121,7 +121,6 @@ class Planner:
 
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
-        self._normaliser = ca.Function("normaliser", [problem.width], [-problem.best_objective])
         self._curvature = self._newton_terms() if self.options.method == "newton" else None
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
@@ -260,7 +259,7 @@ class Planner:
     def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None) -> Plan:
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         params = np.concatenate([start, goal, [width]])
-        normaliser = float(self._normaliser(width))
+        normaliser = self.problem.normaliser(width)
         best = None
         iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
