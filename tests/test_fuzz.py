@@ -5,6 +5,7 @@ exception or a silent NaN. The count of inputs tried is printed at the end of th
 """
 
 import math
+import os
 
 import numpy as np
 import pytest
@@ -16,7 +17,9 @@ from comanip.cli.main import main
 from comanip.estimation import GoalEstimator
 
 FUZZ_COUNT = {"inputs": 0}
-FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+# CI draws the same inputs every run (a failure there is then reproducible, not luck); elsewhere they are new each run
+FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None,
+                derandomize=os.environ.get("CI") == "true")
 
 numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**12, 10**12),
                     st.sampled_from([0.0, -0.0, 1e-300, 1e300, -1e300]))

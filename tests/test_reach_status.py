@@ -42,3 +42,12 @@ def test_cli_plan_reports_the_goal_not_reached(tmp_path, capsys):
     assert main(["plan", "--goal", "1000,0", "--out", str(tmp_path)]) == 1
     summary = json.loads(capsys.readouterr().out)
     assert (summary["success"], summary["status"], summary["reaches_goal"]) == (False, "goal_not_reached", False)
+
+
+@pytest.mark.parametrize("width", [5.3e153, 1e-300, 1e4])
+def test_widths_outside_floating_point_range_are_refused(planar_planner, width):
+    """A goal width whose reward peak under- or overflows (fuzz: 5.3e153 m divided by zero) is refused up front."""
+    with pytest.raises(ValueError, match="between 1e-06 and 1000 m"):
+        planar_planner.solve(np.zeros(4), [0.2, 0.0], width)
+    with pytest.raises(ValueError, match="between 1e-06 and 1000 m"):
+        comanip.presets.planar().replace(width=width)

@@ -61,6 +61,19 @@ def as_count(name: str, value, minimum: int = 1, unit: str = "", *, optional: bo
     return int(value)
 
 
+GOAL_WIDTH_RANGE_M = (1e-6, 1e3)
+"""Goal widths w (m) a solve accepts: outside it the reward's peak under- or overflows in floating point."""
+
+
+def as_goal_width(name: str, value) -> float:
+    """A goal width w (m) as a float within GOAL_WIDTH_RANGE_M, else ValueError."""
+    width = as_positive(name, value, "m")
+    low, high = GOAL_WIDTH_RANGE_M
+    if not low <= width <= high:
+        raise ValueError(f"{name} must be between {low:g} and {high:g} m (goal width), got {value!r}")
+    return width
+
+
 def as_optional_positive(name: str, value, unit: str) -> float | None:
     return None if value is None else as_positive(name, value, unit)
 

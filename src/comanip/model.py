@@ -10,7 +10,7 @@ from dataclasses import MISSING, dataclass, field, replace
 
 import numpy as np
 
-from comanip.arguments import as_count, as_nonnegative, as_positive
+from comanip.arguments import as_count, as_goal_width, as_nonnegative, as_positive
 from comanip.belief.noise import check_noise_form
 from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
@@ -86,7 +86,7 @@ class ReachingModel:
             raise ValueError(f"gamma must be in (0, 1] (discount per step), got {self.gamma!r}")
         as_nonnegative("nu", self.nu, "reward per N²")
         as_nonnegative("kappa", self.kappa, "dimensionless variance")
-        as_positive("width", self.width, "m")
+        as_goal_width("width", self.width)
         check_noise_form(self.noise)
         check_goal_covariance_form(self.goal_covariance)
         check_reward_form(self.reward)

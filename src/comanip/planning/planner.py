@@ -37,7 +37,7 @@ import numpy as np
 
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.arguments import as_count, as_goal_width, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques, retargeted_torques
@@ -171,7 +171,7 @@ class Planner:
                                            + (f", optionally followed by the {model.state_size - 2 * model.n} activation states"
                                               if size != 2 * model.n else "")))
         goal = as_vector("goal", goal, model.d, "task-space position, m")
-        width = model.width if width is None else as_positive("width", width, "m")
+        width = model.width if width is None else as_goal_width("width", width)
         return start, goal, width
 
     def solve(self, start, goal, width: float | None = None, warm_start=None, max_wall_time: float | None = None) -> Plan:
