@@ -72,6 +72,21 @@ def test_readme_python_blocks_run_in_order(tmp_path, monkeypatch):
             pytest.fail(f"the README's Python block at line {line} fails: {type(error).__name__}: {error}")
 
 
+def test_readme_saved_model_plans_under_its_own_name(tmp_path, monkeypatch, capsys):
+    """The first block saves my.yaml; `comanip plan --preset my.yaml` (as the README says next) reports it by
+    the name the snippet gave it, not the preset it was copied from."""
+    import json
+
+    from comanip.cli.main import main
+
+    source = fenced_blocks(README.read_text(encoding="utf-8"), "python")[0][1]
+    monkeypatch.chdir(tmp_path)
+    exec(compile(source, "README.md:first-block", "exec"), {})
+    assert main(["plan", "--preset", "my.yaml", "--out", str(tmp_path / "plan")]) == 0
+    summary = json.loads(capsys.readouterr().out)
+    assert summary["model"] == "my_model" and summary["success"]
+
+
 def test_readme_goal_estimate_snippet_recovers_the_observed_plan_goal(tmp_path, monkeypatch):
     """The goal-estimation snippet observes a plan to [0.3, 0.1]: the regret estimate gives it back."""
     text = README.read_text(encoding="utf-8")
