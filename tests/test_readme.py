@@ -127,3 +127,16 @@ def test_readme_commands_exist():
             for word in second.split("|"):
                 assert word in tree[name], (f"README {where}: 'comanip {name} {word}' is not a subcommand of "
                                             f"'{name}' (have {sorted(tree[name])})")
+
+
+def test_readme_needs_nothing_outside_the_repository():
+    """No pointer to the session's shared folder or its SPEC; every relative link resolves inside the repo."""
+    text = README.read_text(encoding="utf-8")
+    assert "../shared" not in text and "SPEC.md" not in text
+    root = README.parent
+    for target in re.findall(r"\]\(([^)#\s]+)(?:#[^)]*)?\)", text):
+        if "://" in target:
+            continue
+        path = (root / target).resolve()
+        assert path.exists(), f"README links to {target}, which is not in the repository"
+        assert root.resolve() in path.parents, f"README links outside the repository: {target}"
