@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 
-from comanip.cli.arguments import add_model_arguments, load_model
+from comanip.cli.options import add_model_arguments, load_model
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.validation import ValidationSettings, run_validation
 
