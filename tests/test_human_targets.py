@@ -21,7 +21,8 @@ from comanip.analysis import (
 )
 from comanip.cli.main import main
 from comanip.validation import ValidationSettings, run_validation
-from comanip.validation.human_section import HUMAN_FIGURE, run_human_section
+from comanip.plots.validation_figures import HUMAN_FIGURE, draw_human_targets_figure
+from comanip.validation.human_section import run_human_section
 from comanip.validation.markdown import human_targets_markdown
 from comanip.validation.run import _plain
 
@@ -140,14 +141,14 @@ def test_human_section_reports_the_model_beside_the_reference(planar_grid, tmp_p
     settings = ValidationSettings(human_samples=200)
     faster = comanip.presets.planar().replace(kappa=3e-3, name="planar_kappa_3e-3")
     grid = open_loop_grid(comanip.Planner(faster), DISTANCES, WIDTHS)
-    section, figures = run_human_section(faster, comanip.presets.planar(), grid, tmp_path, settings, progress=False)
+    section, results = run_human_section(faster, comanip.presets.planar(), grid, settings, progress=False)
     assert [m["model"] for m in section["models"]] == ["planar_kappa_3e-3", "planar"]
-    assert figures == [tmp_path / HUMAN_FIGURE] and figures[0].stat().st_size > 0
+    figure = draw_human_targets_figure(results, tmp_path)
+    assert figure == tmp_path / HUMAN_FIGURE and figure.stat().st_size > 0
     json.dumps(_plain(section), allow_nan=False)
     markdown = "\n".join(human_targets_markdown(section))
     assert "planar_kappa_3e-3: verdict" in markdown and "planar: verdict" in markdown and "### planar: per condition" in markdown
-    same, _ = run_human_section(comanip.presets.planar(), comanip.presets.planar(), planar_grid, tmp_path, settings,
-                                progress=False)
+    same, _ = run_human_section(comanip.presets.planar(), comanip.presets.planar(), planar_grid, settings, progress=False)
     assert [m["model"] for m in same["models"]] == ["planar"]
 
 

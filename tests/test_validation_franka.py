@@ -14,7 +14,7 @@ from comanip.analysis.speed_profile import SETTLING_FRACTION
 from comanip.cli.main import main
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 from comanip.validation import ValidationSettings, run_validation
-from comanip.validation.arm_section import ARM_FIGURES
+from comanip.plots.validation_figures import ARM_FIGURES
 from comanip.validation.settings import FRANKA_GOAL_OFFSETS
 
 pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
@@ -114,9 +114,9 @@ def test_a_point_mass_run_plans_the_franka_section_with_the_franka_preset(tmp_pa
     import comanip.validation.run as run_module
 
     arms = []
-    monkeypatch.setattr(run_module, "_point_mass_sections", lambda *args: ({}, [], []))  # (sections, figures, grid)
+    monkeypatch.setattr(run_module, "_point_mass_sections", lambda *args: ({}, None, []))  # (sections, figure data, grid)
     monkeypatch.setattr(run_module, "run_arm_section",
-                        lambda arm, out, settings, progress: (arms.append(arm) or franka_run[1]["franka"], []))
+                        lambda arm, out, settings, progress: (arms.append(arm) or franka_run[1]["franka"], None))
     report = run_validation(comanip.presets.planar(), tmp_path, ValidationSettings.quick_run(human_targets=False), progress=False)
     assert [arm.name for arm in arms] == ["franka"] and arms[0].body.name == "panda"
     assert report["model"]["name"] == "planar" and "franka" in report

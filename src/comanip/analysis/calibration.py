@@ -34,7 +34,7 @@ from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, open_loo
 from comanip.arguments import as_count
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
-from comanip.planning.planner import Planner
+from comanip.planning.cache import PlannerCache
 
 #: Fitts' law holds when the better of the two fits has at least this R².
 FITTS_R2_MIN = 0.9
@@ -197,12 +197,14 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
     bar = tqdm(total=len(tasks), desc="calibration", unit="reach", disable=not progress)
     results: dict[int, list[ReachOutcome]] = {i: [] for i in range(len(configurations))}
     if workers == 1:
+        planners = PlannerCache(size=1)
         for task in tasks:
-            results[task[-1][1]].append(_run_condition(*task))
+            results[task[-1][1]].append(_run_condition(planners, *task))
             bar.update(1)
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
-            futures = {pool.submit(_run_condition, *task): task[-1][1] for task in tasks}
+        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
+                                 initializer=_start_worker) as pool:
+            futures = {pool.submit(_run_condition_in_worker, *task): task[-1][1] for task in tasks}
             for future in as_completed(futures):
                 results[futures[future]].append(future.result())
                 bar.update(1)
@@ -210,19 +212,24 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
     return [measure_grid(results[i], c, c.model(base).goal_covariance) for i, c in enumerate(configurations)]
 
 
-_PLANNER: dict[str, Planner] = {}
-"""The planner this process built last, by model. Conditions are submitted configuration by configuration,
-so a worker reuses it for a run of conditions; keeping one bounds the memory a worker holds."""
+_worker_planners: PlannerCache | None = None
+"""A pool worker's planners, made by :func:`_start_worker` (the pool's initializer); None in other processes."""
 
 
-def _run_condition(base_config: dict, configuration: Configuration, distance: float, width: float, n_trials: int,
-                   seed_key: tuple[int, int, int]) -> ReachOutcome:
-    model = configuration.model(ReachingModel.from_config(base_config))
-    key = repr(model.config())
-    if key not in _PLANNER:
-        _PLANNER.clear()
-        _PLANNER[key] = Planner(model)
-    planner = _PLANNER[key]
+def _start_worker() -> None:
+    """Give this pool worker its planner cache. It keeps one planner: conditions are submitted configuration
+    by configuration, so a worker reuses it for a run of conditions, and one bounds the memory a worker holds."""
+    global _worker_planners
+    _worker_planners = PlannerCache(size=1)
+
+
+def _run_condition_in_worker(*task) -> ReachOutcome:
+    return _run_condition(_worker_planners, *task)
+
+
+def _run_condition(planners: PlannerCache, base_config: dict, configuration: Configuration, distance: float,
+                   width: float, n_trials: int, seed_key: tuple[int, int, int]) -> ReachOutcome:
+    planner = planners.planner(configuration.model(ReachingModel.from_config(base_config)))
     if configuration.closed_loop:
         rng = np.random.default_rng(np.random.SeedSequence(list(seed_key)))
         return closed_loop_grid(planner, [distance], [width], n_trials, rng)[0]

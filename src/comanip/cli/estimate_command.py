@@ -16,7 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, add_reach_arguments, input_file, load_model, vector
+from comanip.cli.options import add_model_arguments, add_reach_arguments, input_file, load_model, vector
 from comanip.cli.outputs import output_dir, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 
-from comanip.cli.arguments import add_model_arguments, input_file, input_file_or_folder, load_model
+from comanip.cli.options import add_model_arguments, input_file, input_file_or_folder, load_model
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
 from comanip.fitting.movement_times import fit_movement_times

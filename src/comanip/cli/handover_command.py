@@ -15,7 +15,7 @@ import warnings
 import numpy as np
 
 from comanip.arguments import as_positive
-from comanip.cli.arguments import add_model_arguments, input_file, load_model, vector
+from comanip.cli.options import add_model_arguments, input_file, load_model, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH

@@ -6,7 +6,7 @@ import json
 
 import numpy as np
 
-from comanip.cli.arguments import add_model_arguments, add_reach_arguments, load_model, vector
+from comanip.cli.options import add_model_arguments, add_reach_arguments, load_model, vector
 from comanip.cli.outputs import output_dir, write_manifest
 from comanip.planning.planner import Planner
 

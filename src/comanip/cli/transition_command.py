@@ -17,7 +17,7 @@ import sys
 import time
 from pathlib import Path
 
-from comanip.cli.arguments import add_model_arguments, input_file, load_model, vector
+from comanip.cli.options import add_model_arguments, input_file, load_model, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.multicomponent.transition_csv import read_transition_metadata, shipped_dataset_path, write_transition_csv
 from comanip.multicomponent.transition_data import ARM_LENGTH, default_steps, generate_transition_data

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import json
 
-from comanip.cli.arguments import add_model_arguments, load_model
+from comanip.cli.options import add_model_arguments, load_model
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.validation import ValidationSettings, run_validation
 
@@ -33,11 +33,14 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
+    from comanip.plots.validation_figures import draw_validation_figures
+
     model = load_model(args)
     options = {"workers": args.workers, "seed": args.seed, "franka": args.franka, "human_reference": args.targets_reference}
     settings = ValidationSettings.quick_run(**options) if args.quick else ValidationSettings(**options)
     out = output_dir(args.out, "validate", args.force, create=False)
-    report = run_validation(model, out, settings)  # checks the model against the settings before creating out
+    # checks the model against the settings before creating out; the figures are drawn as a step of their own
+    report = run_validation(model, out, settings, draw=draw_validation_figures)
     summary = {"model": model.name, "out": str(out)}
     if "fitts_grid" in report:
         grid = report["fitts_grid"]

@@ -32,9 +32,7 @@ the paper's; without a prior goal (``prior_goal=None``) it is left out.
 from __future__ import annotations
 
 import math
-import threading
 import time
-from collections import OrderedDict
 from dataclasses import dataclass, replace
 
 import casadi as ca
@@ -48,10 +46,11 @@ from comanip.estimation.initial_goal import search_along_observed_direction, tas
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
 from comanip.estimation.regret_newton import newton_solve
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
-from comanip.estimation.shared import checked_model, estimation_planner, model_key
+from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
 from comanip.optim import CONVERGED, Status
+from comanip.planning.cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.planner import Planner
@@ -300,33 +299,28 @@ class GoalEstimator:
         return solved, status, stats["return_status"], int(stats.get("iter_count", 0))
 
 
-class EstimatorCache:
+class EstimatorCache(ModelCache[GoalEstimator]):
     """Goal estimators kept between calls of :func:`estimate_goal` and :func:`comanip.goal_posterior`.
 
-    One key: a Planner or GoalEstimator is its own (its options are part of what it solves); a
-    ReachingModel is keyed by its parameters (:func:`model_key`, so two loads of a preset share an
+    A :class:`~comanip.planning.cache.ModelCache` with one addition to its key: a Planner is its own key
+    (its options are part of what it solves) and gets an estimator using it; a ReachingModel is keyed by
+    its parameters (:func:`~comanip.planning.cache.model_key`, so two loads of a preset share an
     estimator) and gets an estimator with its own planner. At most ``size`` estimators are kept, the least
     recently used dropped first. Safe to share between threads; an estimator itself is not (give each
     thread its own cache or planner).
     """
 
     def __init__(self, size: int = 4):
-        self.size = size
-        self._estimators: OrderedDict[object, GoalEstimator] = OrderedDict()
-        self._lock = threading.Lock()
+        super().__init__(GoalEstimator, size)
+
+    def key(self, model):
+        return model if isinstance(model, Planner) else super().key(model)
 
     def estimator(self, model: ReachingModel | Planner | GoalEstimator) -> GoalEstimator:
         """The estimator for ``model``, built on first use."""
         if isinstance(model, GoalEstimator):
             return model
-        key = model if isinstance(model, Planner) else model_key(checked_model(model))
-        with self._lock:
-            if key not in self._estimators:
-                self._estimators[key] = GoalEstimator(model)
-                while len(self._estimators) > self.size:
-                    self._estimators.popitem(last=False)
-            self._estimators.move_to_end(key)
-            return self._estimators[key]
+        return self.get(checked_model(model))
 
 
 DEFAULT_CACHE = EstimatorCache()

@@ -1,18 +1,10 @@
-"""The planner an estimator builds for a model, and the key that says two models are the same."""
+"""The planner an estimator builds for a model (the key that says two models are the same is
+:func:`comanip.planning.cache.model_key`)."""
 
 from __future__ import annotations
 
-import json
-
 from comanip.model import ReachingModel
 from comanip.planning.planner import Planner, SolverOptions
-
-
-def model_key(model: ReachingModel) -> str:
-    """A key equal for models with equal parameters (two loads of one preset share it)."""
-    config = model.config()
-    config.pop("description", None)
-    return json.dumps(config, sort_keys=True)
 
 
 def checked_model(model) -> ReachingModel | Planner:

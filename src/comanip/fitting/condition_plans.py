@@ -1,7 +1,9 @@
 """Planning every condition of a fit for one model configuration, here or on a Dask cluster.
 
-Tasks carry the model as its JSON config (plain data), never a Planner: each process builds a Planner once
-per configuration (:func:`cached_planner`) and reuses it for every condition.
+Tasks carry the model as its config (plain data), never a Planner: planners are kept by their model's
+parameters in a cache that the ConditionPlanner owns (planning here) or that each Dask worker owns (a
+:class:`~comanip.planning.worker_cache.WorkerCache` registered on the cluster), so a process builds a
+Planner once per configuration and reuses it for every condition.
 
 Every solve is cold (the planner's multi-start from minimum-jerk guesses), not warm-started from the
 previous evaluation's plan, so that the objective is a function of the parameters alone and the fitted
@@ -14,29 +16,43 @@ costs about 35 ms against 6 ms warm for the planar preset, next to 80 ms for bui
 
 from __future__ import annotations
 
-import json
 import threading
-from functools import lru_cache
 
 import numpy as np
 
 from comanip.model import ReachingModel
+from comanip.planning.cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 
 
-@lru_cache(maxsize=2)
-def cached_planner(model_config: str) -> tuple[Planner, threading.Lock]:
-    """The Planner of a model given as the JSON of ``model.config()``, built once per process, and the lock
-    that serialises its solves (a Planner is not thread-safe, and a Dask worker may run tasks in threads)."""
-    return Planner(ReachingModel.from_config(json.loads(model_config))), threading.Lock()
+_PLANNERS = "comanip-condition-planners"
+"""The name of the WorkerCache that gives each Dask worker its planners."""
+
+_CACHE_SIZE = 2
+"""Planners a cache keeps (a fit alternates between few configurations at a time)."""
 
 
-def plan_condition(model_config: str, start: np.ndarray, goal: np.ndarray, width: float) -> Plan:
-    """One reach, solved cold: start state (2n,), goal (d,) m, width m."""
-    planner, lock = cached_planner(model_config)
+def locked_planner(model: ReachingModel) -> tuple[Planner, threading.Lock]:
+    """A Planner for ``model`` and the lock that serialises its solves (a Planner is not thread-safe, and a
+    Dask worker may run tasks in threads)."""
+    return Planner(model), threading.Lock()
+
+
+def plan_condition(planners: ModelCache, model_config: dict, start: np.ndarray, goal: np.ndarray,
+                   width: float) -> Plan:
+    """One reach, solved cold with the planner ``planners`` (a cache of :func:`locked_planner`) holds for the
+    model given as its config: start state (2n,), goal (d,) m, width m."""
+    planner, lock = planners.get(model_config)
     with lock:
         return planner.solve(start, goal, width)
+
+
+def _plan_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, width: float) -> Plan:
+    """:func:`plan_condition` on a Dask worker, with the worker's planners."""
+    from comanip.planning.worker_cache import worker_cache
+
+    return plan_condition(worker_cache(_PLANNERS), model_config, start, goal, width)
 
 
 class ConditionPlanner:
@@ -52,6 +68,11 @@ class ConditionPlanner:
     def __init__(self, reaches: list[tuple[np.ndarray, np.ndarray, float]], scheduler=None):
         self.reaches = reaches
         self._client, self._owned = _client(scheduler)
+        self._planners = ModelCache(locked_planner, _CACHE_SIZE)
+        if self._client is not None:
+            from comanip.planning.worker_cache import WorkerCache
+
+            self._client.register_plugin(WorkerCache(_PLANNERS, locked_planner, _CACHE_SIZE))
 
     def __enter__(self) -> "ConditionPlanner":
         return self
@@ -62,11 +83,11 @@ class ConditionPlanner:
 
     def plans(self, model: ReachingModel) -> list[Plan]:
         """One plan per reach for this model, in the order of ``reaches``; never raises on a failed solve."""
-        config = json.dumps(model.config())
+        config = model.config()
         tasks = [(config, start, goal, width) for start, goal, width in self.reaches]
         if self._client is None:
-            return [plan_condition(*task) for task in tasks]
-        return self._client.gather(self._client.map(plan_condition, *zip(*tasks), pure=False))
+            return [plan_condition(self._planners, *task) for task in tasks]
+        return self._client.gather(self._client.map(_plan_on_worker, *zip(*tasks), pure=False))
 
 
 def _client(scheduler):

@@ -16,8 +16,6 @@ progress bar.
 
 from __future__ import annotations
 
-import json
-from functools import lru_cache
 
 import numpy as np
 from tqdm import tqdm
@@ -122,13 +120,14 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
 
     conditions = [(float(r), float(w)) for r in distances for w in widths]
     seeds = np.random.SeedSequence(seed).spawn(len(conditions))
-    config = json.dumps(model.config())
+    config = model.config()
     tasks = [(config, r, w, n_trials, arm_length, steps, s) for (r, w), s in zip(conditions, seeds)]
     bar = progress_bar("transition conditions", len(tasks), "condition", progress)
     if workers == 1:
+        planner = Planner(ReachingModel.from_config(config))
         rows = []
-        for task in tasks:
-            rows.append(_condition_task(*task))
+        for _, r, w, *rest in tasks:
+            rows.append(_simulate_seeded(planner, r, w, *rest))
             bar.update()
     else:
         rows = _run_on_local_cluster(tasks, workers, bar)
@@ -140,9 +139,12 @@ def _run_on_local_cluster(tasks: list[tuple], workers: int, bar: tqdm) -> list[d
     """Run condition tasks on a Dask LocalCluster of single-threaded worker processes; rows in task order."""
     from dask.distributed import Client, LocalCluster, as_completed
 
+    from comanip.planning.worker_cache import WorkerCache
+
     # processes, not threads: CasADi/IPOPT solves hold the GIL; no dashboard (no web server in a batch job)
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
             Client(cluster) as client:
+        client.register_plugin(WorkerCache(_PLANNERS, Planner, size=2))
         futures = client.map(_condition_task, *zip(*tasks), pure=False)
         index = {future.key: i for i, future in enumerate(futures)}
         rows = [None] * len(tasks)
@@ -152,15 +154,20 @@ def _run_on_local_cluster(tasks: list[tuple], workers: int, bar: tqdm) -> list[d
     return rows
 
 
-def _condition_task(model_config: str, distance_over_arm_length: float, width: float, n_trials: int,
+_PLANNERS = "comanip-transition-planners"
+"""The name of the WorkerCache that gives each Dask worker its planners (:func:`_run_on_local_cluster`)."""
+
+
+def _condition_task(model_config: dict, distance_over_arm_length: float, width: float, n_trials: int,
                     arm_length: float, steps: int, seed: np.random.SeedSequence) -> dict:
-    planner = _planner_for(model_config)
+    """One condition on a Dask worker, with the worker's planner for the model (built on its first condition)."""
+    from comanip.planning.worker_cache import worker_cache
+
+    return _simulate_seeded(worker_cache(_PLANNERS).get(model_config), distance_over_arm_length, width, n_trials,
+                            arm_length, steps, seed)
+
+
+def _simulate_seeded(planner: Planner, distance_over_arm_length: float, width: float, n_trials: int,
+                     arm_length: float, steps: int, seed: np.random.SeedSequence) -> dict:
     return simulate_condition(planner, distance_over_arm_length, width, n_trials, arm_length, steps,
                               np.random.default_rng(seed))
-
-
-@lru_cache(maxsize=2)
-def _planner_for(model_config: str) -> Planner:
-    """One planner per model per process: a worker builds it on its first condition and reuses it."""
-    return Planner(ReachingModel.from_config(json.loads(model_config)))
-

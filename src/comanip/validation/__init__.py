@@ -1,17 +1,12 @@
-"""The validation run behind ``comanip validate``: analyses, figures and reports in one call.
+"""The validation run behind ``comanip validate``: analyses and reports in one call.
 
-``import comanip.validation`` loads the settings only; :func:`run_validation`, which draws the figures, is
-imported (with matplotlib) on first use.
+The run computes what its figures show and draws nothing itself: ``comanip validate`` draws them with
+:func:`comanip.plots.validation_figures.draw_validation_figures` (so ``import comanip.validation`` does not load
+matplotlib).
 """
 
+from comanip.validation.figure_data import ValidationFigureData
+from comanip.validation.run import run_validation
 from comanip.validation.settings import ValidationSettings
 
-__all__ = ["run_validation", "ValidationSettings"]
-
-
-def __getattr__(name: str):
-    if name == "run_validation":
-        from comanip.validation.run import run_validation
-
-        return run_validation
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+__all__ = ["run_validation", "ValidationFigureData", "ValidationSettings"]

@@ -1,5 +1,6 @@
 """The Franka section of a validation run (paper Section V-B): Panda reaches from the ready pose to goals
-around it, their numbers (:mod:`comanip.analysis.arm_reaches`), figures, and CSV files.
+around it, their numbers (:mod:`comanip.analysis.arm_reaches`) and CSV files, and what its figures show (drawn by
+:mod:`comanip.plots.validation_figures`).
 
 Building the Panda's planner compiles its per-solve functions to C the first time (about a minute, then
 cached on disk; :mod:`comanip.planning.compiled`), so the build gets its own progress line.
@@ -18,30 +19,18 @@ from comanip.model import ReachingModel
 from comanip.planning.compiled import cache_dir
 from comanip.planning.planner import Planner
 from comanip.progress import elapsed, progress_bar
-from comanip.plots.arm_figure import plot_arm_paths, plot_arm_speed_profiles, plot_joint_trajectories
+from comanip.validation.figure_data import ArmFigureData
 from comanip.validation.settings import ValidationSettings
 
-#: Figure files of the section, in the order the report lists them.
-ARM_FIGURES = ("franka_speed_profiles.png", "franka_joint_positions.png", "franka_joint_velocities.png", "franka_paths.png")
-
-
-def run_arm_section(model: ReachingModel, out: Path, settings: ValidationSettings, progress: bool = True) -> tuple[dict, list[Path]]:
-    """Plan the reaches of ``settings.franka_goal_offsets`` with model (an arm), write figures and CSV files
-    into out; returns the section's report dictionary and the figure paths."""
+def run_arm_section(model: ReachingModel, out: Path, settings: ValidationSettings,
+                    progress: bool = True) -> tuple[dict, ArmFigureData]:
+    """Plan the reaches of ``settings.franka_goal_offsets`` with model (an arm), write CSV files into out;
+    returns the section's report dictionary and what its figures show."""
     planner, build_time, compiled_now = build_arm_planner(model, progress)
     offsets = np.array(settings.franka_goal_offsets, dtype=float)
     with progress_bar(f"franka: planning reaches ({model.name})", len(offsets), "reach", progress) as bar:
         reaches = arm_reaches(planner, offsets, settings.franka_width, settings.franka_max_wall_time, progress=bar.update)
     body = model.body
-    name = model.name
-    figures = [
-        plot_arm_speed_profiles(reaches, out / ARM_FIGURES[0], f"{name}: hand speed of plans from the ready pose"),
-        plot_joint_trajectories(reaches, body.q_min, body.q_max, False, out / ARM_FIGURES[1],
-                                f"{name}: joint positions of the plans (dashed: URDF limits)"),
-        plot_joint_trajectories(reaches, -body.qdot_max, body.qdot_max, True, out / ARM_FIGURES[2],
-                                f"{name}: joint velocities of the plans (dashed: URDF limits)"),
-        plot_arm_paths(reaches, out / ARM_FIGURES[3], f"{name}: hand paths from the ready pose (base frame)"),
-    ]
     rows = [reach.summary() for reach in reaches]
     _write_csv(rows, out / "franka_reaches.csv")
     plan_folder = out / "franka_plans"
@@ -58,7 +47,7 @@ def run_arm_section(model: ReachingModel, out: Path, settings: ValidationSetting
         "summary": summarise_reaches(reaches),
         "files": ["franka_reaches.csv", *(f"franka_plans/goal_{k}.csv" for k in range(len(reaches)))],
     }
-    return section, figures
+    return section, ArmFigureData(model, reaches)
 
 
 def build_arm_planner(model: ReachingModel, progress: bool = True) -> tuple[Planner, float, bool]:

@@ -1,6 +1,7 @@
 """The human-likeness section of a validation run (issue 11): the run's model scored on the targets
-(:mod:`comanip.analysis.human_targets`) beside a reference preset (the paper's ``planar`` by default), their
-figure, and the section's report dictionary (rendered by :func:`comanip.validation.markdown.human_targets_markdown`).
+(:mod:`comanip.analysis.human_targets`) beside a reference preset (the paper's ``planar`` by default), and the
+section's report dictionary (rendered by :func:`comanip.validation.markdown.human_targets_markdown`); its figure is
+drawn by :mod:`comanip.plots.validation_figures`.
 
 The run's model is scored on the open-loop grid the run already planned (what a robot predicts) and, when the
 model has an ``observation`` (feedback), on its closed-loop executions (what the person does); the reference's
@@ -10,27 +11,23 @@ grid is planned here (over the same distances and widths) unless the reference i
 from __future__ import annotations
 
 from dataclasses import asdict
-from pathlib import Path
 
 from comanip.analysis.closed_loop_targets import measure_closed_loop_targets
 from comanip.analysis.human_targets import HumanTargetsResult, measure_human_targets
 from comanip.analysis.reach_grid import ReachOutcome
 from comanip.analysis.target_verdicts import HumanTargets
 from comanip.model import ReachingModel
-from comanip.plots.human_targets_figure import plot_human_targets
 from comanip.progress import progress_bar
 from comanip.validation.settings import ValidationSettings
 
-#: Figure file of the section.
-HUMAN_FIGURE = "human_targets.png"
 #: The one definition of w and ID the section states.
 DEFINITION = "w is the goal radius: a reach hits when ‖x − g‖ ≤ w at MT (2w is the full width), and ID = log2(2D/w) bits"
 
 
-def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list[ReachOutcome], out: Path,
-                      settings: ValidationSettings, progress: bool = True) -> tuple[dict, list[Path]]:
+def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list[ReachOutcome],
+                      settings: ValidationSettings, progress: bool = True) -> tuple[dict, list[HumanTargetsResult]]:
     """Score model on grid (its open-loop outcomes over settings.distances × settings.widths, with plans)
-    and reference; write the figure into out. Returns the section's report dictionary and the figure path."""
+    and reference. Returns the section's report dictionary and the scored models (what its figure shows)."""
     same = reference.config() == model.config()
     grid_options = {"seed": settings.seed, "distances": settings.distances, "widths": settings.widths}
     feedback = bool(model.observation)
@@ -41,9 +38,7 @@ def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list
         if not same:
             results.append(measure_human_targets(reference, n_samples=settings.human_samples, progress=bar.update,
                                                  **grid_options))
-    names = " vs ".join(r.model_name for r in results)
-    figure = plot_human_targets(results, out / HUMAN_FIGURE, title=f"human-likeness targets: {names}")
-    return human_section(results), [figure]
+    return human_section(results), results
 
 
 def human_section(results: list[HumanTargetsResult], targets: HumanTargets = HumanTargets()) -> dict:

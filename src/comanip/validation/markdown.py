@@ -25,7 +25,8 @@ def report_markdown(report: dict) -> str:
         lines += human_targets_markdown(report["human_targets"])
     if "franka" in report:
         lines += _franka_section(report["franka"], report["model"])
-    lines += ["Figures: " + ", ".join(f"`{f}`" for f in report["figures"]), ""]
+    if report["figures"]:
+        lines += ["Figures: " + ", ".join(f"`{f}`" for f in report["figures"]), ""]
     return "\n".join(lines)
 
 

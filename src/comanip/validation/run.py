@@ -1,6 +1,8 @@
-"""A validation run: every analysis of the paper's Section IV-D on one model, its figures, the calibration
-study, the human-likeness targets (issue 11) and the Franka section (Section V-B), written as PNGs, CSV files,
-``report.json`` (every number) and ``report.md`` (the same, as tables).
+"""A validation run: every analysis of the paper's Section IV-D on one model, the calibration study, the
+human-likeness targets (issue 11) and the Franka section (Section V-B), written as CSV files, ``report.json``
+(every number) and ``report.md`` (the same, as tables). The run computes what its figures show
+(:class:`~comanip.validation.figure_data.ValidationFigureData`) and leaves the drawing to the caller's ``draw``
+step (``comanip validate`` passes :func:`comanip.plots.validation_figures.draw_validation_figures`).
 
 A point-mass model gets the Section IV-D analyses, the human-likeness targets beside a reference preset
 (``settings.human_targets``, ``settings.human_reference``) and, unless ``settings.franka`` is False, the Franka
@@ -14,6 +16,7 @@ import json
 import math
 import time
 from pathlib import Path
+from typing import Callable
 
 import numpy as np
 
@@ -34,22 +37,22 @@ from comanip.analysis.calibration import HUMAN_MT_RANGE, TREND_TOLERANCE
 from comanip.analysis.reach_grid import ReachOutcome, home_start, unit_direction
 from comanip.model import ReachingModel
 from comanip.planning.planner import Planner
-from comanip.plots.asymmetry_figure import plot_asymmetry_against_difficulty
-from comanip.plots.calibration_figure import plot_calibration
-from comanip.plots.dispersion_figure import plot_dispersion
-from comanip.plots.fitts_figure import plot_fitts
-from comanip.plots.phase_figure import plot_phase
-from comanip.plots.velocity_profiles import plot_velocity_profiles
 from comanip.progress import progress_bar
 from comanip.validation.arm_section import run_arm_section
+from comanip.validation.figure_data import PointMassFigureData, ValidationFigureData
 from comanip.validation.human_section import run_human_section
 from comanip.validation.markdown import report_markdown
 from comanip.validation.settings import ValidationSettings
 
 
 def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSettings | None = None,
-                   progress: bool = True) -> dict:
-    """Run every analysis on model, write figures and reports into out; returns the report dictionary.
+                   progress: bool = True,
+                   draw: Callable[[ValidationFigureData, Path], list[Path]] | None = None) -> dict:
+    """Run every analysis on model, write the reports and CSV files into out; returns the report dictionary.
+
+    ``draw(figure_data, out)``, when given, draws the figures into out (e.g.
+    :func:`comanip.plots.validation_figures.draw_validation_figures`) and returns their paths, which the
+    report lists under "figures"; without it no figure is drawn and the list is empty.
 
     Raises ValueError, before any work, for an arm model with ``settings.franka`` False (nothing to run) and
     for a human-likeness reference that is not a point-mass model.
@@ -68,27 +71,26 @@ def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSe
     out.mkdir(parents=True, exist_ok=True)
     began = time.perf_counter()
     report = {"model": model.config(), "settings": settings.to_dict()}
-    figures = []
+    figure_data = ValidationFigureData()
     if point_mass:
-        sections, figures, grid = _point_mass_sections(model, out, settings, progress)
+        sections, figure_data.point_mass, grid = _point_mass_sections(model, settings, progress)
         report |= sections
         if reference is not None:
-            report["human_targets"], human_figures = run_human_section(model, reference, grid, out, settings, progress)
-            figures += human_figures
+            report["human_targets"], figure_data.human_targets = run_human_section(model, reference, grid, settings, progress)
     if settings.franka:
         arm = model if not point_mass else presets.load("franka")
-        report["franka"], arm_figures = run_arm_section(arm, out, settings, progress)
-        figures += arm_figures
+        report["franka"], figure_data.arm = run_arm_section(arm, out, settings, progress)
+    figures = [] if draw is None else draw(figure_data, out)
     report |= {"figures": [f.name for f in figures], "wall_time_s": time.perf_counter() - began}
     (out / "report.json").write_text(json.dumps(_plain(report), indent=1))
     (out / "report.md").write_text(report_markdown(report))
     return report
 
 
-def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSettings,
-                         progress: bool) -> tuple[dict, list[Path], list[ReachOutcome]]:
-    """The Section IV-D analyses and the calibration study: report entries, figure paths and the open-loop
-    outcomes (with plans) of the distances × widths grid."""
+def _point_mass_sections(model: ReachingModel, settings: ValidationSettings,
+                         progress: bool) -> tuple[dict, PointMassFigureData, list[ReachOutcome]]:
+    """The Section IV-D analyses and the calibration study: report entries, what their figures show, and the
+    open-loop outcomes (with plans) of the distances × widths grid."""
     planner = Planner(model)
     rng = np.random.default_rng(settings.seed)
     n_grid = len(settings.distances) * len(settings.widths)
@@ -114,18 +116,10 @@ def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSe
     measured = measure_grid(grid, Configuration(model.name), model.goal_covariance)
     grid, fits, grid_row = measured.outcomes, [measured.fitts, measured.shannon], measured.summary()
     ids = index_of_difficulty(np.array([o.distance for o in grid]), np.array([o.width for o in grid]))
-    figures = [
-        plot_velocity_profiles(grid, fits[0], settings.profile_distance, settings.profile_width, out / "velocity_profiles.png",
-                               f"{model.name}: speed profiles (solid), minimum jerk with the same MT (dashed)"),
-        plot_fitts(grid, fits, out / "fitts.png", f"{model.name}: movement time against index of difficulty (open-loop plans)"),
-        plot_dispersion([d for _, d in dispersions], dispersion_goal, out / "dispersion.png",
-                        title=f"{model.name}: open-loop executions of the planned torques, goal {dispersion_goal.round(3).tolist()} m"),
-        plot_phase(by_distance, by_velocity, out / "phase.png", f"{model.name}: phase plots along the reach (plans)"),
-        plot_calibration(calibration_rows, out / "calibration.png",
-                         f"calibration study on {model.name}: {len(settings.distances)} distances × {len(settings.widths)} widths"),
-        plot_asymmetry_against_difficulty(calibration_rows, (float(ids.min()), float(ids.max())),
-                                          out / "asymmetry_vs_difficulty.png"),
-    ]
+    figure_data = PointMassFigureData(
+        model.name, grid, fits, settings.profile_distance, settings.profile_width, [d for _, d in dispersions],
+        dispersion_goal, by_distance, by_velocity, calibration_rows, (float(ids.min()), float(ids.max())),
+        len(settings.distances), len(settings.widths))
 
     report = {
         "fitts_grid": {
@@ -158,7 +152,7 @@ def _point_mass_sections(model: ReachingModel, out: Path, settings: ValidationSe
             **{f"cov_reading_{form}_r2_if_log_linear": _r2_if_log_linear_in_d_over_sqrt_w(grid, form) for form in ("fitts", "shannon")},
         },
     }
-    return report, figures, grid
+    return report, figure_data, grid
 
 
 def _r2_if_log_linear_in_d_over_sqrt_w(grid, form: str) -> float:

@@ -1,4 +1,6 @@
-"""Argument helpers shared by the subcommands."""
+"""Command-line options shared by the subcommands: argparse helpers for the model and a reach, loading the
+model, and parsing input paths and vectors. Checks of argument values for the library are in
+:mod:`comanip.arguments`."""
 
 from __future__ import annotations
 
