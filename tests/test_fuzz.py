@@ -16,6 +16,8 @@ import comanip
 from comanip.cli.main import main
 from comanip.estimation import GoalEstimator
 
+pytestmark = pytest.mark.slow  # about 30 s: CI runs it; the fast subset (-m "not slow") leaves it out
+
 FUZZ_COUNT = {"inputs": 0}
 # CI draws the same inputs every run (a failure there is then reproducible, not luck); elsewhere they are new each run
 FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None,
