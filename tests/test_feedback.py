@@ -40,6 +40,7 @@ def _step_function(model):
     return ca.Function("step", [s, u], [model.body.discrete_step(s, u, model.h)])
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("activation", [(), (0.04, 0.04)])
 def test_filter_covariance_matches_the_monte_carlo_of_its_errors(planar_planner, activation):
     # open loop with a fixed command sequence, so the filter's covariance is the same in every run: for a linear

@@ -159,6 +159,7 @@ def test_model_observation_drives_the_closed_loop_estimate():
         comanip.presets.planar().replace(observation=(0.004, 0.04, -0.1))
 
 
+@pytest.mark.slow
 def test_human_preset_trends():
     """What the human preset is for, as trends over the targets' grid: Fitts' law with a steeper slope than the
     paper's (a human one, about 80 ms/bit), a smooth onset and a flat t_peak/MT in the plan, and, in its closed

@@ -42,6 +42,7 @@ def test_dispersion_profile_matches_the_closed_form_of_synthetic_paths(rng):
     assert profile.has_interior_peak
 
 
+@pytest.mark.slow
 def test_closed_loop_reacher_has_an_interior_dispersion_peak(planar_planner, rng):
     # SPEC §9: with replanning from the noisy state the spread across the path rises, then feedback corrects it
     D, w = 0.3, 0.02
