@@ -175,3 +175,13 @@ def test_human_preset_trends():
     closed = measure_closed_loop_targets(human, n_trials=4, distances=(0.3,), widths=(0.005, 0.04))
     small, large = closed.rows
     assert small.asymmetry < large.asymmetry - 0.05 and small.movement_time > large.movement_time
+
+
+def test_a_plan_with_activation_stages_saves_a_csv_whose_header_fits_its_rows(tmp_path, activation_planner):
+    import csv
+
+    plan = activation_planner.solve(np.zeros(4), [0.3, 0.0], 0.04)
+    with open(plan.save_csv(tmp_path / "plan.csv")) as f:
+        rows = list(csv.reader(f))
+    assert rows[0][5:9] == ["a1_0", "a1_1", "a2_0", "a2_1"]
+    assert all(len(row) == len(rows[0]) for row in rows)

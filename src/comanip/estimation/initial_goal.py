@@ -28,10 +28,10 @@ _AT_REST = 1e-6
 
 
 def task_space_state(planner: Planner, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """End-effector position (d,) m and velocity J(q) qdot (d,) m/s of a state [q; qdot] (2n,)."""
+    """End-effector position (d,) m and velocity J(q) qdot (d,) m/s of a state [q; qdot; ...] (2n or nx,)."""
     n = planner.model.n
     x, J = (np.asarray(v) for v in planner.model.body.kinematics_function(state[:n]))
-    return x.ravel(), J @ state[n:]
+    return x.ravel(), J @ state[n:2 * n]
 
 
 def search_along_observed_direction(planner: Planner, start, observed, n_o: int, prior, width: float, R: np.ndarray,

@@ -103,11 +103,14 @@ class Plan:
         return path
 
     def save_csv(self, path: str | Path) -> Path:
-        """One row per step: t, q, qdot, x, x velocity, x std, tau (empty on the last row)."""
+        """One row per step: t, q, qdot, the activation stages (a{stage}_{k}, models with them), x, x velocity,
+        x std, tau (empty on the last row)."""
         path = Path(path)
         n, d = self.torque.shape[1], self.ee_mean.shape[1]
         axes = "xyz"[:d] if d <= 3 else [str(k) for k in range(d)]
+        stages = range(1, (self.mean.shape[1] - 2 * n) // n + 1)
         header = (["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
+                  + [f"a{j}_{k}" for j in stages for k in range(n)]
                   + [f"x_{a}_m" for a in axes] + [f"v_{a}_m_per_s" for a in axes] + [f"std_{a}_m" for a in axes]
                   + [f"tau{k}" for k in range(n)])
         with open(path, "w", newline="") as f:
