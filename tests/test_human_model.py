@@ -155,6 +155,8 @@ def test_model_observation_drives_the_closed_loop_estimate():
     assert run.estimates is not None and not np.allclose(run.estimates[1:, :2], run.states[1:, :2])
     with pytest.raises(ValueError, match="observation"):
         comanip.presets.planar().replace(observation=(0.004, 0.04))
+    with pytest.raises(ValueError, match="observation"):
+        comanip.presets.planar().replace(observation=0.004)
     with pytest.raises(ValueError, match=r"observation\[2\]"):
         comanip.presets.planar().replace(observation=(0.004, 0.04, -0.1))
 

@@ -93,7 +93,7 @@ class ReachingModel:
         check_discount_form(self.discount)
         as_positive("effective_k", self.effective_k, "standard deviations")
         as_nonnegative("stop_weight", self.stop_weight, "(s/m)²")
-        if len(self.observation) not in (0, 3):
+        if not isinstance(self.observation, (tuple, list, np.ndarray)) or len(self.observation) not in (0, 3):
             raise ValueError(f"observation must be () or (position SD m, velocity SD m/s, delay s), got {self.observation!r}")
         object.__setattr__(self, "observation", tuple(as_nonnegative(f"observation[{i}]", v, unit)
                                                       for i, (v, unit) in enumerate(zip(self.observation, ("m", "m/s", "s")))))
