@@ -56,12 +56,19 @@ def check_goal_covariance_form(form: str) -> str:
     return form
 
 
+def goal_variance(width, form: str = "std", effective_k: float = EFFECTIVE_WIDTH_K):
+    """The variance c (m²) per axis of W = c I for a goal width w (m): w², w or (2w/k)² (see goal_covariance)."""
+    check_goal_covariance_form(form)
+    if form == "std":
+        return width**2
+    return width if form == "cov" else (2 * width / effective_k) ** 2
+
+
 def goal_covariance(width, d: int, form: str = "std", effective_k: float = EFFECTIVE_WIDTH_K):
     """W (d, d) from the goal width w (m): w² I (``std``), w I (``cov``) or (2w/k)² I (``effective``).
 
     Works on CasADi and NumPy scalars."""
-    check_goal_covariance_form(form)
-    scale = {"std": width**2, "cov": width, "effective": (2 * width / effective_k) ** 2}[form]
+    scale = goal_variance(width, form, effective_k)
     if isinstance(width, (ca.SX, ca.MX)):
         return scale * ca.DM.eye(d)
     return float(scale) * np.eye(d)
@@ -115,10 +122,13 @@ class GoalReward:
         return float(_hit_function(self.d)(np.asarray(mu_x, float) - np.asarray(goal, float), np.asarray(Sigma_x, float), float(width)))
 
     def peak(self, width):
-        """R of a noiseless hand on the goal: 1/sqrt(det(2π W)) (Gaussian) or 1 (hit)."""
+        """R of a noiseless hand on the goal: 1/sqrt(det(2π W)) (Gaussian) or 1 (hit); a CasADi expression of
+        a symbolic width, a float of a number (the solvers ask for it at every Hessian)."""
         if self.form == "hit":
             return width**0  # 1, of width's type
-        return 1 / ca.sqrt(ca.det(2 * ca.pi * self.covariance(width)))
+        if isinstance(width, (ca.SX, ca.MX)):
+            return 1 / ca.sqrt(ca.det(2 * ca.pi * self.covariance(width)))
+        return (2 * np.pi * goal_variance(float(width), self.goal_covariance_form, self.effective_k)) ** (-self.d / 2)
 
 
 @lru_cache(maxsize=None)

@@ -48,6 +48,7 @@ class ReachProblem:
         # The best objective attainable (hand on the goal with no noise at every step, no effort), used to
         # normalise J for the solver so its tolerances mean the same for every width; the minimiser is unchanged.
         self.best_objective = -float(np.sum(weights)) * self.reward.peak(self.width)
+        self._weight_sum = float(np.sum(weights))
         self.normaliser_function = ca.Function("normaliser", [self.width], [-self.best_objective])
         """``width -> |J_best(w)|`` as a CasADi function (for building other functions of the width)."""
         if model.stop_weight > 0:  # relative to the best reward, so it means the same for every width
@@ -66,7 +67,7 @@ class ReachProblem:
     def normaliser(self, width: float) -> float:
         """|J_best(w)| (> 0) for a goal width w (m): the solvers divide J by it, so their tolerances mean the same
         for every width."""
-        return float(self.normaliser_function(width))
+        return self._weight_sum * self.reward.peak(float(width))
 
     def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
         """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
