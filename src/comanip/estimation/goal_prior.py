@@ -14,6 +14,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -47,3 +48,18 @@ def prior_covariance(prior_std, model, width: float) -> np.ndarray:
         raise ValueError(f"prior_std must be a positive number or {d} of them (m), None (the weak default, "
                          f"{DEFAULT_PRIOR_STD:g} m) or {PAPER_PRIOR!r} (the paper's W from the width), got {prior_std!r}")
     return np.diag(values**2)
+
+
+@dataclass(frozen=True)
+class GoalPrior:
+    """A Gaussian prior over the goal: N(mean, covariance)."""
+
+    mean: np.ndarray
+    """g_bar (d,), m."""
+    covariance: np.ndarray
+    """(d, d), m² (:func:`prior_covariance`)."""
+
+    @property
+    def precision(self) -> np.ndarray:
+        """covariance^-1 (d, d), m^-2."""
+        return np.linalg.inv(self.covariance)
