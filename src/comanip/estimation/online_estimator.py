@@ -127,6 +127,8 @@ _COVARIANCE_ROUNDS = 3
 _BACKTRACKS = 12
 #: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
 _DECREMENT = 1e-9
+#: ... and, relative to -log p, below which a step that no line search can lower counts as converged (rounding).
+_ACCEPTABLE_DECREMENT = 1e-6
 
 
 class OnlineGoalEstimator:
@@ -138,7 +140,7 @@ class OnlineGoalEstimator:
         start: the state at the reach's start (nx,) or [q; qdot] (2n,), at rest (zero velocity and force).
         prior_goal: g_bar (d,) m; None: the start's hand position (with the weak default std, a prior that
             only keeps the estimate finite).
-        prior_std: the prior's standard deviation (m): a number, d numbers, None (the weak default, 1 m)
+        prior_std: the prior's standard deviation (m): a number, d numbers, None (the weak default, 10 m)
             or "width" (the paper's W from the width); :mod:`comanip.estimation.goal_prior`.
         width: goal width w (m); the model's default when None.
         options: :class:`OnlineOptions`.
@@ -384,14 +386,19 @@ class _Problem:
                     break
                 step *= 0.5
             else:
-                return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, "no Newton step lowers the objective", iteration
+                decrement = 0.5 * float(_solve_positive(newton, gauss_newton, descent) @ descent)
+                if decrement <= _ACCEPTABLE_DECREMENT * max(1.0, abs(objective)):
+                    return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, (
+                        f"no Newton step lowers the objective any more (decrement {decrement:.2g})"), iteration
+                return goal, _covariance(terms), Status.FAILED, (
+                    f"no Newton step lowers the objective, though it predicts a decrease of {decrement:.2g}"), iteration
             goal, terms = trial, trial_terms
         return goal, _covariance(terms), Status.MAX_ITERATIONS, f"no convergence in {options.max_iterations} Newton iterations", options.max_iterations
 
     def cold_goal(self) -> np.ndarray | None:
         """The best member of the family along the observed directions (latest velocity, latest displacement
         from the start, and the prior's direction), scored by the observations' likelihood with each step's
-        error taken independently, plus the prior; None when nothing moved and the prior sits at the start."""
+        error taken independently, plus the prior; None when no observation shows movement beyond its noise."""
         e = self.e
         n = e.model.n
         sigma_q, sigma_v = e.options.observation_std
@@ -402,11 +409,11 @@ class _Problem:
         displacement = latest[:n] - e.start_position
         if np.linalg.norm(displacement) > _MOVEMENT_SIGMAS * sigma_q:
             directions.append(displacement / np.linalg.norm(displacement))
+        if not directions:
+            return None
         prior_offset = e.prior_mean - e.start_position
         if np.linalg.norm(prior_offset) > 0:
             directions.append(prior_offset / np.linalg.norm(prior_offset))
-        if not directions:
-            return None
         family, m = e.family, self.m
         noise = e._R[None] / e._counts[self.steps][:, None, None]
         best, best_score = None, math.inf
