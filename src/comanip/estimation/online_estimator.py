@@ -66,12 +66,12 @@ class OnlineOptions:
     family_tolerance: float = 1e-4
     """Largest difference (m) accepted between the family's interpolated mean position and a real plan."""
     tolerance: float = 1e-7
-    """A Newton goal step shorter than this (m), or one that lowers -log p by less than 1e-9, ends an update."""
+    """A Newton goal step shorter than this (m), or one that lowers -log p by less than 1e-6 (taken, then stop), ends an update."""
     max_iterations: int = 20
     """Gauss–Newton iterations per update."""
     step_fraction: float = 0.5
     """Largest goal step, as a fraction of the distance from the start to the current goal (at least one width)."""
-    covariance_tolerance: float = 0.02
+    covariance_tolerance: float = 0.05
     """The belief covariance that weighs the observations is the plan's to a goal within this fraction of the
     distance (start to goal) of the estimate; it is recomputed when the estimate moves farther."""
 
@@ -126,7 +126,7 @@ _COVARIANCE_ROUNDS = 3
 #: Halvings of a Newton step before the iteration gives up.
 _BACKTRACKS = 12
 #: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
-_DECREMENT = 1e-9
+_DECREMENT = 1e-6
 #: ... and, relative to -log p, below which a step that no line search can lower counts as converged (rounding).
 _ACCEPTABLE_DECREMENT = 1e-6
 
@@ -325,12 +325,19 @@ class _Problem:
     def __init__(self, estimator: OnlineGoalEstimator, steps, observed, weights):
         self.e, self.steps, self.observed, self.weights = estimator, steps, observed, weights
         self.m = observed.shape[1]
+        self._predicted: tuple[bytes, ReachPrediction] | None = None    # the last goal's prediction (rounds share it)
+
+    def _prediction(self, goal: np.ndarray) -> ReachPrediction:
+        key = goal.tobytes()
+        if self._predicted is None or self._predicted[0] != key:
+            self._predicted = key, self.e._prediction(goal, order=2, covariance=False)
+        return self._predicted[1]
 
     def _terms(self, whitening: ObservationWhitening, goal):
         """(objective, Hessian (d, d), Gauss–Newton matrix (d, d), minus the gradient (d,)) at ``goal``."""
         e, m = self.e, self.m
         d = len(goal)
-        prediction = e._prediction(goal, order=2, covariance=False)
+        prediction = self._prediction(goal)
         H1, nx = prediction.mean.shape
         grid = np.concatenate([prediction.mean[:, :m, None], prediction.mean_jacobian[:, :m]], axis=2)
         columns = (self.weights @ grid.reshape(H1, -1)).reshape(len(self.steps), m, 1 + d)
