@@ -365,6 +365,13 @@ class _Problem:
             return goal
         return e.start_position + offset * (min(max(D, low), high) / D)
 
+    def _at_range_end(self, goal: np.ndarray) -> bool:
+        return bool(np.linalg.norm(goal - self.e.start_position) >= self.e.family.distances[-1] * (1 - 1e-9))
+
+    def _range_message(self) -> str:
+        return (f"the estimate sits at the largest distance the reach family covers ({self.e.family.distances[-1]:g} m): "
+                "the observations point farther than the model's plans reach")
+
     def newton(self, goal: np.ndarray, whitening: ObservationWhitening):
         """Newton's method from ``goal`` under a fixed ``whitening`` (the Gauss–Newton matrix where the Hessian
         is not positive definite), a backtracking line search on the objective: (goal, covariance (d, d) m²,
@@ -378,9 +385,8 @@ class _Problem:
             if 0.5 * float(step @ descent) <= _DECREMENT or math.sqrt(float(step @ step)) <= options.tolerance:
                 # the Newton step would lower -log p by less than _DECREMENT: take it and stop
                 goal = self._projected(goal + step)
-                if np.linalg.norm(goal - e.start_position) >= e.family.distances[-1] * (1 - 1e-9):
-                    return goal, _covariance(terms), Status.MAX_ITERATIONS, (
-                        f"the estimate sits at the largest distance the reach family covers ({e.family.distances[-1]:g} m)"), iteration
+                if self._at_range_end(goal):
+                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
                 return goal, _covariance(terms), Status.SOLVED, f"converged in {iteration} Newton iterations", iteration
             limit = options.step_fraction * max(math.sqrt(float((goal - e.start_position) @ (goal - e.start_position))), e.width)
             length = math.sqrt(float(step @ step))
@@ -393,6 +399,8 @@ class _Problem:
                     break
                 step *= 0.5
             else:
+                if self._at_range_end(goal):
+                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
                 decrement = 0.5 * float(_solve_positive(newton, gauss_newton, descent) @ descent)
                 if decrement <= _ACCEPTABLE_DECREMENT * max(1.0, abs(objective)):
                     return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, (
