@@ -123,6 +123,9 @@ DEFAULT_FAMILIES = FamilyCache()
 _MOVEMENT_SIGMAS = 3.0
 #: Whitenings rebuilt per update at most (each at the goal the previous round ended at).
 _COVARIANCE_ROUNDS = 3
+#: Relative std along the reach above which the goal's variance there comes from a quadrature, and its points.
+_SKEWED = 0.05
+_QUADRATURE_POINTS = 200
 #: Halvings of a Newton step before the iteration gives up.
 _BACKTRACKS = 12
 #: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
@@ -257,6 +260,7 @@ class OnlineGoalEstimator:
                 iterations += used
                 if not self._stale(goal):
                     break
+            covariance = problem.distance_spread(goal, covariance, whitening)
             if not (np.all(np.isfinite(goal)) and np.all(np.isfinite(covariance))):
                 raise np.linalg.LinAlgError("non-finite estimate")
         except np.linalg.LinAlgError as error:
@@ -364,6 +368,40 @@ class _Problem:
         if low <= D <= high:
             return goal
         return e.start_position + offset * (min(max(D, low), high) / D)
+
+    def distance_spread(self, goal: np.ndarray, covariance: np.ndarray, whitening: ObservationWhitening) -> np.ndarray:
+        """The covariance with its variance along the reach replaced by the posterior's along the line through
+        the start and ``goal`` (1-D quadrature on a grid of distances), and the spread across it scaled by the
+        root mean square distance over D_hat, where the Laplace approximation's relative std along the reach
+        exceeds :data:`_SKEWED`: early in a reach the distance's posterior has a long tail towards far goals
+        that the curvature at the mode does not see."""
+        e = self.e
+        offset = goal - e.start_position
+        D = float(np.linalg.norm(offset))
+        u = offset / D
+        variance = float(u @ covariance @ u)
+        spread = math.sqrt(variance) / D
+        if spread < _SKEWED:
+            return covariance
+        family = e.family
+        distances = np.exp(np.linspace(math.log(D) - 6 * spread, math.log(D) + 6 * spread, _QUADRATURE_POINTS))
+        distances = distances[(distances >= family.distances[0]) & (distances <= family.distances[-1])]
+        n, m = e.model.n, self.m
+        means = (family.along(distances)[:, :, :, None] * u).reshape(len(distances), e.model.H + 1, -1)[:, :, :m]
+        means[:, :, :n] += e.start_position
+        residuals = self.observed[None] - np.einsum("sj,kjm->ksm", self.weights, means)
+        whitened = whitening.matrix @ residuals.reshape(len(distances), -1).T
+        goals = e.start_position + distances[:, None] * u
+        offsets = goals - e.prior_mean
+        energy = 0.5 * (np.sum(whitened**2, axis=0) + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
+        weights = np.exp(-(energy - energy.min())) * np.gradient(distances)
+        weights /= weights.sum()
+        along = float(weights @ (distances - D) ** 2)
+        # across the reach the direction's uncertainty spreads the goal in proportion to its distance
+        across = np.eye(len(u)) - np.outer(u, u)
+        stretch = math.sqrt(max(1.0, float(weights @ distances**2) / D**2))
+        scale = across * stretch + np.outer(u, u)
+        return scale @ covariance @ scale + max(0.0, along - variance) * np.outer(u, u)
 
     def _at_range_end(self, goal: np.ndarray) -> bool:
         return bool(np.linalg.norm(goal - self.e.start_position) >= self.e.family.distances[-1] * (1 - 1e-9))

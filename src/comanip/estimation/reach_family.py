@@ -207,6 +207,15 @@ class ReachFamily:
         turned = self.prediction(np.zeros(self.model.d), self.distances[k] * u, order=0, covariance=False)
         return float(np.abs(plan.mean - turned.mean).max())
 
+    def along(self, distances: np.ndarray) -> np.ndarray:
+        """The mean along the axis per state block, a_b,i(D) (M, H+1, blocks), at distances (M,) m within the range."""
+        x = np.log(np.clip(distances, self._low, self._high))
+        k = np.clip(np.searchsorted(self._path.x, x) - 1, 0, len(self._knots) - 2)
+        dx = (x - self._path.x[k])[:, None]
+        size = (self.H + 1) * self.blocks
+        c = self._path.c[:, k, :size]
+        return (((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]).reshape(len(distances), self.H + 1, self.blocks)
+
     def frame(self, u: np.ndarray) -> np.ndarray:
         """T (nx, nx): the orthogonal map Q (Q e_1 = u) applied to every state block."""
         Q, n = householder(u), self.n
