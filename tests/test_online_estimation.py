@@ -250,3 +250,14 @@ def test_estimate_goal_reports_a_covariance_and_takes_prior_std(cartesian_planne
     assert np.all(np.linalg.eigvalsh(estimate.goal_covariance) > 0)
     with pytest.raises(ValueError, match="prior_std"):
         comanip.estimate_goal(cartesian_planner, np.zeros(6), plan.mean[5], plan.t[5], prior_std=0.0)
+
+
+def test_arbitrary_observations_never_raise(online):
+    """Observations no reach of the model produces (far, fast, backwards, at rest, beyond the horizon)."""
+    rng = np.random.default_rng(5)
+    estimator = fresh(online)
+    for t in np.sort(rng.uniform(0, 4.0, 40)):
+        scale = 10.0 ** rng.uniform(-4, 1)
+        estimate = estimator.update(t, rng.normal(size=3) * scale, rng.normal(size=3) * 10 * scale)
+        assert all(np.all(np.isfinite(v)) for v in (estimate.goal, estimate.goal_covariance, estimate.mean, estimate.cov))
+        assert estimate.success == (estimate.status in ("solved", "solved_acceptable"))

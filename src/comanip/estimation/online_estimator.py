@@ -384,8 +384,11 @@ class _Problem:
         if spread < _SKEWED:
             return covariance
         family = e.family
-        distances = np.exp(np.linspace(math.log(D) - 6 * spread, math.log(D) + 6 * spread, _QUADRATURE_POINTS))
-        distances = distances[(distances >= family.distances[0]) & (distances <= family.distances[-1])]
+        low = max(math.log(D) - 6 * spread, math.log(family.distances[0]))
+        high = min(math.log(D) + 6 * spread, math.log(family.distances[-1]))
+        if high - low < 1e-6:
+            return covariance
+        distances = np.exp(np.linspace(low, high, _QUADRATURE_POINTS))
         n, m = e.model.n, self.m
         means = (family.along(distances)[:, :, :, None] * u).reshape(len(distances), e.model.H + 1, -1)[:, :, :m]
         means[:, :, :n] += e.start_position
