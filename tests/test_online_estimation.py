@@ -261,3 +261,21 @@ def test_arbitrary_observations_never_raise(online):
         estimate = estimator.update(t, rng.normal(size=3) * scale, rng.normal(size=3) * 10 * scale)
         assert all(np.all(np.isfinite(v)) for v in (estimate.goal, estimate.goal_covariance, estimate.mean, estimate.cov))
         assert estimate.success == (estimate.status in ("solved", "solved_acceptable"))
+
+
+def test_cli_estimate_takes_prior_std(tmp_path, capsys, planar_planner):
+    from comanip.cli.main import main
+
+    plan = planar_planner.solve(np.zeros(4), [0.2, 0.1])
+    plan.save_csv(tmp_path / "observed.csv")
+    goals = {}
+    for prior_std in ("0.001", "10", "width"):
+        code = main(["estimate", "--observations", str(tmp_path / "observed.csv"), "--t-obs", "0.21", "--prior", "0.3,0.0",
+                     "--prior-std", prior_std, "--out", str(tmp_path / prior_std)])
+        summary = json.loads(capsys.readouterr().out)
+        assert code == 0 and np.array(summary["goal_covariance"]).shape == (2, 2)
+        goals[prior_std] = np.array(summary["estimated_goal"])
+    assert np.linalg.norm(goals["0.001"] - [0.3, 0.0]) < 0.005       # a tight prior holds the goal
+    assert np.linalg.norm(goals["10"] - [0.2, 0.1]) < 0.005          # a weak one leaves it to the observation
+    assert main(["estimate", "--observations", str(tmp_path / "observed.csv"), "--prior", "0.3,0.0", "--prior-std", "wide"]) != 0
+    assert "--prior-std" in capsys.readouterr().err
