@@ -6,6 +6,7 @@ import json
 
 import numpy as np
 import pytest
+import scipy.linalg
 from scipy.stats import chi2
 
 import comanip
@@ -85,6 +86,18 @@ def test_whitening_matches_the_joint_covariance(cartesian_planner):
     for whitening in (at_once, one_by_one):
         np.testing.assert_allclose(whitening.matrix @ joint @ whitening.matrix.T, np.eye(30), atol=1e-8)
         assert whitening.log_det == pytest.approx(np.linalg.slogdet(joint)[1], rel=1e-10)
+    # observations between grid steps: the error at (i + f) h is (1 - f) e_i + f e_{i+1}, exactly
+    fractions = np.array([0.3, 0.5, 0.1, 0.9, 0.6])
+    every = np.arange(model.H + 1)
+    states = joint_state_covariance(plan, every, step_jacobians)
+    pick = np.zeros((30, 6 * (model.H + 1)))
+    for k, (i, f) in enumerate(zip(steps, fractions)):
+        pick[6 * k:6 * k + 6, 6 * i:6 * i + 6] = (1 - f) * np.eye(6)
+        pick[6 * k:6 * k + 6, 6 * (i + 1):6 * (i + 2)] = f * np.eye(6)
+    exact = pick @ states @ pick.T + scipy.linalg.block_diag(*noise)
+    between = ObservationWhitening(plan.cov, powers, 6, steps, [R + f**2 * (plan.cov[i + 1] - A @ plan.cov[i] @ A.T)
+                                                                for i, f, R in zip(steps, fractions, noise)], fractions)
+    np.testing.assert_allclose(between.matrix @ exact @ between.matrix.T, np.eye(30), atol=1e-8)
 
 
 def issue_cases(rng, count=5):

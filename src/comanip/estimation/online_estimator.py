@@ -20,8 +20,8 @@ and width: for a rotation-invariant point mass from rest, the plan to any goal i
 direction, read from a spline over distance, together with d mu / d g. So an update needs no plan solve.
 What is approximated: the predicted reach is the spline's, within ``family.interpolation_error`` (m, measured
 at build time against real plans; about 1e-4 m or less on the paper presets) of the model's plan; an
-observation between grid steps takes the mean interpolated linearly in time and the state error of the
-nearest step. The first (cold) estimate starts from the best family member along the observed directions.
+observation between grid steps sees the state interpolated linearly between the steps around it (mean and
+error alike, :mod:`comanip.estimation.observation_whitening`). The first (cold) estimate starts from the best family member along the observed directions.
 
 >>> estimator = OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6))
 >>> estimate = estimator.update(0.1, position, velocity)
@@ -182,6 +182,7 @@ class OnlineGoalEstimator:
         self._R = observation_covariance(self.options.observation_std, n)
         H = model.H
         self._counts = np.zeros(H + 1)
+        self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations
         self._sums = np.zeros((H + 1, 2 * n))
         self._weights = np.zeros((H + 1, H + 1))
         self._last_time = -math.inf
@@ -225,14 +226,14 @@ class OnlineGoalEstimator:
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
         observation = np.r_[position, velocity]
         grid = time_s / model.h
-        nearest = min(model.H, int(round(grid)))
         before = min(model.H, int(math.floor(grid * (1 + 1e-9))))
         fraction = 0.0 if before == model.H else min(max(grid - before, 0.0), 1.0)
-        self._counts[nearest] += 1
-        self._sums[nearest] += observation
-        self._weights[nearest, before] += 1.0 - fraction
+        self._counts[before] += 1
+        self._sums[before] += observation
+        self._fractions[before] += fraction
+        self._weights[before, before] += 1.0 - fraction
         if fraction > 0:
-            self._weights[nearest, before + 1] += fraction
+            self._weights[before, before + 1] += fraction
         self._last_time, self._last_observation = time_s, observation
         with self._blas.limit(limits=1, user_api="blas"):   # threads only slow products of this size down
             self.latest = self._estimate(t_begin)
@@ -283,14 +284,31 @@ class OnlineGoalEstimator:
         steps = np.flatnonzero(self._counts)
         whitening = self._whitening
         if self._stale(goal):
-            whitening = ObservationWhitening(self._prediction(goal, order=0).cov, self._powers, 2 * self.model.n, steps,
-                                             self._R[None] / self._counts[steps][:, None, None])
+            cov = self._prediction(goal, order=0).cov
+            whitening = ObservationWhitening(cov, self._powers, 2 * self.model.n, steps,
+                                             np.array([self._step_noise(i, cov) for i in steps]),
+                                             self._fractions[steps] / self._counts[steps])
             self._whitening, self._whitening_goal = whitening, np.array(goal, dtype=float)
-        elif len(whitening.steps) == len(steps):
-            whitening.redo_last(self._R / self._counts[steps[-1]])
         else:
-            whitening.append(steps[-1], self._R / self._counts[steps[-1]])
+            last = steps[-1]
+            noise, fraction = self._step_noise(last, whitening.cov), self._fractions[last] / self._counts[last]
+            if len(whitening.steps) == len(steps):
+                whitening.redo_last(noise, fraction)
+            else:
+                whitening.append(last, noise, fraction)
         return whitening
+
+    def _step_noise(self, i: int, cov: np.ndarray) -> np.ndarray:
+        """Noise covariance (2n, 2n) of the averaged observation of step i: R / m_i + f̄² Q_i, f̄ the mean
+        fraction of a step its observations come after t_i, Q_i = Sigma_{i+1} - A Sigma_i A^T the motor noise
+        of step i (:mod:`comanip.estimation.observation_whitening`)."""
+        m, count = 2 * self.model.n, self._counts[i]
+        mean_fraction = self._fractions[i] / count
+        noise = self._R / count
+        if mean_fraction > 0 and i < self.model.H:
+            A = self._powers[1]
+            noise = noise + mean_fraction**2 * (cov[i + 1] - A @ cov[i] @ A.T)[:m, :m]
+        return noise
 
     def _result(self, goal, covariance, status: Status, message: str, iterations: int, t_begin: float) -> GoalEstimate:
         model, n = self.model, self.model.n
@@ -304,7 +322,7 @@ class OnlineGoalEstimator:
                     mean=prediction.mean, cov=prediction.cov, torque=prediction.torque, ee_mean=prediction.mean[:, :n].copy(),
                     ee_cov=prediction.cov[:, :n, :n].copy(), ee_velocity=prediction.mean[:, n:2 * n].copy(),
                     start=self.start.copy(), goal=np.array(goal, dtype=float), width=self.width, model_name=model.name)
-        return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=min(model.H, int(round(grid))),
+        return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=before,
                                observed_state=self._last_observation.copy(),
                                observation_residual=predicted - self._last_observation, prior_goal=self.prior_goal,
                                method="online", goal_covariance=np.array(covariance, dtype=float))
