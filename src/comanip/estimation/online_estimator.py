@@ -9,11 +9,17 @@ goal g_hat under the model and its covariance, with the model's predicted reach 
 where mu(g) stacks the plan's predicted mean [q; qdot] at the observation times (linearly interpolated
 between grid steps), L is the factor of the observations' joint covariance under the plan's open-loop belief
 plus the observation noise R (:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
-(:mod:`comanip.estimation.goal_prior`). Every observation so far enters. The covariance is held at the
-previous estimate's plan during an update (its dependence on g is left out of the objective, as in iteratively
-reweighted least squares: an exact observation of a plan then gives back its goal), and the minimum is
-found by Gauss–Newton steps warm-started from the previous estimate. The goal's covariance is the Laplace
-approximation with the Gauss–Newton curvature, (G^T G + P0^-1)^-1, G = L^-1 d mu / d g.
+(:mod:`comanip.estimation.goal_prior`). Every observation so far enters. The observations' covariance is that
+of the plan to a goal within 5 % of the distance of the estimate (``OnlineOptions.covariance_tolerance``; its
+dependence on g is left out of the objective, as in iteratively reweighted least squares: an exact
+observation of a plan then gives back its goal). The minimum is found by Newton's method with the exact
+Hessian (the Gauss–Newton matrix where that is not positive definite), warm-started from the previous
+estimate. The goal's covariance is the Laplace approximation, the inverse Hessian at the estimate; where the
+distance is still poorly known (relative std along the reach above 5 %) its variance along the reach comes
+from a 1-D quadrature of the posterior along the line from the start through g_hat, and the spread across
+the reach is scaled by the root-mean-square distance over |g_hat - x_0| (the curvature at the mode misses the
+posterior's long tail towards far goals). Over reaches sampled from the model, the 95 % ellipsoid holds the
+true goal 93.5–98 % of the time from 0.1 s on (docs/measure_goal_estimation.py).
 
 The plans come from a :class:`~comanip.estimation.reach_family.ReachFamily` of the model, built once per model
 and width: for a rotation-invariant point mass from rest, the plan to any goal is a 1-D reach turned onto its
@@ -21,7 +27,8 @@ direction, read from a spline over distance, together with d mu / d g. So an upd
 What is approximated: the predicted reach is the spline's, within ``family.interpolation_error`` (m, measured
 at build time against real plans; about 1e-4 m or less on the paper presets) of the model's plan; an
 observation between grid steps sees the state interpolated linearly between the steps around it (mean and
-error alike, :mod:`comanip.estimation.observation_whitening`). The first (cold) estimate starts from the best family member along the observed directions.
+error alike, :mod:`comanip.estimation.observation_whitening`). The first (cold) estimate starts from the best
+family member along the observed directions.
 
 >>> estimator = OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6))
 >>> estimate = estimator.update(0.1, position, velocity)
