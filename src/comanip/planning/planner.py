@@ -162,17 +162,8 @@ class Planner:
         return solver, deadline
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
-        """Validated (start (nx,), goal (d,), width) or ValueError naming the argument.
-
-        A start of [q; qdot] (2n,) for a model with activation stages gets them at zero force."""
-        model = self.model
-        size = 2 * model.n if np.shape(start) == (2 * model.n,) else model.state_size
-        start = model.full_state(as_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
-                                           + (f", optionally followed by the {model.state_size - 2 * model.n} activation states"
-                                              if size != 2 * model.n else "")))
-        goal = as_vector("goal", goal, model.d, "task-space position, m")
-        width = model.width if width is None else as_goal_width("width", width)
-        return start, goal, width
+        """Validated (start (nx,), goal (d,), width) or ValueError naming the argument (:func:`reach_inputs`)."""
+        return reach_inputs(self.model, start, goal, width)
 
     def solve(self, start, goal, width: float | None = None, warm_start=None, max_wall_time: float | None = None) -> Plan:
         """Plan a reach.
@@ -320,6 +311,20 @@ class Planner:
 def _rank(candidate: SolverResult) -> tuple[bool, float]:
     """Order of the starts' results: within the limits first, then the lower normalised objective."""
     return candidate.status == Status.CONSTRAINTS_VIOLATED, candidate.fun
+
+
+def reach_inputs(model: ReachingModel, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
+    """Validated (start (nx,), goal (d,), width (m)) of a reach for ``model``, or ValueError naming the argument;
+    no planner needed, so callers can check every input before building one.
+
+    A start of [q; qdot] (2n,) for a model with activation stages gets them at zero force."""
+    size = 2 * model.n if np.shape(start) == (2 * model.n,) else model.state_size
+    start = model.full_state(as_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
+                                       + (f", optionally followed by the {model.state_size - 2 * model.n} activation states"
+                                          if size != 2 * model.n else "")))
+    goal = as_vector("goal", goal, model.d, "task-space position, m")
+    width = model.width if width is None else as_goal_width("width", width)
+    return start, goal, width
 
 
 def plan_reach(model: ReachingModel, start, goal, width: float | None = None, **solve_options) -> Plan:
