@@ -18,6 +18,10 @@ from comanip.analysis.calibration import run_calibration, study_configurations
 from comanip.validation.settings import ValidationSettings
 
 
+LABELS = ("Labels: W=std reads W = w²I, W=cov W = wI; iso, chan, rank1: isotropic, per-channel, rank-one noise; "
+          "exp, hyp: exponential, hyperbolic discounting; H: horizon (steps); then any other change.")
+
+
 def study_block(rows: list[dict], settings: ValidationSettings, seconds: float) -> str:
     lines = ["| configuration | mode | t_peak/MT min / median / max | MT (s) | R² Fitts / Shannon | Fitts' law | early peak |",
              "|---|---|---|---|---|---|---|"]
@@ -29,7 +33,7 @@ def study_block(rows: list[dict], settings: ValidationSettings, seconds: float) 
     return (f"Measured by `docs/print_calibration_study.py` ({len(rows)} configurations; D ∈ {list(settings.distances)} m × "
             f"w ∈ {list(settings.widths)} m; closed loop: {settings.calibration_trials} executions per condition; seed "
             f"{settings.seed}; {seconds:.0f} s). Configurations with Fitts' law and an early peak at once: "
-            f"{', '.join(both) if both else '**none**'}.\n\n" + "\n".join(lines))
+            f"{', '.join(both) if both else '**none**'}. {LABELS}\n\n" + "\n".join(lines))
 
 
 def main(argv: list[str] | None = None) -> int:
