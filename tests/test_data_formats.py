@@ -23,7 +23,6 @@ from comanip import presets
 from comanip.belief.noise import NOISE_FORMS
 from comanip.bodies import BODY_TYPES, body_from_config
 from comanip.cli.estimate_command import read_observations
-from comanip.cli.main import build_parser
 from comanip.cli.outputs import write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.estimate import GoalEstimate
@@ -38,6 +37,7 @@ from comanip.objectives.discounting import DISCOUNT_FORMS
 from comanip.objectives.reward import GOAL_COVARIANCE_FORMS, REWARD_FORMS
 from comanip.planning.plan import Plan
 from comanip.simulation.scenario import TrialRecord
+from test_readme import subcommand_tree
 
 DOC = Path(__file__).resolve().parents[1] / "docs" / "data_formats.md"
 
@@ -85,7 +85,8 @@ def expand(patterns: list[str], n: int = 0, stages: int = 0, axes: str = "xyz") 
 
 
 def documented_shapes(heading: str, sizes: dict) -> dict[str, tuple | None]:
-    """{key: shape} from the table's shape column (second), evaluated with sizes; None when the row gives none."""
+    """{key: shape} from the first table's shape column (its second), the sizes' names (H, n, d, nx, K, C, T, ...)
+    evaluated with ``sizes``; rows without a shape in parentheses are left out."""
     shapes = {}
     for row in table(heading):
         match = re.search(r"\(([^)]*)\)", row[1])
@@ -146,9 +147,9 @@ def test_observations_example_is_read_and_its_documented_columns_are_required(tm
     assert header(path) == columns
     times, states = read_observations(path, 2)
     assert times.shape == (3,) and states.shape == (3, 4)
+    rows = [dict(zip(columns, line.split(","))) for line in example.split()[1:]]
     for missing in columns:
         kept = [c for c in columns if c != missing]
-        rows = [dict(zip(columns, line.split(","))) for line in example.split()[1:]]
         reduced = tmp_path / f"without_{missing}.csv"
         reduced.write_text(",".join(kept) + "\n" + "".join(",".join(r[c] for c in kept) + "\n" for r in rows))
         with pytest.raises(ValueError, match=missing):
@@ -201,9 +202,11 @@ def test_transition_model_json_keys(tmp_path):
 # ---- outputs --------------------------------------------------------------------------------------------------
 
 def test_every_command_has_its_row_of_files_and_the_manifest_keys(tmp_path):
-    commands = {ticked(row[0])[0].split()[1] for row in table("Output folders and their files")}
-    subcommands = set(build_parser()._subparsers._group_actions[0].choices)
-    assert commands == subcommands
+    tree = subcommand_tree()
+    commands = [ticked(row[0])[0].split()[1:] for row in table("Output folders and their files")]
+    subcommands = set(tree)
+    assert {words[0] for words in commands} == subcommands
+    assert all(set(words[1].replace("\\|", "|").split("|")) <= tree[words[0]] for words in commands if len(words) > 1)
     manifest_rows = {ticked(row[0])[0]: row for row in table("manifest.json")}
     assert set(ticked(manifest_rows["command"][1])) == subcommands
     (tmp_path / "plan.csv").write_text("t_s\n0\n")
