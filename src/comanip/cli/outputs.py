@@ -17,18 +17,19 @@ MANIFEST = "manifest.json"
 #: (file-name pattern, what the file is), first match wins
 FILE_KINDS = (
     ("plan.json", "the plan: status, success, objective, times, state and end-effector mean and covariance, torques"),
-    ("plan.csv", "the plan, one row per step: t, q, qdot, hand position, velocity and std, torque"),
-    ("estimate.json", "the goal estimate: estimated goal (extras), status, and the plan through the observation"),
+    ("plan.csv", "the plan, one row per step: t, q, qdot, activation-stage forces (if any), hand position, velocity and std, torque"),
+    ("estimate.json", "the goal estimate: estimated goal ('goal'), status, and the plan through the observation"),
     ("estimate.csv", "the estimate's predicted trajectory, one row per step (columns as a plan CSV)"),
     ("posterior.json", "posterior over the candidate goals after each observation prefix, with entropies"),
     ("posterior.png", "figure: posterior probability of each candidate goal over time"),
     ("fit.json", "fitted values, standard errors, residuals per condition and the fit's status"),
     ("model.yaml", "the fitted model, readable by 'comanip plan --preset model.yaml'"),
     ("model.json", "the fitted transition model (Gaussian process), readable by --transition-model"),
-    ("handover_*.json", "handover schedule for one goal: transition time and position, stiffness over time"),
-    ("handover_*.csv", "handover schedule for one goal, one row per time: rest position and stiffness"),
+    # simulate's files before handover's: 'simulate handover' writes handover_near_trial0.csv
     ("*_trial*.csv", "one simulated trial, one row per time step: handle, rest position, stiffness, person's force"),
     ("*_summary.json", "settings, per-trial metrics and their summaries for every goal"),
+    ("handover_*.json", "handover schedule for one goal: transition time and position, stiffness over time"),
+    ("handover_*.csv", "handover schedule for one goal, one row per time: rest position and stiffness"),
     ("*_frames.png", "rendered frame strip of the first trial"),
     ("report.json", "every number of the validation run"),
     ("report.md", "the validation run's tables, readable"),
