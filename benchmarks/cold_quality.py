@@ -1,0 +1,119 @@
+"""Cold-solve quality: random cold problems per point-mass preset, the current planner against a reference.
+
+    .venv/bin/python benchmarks/cold_quality.py [--problems 200] [--presets planar,cartesian,human,human_cartesian]
+                                                [--compare /path/to/worktree-at-main]
+
+Problems (the same for both sides, seeded): goals 0.1–0.4 m from the start in uniformly drawn directions,
+widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per axis).
+The reference is the code of another checkout (``--compare``: its src/ is imported in a separate process)
+or, without it, this code with ``SolverOptions(cold_search="all")`` (every minimum-jerk guess solved to
+convergence, the best kept). Each side runs in its own process, the presets alternating between them.
+
+Prints per preset: objectives of the current code worse / better / equal (relative 1e-6) than the
+reference, successes, median and p90 solve times; writes every problem's row to
+benchmarks/results/cold_quality.csv.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+PRESETS = ("planar", "cartesian", "human", "human_cartesian")
+RELATIVE = 1e-6
+"""Objectives within this relative difference count as equal."""
+
+
+def problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """(start (2n,), goal (d,), width) for ``count`` random cold problems of a point-mass model."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(count):
+        start = np.zeros(2 * model.n)
+        if k % 2:
+            start[model.n:] = rng.uniform(-0.3, 0.3, model.n)
+        direction = rng.normal(size=model.d)
+        goal = rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+        width = float(np.exp(rng.uniform(np.log(0.005), np.log(0.05))))
+        out.append((start, goal, width))
+    return out
+
+
+def worker(preset: str, count: int, cold_search: str | None) -> None:
+    """Solve the preset's problems with the comanip on sys.path; one JSON line per problem on stdout."""
+    import comanip
+    from comanip.planning.planner import SolverOptions
+
+    model = comanip.presets.load(preset)
+    options = SolverOptions(cold_search=cold_search) if cold_search else SolverOptions()
+    planner = comanip.Planner(model, options)
+    planner.solve(np.zeros(2 * model.n), 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
+    for start, goal, width in problems(model, count):
+        plan = planner.solve(start, goal, width)
+        print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
+                          "iterations": plan.iterations}), flush=True)
+
+
+def run_side(src: Path, preset: str, count: int, cold_search: str | None) -> list[dict]:
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    command = [sys.executable, __file__, "--worker", preset, "--problems", str(count)]
+    if cold_search:
+        command += ["--cold-search", cold_search]
+    done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
+    return [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--problems", type=int, default=200)
+    parser.add_argument("--presets", default=",".join(PRESETS))
+    parser.add_argument("--compare", type=Path, default=None, help="checkout of the reference code (its src/ is used)")
+    parser.add_argument("--worker", default=None, help=argparse.SUPPRESS)
+    parser.add_argument("--cold-search", default=None, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        worker(args.worker, args.problems, args.cold_search)
+        return
+    here = Path(__file__).resolve().parents[1] / "src"
+    reference = (args.compare.resolve() / "src", None) if args.compare else (here, "all")
+    label = f"{args.compare}" if args.compare else "cold_search='all'"
+    print(f"reference: {label}; {args.problems} problems per preset; equal = within {RELATIVE:g} relative")
+    print(f"{'preset':<16} {'worse':>6} {'better':>7} {'equal':>6} {'ok new':>7} {'ok ref':>7} "
+          f"{'new ms':>8} {'ref ms':>8} {'new p90':>8} {'ref p90':>8} {'new it':>7} {'ref it':>7}")
+    rows = []
+    for preset in args.presets.split(","):
+        new = run_side(here, preset, args.problems, None)
+        ref = run_side(*reference[:1], preset, args.problems, reference[1])
+        counts = {"worse": 0, "better": 0, "equal": 0}
+        for k, (a, b) in enumerate(zip(new, ref)):
+            relative = (a["objective"] - b["objective"]) / abs(b["objective"])
+            verdict = "worse" if relative > RELATIVE else "better" if relative < -RELATIVE else "equal"
+            counts[verdict] += 1
+            rows.append({"preset": preset, "problem": k, "new_objective": a["objective"], "ref_objective": b["objective"],
+                         "relative": relative, "verdict": verdict, "new_success": a["success"], "ref_success": b["success"],
+                         "new_ms": 1e3 * a["time"], "ref_ms": 1e3 * b["time"], "new_iterations": a["iterations"],
+                         "ref_iterations": b["iterations"]})
+        t_new, t_ref = (np.array([1e3 * r["time"] for r in side]) for side in (new, ref))
+        it_new, it_ref = (np.median([r["iterations"] for r in side]) for side in (new, ref))
+        print(f"{preset:<16} {counts['worse']:>6} {counts['better']:>7} {counts['equal']:>6} "
+              f"{sum(r['success'] for r in new):>7} {sum(r['success'] for r in ref):>7} "
+              f"{np.median(t_new):8.2f} {np.median(t_ref):8.2f} {np.percentile(t_new, 90):8.2f} {np.percentile(t_ref, 90):8.2f} "
+              f"{it_new:7.0f} {it_ref:7.0f}", flush=True)
+    out = Path(__file__).resolve().parent / "results" / "cold_quality.csv"
+    out.parent.mkdir(exist_ok=True)
+    with open(out, "w", newline="") as file:
+        writer = csv.DictWriter(file, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()
