@@ -58,7 +58,8 @@ def worker(preset: str, count: int, cold_search: str | None) -> None:
     for start, goal, width in problems(model, count):
         plan = planner.solve(start, goal, width)
         print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
-                          "iterations": plan.iterations}), flush=True)
+                          "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal) / width),
+                          "moving": bool(np.any(start))}), flush=True)
 
 
 def run_side(src: Path, preset: str, count: int, cold_search: str | None) -> list[dict]:
@@ -96,10 +97,15 @@ def main(argv=None) -> None:
             relative = (a["objective"] - b["objective"]) / abs(b["objective"])
             verdict = "worse" if relative > RELATIVE else "better" if relative < -RELATIVE else "equal"
             counts[verdict] += 1
-            rows.append({"preset": preset, "problem": k, "new_objective": a["objective"], "ref_objective": b["objective"],
+            rows.append({"preset": preset, "problem": k, "distance_over_width": a["distance_over_width"],
+                         "moving": a["moving"], "new_objective": a["objective"], "ref_objective": b["objective"],
                          "relative": relative, "verdict": verdict, "new_success": a["success"], "ref_success": b["success"],
                          "new_ms": 1e3 * a["time"], "ref_ms": 1e3 * b["time"], "new_iterations": a["iterations"],
                          "ref_iterations": b["iterations"]})
+        for row in rows:
+            if row["preset"] == preset and row["verdict"] == "worse":
+                print(f"  worse: problem {row['problem']}, D/w {row['distance_over_width']:.1f}, moving {row['moving']}, "
+                      f"relative {row['relative']:.2e}")
         t_new, t_ref = (np.array([1e3 * r["time"] for r in side]) for side in (new, ref))
         it_new, it_ref = (np.median([r["iterations"] for r in side]) for side in (new, ref))
         print(f"{preset:<16} {counts['worse']:>6} {counts['better']:>7} {counts['equal']:>6} "

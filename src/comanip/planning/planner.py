@@ -47,6 +47,7 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
+from comanip.planning.reach_library import ReachLibrary, is_symmetric
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import Curvature
 
@@ -141,6 +142,22 @@ class Planner:
         self._linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
         self._blas = ThreadpoolController()
         self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
+        self._library = self._reach_library()
+
+    def _reach_library(self) -> ReachLibrary | None:
+        """Solved reaches to start 'ranked' cold solves from (:mod:`comanip.planning.reach_library`), for a
+        point mass whose objective is unchanged by turning and shifting the problem; None otherwise."""
+        model = self.model
+        if self.options.cold_search != "ranked" or not model.body.is_linear or model.d != model.n or model.state_size % model.n:
+            return None
+        if not is_symmetric(self.problem):
+            return None
+
+        def solve(start, goal, width):
+            guesses = self._searched_guesses(start, goal, width)
+            return self._solve_from(guesses, start, goal, width, time.perf_counter(), None).torque
+
+        return ReachLibrary(solve, model.n, model.state_size, model.width)
 
     @property
     def curvature(self) -> Curvature | None:
@@ -257,18 +274,48 @@ class Planner:
         return [min((np.clip(c, low, high) for c in candidates), key=lambda c: self._objective(c, params))]
 
     def _cold_start(self, start, goal, width) -> list[np.ndarray]:
-        """The guesses a cold solve runs (``SolverOptions.cold_search``): every minimum-jerk guess, or for a
-        point mass and a goal within ``narrow_ratio`` widths the one with the lowest objective (evaluating a
-        guess costs about a hundredth of solving from it)."""
+        """The guesses a cold solve runs (``SolverOptions.cold_search``).
+
+        'all', or a nonlinear body: every minimum-jerk guess. 'ranked': the candidate of lowest objective
+        (evaluating one costs about a hundredth of solving from it) among the minimum-jerk guesses and, for a
+        symmetric point mass, the nearest solved reach of the planner's :class:`ReachLibrary` (plus, from a
+        moving start, minimum-jerk moves that bring the start's motion to rest, superposed: the mean is affine
+        in the torques and the start). A goal farther than ``narrow_ratio`` widths, where several local optima
+        compete, also runs the best minimum-jerk guess (without a library: every one) and keeps the better plan.
+        """
+        if self._library is None:
+            return self._searched_guesses(start, goal, width)
+        model = self.model
+        params = np.concatenate([start, goal, [width]])
         guesses = self._cold_guesses(start, goal, self.options.n_starts)
-        model, options = self.model, self.options
-        if options.cold_search == "all" or not model.body.is_linear or len(guesses) == 1:
-            return guesses
-        distance = np.linalg.norm(goal - np.asarray(model.body.kinematics_function(start[: model.n])[0]).ravel())
-        if distance > options.narrow_ratio * width:
+        best_guess = min(guesses, key=lambda guess: self._objective(guess, params))
+        turned = self._library.guess(start, goal, width)
+        if turned is None:
+            return [best_guess]
+        candidates = [turned]
+        motion = start.copy()
+        motion[: model.n] = 0.0
+        if np.any(motion):
+            candidates = [turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n), T,
+                                                        self._linear_dynamics)
+                          for T in guess_durations(model.duration, self.options.n_starts)]
+        best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
+        return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
+
+    def _searched_guesses(self, start, goal, width) -> list[np.ndarray]:
+        """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
+        or a goal beyond ``narrow_ratio`` widths; otherwise the one of lowest objective."""
+        guesses = self._cold_guesses(start, goal, self.options.n_starts)
+        if self.options.cold_search == "all" or not self.model.body.is_linear or self._narrow(start, goal, width):
             return guesses
         params = np.concatenate([start, goal, [width]])
         return [min(guesses, key=lambda guess: self._objective(guess, params))]
+
+    def _narrow(self, start, goal, width) -> bool:
+        """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
+        model = self.model
+        position = np.asarray(model.body.kinematics_function(start[: model.n])[0]).ravel()
+        return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
 
     def _cold_guesses(self, start, goal, count: int) -> list[np.ndarray]:
         """Minimum-jerk reaches to the inverse-kinematics solution, ``count`` durations."""
