@@ -55,17 +55,19 @@ def linear_dynamics_of(body: Body) -> tuple[np.ndarray, np.ndarray]:
 
 
 def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations,
-                       mean: np.ndarray | None = None) -> list[np.ndarray]:
+                       mean: np.ndarray | None = None,
+                       linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> list[np.ndarray]:
     """A plan's torques (H, n) with a rest-to-rest minimum-jerk move by shift_q (n,) superposed, one result
     per duration (s): delta tau = M(q_i) delta qddot_i + D delta qdot_i along the plan's mean (H+1, 2n).
 
     For a linear body the mean is affine in the torques, so each result moves the whole planned mean path
     by a smooth reach of shift_q: a plan for one goal becomes a good start for a nearby goal (three to
     four times fewer Newton iterations than the unmodified plan, benchmarks/README.md). For a nonlinear
-    body (M evaluated along ``mean``, required then) it holds to first order.
+    body (M evaluated along ``mean``, required then) it holds to first order. ``linear_dynamics``: as for
+    :func:`minimum_jerk_torques`.
     """
     if body.is_linear:
-        inertia = np.broadcast_to(np.asarray(body.mass_matrix_function(np.zeros(body.n))), (H, body.n, body.n))
+        inertia = np.broadcast_to((linear_dynamics or linear_dynamics_of(body))[0], (H, body.n, body.n))
     elif mean is None:
         raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
     else:

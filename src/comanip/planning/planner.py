@@ -265,7 +265,7 @@ class Planner:
         J = np.asarray(body.kinematics_function(q_end)[1])
         shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
         candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
-                                                   guess_durations(model.duration, 4), warm_start.mean)
+                                                   guess_durations(model.duration, 4), warm_start.mean, self._linear_dynamics)
         if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
             # far beyond the goal's reward (it underflows there): fresh reaches compete too
             candidates += self._cold_guesses(start, goal, self.options.n_starts)
