@@ -282,8 +282,9 @@ class Planner:
         start with minimum-jerk moves that bring the start's motion to rest superposed: the mean is affine in
         the torques and the start). Where several local optima compete the lowest-objective start can end on
         a worse one, so the plan is compared with others: a goal farther than ``narrow_ratio`` widths also runs
-        the best minimum-jerk guess, a moving start every minimum-jerk guess (the Cartesian preset's moving
-        starts ended up to 0.1 % worse in 4 of 100 otherwise, benchmarks/cold_quality.py).
+        the best minimum-jerk guess, and a start whose motion alone would carry the hand farther than the goal
+        within the horizon every minimum-jerk guess (the plan can brake or ride the motion: the Cartesian
+        preset's moving starts ended up to 0.1 % worse in 4 of 100 otherwise, benchmarks/cold_quality.py).
         """
         if self._library is None:
             return self._searched_guesses(start, goal, width)
@@ -303,9 +304,14 @@ class Planner:
                                                         self._linear_dynamics)
                           for T in guess_durations(model.duration, self.options.n_starts)]
         best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
-        if moving:
+        if moving and self._drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
             return [best] + [guess for guess in guesses if guess is not best]
         return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
+
+    def _drift(self, start, goal, width) -> float:
+        """How far (m) the start's motion alone (zero commands) carries the hand within the horizon."""
+        free = self.problem.trajectory(tau=np.zeros(self.model.H * self.model.n), s0=start, goal=goal, width=width)
+        return float(np.max(np.linalg.norm(np.asarray(free["ee_mean"]).T - free["ee_mean"][:, 0].full().T, axis=1)))
 
     def _searched_guesses(self, start, goal, width) -> list[np.ndarray]:
         """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
