@@ -243,7 +243,7 @@ CASES: dict[str, Callable[[], Case]] = {
 }
 
 
-HEADER = f"{'case':<42} {'build s':>8} {'median ms':>10} {'p90 ms':>8} {'ok':>6} {'paper ms':>9} {'speed-up':>9}"
+HEADER = f"{'case':<50} {'build s':>8} {'median ms':>10} {'p90 ms':>8} {'ok':>6} {'paper ms':>9} {'speed-up':>9}"
 
 
 def run_case(key: str, repeats: int) -> str:
@@ -255,7 +255,7 @@ def run_case(key: str, repeats: int) -> str:
     median, p90 = np.median(times), np.percentile(times, 90)
     paper = f"{1e3 * case.paper_time:9.0f}" if case.paper_time else f"{'-':>9}"
     speedup = f"{case.paper_time / median:8.1f}x" if case.paper_time else f"{'-':>9}"
-    return f"{case.name:<42} {case.build_time:8.2f} {1e3 * median:10.2f} {1e3 * p90:8.2f} {ok:>3}/{len(runs):<2} {paper} {speedup}"
+    return f"{case.name:<50} {case.build_time:8.2f} {1e3 * median:10.2f} {1e3 * p90:8.2f} {ok:>3}/{len(runs):<2} {paper} {speedup}"
 
 
 def run_elsewhere(src: Path, key: str, repeats: int) -> str:

@@ -283,29 +283,30 @@ class Planner:
         the torques and the start). Where several local optima compete the lowest-objective start can end on
         a worse one, so the plan is compared with others: a goal farther than ``narrow_ratio`` widths also runs
         the best minimum-jerk guess, and a start whose motion alone would carry the hand farther than the goal
-        within the horizon every minimum-jerk guess (the plan can brake or ride the motion: the Cartesian
-        preset's moving starts ended up to 0.1 % worse in 4 of 100 otherwise, benchmarks/cold_quality.py).
+        within the horizon runs every minimum-jerk guess instead, as 'all' does (the plan can brake or ride the
+        motion: the Cartesian preset's moving starts ended up to 0.1 % worse in 4 of 100 otherwise,
+        benchmarks/cold_quality.py).
         """
         if self._library is None:
             return self._searched_guesses(start, goal, width)
         model = self.model
-        params = np.concatenate([start, goal, [width]])
-        guesses = self._cold_guesses(start, goal, self.options.n_starts)
-        best_guess = min(guesses, key=lambda guess: self._objective(guess, params))
-        turned = self._library.guess(start, goal, width)
         motion = start.copy()
         motion[: model.n] = 0.0
         moving = bool(np.any(motion))
+        guesses = self._cold_guesses(start, goal, self.options.n_starts)
+        if moving and self._drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
+            return guesses
+        params = np.concatenate([start, goal, [width]])
+        best_guess = min(guesses, key=lambda guess: self._objective(guess, params))
+        turned = self._library.guess(start, goal, width)
         if turned is None:
-            return guesses if moving else [best_guess]
+            return [best_guess]
         candidates = [turned]
         if moving:
             candidates = [turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n), T,
                                                         self._linear_dynamics)
                           for T in guess_durations(model.duration, self.options.n_starts)]
         best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
-        if moving and self._drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
-            return [best] + [guess for guess in guesses if guess is not best]
         return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
 
     def _drift(self, start, goal, width) -> float:
