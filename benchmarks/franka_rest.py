@@ -1,0 +1,88 @@
+"""Franka reaches with and without the speed cost (model options ``stop_weight``, ``joint_velocity_weight``),
+on the same goals in the same run: how the arm ends, how long it whips after the hand stops, and solve times.
+
+    .venv/bin/python benchmarks/franka_rest.py [--goals 8] [--presets franka,franka_rest] [--weights 1,0.02 ...]
+
+Goals: ``--goals`` points 0.15–0.3 m from the ready pose's hand in uniformly drawn directions (seed 0). For each
+model and goal: one cold solve (the multi-start guesses) from rest at the ready pose, then one warm solve to a
+goal moved by up to 5 cm per axis, warm-started from the cold plan. ``--weights s,v`` adds the ``franka`` preset
+with stop_weight s and joint_velocity_weight v (one more row per pair).
+
+Per model: successes; the largest final joint speed max_j |qdot_H,j| (rad/s) over the goals and how many plans
+end below 0.05 rad/s; the time after MT with a joint at ≥ 95 % of its speed limit (s, largest over the goals);
+the medians of cold and warm solve times (ms) and iterations; the normalised objective's median.
+"""
+
+from __future__ import annotations
+
+import argparse
+
+import numpy as np
+
+import comanip
+from comanip.analysis import settling_motion
+
+REST_SPEED = 0.05
+"""rad/s: the issue's bound on every joint's final speed."""
+
+
+def goal_offsets(count: int, rng: np.random.Generator) -> np.ndarray:
+    """``count`` offsets (count, 3), m: uniform directions, distances uniform in 0.15–0.3 m."""
+    directions = rng.normal(size=(count, 3))
+    directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+    return directions * rng.uniform(0.15, 0.3, size=(count, 1))
+
+
+def measure(model: comanip.ReachingModel, offsets: np.ndarray, rng: np.random.Generator) -> dict:
+    """Cold then warm solves of ``model`` to each offset from the ready pose; the row's numbers."""
+    planner = comanip.Planner(model)
+    home = model.body.home_position
+    start = np.r_[home, np.zeros(model.n)]
+    origin = np.asarray(model.body.kinematics_function(home)[0]).ravel()
+    rows = []
+    for offset in offsets:
+        cold = planner.solve(start, origin + offset)
+        warm = planner.solve(start, origin + offset + rng.uniform(-0.05, 0.05, 3), warm_start=cold)
+        motions = [settling_motion(model, plan) for plan in (cold, warm)]
+        rows.append((cold, warm, motions))
+    plans = [plan for cold, warm, _ in rows for plan in (cold, warm)]
+    motions = [m for *_, pair in rows for m in pair]
+    return {
+        "ok": sum(p.success for p in plans), "plans": len(plans),
+        "final_speed_max": max(m.final_joint_speed for m in motions),
+        "at_rest": sum(m.final_joint_speed < REST_SPEED for m in motions),
+        "limit_time_max": max(m.time_at_velocity_limit for m in motions),
+        "cold_ms": 1e3 * np.median([c.solve_time for c, _, _ in rows]),
+        "warm_ms": 1e3 * np.median([w.solve_time for _, w, _ in rows]),
+        "cold_iterations": np.median([c.iterations for c, _, _ in rows]),
+        "warm_iterations": np.median([w.iterations for _, w, _ in rows]),
+        "objective": np.median([c.objective / planner.problem.normaliser(c.width) for c, _, _ in rows]),
+    }
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--goals", type=int, default=8)
+    parser.add_argument("--presets", default="franka,franka_rest")
+    parser.add_argument("--weights", nargs="*", default=[], help="stop_weight,joint_velocity_weight pairs")
+    args = parser.parse_args(argv)
+    offsets = goal_offsets(args.goals, np.random.default_rng(0))
+    models = [comanip.presets.load(name) for name in args.presets.split(",") if name]
+    for pair in args.weights:
+        stop, running = (float(v) for v in pair.split(","))
+        models.append(comanip.presets.load("franka").replace(stop_weight=stop, joint_velocity_weight=running,
+                                                             name=f"franka s={stop:g} v={running:g}"))
+    print(f"| model | stop_weight | joint_velocity_weight | ok | max final joint speed (rad/s) | plans at rest "
+          f"(< {REST_SPEED}) | max time at a speed limit after MT (s) | cold ms | warm ms | cold iterations "
+          f"| warm iterations | median J/\\|J_best\\| |")
+    print("|---" * 12 + "|")
+    for model in models:
+        r = measure(model, offsets, np.random.default_rng(1))
+        print(f"| {model.name} | {model.stop_weight:g} | {model.joint_velocity_weight:g} | {r['ok']}/{r['plans']} "
+              f"| {r['final_speed_max']:.3f} | {r['at_rest']}/{r['plans']} | {r['limit_time_max']:.3f} "
+              f"| {r['cold_ms']:.0f} | {r['warm_ms']:.0f} | {r['cold_iterations']:.0f} | {r['warm_iterations']:.0f} "
+              f"| {r['objective']:.4f} |", flush=True)
+
+
+if __name__ == "__main__":
+    main()
