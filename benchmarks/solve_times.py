@@ -64,9 +64,10 @@ def reach_case(preset: str, paper_time: float, options: SolverOptions | None = N
     return make
 
 
-def cold_case(preset: str, paper_time: float | None = None) -> Callable[[], Case]:
+def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4)) -> Callable[[], Case]:
     """Cold solves (no warm start: the model's multi-start guesses) from rest at the home position to goals
-    0.1–0.4 m away in uniformly drawn directions, a new goal each time (a user's first plan for a goal)."""
+    ``distances`` (m; 0.1–0.4 m) away in uniformly drawn directions, a new goal each time (a user's first plan
+    for a goal)."""
 
     def make() -> Case:
         model = comanip.presets.load(preset)
@@ -79,7 +80,7 @@ def cold_case(preset: str, paper_time: float | None = None) -> Callable[[], Case
 
         def solve(k: int) -> tuple[float, bool]:
             direction = rng.normal(size=model.d)
-            goal = origin + rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+            goal = origin + rng.uniform(*distances) * direction / np.linalg.norm(direction)
             plan = planner.solve(start, goal, model.width)
             return plan.solve_time, plan.success
 
@@ -211,6 +212,9 @@ CASES: dict[str, Callable[[], Case]] = {
     "planar_ipopt": reach_case("planar", 0.04, SolverOptions(method="ipopt"), " IPOPT"),
     "cartesian_ipopt": reach_case("cartesian", 0.20, SolverOptions(method="ipopt"), " IPOPT"),
     "franka": reach_case("franka", 1.3, reach=(0.15, 0.1, -0.1)),
+    "franka_cold": cold_case("franka", 1.3, distances=(0.15, 0.3)),
+    "franka_rest": reach_case("franka_rest", 1.3, reach=(0.15, 0.1, -0.1)),
+    "franka_rest_cold": cold_case("franka_rest", 1.3, distances=(0.15, 0.3)),
     "planar_cold": cold_case("planar", 0.04),
     "cartesian_cold": cold_case("cartesian", 0.20),
     "human": reach_case("human", None),
