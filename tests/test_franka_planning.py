@@ -117,8 +117,8 @@ SPEED_COST = dict(stop_weight=0.7, joint_velocity_weight=0.3)
 
 @pytest.fixture(scope="module")
 def short_franka_rest():
-    """The short Franka problem with the speed cost, and the same problem without it."""
-    model = comanip.presets.load("franka").replace(H=5, **SPEED_COST)
+    """A 3-step Franka problem with the speed cost, and the same problem without it."""
+    model = comanip.presets.load("franka").replace(H=3, **SPEED_COST)
     problem = ReachProblem(model)
     bare = LinearisedCurvature(ReachProblem(model.replace(stop_weight=0.0, joint_velocity_weight=0.0)), compile=False)
     return model, problem, LinearisedCurvature(problem, compile=False), bare
@@ -163,7 +163,7 @@ def test_speed_cost_hessian_is_the_gauss_newton_term_and_close_to_the_exact_one(
     cost = velocity_cost([m[n:2 * n] for m in problem.means[1:]], [S[n:2 * n, n:2 * n] for S in problem.covs[1:]],
                          SPEED_COST["stop_weight"], SPEED_COST["joint_velocity_weight"])
     exact = ca.Function("speed_hessian", [x, problem.s0], [ca.hessian(cost, x)[0]])
-    for _ in range(2):
+    for _ in range(3):
         tau, p = _point(model, rng)
         data = curvature.evaluate(tau, p)[2]
         share = curvature.hessian(data) - bare.hessian(bare.evaluate(tau, p)[2])
