@@ -180,7 +180,8 @@ def test_speed_cost_hessian_is_the_gauss_newton_term_and_close_to_the_exact_one(
 @pytest.mark.parametrize("offset", [[0.15, 0.1, -0.1], [0.0, -0.2, 0.1], [-0.1, 0.15, 0.15]])
 def test_franka_rest_plans_end_at_rest_without_whipping(franka_rest_planner, offset):
     """The ``franka_rest`` preset (speed cost on): every joint ends slower than 0.05 rad/s and none runs at its
-    speed limit once the hand has stopped. The paper's ``franka`` preset fails both on the first goal."""
+    speed limit once the hand has stopped. The paper's ``franka`` preset fails both on the first goal
+    (test_paper_franka_plan_ends_moving)."""
     from comanip.analysis import settling_motion
 
     planner = franka_rest_planner
@@ -192,6 +193,19 @@ def test_franka_rest_plans_end_at_rest_without_whipping(franka_rest_planner, off
     motion = settling_motion(model, plan)
     assert motion.final_joint_speed < 0.05
     assert motion.time_at_velocity_limit == 0.0
+
+
+def test_paper_franka_plan_ends_moving(franka_planner):
+    """What franka_rest removes: the paper's plan to [0.15, 0.1, -0.1] m from the ready pose keeps a wrist joint at
+    its speed limit after the hand has stopped and ends with a joint faster than 1 rad/s."""
+    from comanip.analysis import settling_motion
+
+    model = franka_planner.model
+    start = np.r_[model.body.home_position, np.zeros(7)]
+    goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
+    plan = franka_planner.solve(start, goal)
+    motion = settling_motion(model, plan)
+    assert plan.success and motion.final_joint_speed > 1.0 and motion.time_at_velocity_limit > 0.1
 
 
 def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(franka_planner):
