@@ -4,8 +4,9 @@ on the same goals in the same run: how the arm ends, how long it whips after the
     .venv/bin/python benchmarks/franka_rest.py [--goals 8] [--presets franka,franka_rest] [--weights 1,0.02 ...]
 
 Goals: ``--goals`` points 0.15–0.3 m from the ready pose's hand in uniformly drawn directions (seed 0). For each
-model and goal: one cold solve (the multi-start guesses) from rest at the ready pose, then one warm solve to a
-goal moved by up to 5 cm per axis, warm-started from the cold plan. ``--weights s,v`` adds the ``franka`` preset
+goal and model: one cold solve (the multi-start guesses) from rest at the ready pose, then one warm solve to a
+goal moved by up to 5 cm per axis, warm-started from the cold plan. The models take turns goal by goal, so the
+machine's load falls on every row alike. ``--weights s,v`` adds the ``franka`` preset
 with stop_weight s and joint_velocity_weight v (one more row per pair).
 
 Per model: successes; the largest final joint speed max_j |qdot_H,j| (rad/s) over the goals and how many plans
@@ -35,31 +36,32 @@ def goal_offsets(count: int, rng: np.random.Generator) -> np.ndarray:
     return directions * rng.uniform(0.15, 0.3, size=(count, 1))
 
 
-def measure(model: comanip.ReachingModel, offsets: np.ndarray, rng: np.random.Generator) -> dict:
-    """Cold then warm solves of ``model`` to each offset from the ready pose; the row's numbers."""
-    planner = comanip.Planner(model)
-    home = model.body.home_position
-    start = np.r_[home, np.zeros(model.n)]
-    origin = np.asarray(model.body.kinematics_function(home)[0]).ravel()
-    rows = []
-    for offset in offsets:
-        cold = planner.solve(start, origin + offset)
-        warm = planner.solve(start, origin + offset + rng.uniform(-0.05, 0.05, 3), warm_start=cold)
-        motions = [settling_motion(model, plan) for plan in (cold, warm)]
-        rows.append((cold, warm, motions))
-    plans = [plan for cold, warm, _ in rows for plan in (cold, warm)]
-    motions = [m for *_, pair in rows for m in pair]
+def solve_pair(planner: comanip.Planner, origin: np.ndarray, offset: np.ndarray, shift: np.ndarray):
+    """(cold plan to origin + offset, warm plan to origin + offset + shift from it), from rest at the ready pose."""
+    model = planner.model
+    start = np.r_[model.body.home_position, np.zeros(model.n)]
+    cold = planner.solve(start, origin + offset)
+    return cold, planner.solve(start, origin + offset + shift, warm_start=cold)
+
+
+def summarise(planner: comanip.Planner, pairs: list) -> dict:
+    """The row's numbers from one model's (cold, warm) plans."""
+    model = planner.model
+    plans = [plan for pair in pairs for plan in pair]
+    motions = [settling_motion(model, plan) for plan in plans]
+    colds = [cold for cold, _ in pairs]
+    warms = [warm for _, warm in pairs]
     return {
         "ok": sum(p.success for p in plans), "plans": len(plans),
         "final_speed_max": max(m.final_joint_speed for m in motions),
         "at_rest": sum(m.final_joint_speed < REST_SPEED for m in motions),
         "limit_time_max": max(m.time_at_velocity_limit for m in motions),
-        "cold_ms": 1e3 * np.median([c.solve_time for c, _, _ in rows]),
-        "warm_ms": 1e3 * np.median([w.solve_time for _, w, _ in rows]),
-        "cold_iterations": np.median([c.iterations for c, _, _ in rows]),
-        "warm_iterations": np.median([w.iterations for _, w, _ in rows]),
-        "objective": np.median([paper_objective(model, planner, c) for c, _, _ in rows]),
-        "mt": np.median([speed_metrics(c.t, c.ee_speed).movement_time for c, _, _ in rows]),
+        "cold_ms": 1e3 * np.median([c.solve_time for c in colds]),
+        "warm_ms": 1e3 * np.median([w.solve_time for w in warms]),
+        "cold_iterations": np.median([c.iterations for c in colds]),
+        "warm_iterations": np.median([w.iterations for w in warms]),
+        "objective": np.median([paper_objective(model, planner, c) for c in colds]),
+        "mt": np.median([speed_metrics(c.t, c.ee_speed).movement_time for c in colds]),
     }
 
 
@@ -87,8 +89,14 @@ def main(argv=None) -> None:
           f"(< {REST_SPEED}) | max time at a speed limit after MT (s) | cold ms | warm ms | cold iterations "
           f"| warm iterations | median MT (s) | median paper J/\\|J_best\\| |")
     print("|---" * 13 + "|")
-    for model in models:
-        r = measure(model, offsets, np.random.default_rng(1))
+    planners = [comanip.Planner(model) for model in models]
+    home = models[0].body.home_position
+    origin = np.asarray(models[0].body.kinematics_function(home)[0]).ravel()
+    shifts = np.random.default_rng(1).uniform(-0.05, 0.05, size=offsets.shape)
+    # goal by goal, every model in turn: the machine's load falls on all rows alike
+    pairs = [[solve_pair(planner, origin, offset, shift) for planner in planners] for offset, shift in zip(offsets, shifts)]
+    for k, (model, planner) in enumerate(zip(models, planners)):
+        r = summarise(planner, [row[k] for row in pairs])
         print(f"| {model.name} | {model.stop_weight:g} | {model.joint_velocity_weight:g} | {r['ok']}/{r['plans']} "
               f"| {r['final_speed_max']:.3f} | {r['at_rest']}/{r['plans']} | {r['limit_time_max']:.3f} "
               f"| {r['cold_ms']:.0f} | {r['warm_ms']:.0f} | {r['cold_iterations']:.0f} | {r['warm_iterations']:.0f} "
