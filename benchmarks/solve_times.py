@@ -72,11 +72,11 @@ def reach_case(preset: str, paper_time: float, options: SolverOptions | None = N
     return make
 
 
-def cold_case(preset: str, paper_time: float | None = None, moving: bool = False) -> Callable[[], Case]:
-    """Cold solves (no warm start) from the home position to goals 0.1–0.4 m away in uniformly drawn
-    directions, a new goal each time (a user's first plan for a goal), at the model's width; from rest, or
-    (``moving``) with start velocities uniform in ±0.3 m/s per axis. The planner is fresh: its first solves
-    also fill its reach library (comanip.planning.reach_library)."""
+def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4), moving: bool = False) -> Callable[[], Case]:
+    """Cold solves (no warm start) from the home position to goals ``distances`` (m; 0.1–0.4 m) away in
+    uniformly drawn directions, a new goal each time (a user's first plan for a goal), at the model's width;
+    from rest, or (``moving``) with start velocities uniform in ±0.3 m/s per axis. The planner is fresh: its
+    first solves also fill its reach library (comanip.planning.reach_library)."""
 
     def make() -> Case:
         model = comanip.presets.load(preset)
@@ -89,7 +89,7 @@ def cold_case(preset: str, paper_time: float | None = None, moving: bool = False
 
         def solve(k: int) -> tuple[float, bool]:
             direction = rng.normal(size=model.d)
-            goal = origin + rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+            goal = origin + rng.uniform(*distances) * direction / np.linalg.norm(direction)
             velocity = rng.uniform(-0.3, 0.3, model.n) if moving else np.zeros(model.n)
             plan = planner.solve(np.r_[start[: model.n], velocity], goal, model.width)
             return plan.solve_time, plan.success
@@ -223,6 +223,9 @@ CASES: dict[str, Callable[[], Case]] = {
     "planar_ipopt": reach_case("planar", 0.04, SolverOptions(method="ipopt"), " IPOPT"),
     "cartesian_ipopt": reach_case("cartesian", 0.20, SolverOptions(method="ipopt"), " IPOPT"),
     "franka": reach_case("franka", 1.3, reach=(0.15, 0.1, -0.1)),
+    "franka_cold": cold_case("franka", 1.3, distances=(0.15, 0.3)),
+    "franka_rest": reach_case("franka_rest", 1.3, reach=(0.15, 0.1, -0.1)),
+    "franka_rest_cold": cold_case("franka_rest", 1.3, distances=(0.15, 0.3)),
     "planar_cold": cold_case("planar", 0.04),
     "cartesian_cold": cold_case("cartesian", 0.20),
     "human": reach_case("human", None),

@@ -28,7 +28,7 @@ import casadi as ca
 import numpy as np
 
 from comanip.belief.noise import noise_covariance
-from comanip.objectives.reach_objective import stopping_cost
+from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
 from comanip.planning.reach_problem import ReachProblem
@@ -71,7 +71,7 @@ class ReachCurvature:
         self._effort = 2 * model.nu
         self._noise_hessian = _noise_second_derivatives(model)
         self._G = _constant_sensitivities(model)
-        self._stop_hessian = _stopping_hessian(problem)
+        self._velocity_hessian = _velocity_cost_hessian(problem)
         self._build_constant_products()
 
     # -- the compiled per-solve function -------------------------------------------------------------
@@ -158,8 +158,8 @@ class ReachCurvature:
         steps = np.arange(H)
         hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks.reshape(H, n, n)
         hessian[np.diag_indices(H * n)] += self._effort / self.normaliser(width)
-        if self._stop_hessian is not None:  # the stopping cost is scaled by |J_best| already
-            hessian += self._stop_hessian
+        if self._velocity_hessian is not None:  # the speed cost is scaled by |J_best| already
+            hessian += self._velocity_hessian
         return hessian
 
     def goal_derivatives(self, data: ReachTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -227,16 +227,17 @@ def _noise_second_derivatives(model) -> np.ndarray:
     return D
 
 
-def _stopping_hessian(problem: ReachProblem) -> np.ndarray | None:
-    """∇² of the stopping cost over |J_best| (H·n, H·n), constant for a linear body (it is quadratic in tau);
-    None without one."""
+def _velocity_cost_hessian(problem: ReachProblem) -> np.ndarray | None:
+    """∇² of the speed cost (stop_weight, joint_velocity_weight) over |J_best| (H·n, H·n), constant for a linear
+    body (it is quadratic in tau); None without one."""
     model = problem.model
-    if model.stop_weight == 0:
+    if not model.has_velocity_cost:
         return None
     n = model.n
     x = ca.vec(problem.tau)
-    cost = stopping_cost(problem.means[-1][n:2 * n], problem.covs[-1][n:2 * n, n:2 * n], model.stop_weight)
-    hessian = ca.Function("stop_hessian", [x, problem.s0], [ca.hessian(cost, x)[0]])
+    cost = velocity_cost([m[n:2 * n] for m in problem.means[1:]], [S[n:2 * n, n:2 * n] for S in problem.covs[1:]],
+                         model.stop_weight, model.joint_velocity_weight)
+    hessian = ca.Function("velocity_hessian", [x, problem.s0], [ca.hessian(cost, x)[0]])
     return np.asarray(hessian(np.zeros(x.numel()), np.zeros(problem.s0.numel())))
 
 

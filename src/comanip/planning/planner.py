@@ -127,9 +127,9 @@ class Planner:
             raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")
         self.model = model
         self.options = options or SolverOptions()
-        if not model.body.is_linear and (model.activation or model.stop_weight > 0):
-            raise ValueError(f"activation stages and stop_weight are supported for point-mass bodies; the {model.body.name!r} "
-                             f"body needs activation=() and stop_weight=0")
+        if not model.body.is_linear and model.activation:
+            raise ValueError(f"activation stages are supported for point-mass bodies; the {model.body.name!r} "
+                             f"body needs activation=()")
         if self.options.method == "ipopt" and not model.body.is_linear:
             raise ValueError(f"method 'ipopt' (exact Hessian of the expanded problem) is for point masses; the "
                              f"{model.body.name!r} body needs method 'newton'")

@@ -14,7 +14,7 @@ import numpy as np
 from comanip.belief.propagation import belief_step_function, end_effector_belief_function
 from comanip.model import ReachingModel
 from comanip.objectives.discounting import discount_weights
-from comanip.objectives.reach_objective import reach_objective, stopping_cost
+from comanip.objectives.reach_objective import reach_objective, velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction
 from comanip.planning.plan import Plan
@@ -52,9 +52,10 @@ class ReachProblem:
         self._weight_sum = float(np.sum(weights))
         self.normaliser_function = ca.Function("normaliser", [self.width], [-self.best_objective])
         """``width -> |J_best(w)|`` as a CasADi function (for building other functions of the width)."""
-        if model.stop_weight > 0:  # relative to the best reward, so it means the same for every width
-            self.objective += -self.best_objective * stopping_cost(self.means[-1][n:2 * n], self.covs[-1][n:2 * n, n:2 * n],
-                                                                   model.stop_weight)
+        if model.has_velocity_cost:  # relative to the best reward, so it means the same for every width
+            self.objective += -self.best_objective * velocity_cost(
+                [m[n:2 * n] for m in self.means[1:]], [S[n:2 * n, n:2 * n] for S in self.covs[1:]],
+                model.stop_weight, model.joint_velocity_weight)
 
         self.trajectory = ca.Function(
             "trajectory", [ca.vec(self.tau), self.s0, self.goal, self.width],
