@@ -64,7 +64,7 @@ def test_planner_solve_extreme_but_valid(small_planner, goal, width):
 model_fields = st.fixed_dictionaries({}, optional={
     "h": numbers, "H": st.one_of(st.integers(-5, 12), numbers), "gamma": numbers, "nu": numbers, "kappa": numbers,
     "width": numbers, "noise": st.text(max_size=8), "reward": st.sampled_from(["gaussian", "hit", "bogus", ""]),
-    "effective_k": numbers, "stop_weight": numbers, "activation": st.lists(numbers, max_size=2),
+    "effective_k": numbers, "stop_weight": numbers, "joint_velocity_weight": numbers, "activation": st.lists(numbers, max_size=2),
     "discount": st.sampled_from(["exponential", "hyperbolic", "x"])})
 
 
