@@ -14,6 +14,7 @@ the two rows are printed one under the other ('new' and 'ref').
 from __future__ import annotations
 
 import argparse
+import json
 import os
 import subprocess
 import sys
@@ -249,23 +250,42 @@ CASES: dict[str, Callable[[], Case]] = {
 HEADER = f"{'case':<50} {'build s':>8} {'median ms':>10} {'p90 ms':>8} {'ok':>6} {'paper ms':>9} {'speed-up':>9}"
 
 
-def run_case(key: str, repeats: int) -> str:
-    """The case's table row (timed in this process)."""
+def measure_case(key: str, repeats: int) -> dict:
+    """The case timed in this process: name, build_s, median_s, p90_s, ok, runs, paper_s."""
     case = CASES[key]()
     runs = [case.solve(k) for k in range(repeats)]
     times = np.array([t for t, _ in runs])
-    ok = sum(s for _, s in runs)
-    median, p90 = np.median(times), np.percentile(times, 90)
-    paper = f"{1e3 * case.paper_time:9.0f}" if case.paper_time else f"{'-':>9}"
-    speedup = f"{case.paper_time / median:8.1f}x" if case.paper_time else f"{'-':>9}"
-    return f"{case.name:<50} {case.build_time:8.2f} {1e3 * median:10.2f} {1e3 * p90:8.2f} {ok:>3}/{len(runs):<2} {paper} {speedup}"
+    return {"name": case.name, "build_s": case.build_time, "median_s": float(np.median(times)),
+            "p90_s": float(np.percentile(times, 90)), "ok": int(sum(s for _, s in runs)), "runs": len(runs),
+            "paper_s": case.paper_time}
 
 
-def run_elsewhere(src: Path, key: str, repeats: int) -> str:
-    """The case's row timed in a fresh process importing comanip from ``src``."""
+def text_row(row: dict) -> str:
+    paper = row["paper_s"]
+    return (f"{row['name']:<50} {row['build_s']:8.2f} {1e3 * row['median_s']:10.2f} {1e3 * row['p90_s']:8.2f} "
+            f"{row['ok']:>3}/{row['runs']:<2} " + (f"{1e3 * paper:9.0f} {paper / row['median_s']:8.1f}x" if paper else f"{'-':>9} {'-':>9}"))
+
+
+def _time(seconds: float) -> str:
+    return f"{seconds:.2f} s" if seconds >= 0.1 else f"{1e3 * seconds:.1f} ms"
+
+
+def markdown_table(rows: list[dict], repeats: int) -> str:
+    """The README's speed block: one row per case, medians of ``repeats`` solves."""
+    lines = [f"Measured by `benchmarks/solve_times.py --markdown --repeats {repeats} --only …` (median and p90 of "
+             f"{repeats} solves per case; successes count plans that reach their goal):", "",
+             "| case | median | p90 | succeeded | paper |", "|---|---|---|---|---|"]
+    for row in rows:
+        lines.append(f"| {row['name']} | {_time(row['median_s'])} | {_time(row['p90_s'])} | {row['ok']}/{row['runs']} | "
+                     f"{_time(row['paper_s']) if row['paper_s'] else '–'} |")
+    return "\n".join(lines)
+
+
+def measure_elsewhere(src: Path, key: str, repeats: int) -> dict:
+    """The case timed in a fresh process importing comanip from ``src``."""
     done = subprocess.run([sys.executable, __file__, "--only", key, "--repeats", str(repeats), "--row"],
                           env={**os.environ, "PYTHONPATH": str(src)}, check=True, capture_output=True, text=True)
-    return done.stdout.strip().splitlines()[-1]
+    return json.loads(done.stdout.strip().splitlines()[-1])
 
 
 def main(argv=None) -> None:
@@ -273,6 +293,7 @@ def main(argv=None) -> None:
     parser.add_argument("--repeats", type=int, default=50)
     parser.add_argument("--only", default="", help=f"comma-separated case keys to run, of: {', '.join(CASES)}")
     parser.add_argument("--compare", type=Path, default=None, help="another checkout to time side by side (its src/)")
+    parser.add_argument("--markdown", action="store_true", help="print the README's markdown table instead (no --compare)")
     parser.add_argument("--row", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     wanted = [w for w in args.only.split(",") if w]
@@ -281,18 +302,25 @@ def main(argv=None) -> None:
         raise SystemExit(f"unknown case keys {unknown}; the cases are {', '.join(CASES)}")
     keys = [key for key in CASES if not wanted or key in wanted]
     if args.row:
-        print(run_case(keys[0], args.repeats))
+        print(json.dumps(measure_case(keys[0], args.repeats)))
+        return
+    if args.markdown:
+        rows = []
+        for key in keys:
+            rows.append(measure_case(key, args.repeats))
+            print(text_row(rows[-1]), file=sys.stderr, flush=True)   # progress
+        print(markdown_table(rows, args.repeats).replace("--only …", "--only " + ",".join(keys)))
         return
     if args.compare is None:
         print(HEADER)
         for key in keys:
-            print(run_case(key, args.repeats), flush=True)
+            print(text_row(measure_case(key, args.repeats)), flush=True)
         return
     here = Path(__file__).resolve().parents[1] / "src"
     print(f"{'code':<5}{HEADER}")
     for key in keys:
         for label, src in (("new", here), ("ref", args.compare.resolve() / "src")):
-            print(f"{label:<5}{run_elsewhere(src, key, args.repeats)}", flush=True)
+            print(f"{label:<5}{text_row(measure_elsewhere(src, key, args.repeats))}", flush=True)
 
 
 if __name__ == "__main__":
