@@ -32,6 +32,7 @@ import numpy as np
 from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
 from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped, TwistStamped
 from nav_msgs.msg import Path
+import rclpy
 from rcl_interfaces.msg import ParameterDescriptor
 from rclpy.node import Node
 from rclpy.parameter import Parameter
@@ -95,6 +96,9 @@ class GoalNode(Node):
 
     def __init__(self, settings: NodeSettings, *, node_name: str = "comanip_goal", use_sim_time: bool = False, **node_kwargs):
         super().__init__(node_name, parameter_overrides=[Parameter("use_sim_time", value=use_sim_time)], **node_kwargs)
+        self._lock = threading.Condition()
+        self._stopping = False
+        self._worker: threading.Thread | None = None
         self.settings = self._declared(settings)
         s = self.settings
         model = s.model()
@@ -102,7 +106,6 @@ class GoalNode(Node):
         self._horizon = model.H * model.h
         self._estimator = GoalEstimator(estimation_planner(model))
         self._transition = TransitionModel()
-        self._lock = threading.Condition()
         self._reach: Reach | None = None
         self._reach_estimator = None
         self._prior = None if s.prior_goal is None else np.array(s.prior_goal)
@@ -115,7 +118,6 @@ class GoalNode(Node):
         self._last_queued: float | None = None
         self._pending: Observation | None = None
         self._busy = False
-        self._stopping = False
         self._good: GoodEstimate | None = None
         self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, estimates=0, failed=0)
         self._last = dict(solve_ok=True, solve_status="none", solve_time_s=float("nan"), latency_s=float("nan"), rejection="", event="started")
@@ -353,5 +355,29 @@ class GoalNode(Node):
         with self._lock:
             self._stopping = True
             self._lock.notify()
-        self._worker.join(timeout=5.0)
+        if self._worker is not None:
+            self._worker.join(timeout=5.0)
         return super().destroy_node()
+
+
+def spin(settings: NodeSettings, ros_args: list[str]) -> int:
+    """Run the node until Ctrl-C or a ROS shutdown; ``ros_args`` follow ``--ros-args`` (remappings, parameters)."""
+    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+
+    rclpy.init(args=["comanip", "--ros-args", *ros_args] if ros_args else None)
+    node = None
+    try:
+        node = GoalNode(settings)
+        used = node.settings
+        node.get_logger().info(f"estimating from {node.resolve_topic_name(used.hand_pose_topic)} in frame "
+                               f"{used.frame_id!r} with the {used.preset!r} model")
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0
