@@ -92,9 +92,11 @@ class GoodEstimate:
 
 
 class GoalNode(Node):
-    """The node; ``settings`` as checked NodeSettings (ROS parameters given with --ros-args override them)."""
+    """The node; ``settings`` as checked NodeSettings (ROS parameters given with --ros-args override them),
+    ``transition_model`` the fitted :class:`TransitionModel` of the handover (None: fit on the shipped data, ~5 s)."""
 
-    def __init__(self, settings: NodeSettings, *, node_name: str = "comanip_goal", use_sim_time: bool = False, **node_kwargs):
+    def __init__(self, settings: NodeSettings, *, transition_model: TransitionModel | None = None, node_name: str = "comanip_goal",
+                 use_sim_time: bool = False, **node_kwargs):
         super().__init__(node_name, parameter_overrides=[Parameter("use_sim_time", value=use_sim_time)], **node_kwargs)
         self._lock = threading.Condition()
         self._stopping = False
@@ -105,7 +107,7 @@ class GoalNode(Node):
         self._d = model.d
         self._horizon = model.H * model.h
         self._estimator = GoalEstimator(estimation_planner(model))
-        self._transition = TransitionModel()
+        self._transition = transition_model if transition_model is not None else TransitionModel()
         self._reach: Reach | None = None
         self._reach_estimator = None
         self._prior = None if s.prior_goal is None else np.array(s.prior_goal)

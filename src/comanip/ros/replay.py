@@ -56,6 +56,8 @@ class Recording:
     """(stamp, rest position (3,) m, stiffness (6,)) of each equilibrium pose with the stiffness that followed it."""
     statuses: list = field(default_factory=list)
     """(stamp, level, message, values dict) of every status."""
+    republished: int = 0
+    """How many goal messages repeated an estimate already received (the node's status_rate republishing)."""
     sent: dict = field(default_factory=dict)
     """pose stamp -> time.perf_counter() when it was published."""
     wall_time: float = 0.0
@@ -95,13 +97,14 @@ class Recording:
 
 
 class Replay:
-    """The goal node and a player node on one executor in a private ROS context; use as a context manager."""
+    """The goal node and a player node on one executor in a private ROS context; use as a context manager.
+    ``transition_model`` goes to the node (:class:`~comanip.ros.node.GoalNode`)."""
 
-    def __init__(self, settings: NodeSettings):
+    def __init__(self, settings: NodeSettings, transition_model=None):
         self.settings = settings
         self.context = Context()
         rclpy.init(context=self.context)
-        self.node = GoalNode(settings, use_sim_time=True, context=self.context)
+        self.node = GoalNode(settings, transition_model=transition_model, use_sim_time=True, context=self.context)
         self.player = Node("comanip_replay", context=self.context)
         self.recording = Recording()
         s, player = settings, self.player
@@ -135,7 +138,8 @@ class Replay:
     def _on_goal(self, message: PoseWithCovarianceStamped) -> None:
         stamp = seconds(message.header.stamp)
         if any(stamp == g[0] for g in self.recording.goals[-3:]):
-            return  # a republished estimate
+            self.recording.republished += 1
+            return
         d = self.node._d
         p = message.pose.pose.position
         covariance = np.asarray(message.pose.covariance).reshape(6, 6)[:d, :d]
@@ -171,6 +175,12 @@ class Replay:
         """Set the node's clock to BASE_STAMP + t (s)."""
         self._clock.publish(Clock(clock=stamp_of(BASE_STAMP + t)))
         self.executor.spin_once(timeout_sec=0.0)
+
+    def drain(self, seconds: float) -> None:
+        """Handle callbacks for ``seconds`` of wall time (each spin handles one)."""
+        end = time.perf_counter() + seconds
+        while time.perf_counter() < end:
+            self.executor.spin_once(timeout_sec=0.001)
 
     def publish(self, t: float, position, velocity, *, frame_id: str | None = None, twist: bool = True) -> None:
         """Publish the twist and the pose of the hand at t (s after BASE_STAMP): position (3,) m, velocity (3,) m/s."""
@@ -219,16 +229,16 @@ class Replay:
         end = max([times[-1]] + [rows[-1, 1] for rows in self.recording.schedules[-1:]])
         for t in np.arange(times[-1], end + 1.0 / self.settings.command_rate, 1.0 / self.settings.command_rate):
             self.set_clock(float(t))
-            self.executor.spin_once(timeout_sec=0.002)
-        for _ in range(5):
-            self.executor.spin_once(timeout_sec=0.01)
+            self.drain(0.002)
+        self.drain(0.05)
         return self.recording
 
 
-def replay_csv(settings: NodeSettings, observations: str | Path, out: str | Path, speed: float | None = None) -> tuple[Recording, list[Path]]:
+def replay_csv(settings: NodeSettings, observations: str | Path, out: str | Path, speed: float | None = None,
+               transition_model=None) -> tuple[Recording, list[Path]]:
     """Replay a CSV of hand states (``comanip estimate`` format) through the node; write the recording to ``out``."""
     model = settings.model()
     times, states = read_observations(Path(observations), model.n)
-    with Replay(settings) as replay:
+    with Replay(settings, transition_model) as replay:
         recording = replay.run(times, states, speed)
     return recording, recording.write(out, model.d)
