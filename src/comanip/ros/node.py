@@ -114,8 +114,8 @@ class GoalNode(Node):
         self._last_pose: float | None = None
         self._last_twist: float | None = None
         self._twists: list[Sample] = []
-        self._unpaired: tuple[Sample, float | None, float] | None = None
-        """A checked hand pose waiting for its twist: (sample, the previous pose's stamp, when it arrived)."""
+        self._unpaired: list[tuple[Sample, float | None, float]] = []
+        """Checked hand poses waiting for their twists: (sample, the previous pose's stamp, when it arrived)."""
         self._last_input_clock: float | None = None
         self._last_queued: float | None = None
         self._pending: Observation | None = None
@@ -174,31 +174,36 @@ class GoalNode(Node):
                 self._reject(error)
                 handled, queued = True, False
             else:
-                replaced = self._unpaired is not None
-                if replaced:
-                    self._counts["inputs"] += 1
-                    self._reject(RejectedMessage(f"hand pose rejected: no hand twist within {self.settings.twist_tolerance:g} s "
-                                                 f"of its stamp {self._unpaired[0].stamp:.6f} s"))
-                self._unpaired = (sample, self._last_pose, received)
+                self._unpaired.append((sample, self._last_pose, received))
                 self._last_pose = sample.stamp
                 self._last_input_clock = self.now()
                 handled, queued = self._pair()
-                handled = handled or replaced
         if handled and not queued:
             self._publish_status()
 
     def _pair(self) -> tuple[bool, bool]:
-        """Pair the pose waiting for its twist with the twist stamped nearest it (within twist_tolerance) and
-        observe it; (whether a pose was handled, whether it was queued for an estimate)."""
-        if self._unpaired is None or not self._twists:
-            return False, False
-        sample, previous, received = self._unpaired
-        nearest = min(self._twists, key=lambda twist: abs(twist.stamp - sample.stamp))
-        if abs(nearest.stamp - sample.stamp) > self.settings.twist_tolerance + 1e-9:
-            return False, False
-        self._unpaired = None
-        self._counts["inputs"] += 1
-        return True, self._observe(sample, nearest.vector, previous, received)
+        """Pair each pose waiting for its twist with the twist stamped nearest it (within twist_tolerance) and
+        observe it, in stamp order; a pose older than the newest twist by more than the tolerance never will
+        be paired (twists arrive in stamp order) and is rejected. Returns (whether a pose was handled, whether
+        one was queued for an estimate)."""
+        tolerance = self.settings.twist_tolerance + 1e-9
+        handled = queued = False
+        waiting = []
+        for sample, previous, received in self._unpaired:
+            nearest = min(self._twists, key=lambda twist: abs(twist.stamp - sample.stamp)) if self._twists else None
+            if nearest is not None and abs(nearest.stamp - sample.stamp) <= tolerance:
+                self._counts["inputs"] += 1
+                handled = True
+                queued = self._observe(sample, nearest.vector, previous, received) or queued
+            elif self._last_twist is not None and sample.stamp < self._last_twist - tolerance or len(self._unpaired) > QUEUE_DEPTH:
+                self._counts["inputs"] += 1
+                handled = True
+                self._reject(RejectedMessage(f"hand pose rejected: no hand twist within {self.settings.twist_tolerance:g} s "
+                                             f"of its stamp {sample.stamp:.6f} s"))
+            else:
+                waiting.append((sample, previous, received))
+        self._unpaired = waiting
+        return handled, queued
 
     def _observe(self, sample: Sample, velocity: np.ndarray, previous: float | None, received: float) -> bool:
         """Start a reach (after none, a reset or a gap since the ``previous`` pose stamp), or queue the
@@ -240,7 +245,7 @@ class GoalNode(Node):
 
     def _on_reset(self, _message: Empty) -> None:
         with self._lock:
-            self._reach, self._pending, self._good, self._last_queued = None, None, None, None
+            self._reach, self._pending, self._good, self._last_queued, self._unpaired = None, None, None, None, []
             self._last["event"] = "reset: the next hand pose starts a reach"
             self.get_logger().info(self._last["event"])
 

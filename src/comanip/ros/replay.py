@@ -216,8 +216,8 @@ class Replay:
         begin = time.perf_counter()
         for k, (t, state) in enumerate(zip(times, states)):
             if speed is not None:
-                while time.perf_counter() < begin + t / speed:
-                    self.executor.spin_once(timeout_sec=max(0.0, min(0.005, begin + t / speed - time.perf_counter())))
+                while (wait := begin + t / speed - time.perf_counter()) > 0:
+                    self.executor.spin_once(timeout_sec=wait)
             self.set_clock(t)
             self.publish(t, state[:d], state[d:2 * d])
             if speed is None:
