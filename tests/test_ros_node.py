@@ -7,7 +7,7 @@ import pytest
 
 rclpy = pytest.importorskip("rclpy", reason="the ROS 2 node needs the 'ros' extra: pip install -e '.[test,ros]'")
 
-from comanip.estimation import GoalEstimator  # noqa: E402
+from comanip.estimation.online_estimator import FamilyCache  # noqa: E402
 from comanip.estimation.shared import estimation_planner  # noqa: E402
 from comanip.multicomponent.handover import plan_handover  # noqa: E402
 from comanip.multicomponent.transition_model import TransitionModel  # noqa: E402
@@ -20,9 +20,8 @@ GOAL = np.array([0.4, 0.25, -0.1])
 
 @pytest.fixture(scope="module")
 def reach():
-    """The Cartesian model's plan from rest at the origin to GOAL: the synthetic hand. The wall-time budget is
-    far above a solve's so that which solves finish does not depend on the machine's load."""
-    settings = NodeSettings(max_wall_time=30.0)
+    """The Cartesian model's plan from rest at the origin to GOAL: the synthetic hand."""
+    settings = NodeSettings()
     planner = estimation_planner(settings.model())
     return settings, planner, planner.solve(np.zeros(6), GOAL)
 
@@ -47,7 +46,7 @@ def replayed(reach, transition, tmp_path_factory):
 def library(reach):
     """What the library gives for the same observations fed to the same estimator in the same order."""
     settings, planner, plan = reach
-    estimator = reach_estimator(GoalEstimator(planner), plan.mean[0], None, settings.width, settings.max_wall_time)
+    estimator = reach_estimator(planner, FamilyCache(), plan.mean[0], None, settings.width)
     horizon = plan.t[-1]
     estimates = [estimator.update(t, s[:3], s[3:]) for t, s in zip(plan.t[1:], plan.mean[1:]) if t < horizon]
     return [(t, e) for t, e in zip(plan.t[1:], estimates) if e.success]
@@ -60,7 +59,8 @@ def test_the_published_estimates_are_the_librarys(replayed, library):
         assert stamp - BASE_STAMP == pytest.approx(t, abs=1e-9)
         np.testing.assert_allclose(goal, estimate.goal, atol=1e-9)
         np.testing.assert_allclose(covariance, estimate.goal_covariance, atol=1e-12)
-    np.testing.assert_allclose(recording.goals[-1][1], GOAL, atol=1e-6)  # an exact observation of a plan gives its goal back
+    # exact observations of a plan give its goal back (to the reach family's interpolation, ~1e-4 m or less)
+    np.testing.assert_allclose(recording.goals[-1][1], GOAL, atol=1e-4)
 
 
 def test_the_published_prediction_and_schedule_are_the_librarys(reach, replayed, library, transition):
@@ -133,7 +133,7 @@ def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, t
                  "hand twist rejected: frame 'camera'", "hand pose rejected: stamp 1000.220000 s is not after the previous one",
                  "hand twist rejected: non-finite values", "hand pose rejected: no hand twist within 0.005 s of its stamp 1000.340000 s"):
         assert line in log
-    np.testing.assert_allclose(goal, GOAL, atol=1e-6)  # and it went on estimating
+    np.testing.assert_allclose(goal, GOAL, atol=1e-4)  # and it went on estimating
 
 
 def test_stale_when_input_stops_with_the_last_estimate_still_published(reach, transition):
@@ -154,11 +154,12 @@ def test_stale_when_input_stops_with_the_last_estimate_still_published(reach, tr
         assert replay.recording.republished > republished
 
 
-def test_stale_when_every_solve_fails_and_nothing_is_published(reach, transition):
+def test_stale_when_estimates_overrun_the_budget_and_still_published(reach, transition):
     _, _, plan = reach
-    with Replay(NodeSettings(max_wall_time=1e-6), transition) as replay:
+    with Replay(NodeSettings(max_wall_time=1e-9), transition) as replay:
         for k in range(8):
             replay.set_clock(plan.t[k])
             replay.publish(plan.t[k], plan.mean[k, :3], plan.mean[k, 3:])
             values = replay.wait_handled(k + 1)
-        assert values["stale"] == "true" and int(values["failed"]) > 0 and not replay.recording.goals
+        assert values["stale"] == "true" and values["stale_reason"].startswith("last estimate took")
+        assert int(values["late"]) == int(values["estimates"]) == len(replay.recording.goals) > 0

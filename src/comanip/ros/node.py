@@ -6,9 +6,12 @@ longer than ``input_timeout``): that pose and the twist paired with it are the s
 stamp is t = 0. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
 t = stamp - start stamp; at most ``estimation_rate`` of them per second of input time go to the estimator.
 
-The estimate runs in a worker thread with ``max_wall_time`` per solve, so the executor's callbacks only check
-and queue messages and never wait for a solve; when the worker falls behind, the newest observation replaces
-one still queued (counted as skipped). Each successful estimate is published at once: g_hat with covariance,
+The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
+far, any time; the reach starts at rest at the first pose's position) and run in a worker thread, so the
+executor's callbacks only check and queue messages and never wait for a solve; when the worker falls behind,
+the newest observation replaces one still queued (counted as skipped). An estimate is a few Gauss–Newton steps
+on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes longer than
+``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in time. Each successful estimate is published at once: g_hat with covariance,
 the predicted hand path, and the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover`
 on the predicted reach (the robot's impedance rest position follows the predicted hand, and its stiffness
 ramps to 0 where the transition model predicts the person takes over). Timers republish the last good
@@ -16,8 +19,8 @@ estimate and the status (``status_rate``), and sample the schedule at the node's
 pose and stiffness (``command_rate``). The status is also published after every hand pose is handled, so a
 replay can step in lock with the node.
 
-Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed,
-or no input came for ``input_timeout``; the last good estimate and schedule keep being published.
+Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed
+or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep being published.
 Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
 """
 
@@ -38,11 +41,12 @@ from rclpy.node import Node
 from rclpy.parameter import Parameter
 from std_msgs.msg import Empty, Float64MultiArray
 
-from comanip.estimation import GoalEstimate, GoalEstimator
+from comanip.estimation import GoalEstimate, OnlineGoalEstimator
+from comanip.estimation.online_estimator import FamilyCache
 from comanip.estimation.shared import estimation_planner
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
-from comanip.ros.interim_estimator import InterimGoalEstimator
+from comanip.planning.planner import Planner
 from comanip.ros.messages import (RejectedMessage, Sample, goal_message, path_message, pose_of, read_vector, schedule_message,
                                   stamp_of, status_message)
 from comanip.ros.settings import NodeSettings
@@ -51,16 +55,15 @@ QUEUE_DEPTH = 50
 """Depth of every subscription and publisher queue (messages)."""
 
 
-def reach_estimator(estimator: GoalEstimator, start, prior_goal, width, max_wall_time):
-    """The goal estimator of one reach from ``start`` (2n,): the one place that names the estimator. When
-    ``comanip.estimation.OnlineGoalEstimator`` is merged this becomes
-    ``OnlineGoalEstimator(estimator.planner, start, prior_goal=prior_goal, width=width)``."""
-    return InterimGoalEstimator(estimator, start, prior_goal=prior_goal, width=width, max_wall_time=max_wall_time)
+def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width) -> OnlineGoalEstimator:
+    """The goal estimator of one reach from ``start`` (2n,), at rest: the one place that names the estimator."""
+    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families)
 
 
 @dataclass
 class Reach:
-    """The reach in progress: its number, start stamp (s), start state s_0 (2n,) and prior goal (d,) or None."""
+    """The reach in progress: its number, start stamp (s), start state s_0 (2n,) (at rest at the first pose's
+    position: the estimator's plans start from rest) and prior goal (d,) or None."""
 
     number: int
     start_stamp: float
@@ -106,7 +109,9 @@ class GoalNode(Node):
         model = s.model()
         self._d = model.d
         self._horizon = model.H * model.h
-        self._estimator = GoalEstimator(estimation_planner(model))
+        self._planner = estimation_planner(model)
+        self._families = FamilyCache(size=1)
+        reach_estimator(self._planner, self._families, np.zeros(model.state_size), None, s.width)  # builds the reach family once
         self._transition = transition_model if transition_model is not None else TransitionModel()
         self._reach: Reach | None = None
         self._reach_estimator = None
@@ -121,7 +126,7 @@ class GoalNode(Node):
         self._pending: Observation | None = None
         self._busy = False
         self._good: GoodEstimate | None = None
-        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, estimates=0, failed=0)
+        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, estimates=0, failed=0, late=0)
         self._last = dict(solve_ok=True, solve_status="none", solve_time_s=float("nan"), latency_s=float("nan"), rejection="", event="started")
 
         self._goal_pub = self.create_publisher(PoseWithCovarianceStamped, s.goal_topic, QUEUE_DEPTH)
@@ -212,7 +217,7 @@ class GoalNode(Node):
         reach = self._reach
         if reach is None or (previous is not None and sample.stamp - previous > s.input_timeout):
             number = 1 if reach is None else reach.number + 1
-            self._reach = Reach(number, sample.stamp, np.r_[sample.vector, velocity], self._prior)
+            self._reach = Reach(number, sample.stamp, np.r_[sample.vector, np.zeros_like(velocity)], self._prior)
             self._last_queued = sample.stamp
             self._last["event"] = f"reach {number} started at stamp {sample.stamp:.6f} s"
             self.get_logger().info(self._last["event"])
@@ -254,7 +259,7 @@ class GoalNode(Node):
         self._last["rejection"] = str(error)
         self.get_logger().warning(str(error))
 
-    # ---- the worker: one solve at a time, with its wall-time budget
+    # ---- the worker: one estimate at a time, the newest observation first
     def _work(self) -> None:
         while True:
             with self._lock:
@@ -276,7 +281,7 @@ class GoalNode(Node):
     def _estimate(self, job: Observation) -> None:
         s = self.settings
         if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
-            estimator = reach_estimator(self._estimator, job.reach.start, job.reach.prior_goal, s.width, s.max_wall_time)
+            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width)
             self._reach_estimator = (job.reach, estimator)
         estimator = self._reach_estimator[1]
         try:
@@ -287,6 +292,8 @@ class GoalNode(Node):
             return
         ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.ee_mean)))
         self._last.update(solve_ok=ok, solve_status=estimate.status, solve_time_s=estimate.solve_time)
+        if estimate.solve_time > s.max_wall_time:
+            self._counts["late"] += 1
         if not ok:
             self._counts["failed"] += 1
             self.get_logger().warning(f"estimate at t = {job.t:.3f} s failed ({estimate.status}: {estimate.message}); "
@@ -338,6 +345,8 @@ class GoalNode(Node):
             return "no estimate yet"
         if not self._last["solve_ok"]:
             return f"last solve: {self._last['solve_status']}"
+        if self._last["solve_time_s"] > self.settings.max_wall_time:
+            return f"last estimate took {self._last['solve_time_s']:.3g} s, over max_wall_time {self.settings.max_wall_time:g} s"
         if self._last_input_clock is not None and self.now() - self._last_input_clock > self.settings.input_timeout:
             return f"no input for more than {self.settings.input_timeout:g} s"
         return ""
