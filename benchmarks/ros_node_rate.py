@@ -1,17 +1,16 @@
 """The ROS 2 goal node's achieved rate and latency in replay (needs the 'ros' extra).
 
-    .venv/bin/python benchmarks/ros_node_rate.py [--repeats 3] [--speeds 1,5]
+    .venv/bin/python benchmarks/ros_node_rate.py [--repeats 3] [--tracker-rate 100]
 
-The hand: the Cartesian preset's plan from rest to (0.4, 0.25, -0.1) m, its mean states on the model's own
-grid (h = 55 ms, 18.2 poses/s: today's estimator matches an observation to the grid step before it, so poses
-between steps would be read as the wrong step; the online estimator takes any time), replayed through the
-node in-process (:mod:`comanip.ros.replay`) for the whole 2.75 s reach, every pose sent to the estimator
-(estimation_rate 1000 Hz):
+The hand: the Cartesian preset's plan from rest to (0.4, 0.25, -0.1) m, sampled by a tracker at
+``--tracker-rate`` Hz (the plan's mean positions and velocities interpolated linearly between its 55 ms
+steps), replayed through the node in-process (:mod:`comanip.ros.replay`) for the whole 2.75 s reach:
 
-- lock step: each pose waits for the node to finish with it: the node's throughput, estimates per second of
-  wall time;
-- at ``--speeds`` times real time (1: real time; 5: 91 poses/s): the estimates the node published per
-  second and the poses it skipped because a solve was still running (the newest pose replaces a queued one).
+- lock step, every pose estimated (estimation_rate above the tracker's): each pose waits for the node to
+  finish with it, so this is the node's throughput, estimates per second of wall time;
+- real time, estimation_rate 20 Hz (the default) and the tracker's rate: the estimates the node published per
+  second of wall time, and the poses it skipped (beyond the rate limit, or because an estimate was still
+  running: the newest pose replaces a queued one).
 
 Latency: wall time from publishing a pose to receiving the goal estimate made from it (the first estimate
 of a reach, a cold start, apart). Rows print medians over ``--repeats`` replays; the node is built once per
@@ -33,10 +32,11 @@ from comanip.ros.settings import NodeSettings
 GOAL = np.array([0.4, 0.25, -0.1])
 
 
-def planned_reach() -> tuple[np.ndarray, np.ndarray]:
-    """Times (H+1,) s and mean states (H+1, 6) of the planned reach."""
+def tracker_samples(rate: float) -> tuple[np.ndarray, np.ndarray]:
+    """Times (K,) s and states (K, 6) of the planned reach sampled at ``rate`` Hz."""
     plan = estimation_planner(NodeSettings().model()).solve(np.zeros(6), GOAL)
-    return plan.t, plan.mean
+    times = np.arange(0.0, plan.t[-1], 1.0 / rate)
+    return times, np.column_stack([np.interp(times, plan.t, plan.mean[:, k]) for k in range(6)])
 
 
 def replay_once(settings: NodeSettings, transition: TransitionModel, times, states, speed: float | None) -> dict:
@@ -56,21 +56,21 @@ def replay_once(settings: NodeSettings, transition: TransitionModel, times, stat
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=3, help="replays per mode (default: %(default)s)")
-    parser.add_argument("--speeds", default="1,5", help="replay speeds, multiples of real time (default: %(default)s)")
+    parser.add_argument("--tracker-rate", type=float, default=100.0, help="hand poses per second (default: %(default)s)")
     args = parser.parse_args(argv)
-    times, states = planned_reach()
+    times, states = tracker_samples(args.tracker_rate)
     transition = TransitionModel()
-    settings = NodeSettings(estimation_rate=1000.0)
-    modes = [("lock step", None)] + [(f"{float(v):g}× real time", float(v)) for v in args.speeds.split(",")]
-    print(f"{len(times)} hand poses over {times[-1]:.2f} s of reach; medians of {args.repeats} replays\n")
-    print("| replay | poses/s sent | estimates | achieved estimate rate (Hz) | skipped poses | latency median (ms) "
+    modes = [("lock step", None, 10 * args.tracker_rate), ("real time", 1.0, 20.0), ("real time", 1.0, 10 * args.tracker_rate)]
+    print(f"{len(times)} hand poses at {args.tracker_rate:g} Hz over {times[-1]:.2f} s of reach; medians of {args.repeats} replays\n")
+    print("| replay | estimation_rate (Hz) | estimates | achieved estimate rate (Hz) | skipped poses | latency median (ms) "
           "| latency p95 (ms) | first (cold) estimate (ms) | final goal error (mm) | node build (s) |")
     print("|---|---|---|---|---|---|---|---|---|---|")
-    for name, speed in modes:
+    for name, speed, rate in modes:
+        settings = NodeSettings(estimation_rate=rate)
         runs = [replay_once(settings, transition, times, states, speed) for _ in range(args.repeats)]
         m = {key: float(np.median([r[key] for r in runs])) for key in runs[0]}
-        sent = "as handled" if speed is None else f"{speed / (times[1] - times[0]):.0f}"
-        print(f"| {name} | {sent} | {m['estimates']:.0f} | {m['rate_hz']:.1f} | {m['skipped']:.0f} | {m['median_ms']:.1f} "
+        shown = "every pose" if rate > args.tracker_rate else f"{rate:g}"
+        print(f"| {name} | {shown} | {m['estimates']:.0f} | {m['rate_hz']:.1f} | {m['skipped']:.0f} | {m['median_ms']:.1f} "
               f"| {m['p95_ms']:.1f} | {m['cold_ms']:.0f} | {m['goal_error_mm']:.2g} | {m['build_s']:.1f} |")
 
 

@@ -125,7 +125,7 @@ def status_message(level: bytes, text: str, values: dict, stamp: float) -> Diagn
     array = DiagnosticArray()
     array.header.stamp = stamp_of(stamp)
     status = DiagnosticStatus(level=level, name="comanip goal node", message=text, hardware_id="")
-    status.values = [KeyValue(key=str(k), value=_text(v)) for k, v in values.items()]
+    status.values = [KeyValue(key=str(k), value=status_text(v)) for k, v in values.items()]
     array.status = [status]
     return array
 
@@ -135,7 +135,8 @@ def status_values(message: DiagnosticArray) -> dict:
     return {kv.key: kv.value for kv in message.status[0].values}
 
 
-def _text(value) -> str:
+def status_text(value) -> str:
+    """A status value as the message carries it: floats to 9 digits, booleans as 'true'/'false'."""
     if isinstance(value, float):
         return "nan" if math.isnan(value) else f"{value:.9g}"
     return str(value).lower() if isinstance(value, bool) else str(value)

@@ -11,16 +11,18 @@ far, any time; the reach starts at rest at the first pose's position) and run in
 executor's callbacks only check and queue messages and never wait for a solve; when the worker falls behind,
 the newest observation replaces one still queued (counted as skipped). An estimate is a few Gauss–Newton steps
 on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes longer than
-``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in time. Each successful estimate is published at once: g_hat with covariance,
+``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in time.
+Each successful estimate is published at once: g_hat with covariance,
 the predicted hand path, and the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover`
 on the predicted reach (the robot's impedance rest position follows the predicted hand, and its stiffness
 ramps to 0 where the transition model predicts the person takes over). Timers republish the last good
 estimate and the status (``status_rate``), and sample the schedule at the node's clock into the equilibrium
-pose and stiffness (``command_rate``). The status is also published after every hand pose is handled, so a
-replay can step in lock with the node.
+pose and stiffness (``command_rate``). The status is also published after every estimate and every
+rejected input.
 
 Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed
-or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep being published.
+or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep
+being published.
 Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
 """
 
@@ -165,9 +167,7 @@ class GoalNode(Node):
                 return
             self._last_twist = sample.stamp
             self._twists = self._twists[-(QUEUE_DEPTH - 1):] + [sample]
-            handled, queued = self._pair()
-        if handled and not queued:
-            self._publish_status()
+            self._pair()
 
     def _on_pose(self, message: PoseStamped) -> None:
         received = time.perf_counter()
@@ -177,42 +177,34 @@ class GoalNode(Node):
             except RejectedMessage as error:
                 self._counts["inputs"] += 1
                 self._reject(error)
-                handled, queued = True, False
-            else:
-                self._unpaired.append((sample, self._last_pose, received))
-                self._last_pose = sample.stamp
-                self._last_input_clock = self.now()
-                handled, queued = self._pair()
-        if handled and not queued:
-            self._publish_status()
+                return
+            self._unpaired.append((sample, self._last_pose, received))
+            self._last_pose = sample.stamp
+            self._last_input_clock = self.now()
+            self._pair()
 
-    def _pair(self) -> tuple[bool, bool]:
+    def _pair(self) -> None:
         """Pair each pose waiting for its twist with the twist stamped nearest it (within twist_tolerance) and
         observe it, in stamp order; a pose older than the newest twist by more than the tolerance never will
-        be paired (twists arrive in stamp order) and is rejected. Returns (whether a pose was handled, whether
-        one was queued for an estimate)."""
+        be paired (twists arrive in stamp order) and is rejected."""
         tolerance = self.settings.twist_tolerance + 1e-9
-        handled = queued = False
         waiting = []
         for sample, previous, received in self._unpaired:
             nearest = min(self._twists, key=lambda twist: abs(twist.stamp - sample.stamp)) if self._twists else None
             if nearest is not None and abs(nearest.stamp - sample.stamp) <= tolerance:
                 self._counts["inputs"] += 1
-                handled = True
-                queued = self._observe(sample, nearest.vector, previous, received) or queued
+                self._observe(sample, nearest.vector, previous, received)
             elif self._last_twist is not None and sample.stamp < self._last_twist - tolerance or len(self._unpaired) > QUEUE_DEPTH:
                 self._counts["inputs"] += 1
-                handled = True
                 self._reject(RejectedMessage(f"hand pose rejected: no hand twist within {self.settings.twist_tolerance:g} s "
                                              f"of its stamp {sample.stamp:.6f} s"))
             else:
                 waiting.append((sample, previous, received))
         self._unpaired = waiting
-        return handled, queued
 
-    def _observe(self, sample: Sample, velocity: np.ndarray, previous: float | None, received: float) -> bool:
+    def _observe(self, sample: Sample, velocity: np.ndarray, previous: float | None, received: float) -> None:
         """Start a reach (after none, a reset or a gap since the ``previous`` pose stamp), or queue the
-        observation (True), or count it skipped or ignored (False)."""
+        observation, or count it skipped or ignored."""
         s = self.settings
         reach = self._reach
         if reach is None or (previous is not None and sample.stamp - previous > s.input_timeout):
@@ -221,21 +213,20 @@ class GoalNode(Node):
             self._last_queued = sample.stamp
             self._last["event"] = f"reach {number} started at stamp {sample.stamp:.6f} s"
             self.get_logger().info(self._last["event"])
-            return False
+            return
         t = sample.stamp - reach.start_stamp
         if t >= self._horizon:
             self._counts["ignored"] += 1
             self._last["event"] = f"pose at t = {t:.3f} s is past the model's horizon {self._horizon:g} s; waiting for a reset"
-            return False
+            return
         if sample.stamp - self._last_queued < (1.0 - 1e-6) / s.estimation_rate:
             self._counts["skipped"] += 1
-            return False
+            return
         if self._pending is not None:
             self._counts["skipped"] += 1
         self._pending = Observation(reach, t, sample.stamp, sample.vector, velocity, received)
         self._last_queued = sample.stamp
         self._lock.notify()
-        return True
 
     def _on_prior(self, message: PointStamped) -> None:
         with self._lock:
@@ -255,9 +246,11 @@ class GoalNode(Node):
             self.get_logger().info(self._last["event"])
 
     def _reject(self, error: RejectedMessage) -> None:
+        """Count and log a rejected input, and say so in a status at once (called holding the lock)."""
         self._counts["rejected"] += 1
         self._last["rejection"] = str(error)
         self.get_logger().warning(str(error))
+        self._publish_status()
 
     # ---- the worker: one estimate at a time, the newest observation first
     def _work(self) -> None:
@@ -289,6 +282,9 @@ class GoalNode(Node):
         except ValueError as error:
             self._last["solve_status"] = f"refused: {error}"
             self.get_logger().info(f"observation at t = {job.t:.3f} s not used: {error}")
+            return
+        if estimate.status == "uninformative":  # the hand has not moved yet: nothing to estimate, nothing failed
+            self._last.update(solve_status=estimate.status, event=f"waiting for movement at t = {job.t:.3f} s")
             return
         ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.ee_mean)))
         self._last.update(solve_ok=ok, solve_status=estimate.status, solve_time_s=estimate.solve_time)
@@ -351,19 +347,24 @@ class GoalNode(Node):
             return f"no input for more than {self.settings.input_timeout:g} s"
         return ""
 
-    def _publish_status(self) -> None:
+    def status(self) -> tuple[str, dict]:
+        """(why the estimate is stale, '' when fresh; the status values: counts, last solve, last rejection, ...)."""
         with self._lock:
             reason = self.stale_reason()
             good, reach = self._good, self._reach
-            values = dict(stale=bool(reason), stale_reason=reason, **self._counts,
-                          pending=self._pending is not None or self._busy, reach=0 if reach is None else reach.number,
-                          reach_start_stamp_s=float("nan") if reach is None else reach.start_stamp,
-                          estimate_stamp_s=float("nan") if good is None else good.stamp,
-                          goal_m=[] if good is None else good.estimate.goal.tolist(),
-                          transition_time_s=float("nan") if good is None else good.schedule.transition_time,
-                          last_solve_status=self._last["solve_status"], last_solve_time_s=self._last["solve_time_s"],
-                          last_latency_s=self._last["latency_s"], last_rejection=self._last["rejection"],
-                          last_event=self._last["event"])
+            return reason, dict(stale=bool(reason), stale_reason=reason, **self._counts,
+                                pending=bool(self._pending is not None or self._busy or self._unpaired),
+                                reach=0 if reach is None else reach.number,
+                                reach_start_stamp_s=float("nan") if reach is None else reach.start_stamp,
+                                estimate_stamp_s=float("nan") if good is None else good.stamp,
+                                goal_m=[] if good is None else good.estimate.goal.tolist(),
+                                transition_time_s=float("nan") if good is None else good.schedule.transition_time,
+                                last_solve_status=self._last["solve_status"], last_solve_time_s=self._last["solve_time_s"],
+                                last_latency_s=self._last["latency_s"], last_rejection=self._last["rejection"],
+                                last_event=self._last["event"])
+
+    def _publish_status(self) -> None:
+        reason, values = self.status()
         level = DiagnosticStatus.WARN if reason else DiagnosticStatus.OK
         self._status_pub.publish(status_message(level, reason or "estimating", values, self.now()))
 

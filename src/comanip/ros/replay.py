@@ -5,8 +5,8 @@ The recording is a CSV of timestamped states in the format ``comanip estimate --
 published as a TwistStamped and a PoseStamped stamped ``BASE_STAMP + t_k`` while a /clock message sets the
 node's clock (use_sim_time) to the same time, so the node sees the recording's own time whatever the speed:
 
-- ``speed=None`` (lock step, as fast as the node goes): each row waits for the node's status saying it was
-  handled and no estimate is pending, so every row the node would estimate at its ``estimation_rate`` is
+- ``speed=None`` (lock step, as fast as the node goes): each row waits until the node (in the same process)
+  has handled it and has no estimate pending, so every row the node would estimate at its ``estimation_rate`` is
   estimated, reproducibly;
 - ``speed=s > 0``: rows go out at s times real time and the node keeps up or skips (s = 1: real time).
 
@@ -34,7 +34,7 @@ from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64MultiArray
 
 from comanip.cli.estimate_command import read_observations
-from comanip.ros.messages import SCHEDULE_COLUMNS, read_schedule, seconds, stamp_of, status_values
+from comanip.ros.messages import SCHEDULE_COLUMNS, read_schedule, seconds, stamp_of, status_text, status_values
 from comanip.ros.node import GoalNode
 from comanip.ros.settings import NodeSettings
 
@@ -200,14 +200,15 @@ class Replay:
         self._pose.publish(message)
 
     def wait_handled(self, poses: int, timeout: float = 30.0) -> dict:
-        """Spin until the node's status says ``poses`` hand poses were handled and nothing is pending; its values."""
+        """Spin until the node has handled ``poses`` hand poses and has no estimate pending; its status values
+        (as the status message carries them, strings)."""
         deadline = time.perf_counter() + timeout
         while time.perf_counter() < deadline:
-            self.executor.spin_once(timeout_sec=0.01)
-            if self.recording.statuses:
-                values = self.recording.statuses[-1][3]
-                if int(values["inputs"]) >= poses and values["pending"] == "false":
-                    return values
+            self.executor.spin_once(timeout_sec=0.001)
+            _, values = self.node.status()
+            if values["inputs"] >= poses and not values["pending"]:
+                self.drain(0.005)  # what the node published on the way out
+                return {key: status_text(value) for key, value in self.node.status()[1].items()}
         raise TimeoutError(f"the node did not handle {poses} hand poses within {timeout:g} s")
 
     def run(self, times, states, speed: float | None = None) -> Recording:
