@@ -88,12 +88,14 @@ class Observation:
 
 @dataclass
 class GoodEstimate:
-    """The last successful estimate, the schedule built on it, and when (stamps in s)."""
+    """The last successful estimate, the schedule built on it, when (stamps in s), and its three messages
+    (built once, republished as they are)."""
 
     estimate: GoalEstimate
     schedule: HandoverSchedule
     reach: Reach
     stamp: float
+    messages: tuple
 
 
 class GoalNode(Node):
@@ -298,7 +300,10 @@ class GoalNode(Node):
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
             schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
-        good = GoodEstimate(estimate, schedule, job.reach, job.stamp)
+        frame = s.frame_id
+        messages = (goal_message(estimate.goal, estimate.goal_covariance, job.stamp, frame),
+                    path_message(estimate, job.reach.start_stamp, frame), schedule_message(schedule, job.reach.start_stamp))
+        good = GoodEstimate(estimate, schedule, job.reach, job.stamp, messages)
         with self._lock:
             if self._reach is not job.reach:
                 return  # a reset or a new reach came while solving
@@ -309,10 +314,10 @@ class GoalNode(Node):
 
     # ---- publishing
     def _publish_estimate(self, good: GoodEstimate) -> None:
-        frame = self.settings.frame_id
-        self._goal_pub.publish(goal_message(good.estimate.goal, good.estimate.goal_covariance, good.stamp, frame))
-        self._path_pub.publish(path_message(good.estimate, good.reach.start_stamp, frame))
-        self._schedule_pub.publish(schedule_message(good.schedule, good.reach.start_stamp))
+        goal, path, schedule = good.messages
+        self._goal_pub.publish(goal)
+        self._path_pub.publish(path)
+        self._schedule_pub.publish(schedule)
 
     def _publish_command(self) -> None:
         good = self._good

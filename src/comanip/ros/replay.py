@@ -56,6 +56,8 @@ class Recording:
     """(stamp, rest position (3,) m, stiffness (6,)) of each equilibrium pose with the stiffness that followed it."""
     statuses: list = field(default_factory=list)
     """(stamp, level, message, values dict) of every status."""
+    lost: int = 0
+    """Hand poses sent that the node never received (dropped by the middleware's queues when it fell behind)."""
     republished: int = 0
     """How many goal messages repeated an estimate already received (the node's status_rate republishing)."""
     sent: dict = field(default_factory=dict)
@@ -211,6 +213,19 @@ class Replay:
                 return {key: status_text(value) for key, value in self.node.status()[1].items()}
         raise TimeoutError(f"the node did not handle {poses} hand poses within {timeout:g} s")
 
+    def wait_idle(self, quiet: float = 0.2, timeout: float = 30.0) -> None:
+        """Spin until the node has no estimate pending and has handled no new pose for ``quiet`` seconds (when
+        it cannot keep up, the middleware drops messages beyond its queues: they never come)."""
+        deadline, seen, since = time.perf_counter() + timeout, -1, time.perf_counter()
+        while time.perf_counter() < deadline:
+            self.executor.spin_once(timeout_sec=0.001)
+            values = self.node.status()[1]
+            if values["inputs"] != seen or values["pending"]:
+                seen, since = values["inputs"], time.perf_counter()
+            elif time.perf_counter() - since > quiet:
+                return
+        raise TimeoutError(f"the node was still busy after {timeout:g} s")
+
     def run(self, times, states, speed: float | None = None) -> Recording:
         """Replay states (K, 2d) [x; xdot] at times (K,) s (module docstring); returns the recording."""
         d = self.node._d
@@ -225,8 +240,12 @@ class Replay:
                 self.wait_handled(k + 1)
             else:
                 self.executor.spin_once(timeout_sec=0.0)
-        self.wait_handled(len(times))
+        if speed is None:
+            self.wait_handled(len(times))
+        else:
+            self.wait_idle()
         self.recording.wall_time = time.perf_counter() - begin
+        self.recording.lost = len(times) - self.node.status()[1]["inputs"]
         end = max([times[-1]] + [rows[-1, 1] for rows in self.recording.schedules[-1:]])
         for t in np.arange(times[-1], end + 1.0 / self.settings.command_rate, 1.0 / self.settings.command_rate):
             self.set_clock(float(t))
