@@ -25,6 +25,7 @@ replay (build time apart). Default budget max_wall_time 0.25 s.
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import sys
 import tempfile
@@ -35,7 +36,7 @@ import numpy as np
 
 from comanip.estimation.shared import estimation_planner
 from comanip.multicomponent.transition_model import TransitionModel
-from comanip.ros.replay import Replay
+from comanip.ros.replay import Replay, private_domain
 from comanip.ros.settings import NodeSettings
 
 GOAL = np.array([0.4, 0.25, -0.1])
@@ -74,8 +75,10 @@ def two_processes(rate: float, times, states) -> dict:
     params = Path(tempfile.mkdtemp()) / "params.yaml"
     params.write_text(f"estimation_rate: {rate}\n")
     t0 = time.time()
-    node = subprocess.Popen([sys.executable, "-m", "comanip.ros", "--params", str(params)], stderr=subprocess.DEVNULL)
-    rclpy.init()
+    domain = private_domain()
+    node = subprocess.Popen([sys.executable, "-m", "comanip.ros", "--params", str(params)], stderr=subprocess.DEVNULL,
+                            env={**os.environ, "ROS_DOMAIN_ID": str(domain)})
+    rclpy.init(domain_id=domain)
     player = Node("comanip_rate_benchmark")
     goals, statuses = {}, []
     player.create_subscription(PoseWithCovarianceStamped, "goal/estimate", lambda m: goals.setdefault(

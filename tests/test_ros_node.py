@@ -1,11 +1,13 @@
 """The ROS 2 goal node in-process (no robot, no ROS installation): a planned reach replayed through it gives
-the library's own estimates, predictions and handover schedule; bad messages are logged and rejected; a
-failed solve or a silent input leaves the last good estimate published and marked stale."""
+the library's own estimates, predictions and handover schedule; bad messages are logged and rejected; an
+estimate over its budget or a silent input leaves the last good estimate published and marked stale."""
 
 import numpy as np
 import pytest
 
 rclpy = pytest.importorskip("rclpy", reason="the ROS 2 node needs the 'ros' extra: pip install -e '.[test,ros]'")
+
+from geometry_msgs.msg import PointStamped  # noqa: E402
 
 from comanip.estimation.online_estimator import FamilyCache  # noqa: E402
 from comanip.estimation.shared import estimation_planner  # noqa: E402
@@ -117,8 +119,16 @@ def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, t
             if handled:
                 replay.wait_handled(poses)
 
+        prior = replay.player.create_publisher(PointStamped, settings.prior_goal_topic, 10)
+        for frame in ("camera", settings.frame_id):            # a prior in another frame, then a good one
+            message = PointStamped()
+            message.header.frame_id, (message.point.x, message.point.y, message.point.z) = frame, GOAL.tolist()
+            prior.publish(message)
+            replay.drain(0.2)
+        assert replay.node.status()[1]["last_event"] == f"prior goal {GOAL.tolist()} m, for the next reach"
         for k in range(6):
             send(k)
+        assert np.array_equal(replay.node._reach.prior_goal, GOAL)
         send(6, position=nan)                          # a NaN position (its twist is fine)
         send(6, frame="camera")                        # another frame: pose and twist
         send(4)                                        # stamps before the last accepted pose and twist
@@ -128,8 +138,8 @@ def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, t
         values = replay.recording.statuses[-1][3]
         goal = replay.recording.goals[-1][1]
     log = capfd.readouterr().err
-    assert int(values["rejected"]) == 7
-    for line in ("hand pose rejected: non-finite values", "hand pose rejected: frame 'camera' is not the node's frame 'world'",
+    assert int(values["rejected"]) == 8
+    for line in ("prior goal rejected: frame 'camera'", "hand pose rejected: non-finite values", "hand pose rejected: frame 'camera' is not the node's frame 'world'",
                  "hand twist rejected: frame 'camera'", "hand pose rejected: stamp 1000.220000 s is not after the previous one",
                  "hand twist rejected: non-finite values", "hand pose rejected: no hand twist within 0.005 s of its stamp 1000.340000 s"):
         assert line in log

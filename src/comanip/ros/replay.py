@@ -18,6 +18,7 @@ writes it as CSV files.
 from __future__ import annotations
 
 import csv
+import os
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -98,14 +99,20 @@ class Recording:
         return written
 
 
+def private_domain() -> int:
+    """A DDS domain id (100–199) for this process's replays, so that other ROS 2 processes on the machine
+    (a running node, another replay) neither see nor disturb them."""
+    return 100 + os.getpid() % 100
+
+
 class Replay:
-    """The goal node and a player node on one executor in a private ROS context; use as a context manager.
-    ``transition_model`` goes to the node (:class:`~comanip.ros.node.GoalNode`)."""
+    """The goal node and a player node on one executor in a private ROS context, on :func:`private_domain`;
+    use as a context manager. ``transition_model`` goes to the node (:class:`~comanip.ros.node.GoalNode`)."""
 
     def __init__(self, settings: NodeSettings, transition_model=None):
         self.settings = settings
         self.context = Context()
-        rclpy.init(context=self.context)
+        rclpy.init(context=self.context, domain_id=private_domain())
         self.node = GoalNode(settings, transition_model=transition_model, use_sim_time=True, context=self.context)
         self.player = Node("comanip_replay", context=self.context)
         self.recording = Recording()
