@@ -46,7 +46,8 @@ def run(args) -> int:
         write_manifest(out, "ros", written)
         last = recording.statuses[-1][3] if recording.statuses else {}
         print(json.dumps({"estimates": len(recording.goals), "last_goal_m": recording.goals[-1][1].tolist() if recording.goals else None,
-                          "rejected": last.get("rejected"), "failed": last.get("failed"), "wall_time_s": recording.wall_time,
+                          "rejected": int(last.get("rejected", 0)), "failed": int(last.get("failed", 0)),
+                          "wall_time_s": recording.wall_time,
                           "files": [str(p) for p in written]}, indent=1))
         return 0 if recording.goals else 1
     from comanip.ros.node import spin
