@@ -1,5 +1,7 @@
 """The ROS node's settings: the CLI's validators and messages, read from YAML (no ROS needed)."""
 
+from pathlib import Path
+
 import pytest
 
 from comanip.cli.main import main
@@ -39,3 +41,12 @@ def test_the_command_reports_a_bad_parameter_file_in_one_line(tmp_path, capsys):
     params.write_text("status_rate: 0\n")
     assert main(["ros", "--params", str(params)]) == 2
     assert capsys.readouterr().err.strip() == "comanip ros: error: status_rate must be a finite number > 0 (Hz), got 0"
+
+
+def test_the_readmes_franka_parameters_are_valid(tmp_path):
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    block = readme.split("```yaml\ncomanip_goal:", 1)[1].split("```", 1)[0]
+    params = tmp_path / "franka.yaml"
+    params.write_text("comanip_goal:" + block)
+    settings = NodeSettings.from_yaml(params)
+    assert settings.frame_id == "fr3_link0" and settings.equilibrium_topic.endswith("/equilibrium_pose")
