@@ -34,7 +34,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--prior", type=vector, help="prior goal g_bar (m), comma-separated (default: no regulariser)")
     parser.add_argument("--prior-std", type=prior_std, default=None,
                         help="how uncertain --prior is (m): one number or one per axis, comma-separated, or 'width' for the "
-                             "paper's W from the goal width (default: 1 m, a weak prior)")
+                             "paper's W from the goal width (default: 10 m, a weak prior)")
     parser.add_argument("--method", choices=METHODS, default="regret", help="'regret' (default) or 'paper' (eq. 11 as printed)")
     parser.add_argument("--candidates", type=candidate_list, help="candidate goals for a posterior, e.g. '0.3,0;0.2,0.2' (m)")
     parser.set_defaults(func=run)

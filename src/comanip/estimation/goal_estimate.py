@@ -22,8 +22,8 @@ Observations before 2h: at step 1 only the velocity is held, at step 0 the estim
 (status 'uninformative'); :mod:`comanip.estimation.observation` says why.
 
 The regulariser (g - g_bar)^T P0^-1 (g - g_bar) is the paper's with the prior's own covariance P0 in place of
-W: ``prior_std`` says how rough the guess g_bar is (m; default 1 m, a weak prior that moves an exact
-observation's estimate by about a millimetre), and ``prior_std="width"`` gives the paper's P0 = W (W = w² I by
+W: ``prior_std`` says how rough the guess g_bar is (m; default 10 m, a weak prior that moves an exact
+observation's estimate by a fraction of a millimetre), and ``prior_std="width"`` gives the paper's P0 = W (W = w² I by
 default), which dominates an early observation (:mod:`comanip.estimation.goal_prior`). Without a prior goal
 (``prior_goal=None``) it is left out.
 
@@ -138,7 +138,7 @@ class GoalEstimator:
                 (:mod:`comanip.estimation.observation`).
             prior_goal: g_bar (d,), m, for the regulariser; None leaves it out.
             width: goal width w (m); the model's default when None.
-            prior_std: how uncertain g_bar is (m): a number, d numbers, None (the weak default, 1 m) or
+            prior_std: how uncertain g_bar is (m): a number, d numbers, None (the weak default, 10 m) or
                 "width" (the paper's W from the width); :mod:`comanip.estimation.goal_prior`.
             method: 'regret' (default) or 'paper' (eq. 11 as printed).
             warm_start: a previous estimate (its full state is reused) or any plan of this model (its torques

@@ -66,12 +66,12 @@ class OnlineOptions:
     family_tolerance: float = 1e-4
     """Largest difference (m) accepted between the family's interpolated mean position and a real plan."""
     tolerance: float = 1e-7
-    """A Newton goal step shorter than this (m), or one that lowers -log p by less than 1e-9, ends an update."""
+    """A Newton goal step shorter than this (m), or one that lowers -log p by less than 1e-6 (taken, then stop), ends an update."""
     max_iterations: int = 20
     """Gauss–Newton iterations per update."""
     step_fraction: float = 0.5
     """Largest goal step, as a fraction of the distance from the start to the current goal (at least one width)."""
-    covariance_tolerance: float = 0.02
+    covariance_tolerance: float = 0.05
     """The belief covariance that weighs the observations is the plan's to a goal within this fraction of the
     distance (start to goal) of the estimate; it is recomputed when the estimate moves farther."""
 
@@ -123,10 +123,15 @@ DEFAULT_FAMILIES = FamilyCache()
 _MOVEMENT_SIGMAS = 3.0
 #: Whitenings rebuilt per update at most (each at the goal the previous round ended at).
 _COVARIANCE_ROUNDS = 3
+#: Relative std along the reach above which the goal's variance there comes from a quadrature, and its points.
+_SKEWED = 0.05
+_QUADRATURE_POINTS = 200
 #: Halvings of a Newton step before the iteration gives up.
 _BACKTRACKS = 12
 #: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
-_DECREMENT = 1e-9
+_DECREMENT = 1e-6
+#: ... and, relative to -log p, below which a step that no line search can lower counts as converged (rounding).
+_ACCEPTABLE_DECREMENT = 1e-6
 
 
 class OnlineGoalEstimator:
@@ -138,7 +143,7 @@ class OnlineGoalEstimator:
         start: the state at the reach's start (nx,) or [q; qdot] (2n,), at rest (zero velocity and force).
         prior_goal: g_bar (d,) m; None: the start's hand position (with the weak default std, a prior that
             only keeps the estimate finite).
-        prior_std: the prior's standard deviation (m): a number, d numbers, None (the weak default, 1 m)
+        prior_std: the prior's standard deviation (m): a number, d numbers, None (the weak default, 10 m)
             or "width" (the paper's W from the width); :mod:`comanip.estimation.goal_prior`.
         width: goal width w (m); the model's default when None.
         options: :class:`OnlineOptions`.
@@ -255,6 +260,7 @@ class OnlineGoalEstimator:
                 iterations += used
                 if not self._stale(goal):
                     break
+            covariance = problem.distance_spread(goal, covariance, whitening)
             if not (np.all(np.isfinite(goal)) and np.all(np.isfinite(covariance))):
                 raise np.linalg.LinAlgError("non-finite estimate")
         except np.linalg.LinAlgError as error:
@@ -323,12 +329,19 @@ class _Problem:
     def __init__(self, estimator: OnlineGoalEstimator, steps, observed, weights):
         self.e, self.steps, self.observed, self.weights = estimator, steps, observed, weights
         self.m = observed.shape[1]
+        self._predicted: tuple[bytes, ReachPrediction] | None = None    # the last goal's prediction (rounds share it)
+
+    def _prediction(self, goal: np.ndarray) -> ReachPrediction:
+        key = goal.tobytes()
+        if self._predicted is None or self._predicted[0] != key:
+            self._predicted = key, self.e._prediction(goal, order=2, covariance=False)
+        return self._predicted[1]
 
     def _terms(self, whitening: ObservationWhitening, goal):
         """(objective, Hessian (d, d), Gauss–Newton matrix (d, d), minus the gradient (d,)) at ``goal``."""
         e, m = self.e, self.m
         d = len(goal)
-        prediction = e._prediction(goal, order=2, covariance=False)
+        prediction = self._prediction(goal)
         H1, nx = prediction.mean.shape
         grid = np.concatenate([prediction.mean[:, :m, None], prediction.mean_jacobian[:, :m]], axis=2)
         columns = (self.weights @ grid.reshape(H1, -1)).reshape(len(self.steps), m, 1 + d)
@@ -356,6 +369,50 @@ class _Problem:
             return goal
         return e.start_position + offset * (min(max(D, low), high) / D)
 
+    def distance_spread(self, goal: np.ndarray, covariance: np.ndarray, whitening: ObservationWhitening) -> np.ndarray:
+        """The covariance with its variance along the reach replaced by the posterior's along the line through
+        the start and ``goal`` (1-D quadrature on a grid of distances), and the spread across it scaled by the
+        root mean square distance over D_hat, where the Laplace approximation's relative std along the reach
+        exceeds :data:`_SKEWED`: early in a reach the distance's posterior has a long tail towards far goals
+        that the curvature at the mode does not see."""
+        e = self.e
+        offset = goal - e.start_position
+        D = float(np.linalg.norm(offset))
+        u = offset / D
+        variance = float(u @ covariance @ u)
+        spread = math.sqrt(variance) / D
+        if spread < _SKEWED:
+            return covariance
+        family = e.family
+        low = max(math.log(D) - 6 * spread, math.log(family.distances[0]))
+        high = min(math.log(D) + 6 * spread, math.log(family.distances[-1]))
+        if high - low < 1e-6:
+            return covariance
+        distances = np.exp(np.linspace(low, high, _QUADRATURE_POINTS))
+        n, m = e.model.n, self.m
+        means = (family.along(distances)[:, :, :, None] * u).reshape(len(distances), e.model.H + 1, -1)[:, :, :m]
+        means[:, :, :n] += e.start_position
+        residuals = self.observed[None] - np.einsum("sj,kjm->ksm", self.weights, means)
+        whitened = whitening.matrix @ residuals.reshape(len(distances), -1).T
+        goals = e.start_position + distances[:, None] * u
+        offsets = goals - e.prior_mean
+        energy = 0.5 * (np.sum(whitened**2, axis=0) + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
+        weights = np.exp(-(energy - energy.min())) * np.gradient(distances)
+        weights /= weights.sum()
+        along = float(weights @ (distances - D) ** 2)
+        # across the reach the direction's uncertainty spreads the goal in proportion to its distance
+        across = np.eye(len(u)) - np.outer(u, u)
+        stretch = math.sqrt(max(1.0, float(weights @ distances**2) / D**2))
+        scale = across * stretch + np.outer(u, u)
+        return scale @ covariance @ scale + max(0.0, along - variance) * np.outer(u, u)
+
+    def _at_range_end(self, goal: np.ndarray) -> bool:
+        return bool(np.linalg.norm(goal - self.e.start_position) >= self.e.family.distances[-1] * (1 - 1e-9))
+
+    def _range_message(self) -> str:
+        return (f"the estimate sits at the largest distance the reach family covers ({self.e.family.distances[-1]:g} m): "
+                "the observations point farther than the model's plans reach")
+
     def newton(self, goal: np.ndarray, whitening: ObservationWhitening):
         """Newton's method from ``goal`` under a fixed ``whitening`` (the Gauss–Newton matrix where the Hessian
         is not positive definite), a backtracking line search on the objective: (goal, covariance (d, d) m²,
@@ -369,9 +426,8 @@ class _Problem:
             if 0.5 * float(step @ descent) <= _DECREMENT or math.sqrt(float(step @ step)) <= options.tolerance:
                 # the Newton step would lower -log p by less than _DECREMENT: take it and stop
                 goal = self._projected(goal + step)
-                if np.linalg.norm(goal - e.start_position) >= e.family.distances[-1] * (1 - 1e-9):
-                    return goal, _covariance(terms), Status.MAX_ITERATIONS, (
-                        f"the estimate sits at the largest distance the reach family covers ({e.family.distances[-1]:g} m)"), iteration
+                if self._at_range_end(goal):
+                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
                 return goal, _covariance(terms), Status.SOLVED, f"converged in {iteration} Newton iterations", iteration
             limit = options.step_fraction * max(math.sqrt(float((goal - e.start_position) @ (goal - e.start_position))), e.width)
             length = math.sqrt(float(step @ step))
@@ -384,14 +440,21 @@ class _Problem:
                     break
                 step *= 0.5
             else:
-                return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, "no Newton step lowers the objective", iteration
+                if self._at_range_end(goal):
+                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
+                decrement = 0.5 * float(_solve_positive(newton, gauss_newton, descent) @ descent)
+                if decrement <= _ACCEPTABLE_DECREMENT * max(1.0, abs(objective)):
+                    return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, (
+                        f"no Newton step lowers the objective any more (decrement {decrement:.2g})"), iteration
+                return goal, _covariance(terms), Status.FAILED, (
+                    f"no Newton step lowers the objective, though it predicts a decrease of {decrement:.2g}"), iteration
             goal, terms = trial, trial_terms
         return goal, _covariance(terms), Status.MAX_ITERATIONS, f"no convergence in {options.max_iterations} Newton iterations", options.max_iterations
 
     def cold_goal(self) -> np.ndarray | None:
         """The best member of the family along the observed directions (latest velocity, latest displacement
         from the start, and the prior's direction), scored by the observations' likelihood with each step's
-        error taken independently, plus the prior; None when nothing moved and the prior sits at the start."""
+        error taken independently, plus the prior; None when no observation shows movement beyond its noise."""
         e = self.e
         n = e.model.n
         sigma_q, sigma_v = e.options.observation_std
@@ -402,11 +465,11 @@ class _Problem:
         displacement = latest[:n] - e.start_position
         if np.linalg.norm(displacement) > _MOVEMENT_SIGMAS * sigma_q:
             directions.append(displacement / np.linalg.norm(displacement))
+        if not directions:
+            return None
         prior_offset = e.prior_mean - e.start_position
         if np.linalg.norm(prior_offset) > 0:
             directions.append(prior_offset / np.linalg.norm(prior_offset))
-        if not directions:
-            return None
         family, m = e.family, self.m
         noise = e._R[None] / e._counts[self.steps][:, None, None]
         best, best_score = None, math.inf

@@ -92,7 +92,8 @@ class ReachFamily:
         size: number of members to start from (geometrically spaced over the range).
         tolerance: largest acceptable difference (m) between the interpolated mean position and a real plan;
             the plan at the midpoint (in log D) of every pair of neighbouring members is solved and compared,
-            and where it differs by more, it joins the family (``refinements`` rounds at most).
+            and where it differs by more, it joins the family (``refinements`` rounds at most); the range ends
+            below an interval that is still off (e.g. where plans of a short horizon have several optima).
 
     Raises ValueError when the model is not rotation-invariant (see the module docstring), or when the
     plan to D_min does not converge.
@@ -121,7 +122,8 @@ class ReachFamily:
         self._fit(plans)
         self.interpolation_error = self._refine(tolerance, refinements)
         """Largest |mean position| difference (m) between the spline and a real plan at the midpoints (in log D)
-        of the members checked last: the tolerance of every prediction within the range."""
+        of the intervals between members: the accuracy of every prediction within the range (at most the
+        tolerance; the range ends where that cannot be reached)."""
         self.invariance_error = self._invariance_error(planner)
         """Largest |mean| difference between an oblique plan and the turned member (state units)."""
         if self.invariance_error > INVARIANCE_TOLERANCE:
@@ -159,21 +161,24 @@ class ReachFamily:
         self._eye = np.eye(self.model.d)
 
     def _refine(self, tolerance: float, rounds: int) -> float:
-        """Check the spline at the midpoints of the intervals not yet known to be fine; add the plans that
-        differ by more than ``tolerance`` (m); return the largest difference found in the last round."""
+        """Check the spline at the midpoint (in log D) of every interval between members; where a real plan
+        differs by more than ``tolerance`` (m), add it to the family and check the two halves in the next
+        round. After ``rounds`` rounds, intervals still off (or whose midpoint plan does not succeed) end the
+        family's range below them. Returns the largest difference (m) over the intervals kept."""
         d = self.model.d
+        errors: dict[float, float] = {}                 # lower member's distance -> midpoint error of its interval
         unchecked = set(range(len(self.plans) - 1))
-        worst = np.inf
-        for _ in range(rounds):
-            added, worst = [], 0.0
+        for round_ in range(rounds + 1):
+            added = []
             for k in sorted(unchecked):
                 D = float(np.sqrt(self.distances[k] * self.distances[k + 1]))
                 plan = self._plan(D, self.plans[k])
                 if plan is None:
+                    errors[float(self.distances[k])] = np.inf
                     continue
-                error = float(np.abs(self.prediction(np.zeros(d), plan.goal, order=0, covariance=False).mean[:, :d] - plan.mean[:, :d]).max())
-                worst = max(worst, error)
-                if error > tolerance:
+                predicted = self.prediction(np.zeros(d), plan.goal, order=0, covariance=False).mean[:, :d]
+                errors[float(self.distances[k])] = error = float(np.abs(predicted - plan.mean[:, :d]).max())
+                if error > tolerance and round_ < rounds:
                     added.append(plan)
             if not added:
                 break
@@ -181,7 +186,17 @@ class ReachFamily:
             self._fit(plans)
             new = {float(p.goal[0]) for p in added}
             unchecked = {k for k in range(len(plans) - 1) if float(plans[k].goal[0]) in new or float(plans[k + 1].goal[0]) in new}
-        return worst
+        kept = len(self.plans)
+        for k in range(len(self.plans) - 1):
+            if errors.get(float(self.distances[k]), 0.0) > tolerance:
+                kept = k + 1
+                break
+        if kept < len(self.plans):
+            if kept < 4:
+                raise ValueError(f"the reach family is not accurate to {tolerance:g} m even at short distances "
+                                 f"(interval from {self.distances[0]:g} m); raise the tolerance or the size")
+            self._fit(self.plans[:kept])
+        return max((e for D, e in errors.items() if D < self.distances[-1]), default=0.0)
 
     def _invariance_error(self, planner: Planner) -> float:
         if self.model.d == 1:
@@ -191,6 +206,15 @@ class ReachFamily:
         plan = planner.solve(np.zeros(self.nx), self.distances[k] * u, self.width)
         turned = self.prediction(np.zeros(self.model.d), self.distances[k] * u, order=0, covariance=False)
         return float(np.abs(plan.mean - turned.mean).max())
+
+    def along(self, distances: np.ndarray) -> np.ndarray:
+        """The mean along the axis per state block, a_b,i(D) (M, H+1, blocks), at distances (M,) m within the range."""
+        x = np.log(np.clip(distances, self._low, self._high))
+        k = np.clip(np.searchsorted(self._path.x, x) - 1, 0, len(self._knots) - 2)
+        dx = (x - self._path.x[k])[:, None]
+        size = (self.H + 1) * self.blocks
+        c = self._path.c[:, k, :size]
+        return (((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]).reshape(len(distances), self.H + 1, self.blocks)
 
     def frame(self, u: np.ndarray) -> np.ndarray:
         """T (nx, nx): the orthogonal map Q (Q e_1 = u) applied to every state block."""
