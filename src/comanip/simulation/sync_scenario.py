@@ -24,6 +24,7 @@ from comanip.analysis.speed_profile import speed_metrics
 from comanip.arguments import as_positive, as_vector
 from comanip.control.impedance import CartesianImpedanceController, RobotState
 from comanip.estimation import GoalEstimator
+from comanip.estimation.goal_prior import PAPER_PRIOR
 from comanip.planning.plan import Plan
 from comanip.simulation.rest_trajectory import RestTrajectory
 from comanip.simulation.scenario import TABLE_CENTRE, ScenarioSettings, SettledStart, TrialRecord, check_workspace, reach_times, run_trial
@@ -80,8 +81,10 @@ class SyncRobot:
         if self.rest is None:
             if t < t_o - 1e-9:
                 return position, velocity            # no stiffness: the rest follows the handle
+            # the paper's one-shot estimate, its prior weighted by W from the width (paper VI-A)
             self.estimate = self.estimator.estimate(self.start.state, self.observed, self.observation_time,
-                                                    self.prior_goal, self.width, warm_start=self.warm_start)
+                                                    self.prior_goal, self.width, prior_std=PAPER_PRIOR,
+                                                    warm_start=self.warm_start)
             self.rest = RestTrajectory(self.estimate, 0.0, self.dt, self.duration)
             if self.settings.known_height:
                 end_at_height(self.rest, self.settings.goal[2])
