@@ -113,6 +113,9 @@ class CartesianImpedanceController:
         self._stiffness = np.r_[gains.translational_stiffness, np.full(3, gains.rotational_stiffness)]
         self._damping = None
         self._designed_at = np.full(n, np.inf)
+        self.last_force = np.zeros(3)
+        """The translational part of the last commanded wrench K e + D e_dot (3,), N: the force the
+        impedance applies at the TCP (before any torque clipping)."""
 
     @property
     def translational_stiffness(self) -> np.ndarray:
@@ -140,6 +143,7 @@ class CartesianImpedanceController:
         if velocity_rest is not None:
             twist_error[:3] += velocity_rest
         wrench = self._stiffness * error + self._damping @ twist_error
+        self.last_force = wrench[:3].copy()
         tau_0 = g.nullspace_stiffness * (self.rest_posture - q) - self._nullspace_damping * qdot
         tau = state.gravity + J.T @ wrench + self._nullspace_projector @ tau_0
         if self.torque_limit is not None:
