@@ -2,8 +2,10 @@
 
 All come from a :class:`~comanip.simulation.scenario.TrialRecord` (K samples, time step dt, s):
 
-- **interaction force**: the person's force on the handle F_p (K, 3), N, as RMS and peak of ||F_p|| over the
-  trial; and the same for F_p - F_p(0), the change from the force that holds the object at rest before the
+Force and work are taken from ``from_time`` on (the sync scenario: t_o, from when the robot leads; before
+that every robot is passive alike), the other measures over the whole trial.
+
+- **interaction force**: the person's force on the handle F_p (K, 3), N, as RMS and peak of ||F_p||; and the same for F_p - F_p(0), the change from the force that holds the object at rest before the
   reach (mostly its uncompensated weight, which every robot here leaves to the person alike);
 - **work against the robot** (J): sum of max(0, -F_r · v) dt with F_r the impedance's force on the handle:
   the energy the robot's spring and damper take out of the handle's motion, which the person supplies;
@@ -54,15 +56,19 @@ def movement_time(record: TrialRecord) -> float:
     return float(timing.movement_time) if timing.settled else float(record.t[-1])
 
 
-def trial_measures(record: TrialRecord, width: float, person_axes=(0, 1), robot_axes=(2,)) -> dict:
-    """The measures of the module docstring for one trial; width w (m) sets the completion tolerance w/2.
+def trial_measures(record: TrialRecord, width: float, person_axes=(0, 1), robot_axes=(2,), from_time: float = 0.0) -> dict:
+    """The measures of the module docstring for one trial; width w (m) sets the completion tolerance w/2,
+    from_time (s) where the force and work measures start.
     person_axes and robot_axes: indices of the axes each leads (the sync scenario's x–y and z); with
     robot_axes empty the synchronisation measures are NaN."""
     t, dt = record.t, float(record.t[1] - record.t[0])
-    force = np.linalg.norm(record.person_force, axis=1)
-    change = np.linalg.norm(record.person_force - record.person_force[0], axis=1)
-    robot_power = np.sum(record.robot_force * record.velocity, axis=1)
-    person_power = np.sum(record.person_force * record.velocity, axis=1)
+    if not (np.isfinite(from_time) and t[0] <= from_time < t[-1]):
+        raise ValueError(f"from_time must lie within the trial, [{t[0]}, {t[-1]}) s, got {from_time!r}")
+    leading = t >= from_time - 1e-9
+    force = np.linalg.norm(record.person_force[leading], axis=1)
+    change = np.linalg.norm(record.person_force[leading] - record.person_force[0], axis=1)
+    robot_power = np.sum(record.robot_force * record.velocity, axis=1)[leading]
+    person_power = np.sum(record.person_force * record.velocity, axis=1)[leading]
     mt = movement_time(record)
     moving = t <= mt
     measures = {

@@ -134,9 +134,9 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
     errors), and the tracking error on the normalised-time grid (P,), (P, 3).
 
     goal_estimate: the robot's last goal estimate (3,), m, or None. The tracking errors are taken from t_o
-    (when the first estimate exists) to MT and reported on a grid of t / MT.
+    (when the first estimate exists) to MT and reported on a grid of t / MT; force and work from t_o on.
     """
-    measures = trial_measures(record, width)
+    measures = trial_measures(record, width, from_time=observation_time)
     speed = np.linalg.norm(record.velocity, axis=1)
     timing = speed_metrics(record.t, speed)
     mt = measures["movement_time_s"]
