@@ -26,13 +26,13 @@ BEGIN = "<!-- human-targets:begin -->"
 END = "<!-- human-targets:end -->"
 
 
-def replace_block(text: str, block: str) -> str:
-    """text with the lines between the BEGIN and END markers (each once, in that order) replaced by block."""
-    if text.count(BEGIN) != 1 or text.count(END) != 1 or text.index(BEGIN) > text.index(END):
-        raise ValueError(f"the README must hold {BEGIN} once, followed by {END} once")
-    head, rest = text.split(BEGIN)
-    _, tail = rest.split(END)
-    return f"{head}{BEGIN}\n{block.strip()}\n{END}{tail}"
+def replace_block(text: str, block: str, begin: str = BEGIN, end: str = END) -> str:
+    """text with the lines between the begin and end markers (each once, in that order) replaced by block."""
+    if text.count(begin) != 1 or text.count(end) != 1 or text.index(begin) > text.index(end):
+        raise ValueError(f"the README must hold {begin} once, followed by {end} once")
+    head, rest = text.split(begin)
+    _, tail = rest.split(end)
+    return f"{head}{begin}\n{block.strip()}\n{end}{tail}"
 
 
 def measured_block(names: list[str], samples: int, seed: int, trials: int) -> str:

@@ -131,6 +131,13 @@ class CartesianImpedanceController:
             self._stiffness[:3] = stiffness
             self._damping = None
 
+    def reset(self) -> None:
+        """Forget the configuration-dependent design (the next call redesigns at its state), so runs that
+        start from the same state compute the same torques whatever ran before."""
+        self._damping = None
+        self._designed_at = np.full(len(self.rest_posture), np.inf)
+        self.last_force = np.zeros(3)
+
     def __call__(self, state: RobotState, position_rest, rotation_rest, velocity_rest=None) -> np.ndarray:
         """Joint torques (n,), N·m, for the rest pose (position_rest (3,) m, rotation_rest (3, 3)) moving at
         velocity_rest (3,) m/s (zero when None)."""

@@ -9,7 +9,8 @@ that every robot is passive alike), the other measures over the whole trial.
   reach (mostly its uncompensated weight, which every robot here leaves to the person alike);
 - **work against the robot** (J): sum of max(0, -F_r · v) dt with F_r the impedance's force on the handle:
   the energy the robot's spring and damper take out of the handle's motion, which the person supplies;
-  and the person's own positive work, sum of max(0, F_p · v) dt;
+  and the person's positive work beyond holding the object, sum of max(0, (F_p - F_p(0)) · v) dt (the
+  holding force itself does negative work as the object is lowered, and would hide the rest);
 - **synchronisation** between the axes the person leads (L_p) and those the robot leads (L_r): the progress
   p_L(t) = (x_L(t) - x_L(0)) · (g_L - x_L(0)) / ||g_L - x_L(0)||² of each group toward the goal, their
   RMS difference over the movement [0, MT] (dimensionless: 0.1 is 10 % of the reach), and the lag
@@ -68,7 +69,7 @@ def trial_measures(record: TrialRecord, width: float, person_axes=(0, 1), robot_
     force = np.linalg.norm(record.person_force[leading], axis=1)
     change = np.linalg.norm(record.person_force[leading] - record.person_force[0], axis=1)
     robot_power = np.sum(record.robot_force * record.velocity, axis=1)[leading]
-    person_power = np.sum(record.person_force * record.velocity, axis=1)[leading]
+    person_power = np.sum((record.person_force - record.person_force[0]) * record.velocity, axis=1)[leading]
     mt = movement_time(record)
     moving = t <= mt
     measures = {

@@ -29,7 +29,7 @@ COMPARED = {
     "peak_force_change_N": ("peak force change (N)", 1.0),
     "rms_force_N": ("RMS force (N)", 1.0),
     "work_against_robot_J": ("work against robot (J)", 1.0),
-    "person_work_J": ("person's work (J)", 1.0),
+    "person_work_J": ("person's work beyond holding (J)", 1.0),
     "sync_error_rms": ("sync error (% of reach)", 100.0),
     "completion_time_s": ("completion (s)", 1.0),
     "final_error_m": ("placement error (mm)", 1e3),

@@ -192,6 +192,10 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
         estimated = np.full((len(record.t), 3), np.nan) if prediction is None else np.array([prediction.rest(t)[0] for t in record.t])
         metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time)
         metrics["predictions"] = robot.predictions
+        if prediction is not None and prediction.plan is not None and prediction.plan is not context.prior_plan:
+            estimate = prediction.plan
+            metrics.update(estimate_success=bool(estimate.success), estimate_status=str(estimate.status),
+                           estimate_time_s=float(estimate.solve_time))
         trials.append(SyncTrial(record, settings.policy, None if prediction is None else prediction.plan, estimated,
                                 metrics, grid, error))
     return trials
