@@ -5,7 +5,7 @@ Multi-component Reaching Strategies". See ``comanip.planning.planner`` for the p
 """
 
 from comanip import presets
-from comanip.estimation import estimate_goal, goal_posterior
+from comanip.estimation import OnlineGoalEstimator, estimate_goal, goal_posterior
 from comanip.fitting import FitResult, fit_model, fit_movement_times
 from comanip.model import ReachingModel
 from comanip.multicomponent.transition_model import TransitionModel
@@ -13,5 +13,5 @@ from comanip.planning import Plan, Planner, SolverOptions, plan_reach
 
 __version__ = "0.1.0"
 
-__all__ = ["presets", "ReachingModel", "Plan", "Planner", "SolverOptions", "plan_reach", "TransitionModel", "estimate_goal", "goal_posterior",
+__all__ = ["presets", "ReachingModel", "Plan", "Planner", "SolverOptions", "plan_reach", "TransitionModel", "estimate_goal", "goal_posterior", "OnlineGoalEstimator",
            "fit_model", "fit_movement_times", "FitResult"]

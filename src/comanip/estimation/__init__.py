@@ -3,5 +3,6 @@
 from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_estimate import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
 from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
+from comanip.estimation.online_estimator import OnlineGoalEstimator, OnlineOptions
 
-__all__ = ["EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior", "estimate_goal", "goal_posterior"]
+__all__ = ["EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior", "estimate_goal", "goal_posterior", "OnlineGoalEstimator", "OnlineOptions"]

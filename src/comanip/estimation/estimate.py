@@ -26,7 +26,7 @@ class GoalEstimate(Plan):
     prior_goal: np.ndarray | None = None
     """g_bar (d,), m, of the regulariser; None without one."""
     method: str = "regret"
-    """'regret' or 'paper' (eq. 11 as printed)."""
+    """'regret', 'paper' (eq. 11 as printed) or 'online' (:class:`comanip.estimation.OnlineGoalEstimator`)."""
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
     """Multipliers of the observation constraint (one per observed row); a later estimate at a step like
     this one's starts from them."""
@@ -36,6 +36,9 @@ class GoalEstimate(Plan):
     """max |F| of the regret's first-order conditions at the estimate ('regret' method)."""
     unconstrained_torque: np.ndarray | None = None
     """The plan to the estimated goal, not held to the observation (H, n) ('regret' method)."""
+    goal_covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
+    """Covariance of the estimated goal (d, d), m²: the Laplace approximation of the posterior (the Gauss–Newton
+    curvature of the observations' negative log-likelihood under the model's belief, plus the prior's)."""
     plan_status: str | None = None
     """For an 'uninformative' estimate (observation at step 0): the status of the plan to the prior goal."""
 
