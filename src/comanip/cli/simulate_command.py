@@ -24,7 +24,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial (default: %(default)s)")
     parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
     parser.add_argument("--policy", help="sync only: the robot policy, one of passive, prior-only, constant-velocity, "
-                                         "minimum-jerk, one-shot (default), or all of them")
+                                         "minimum-jerk, one-shot (default), continuous, or all of them")
     add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")

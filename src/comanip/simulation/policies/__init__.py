@@ -5,12 +5,14 @@
 - ``prior-only`` (:mod:`prior_only`): the model's reach to the prior goal;
 - ``constant-velocity`` (:mod:`constant_velocity`): the hand's current velocity extrapolated;
 - ``minimum-jerk`` (:mod:`minimum_jerk_fit`): a Flash–Hogan reach fitted to the observed prefix;
-- ``one-shot`` (:mod:`one_shot`): the paper's estimate at t_o, never revised (the scenario's default).
+- ``one-shot`` (:mod:`one_shot`): the paper's estimate at t_o, never revised (the scenario's default);
+- ``continuous`` (:mod:`continuous`): comanip's online estimate, revised with every observation.
 
 >>> policy = POLICIES["minimum-jerk"](context)      # context: a PolicyContext
 """
 
 from comanip.simulation.policies.constant_velocity import ConstantVelocityPolicy
+from comanip.simulation.policies.continuous import ContinuousPolicy
 from comanip.simulation.policies.minimum_jerk_fit import MinimumJerkPolicy
 from comanip.simulation.policies.one_shot import OneShotPolicy
 from comanip.simulation.policies.passive import PassivePolicy
@@ -19,7 +21,7 @@ from comanip.simulation.policies.protocol import DEFAULT_UPDATE_INTERVAL, Policy
 
 #: policy name -> class (constructed with a PolicyContext)
 POLICIES = {cls.name: cls for cls in (PassivePolicy, PriorOnlyPolicy, ConstantVelocityPolicy, MinimumJerkPolicy,
-                                      OneShotPolicy)}
+                                      OneShotPolicy, ContinuousPolicy)}
 
 
 def check_policy(name) -> str:
@@ -29,5 +31,5 @@ def check_policy(name) -> str:
     return name
 
 
-__all__ = ["ConstantVelocityPolicy", "DEFAULT_UPDATE_INTERVAL", "MinimumJerkPolicy", "OneShotPolicy", "POLICIES",
+__all__ = ["ConstantVelocityPolicy", "ContinuousPolicy", "DEFAULT_UPDATE_INTERVAL", "MinimumJerkPolicy", "OneShotPolicy", "POLICIES",
            "PassivePolicy", "PolicyContext", "Prediction", "PriorOnlyPolicy", "RobotPolicy", "check_policy"]
