@@ -3,6 +3,12 @@ no number in it is typed by hand.
 
     PYTHONPATH=src python docs/make_policy_comparison.py [--trials 20] [--seed 0] [--readme README.md]
 
+On a busy machine the goals can run in separate processes and be merged afterwards:
+
+    PYTHONPATH=src python docs/make_policy_comparison.py --goals near,far --save /tmp/a.pkl
+    PYTHONPATH=src python docs/make_policy_comparison.py --goals right,high --save /tmp/b.pkl
+    PYTHONPATH=src python docs/make_policy_comparison.py --load /tmp/a.pkl /tmp/b.pkl
+
 Runs every robot policy (:data:`comanip.simulation.policies.POLICIES`) on the synchronisation scenario for
 the near and far goals and two more (GOALS), ``--trials`` trials each with the same person seeds for every
 policy, and writes docs/policy_comparison_sync.csv and .md (median [q25, q75] over the trials),
@@ -13,6 +19,7 @@ docs/figures/policy_comparison_sync.png, and the table with its verdicts between
 from __future__ import annotations
 
 import argparse
+import pickle
 import time
 from pathlib import Path
 
@@ -62,21 +69,39 @@ def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--trials", type=int, default=20, help="trials per goal and policy (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial's person (default: %(default)s)")
+    parser.add_argument("--goals", default=",".join(GOALS), help="comma-separated labels of GOALS (default: all)")
+    parser.add_argument("--save", type=Path, help="only simulate, and pickle the results here (for --load)")
+    parser.add_argument("--load", type=Path, nargs="+", help="merge pickled results instead of simulating")
     parser.add_argument("--readme", type=Path, default=DOCS.parent / "README.md")
     args = parser.parse_args(argv)
-    settings = {label: SyncSettings(goal=goal, trials=args.trials, seed=args.seed) for label, goal in GOALS.items()}
-    began = time.perf_counter()
-    results = compare_sync_policies(settings, list(POLICIES), ScenarioSetup(next(iter(settings.values()))), progress=True)
-    wall = time.perf_counter() - began
+    if args.load:
+        runs = [pickle.loads(path.read_bytes()) for path in args.load]
+        results = {label: by_policy for run in runs for label, by_policy in run["results"].items()}
+        wall, trials, seed = sum(run["wall_s"] for run in runs), runs[0]["trials"], runs[0]["seed"]
+        settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in results}
+    else:
+        labels = [label for label in args.goals.split(",") if label]
+        unknown = sorted(set(labels) - set(GOALS))
+        if unknown:
+            raise ValueError(f"--goals must name goals of {list(GOALS)}, got {unknown}")
+        trials, seed = args.trials, args.seed
+        settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in labels}
+        began = time.perf_counter()
+        results = compare_sync_policies(settings, list(POLICIES), ScenarioSetup(next(iter(settings.values()))), progress=True)
+        wall = time.perf_counter() - began
+        if args.save:
+            args.save.write_bytes(pickle.dumps({"results": results, "wall_s": wall, "trials": trials, "seed": seed}))
+            print(f"saved {args.save} ({wall / 60:.0f} min)")
+            return 0
     rows = comparison_rows(results)
     files = write_comparison(rows, DOCS / "policy_comparison_sync")
     figure = plot_policy_comparison(results, DOCS / "figures" / "policy_comparison_sync.png")
     goals = "; ".join(f"{label} {np.round(s.goal, 2).tolist()}" for label, s in settings.items())
-    block = (f"Measured by `PYTHONPATH=src python docs/make_policy_comparison.py --trials {args.trials} --seed {args.seed}` "
-             f"({args.trials} trials per goal and policy, person seeds {args.seed}–{args.seed + args.trials - 1} for every "
+    block = (f"Measured by `PYTHONPATH=src python docs/make_policy_comparison.py --trials {trials} --seed {seed}` "
+             f"({trials} trials per goal and policy, person seeds {seed}–{seed + trials - 1} for every "
              f"policy; goals (m): {goals}; prior goal {list(next(iter(settings.values())).prior_goal)} m; "
-             f"{wall / 60:.0f} min on the shared 2-core machine). Each cell: median [q25, q75] over the trials; force "
-             f"and work from t_o = 0.2 s on.\n\n"
+             f"{wall / 60:.0f} min of simulation on the shared, loaded 2-core machine). Each cell: median [q25, q75] over "
+             f"the trials; force and work from t_o = 0.2 s on.\n\n"
              f"{markdown_table(rows)}\n"
              f"Verdicts (issue 12's \"done when\"):\n\n" + "\n".join(verdicts(rows)) + "\n\n"
              f"![policy comparison]({figure.relative_to(DOCS.parent)})")
