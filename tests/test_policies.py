@@ -152,3 +152,13 @@ def test_unknown_policy_and_policy_for_handover_are_rejected():
     from comanip.cli.main import main
 
     assert main(["simulate", "handover", "--policy", "passive", "--trials", "1"]) == 2
+
+
+@pytest.mark.slow
+def test_continuous_estimate_is_revised_at_every_update(runs):
+    settings, _, trials, _ = runs
+    record = trials["continuous"].record
+    after = record.t >= settings.observation_time - 1e-9
+    revisions = np.count_nonzero(np.any(np.diff(record.goal_estimate[after], axis=0) != 0, axis=1))
+    assert trials["continuous"].metrics["predictions"] == trials["constant-velocity"].metrics["predictions"]
+    assert revisions == trials["continuous"].metrics["predictions"] - 1      # a new goal at every update after the first
