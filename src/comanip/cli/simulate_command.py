@@ -88,6 +88,13 @@ def run(args) -> int:
                             "timing": timing[label]}
         if args.scenario == "handover":
             goals_out[label]["schedule"] = result.schedule.summary()
+            if result.dispersion is not None:
+                # the lead at 400 N/m holds the spread down until the release, so this peak lies inside T by
+                # construction; the person's own transition is measured with a passive robot
+                # (docs/measure_handover_transition.py)
+                goals_out[label]["transition"] = {
+                    "predicted_distance_m": result.schedule.transition_distance,
+                    "handover_spread_peak_distance_m": result.dispersion.transition_distance}
         if label in by_policy:
             goals_out[label]["policies"] = {name: summarise([trial.metrics for trial in trials])
                                             for name, trials in by_policy[label].items()}
