@@ -112,7 +112,7 @@ def noisy_estimate_errors(estimator, goals, prior_offset, rng, warm_from_prior):
         observed = rng.multivariate_normal(plan.mean[n_o], plan.cov[n_o])
         prior = None if prior_offset is None else goal + prior_offset * rng.normal(size=len(goal)) / np.sqrt(len(goal))
         warm = estimator.planner.solve(plan.start, prior, warm_start=plan) if warm_from_prior else None
-        estimate = estimator.estimate(plan.start, observed, T_OBS, prior_goal=prior, warm_start=warm)
+        estimate = estimator.estimate(plan.start, observed, T_OBS, prior_goal=prior, warm_start=warm, prior_std=prior_offset)
         assert estimate.success, estimate.message
         assert np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.torque))
         error, u = estimate.goal - goal, goal / np.linalg.norm(goal)

@@ -20,6 +20,7 @@ import numpy as np
 import comanip
 from comanip.belief import sample_trajectories
 from comanip.estimation import GoalEstimator, goal_posterior
+from comanip.estimation.goal_prior import PAPER_PRIOR
 
 PATH = Path(__file__).with_name("reference_results.npz")
 FRANKA_PATH = Path(__file__).with_name("reference_results_franka.npz")
@@ -79,10 +80,13 @@ def _estimates(planners: dict) -> dict:
             observed = plan.mean[n_o]
             prior = goal + 0.05 * _direction(90, 0, model.d)
             out.update(_estimate_entries(f"estimate/{preset}/{k}/cold", estimator.estimate(plan.start, observed, T_OBS)))
-            out.update(_estimate_entries(f"estimate/{preset}/{k}/prior", estimator.estimate(plan.start, observed, T_OBS, prior)))
+            # the stored estimates weigh the prior with W from the width, the default before issue 12
+            out.update(_estimate_entries(f"estimate/{preset}/{k}/prior",
+                                         estimator.estimate(plan.start, observed, T_OBS, prior, prior_std=PAPER_PRIOR)))
             prior_plan = estimator.planner.solve(plan.start, prior)
             out.update(_estimate_entries(f"estimate/{preset}/{k}/warm",
-                                         estimator.estimate(plan.start, observed, T_OBS, prior, warm_start=prior_plan)))
+                                         estimator.estimate(plan.start, observed, T_OBS, prior, warm_start=prior_plan,
+                                                            prior_std=PAPER_PRIOR)))
     return out
 
 

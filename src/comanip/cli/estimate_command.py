@@ -20,6 +20,7 @@ from comanip.cli.options import add_model_arguments, add_reach_arguments, input_
 from comanip.cli.outputs import output_dir, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
+from comanip.estimation.goal_prior import PAPER_PRIOR
 
 
 def add_parser(subparsers) -> None:
@@ -31,9 +32,20 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, "
                         "the paper's); before the model's step h it says nothing about the goal and needs --prior")
     parser.add_argument("--prior", type=vector, help="prior goal g_bar (m), comma-separated (default: no regulariser)")
+    parser.add_argument("--prior-std", type=prior_std, default=None,
+                        help="how uncertain --prior is (m): one number or one per axis, comma-separated, or 'width' for the "
+                             "paper's W from the goal width (default: 10 m, a weak prior)")
     parser.add_argument("--method", choices=METHODS, default="regret", help="'regret' (default) or 'paper' (eq. 11 as printed)")
     parser.add_argument("--candidates", type=candidate_list, help="candidate goals for a posterior, e.g. '0.3,0;0.2,0.2' (m)")
     parser.set_defaults(func=run)
+
+
+def prior_std(text: str):
+    """Parse '0.05', '0.05,0.05,0.1' (m) or 'width'; an argparse type."""
+    if text.strip() == PAPER_PRIOR:
+        return PAPER_PRIOR
+    values = vector(text)
+    return float(values[0]) if values.size == 1 else values
 
 
 def candidate_list(text: str) -> np.ndarray:
@@ -82,9 +94,12 @@ def run(args) -> int:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
     out = output_dir(args.out, "estimate", args.force)
 
-    estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, method=args.method, max_wall_time=args.max_wall_time)
+    estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, prior_std=args.prior_std, method=args.method,
+                                  max_wall_time=args.max_wall_time)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
+               "prior_std": args.prior_std if args.prior_std is None or isinstance(args.prior_std, (str, float)) else args.prior_std.tolist(),
+               "goal_covariance": estimate.goal_covariance.tolist(),
                "t_obs_s": float(t_obs), "observed_step": estimate.observed_step, "method": args.method,
                "width": estimate.width, "success": estimate.success, "status": estimate.status, "message": estimate.message,
                "solve_time_s": estimate.solve_time, "iterations": estimate.iterations, "regret": estimate.regret}

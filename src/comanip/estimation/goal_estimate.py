@@ -21,8 +21,18 @@ Two methods:
 Observations before 2h: at step 1 only the velocity is held, at step 0 the estimate is the prior's plan
 (status 'uninformative'); :mod:`comanip.estimation.observation` says why.
 
-The regulariser (g - g_bar)^T W^-1 (g - g_bar), W from the width as the model says (W = w² I by default), is
-the paper's; without a prior goal (``prior_goal=None``) it is left out.
+The regulariser (g - g_bar)^T P0^-1 (g - g_bar) is the paper's with the prior's own covariance P0 in place of
+W: ``prior_std`` says how rough the guess g_bar is (m; default 10 m, a weak prior that moves an exact
+observation's estimate by a fraction of a millimetre), and ``prior_std="width"`` gives the paper's P0 = W (W = w² I by
+default), which dominates an early observation (:mod:`comanip.estimation.goal_prior`). Without a prior goal
+(``prior_goal=None``) it is left out.
+
+Every estimate reports ``goal_covariance`` (d, d) m², the Laplace approximation of the goal's posterior at
+the estimate: the Gauss–Newton curvature S^T (Sigma_no + R)^-1 S of the observation's likelihood, S = d mu_no /
+d g the sensitivity of the plan's mean at the observed step to the goal (from the regret's own KKT solves),
+Sigma_no the plan's state covariance there and R the observation noise (``EstimatorOptions.observation_std``),
+plus the prior's precision (the weak default's when there is no prior goal, which keeps it finite). For a
+continuous stream of observations use :class:`comanip.estimation.OnlineGoalEstimator`.
 
 >>> estimator = GoalEstimator(comanip.presets.cartesian())
 >>> estimate = estimator.estimate(start=np.zeros(6), observed=s_o, t_obs=0.2)
@@ -42,6 +52,7 @@ from threadpoolctl import ThreadpoolController
 from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.estimate import GoalEstimate
+from comanip.estimation.goal_prior import GoalPrior, prior_covariance
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
 from comanip.estimation.regret_newton import newton_solve
@@ -112,8 +123,8 @@ class GoalEstimator:
         self._blas = ThreadpoolController()
         self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
 
-    def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, method: str = "regret",
-                 warm_start: Plan | None = None, max_wall_time: float | None = None) -> GoalEstimate:
+    def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, prior_std=None,
+                 method: str = "regret", warm_start: Plan | None = None, max_wall_time: float | None = None) -> GoalEstimate:
         """Estimate the goal of a reach from its start and a state observed at t_obs.
 
         Args:
@@ -127,6 +138,8 @@ class GoalEstimator:
                 (:mod:`comanip.estimation.observation`).
             prior_goal: g_bar (d,), m, for the regulariser; None leaves it out.
             width: goal width w (m); the model's default when None.
+            prior_std: how uncertain g_bar is (m): a number, d numbers, None (the weak default, 10 m) or
+                "width" (the paper's W from the width); :mod:`comanip.estimation.goal_prior`.
             method: 'regret' (default) or 'paper' (eq. 11 as printed).
             warm_start: a previous estimate (its full state is reused) or any plan of this model (its torques
                 and goal seed the solve, e.g. the plan to the prior goal); None searches for a start.
@@ -137,7 +150,7 @@ class GoalEstimator:
             A :class:`GoalEstimate`: the plan through the observation to the estimated goal, with the observed
             step, ``observation_residual`` (mean at n_o minus the observed state, (nx,)) and, for the regret,
             ``regret`` (J units), ``residual`` (max |F|) and ``unconstrained_torque`` (the plan to the
-            estimated goal, not held to the observation, (H, n)); never raises on a failed solve (check
+            estimated goal, not held to the observation, (H, n)), and ``goal_covariance`` (d, d) m²; never raises on a failed solve (check
             ``success`` and ``status``).
         """
         t_begin = time.perf_counter()
@@ -145,7 +158,8 @@ class GoalEstimator:
         start, _, width = self.planner.check_inputs(start, np.zeros(model.d), width)
         observed = observed_state(model, observed)
         n_o = observation_step(model, t_obs)
-        prior = None if prior_goal is None else as_vector("prior_goal", prior_goal, model.d, "task-space position, m")
+        prior_cov = prior_covariance(prior_std, model, width)
+        prior = None if prior_goal is None else GoalPrior(as_vector("prior_goal", prior_goal, model.d, "task-space position, m"), prior_cov)
         if method not in METHODS:
             raise ValueError(f"method must be one of {METHODS}, got {method!r}")
         if method == "paper" and not model.body.is_linear:
@@ -181,9 +195,27 @@ class GoalEstimator:
         plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
                                       success=status in CONVERGED, message=message,
                                       solve_time=time.perf_counter() - t_begin, iterations=iterations)
+        covariance = self._goal_covariance(point, plan, start, observed, n_o, rows, prior, width)
         return GoalEstimate.of(plan, t_obs=float(t_obs), observed_step=n_o, observed_state=observed,
-                               observation_residual=plan.mean[n_o] - observed, prior_goal=prior, method=method,
-                               multipliers=point.lam.copy(), **details)
+                               observation_residual=plan.mean[n_o] - observed, prior_goal=None if prior is None else prior.mean,
+                               method=method, multipliers=point.lam.copy(), goal_covariance=covariance, **details)
+
+    def _goal_covariance(self, point: RegretPoint, plan: Plan, start, observed, n_o, rows, prior: GoalPrior | None, width) -> np.ndarray:
+        """The Laplace covariance (d, d) m² of the estimate (module docstring); the prior's (or the weak default
+        prior's) covariance where the curvature cannot be evaluated."""
+        model = self.model
+        fallback = prior.covariance if prior is not None else prior_covariance(None, model, width)
+        precision = np.linalg.inv(fallback)
+        try:
+            with self._blas.limit(limits=1, user_api="blas"):
+                linearisation = self._regret.linearise(point, start, observed, n_o, rows, prior, width)
+                S = linearisation.A_c[:len(rows)] @ linearisation.plan_goal_sensitivity()
+            R = observation_covariance(self.options.observation_std, model.n)
+            C = (plan.cov[n_o][:2 * model.n, :2 * model.n] + R)[np.ix_(rows, rows)]
+            covariance = np.linalg.inv(S.T @ np.linalg.solve(C, S) + precision)
+        except np.linalg.LinAlgError:
+            return fallback
+        return 0.5 * (covariance + covariance.T) if np.all(np.isfinite(covariance)) else fallback
 
     def _regret_solve(self, point: RegretPoint | None, cold_point, start, observed, n_o, rows, prior, width, deadline):
         """Newton's method on the regret from ``point`` (from ``cold_point()`` when None, or when a warm start
@@ -215,13 +247,13 @@ class GoalEstimator:
 
     def _uninformative(self, start, observed, t_obs, prior, width, method, warm_start, max_wall_time, t_begin) -> GoalEstimate:
         """The estimate from an observation at step 0: the plan to the prior goal, status 'uninformative'."""
-        plan = self.planner.solve(start, prior, width, warm_start=warm_start, max_wall_time=max_wall_time)
+        plan = self.planner.solve(start, prior.mean, width, warm_start=warm_start, max_wall_time=max_wall_time)
         message = (f"the observation at t_obs = {t_obs:g} s falls on step 0, the start itself, and says nothing about the goal: "
                    f"the estimate is the prior goal and the trajectory its plan (plan status '{plan.status}')")
         plan = replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
         return GoalEstimate.of(plan, t_obs=t_obs, observed_step=0, observed_state=observed,
-                               observation_residual=plan.mean[0] - observed, prior_goal=prior, method=method,
-                               plan_status=plan.status)
+                               observation_residual=plan.mean[0] - observed, prior_goal=prior.mean, method=method,
+                               plan_status=plan.status, goal_covariance=prior.covariance.copy())
 
     @property
     def _max_iterations(self) -> int:
@@ -256,7 +288,7 @@ class GoalEstimator:
         found = search_along_observed_direction(self.planner, start, observed, n_o, prior, width, R, self.options.search_distances,
                                                 self.step_jacobians, remaining_time)
         if found is None:
-            goal = prior if prior is not None else task_space_state(self.planner, observed)[0]
+            goal = prior.mean if prior is not None else task_space_state(self.planner, observed)[0]
             plan = self.planner.solve(start, goal, width, max_wall_time=remaining_time())
         else:
             goal, plan = found
@@ -264,17 +296,17 @@ class GoalEstimator:
         return RegretPoint(tau.copy(), np.zeros(n_rows), tau.copy(), np.asarray(goal, dtype=float).copy())
 
     def _paper_solver(self, n_o: int, rows: np.ndarray) -> tuple[ca.Function, IpoptDeadline]:
-        """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1); the
-        constraint holds the observed ``rows`` (fixed by n_o) of the state."""
+        """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1, P0^-1 (d, d));
+        the constraint holds the observed ``rows`` (fixed by n_o) of the state."""
         if n_o not in self._paper_solvers:
             p, model = self.problem, self.model
             observed = ca.SX.sym("observed", 2 * model.n)
             prior, use_prior = ca.SX.sym("prior", model.d), ca.SX.sym("use_prior")
-            W = goal_covariance(p.width, model.d, model.goal_covariance)
+            precision = ca.SX.sym("precision", model.d, model.d)
             error = p.goal - prior
-            objective = (p.objective + use_prior * ca.dot(error, ca.solve(W, error))) / (-p.best_objective)
+            objective = (p.objective + use_prior * ca.dot(error, ca.mtimes(precision, error))) / (-p.best_objective)
             x = ca.vertcat(ca.vec(p.tau), p.goal)
-            params = ca.vertcat(p.s0, observed, prior, p.width, use_prior)
+            params = ca.vertcat(p.s0, observed, prior, p.width, use_prior, ca.vec(precision))
             deadline = IpoptDeadline(x.numel(), params.numel(), len(rows))
             ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations * 10, "tol": self.options.tolerance}
             solver = ca.nlpsol(f"goal_estimate_eq11_{n_o}", "ipopt",
@@ -286,7 +318,9 @@ class GoalEstimator:
     def _paper_solve(self, point: RegretPoint, start, observed, n_o, rows, prior, width, budget):
         solver, deadline = self._paper_solver(n_o, rows)
         deadline.time = math.inf if budget is None else time.perf_counter() + budget
-        params = np.r_[start, observed, np.zeros(self.model.d) if prior is None else prior, width, prior is not None]
+        d = self.model.d
+        params = np.r_[start, observed, np.zeros(d) if prior is None else prior.mean, width, prior is not None,
+                       np.zeros(d * d) if prior is None else prior.precision.ravel(order="F")]
         result = solver(x0=np.r_[point.tau_c, point.goal], p=params, lbg=0, ubg=0)
         stats = solver.stats()
         status = ipopt_status(stats, deadline)

@@ -19,7 +19,6 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from comanip.estimation.observation import prefix_log_likelihoods
-from comanip.objectives.reward import goal_covariance
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 
@@ -38,12 +37,12 @@ def search_along_observed_direction(planner: Planner, start, observed, n_o: int,
                                     distances: tuple[float, float], step_jacobians, remaining_time) -> tuple[np.ndarray, Plan] | None:
     """The goal x_o + D u, u the observed direction, whose plan makes the observed state most likely.
 
-    With a prior goal g_bar the score is the posterior: the log-likelihood plus log N(g; g_bar, W), so where
-    the observation says little about the distance (early in a slow reach) the prior decides it.
+    With a prior (a :class:`GoalPrior`) the score is the posterior: the log-likelihood plus log N(g; g_bar, P0),
+    so where the observation says little about the distance (early in a slow reach) the prior decides it.
 
     Args:
         planner: the model's planner. start, observed: states (2n,). n_o: observed step.
-        prior: prior goal g_bar (d,) m, or None. width: goal width (m). R: observation-noise floor (2n, 2n).
+        prior: the :class:`GoalPrior`, or None. width: goal width (m). R: observation-noise floor (2n, 2n).
         distances: (D_min, D_max), m, the range searched beyond the observed hand position.
         step_jacobians: the body's linearised step function (for the belief's likelihood).
         remaining_time: () -> seconds left (None: no budget), handed to each plan.
@@ -67,13 +66,11 @@ def search_along_observed_direction(planner: Planner, start, observed, n_o: int,
                                             warm_start=warm, max_wall_time=remaining_time())
         return tried[log_distance]
 
-    W = goal_covariance(width, planner.model.d, planner.model.goal_covariance)
-
     def misfit(log_distance: float) -> float:
         plan = plan_at(log_distance)
         score = -float(prefix_log_likelihoods(plan, observed[None, :], np.array([n_o]), R, step_jacobians)[-1])
         if prior is not None:
-            score += 0.5 * (plan.goal - prior) @ np.linalg.solve(W, plan.goal - prior)
+            score += 0.5 * (plan.goal - prior.mean) @ np.linalg.solve(prior.covariance, plan.goal - prior.mean)
         return score
 
     low, high = np.log(distances[0]), np.log(distances[1])

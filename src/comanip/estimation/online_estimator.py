@@ -35,6 +35,8 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
+from scipy.linalg import lapack
+from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
@@ -64,11 +66,14 @@ class OnlineOptions:
     family_tolerance: float = 1e-4
     """Largest difference (m) accepted between the family's interpolated mean position and a real plan."""
     tolerance: float = 1e-7
-    """A Gauss–Newton goal step shorter than this (m) ends an update."""
+    """A Newton goal step shorter than this (m), or one that lowers -log p by less than 1e-6 (taken, then stop), ends an update."""
     max_iterations: int = 20
     """Gauss–Newton iterations per update."""
     step_fraction: float = 0.5
     """Largest goal step, as a fraction of the distance from the start to the current goal (at least one width)."""
+    covariance_tolerance: float = 0.05
+    """The belief covariance that weighs the observations is the plan's to a goal within this fraction of the
+    distance (start to goal) of the estimate; it is recomputed when the estimate moves farther."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
@@ -80,6 +85,7 @@ class OnlineOptions:
         as_positive("tolerance", self.tolerance, "m")
         as_count("max_iterations", self.max_iterations)
         as_positive("step_fraction", self.step_fraction, "fraction")
+        as_positive("covariance_tolerance", self.covariance_tolerance, "fraction of the distance")
 
 
 class ModelFamilies:
@@ -115,6 +121,17 @@ DEFAULT_FAMILIES = FamilyCache()
 
 #: Observed speed and displacement beyond this many noise standard deviations count as movement.
 _MOVEMENT_SIGMAS = 3.0
+#: Whitenings rebuilt per update at most (each at the goal the previous round ended at).
+_COVARIANCE_ROUNDS = 3
+#: Relative std along the reach above which the goal's variance there comes from a quadrature, and its points.
+_SKEWED = 0.05
+_QUADRATURE_POINTS = 200
+#: Halvings of a Newton step before the iteration gives up.
+_BACKTRACKS = 12
+#: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
+_DECREMENT = 1e-6
+#: ... and, relative to -log p, below which a step that no line search can lower counts as converged (rounding).
+_ACCEPTABLE_DECREMENT = 1e-6
 
 
 class OnlineGoalEstimator:
@@ -126,7 +143,7 @@ class OnlineGoalEstimator:
         start: the state at the reach's start (nx,) or [q; qdot] (2n,), at rest (zero velocity and force).
         prior_goal: g_bar (d,) m; None: the start's hand position (with the weak default std, a prior that
             only keeps the estimate finite).
-        prior_std: the prior's standard deviation (m): a number, d numbers, None (the weak default, 1 m)
+        prior_std: the prior's standard deviation (m): a number, d numbers, None (the weak default, 10 m)
             or "width" (the paper's W from the width); :mod:`comanip.estimation.goal_prior`.
         width: goal width w (m); the model's default when None.
         options: :class:`OnlineOptions`.
@@ -169,6 +186,9 @@ class OnlineGoalEstimator:
         self._weights = np.zeros((H + 1, H + 1))
         self._last_time = -math.inf
         self._last_observation = np.zeros(2 * n)
+        self._whitening: ObservationWhitening | None = None
+        self._blas = ThreadpoolController()
+        self._whitening_goal = np.zeros(d)
         self.latest: GoalEstimate | None = None
         """The last estimate, None before the first update."""
 
@@ -214,7 +234,8 @@ class OnlineGoalEstimator:
         if fraction > 0:
             self._weights[nearest, before + 1] += fraction
         self._last_time, self._last_observation = time_s, observation
-        self.latest = self._estimate(t_begin)
+        with self._blas.limit(limits=1, user_api="blas"):   # threads only slow products of this size down
+            self.latest = self._estimate(t_begin)
         return self.latest
 
     def _estimate(self, t_begin: float) -> GoalEstimate:
@@ -222,8 +243,7 @@ class OnlineGoalEstimator:
         counts = self._counts[steps]
         observed = self._sums[steps] / counts[:, None]
         weights = self._weights[steps] / counts[:, None]
-        noise = self._R[None] / counts[:, None, None]
-        problem = _Problem(self, steps, observed, weights, noise)
+        problem = _Problem(self, steps, observed, weights)
         previous = self.latest
         try:
             if previous is None or previous.status in (Status.UNINFORMATIVE, Status.FAILED):
@@ -231,25 +251,50 @@ class OnlineGoalEstimator:
                 if goal is None:
                     return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE,
                                         "no observation shows movement: the estimate is the prior", 0, t_begin)
-                rounds = 2
             else:
-                goal, rounds = previous.goal, 1
+                goal = previous.goal
             iterations = 0
-            for _ in range(rounds):
-                goal, info, status, message, used = problem.gauss_newton(goal)
+            for _ in range(_COVARIANCE_ROUNDS):
+                whitening = self._whitening_at(goal)
+                goal, covariance, status, message, used = problem.newton(goal, whitening)
                 iterations += used
-            covariance = np.linalg.inv(info)
+                if not self._stale(goal):
+                    break
+            covariance = problem.distance_spread(goal, covariance, whitening)
             if not (np.all(np.isfinite(goal)) and np.all(np.isfinite(covariance))):
                 raise np.linalg.LinAlgError("non-finite estimate")
         except np.linalg.LinAlgError as error:
+            self._whitening = None
             goal, covariance = (self.prior_mean, self.prior_cov) if previous is None else (previous.goal, previous.goal_covariance)
-            return self._result(goal, covariance, Status.FAILED, f"the Gauss–Newton iteration failed ({error}); "
+            return self._result(goal, covariance, Status.FAILED, f"the Newton iteration failed ({error}); "
                                 "the previous estimate is kept", 0, t_begin)
         return self._result(goal, 0.5 * (covariance + covariance.T), status, message, iterations, t_begin)
 
+    def _stale(self, goal: np.ndarray) -> bool:
+        """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance."""
+        if self._whitening is None:
+            return True
+        distance = np.linalg.norm(goal - self.start_position)
+        return bool(np.linalg.norm(goal - self._whitening_goal) > self.options.covariance_tolerance * max(distance, self.width))
+
+    def _whitening_at(self, goal: np.ndarray) -> ObservationWhitening:
+        """The whitening of the observations so far under the belief of the plan to a goal near ``goal``: the
+        current one extended by the new observation, or rebuilt at ``goal`` when it is stale."""
+        steps = np.flatnonzero(self._counts)
+        whitening = self._whitening
+        if self._stale(goal):
+            whitening = ObservationWhitening(self._prediction(goal, order=0).cov, self._powers, 2 * self.model.n, steps,
+                                             self._R[None] / self._counts[steps][:, None, None])
+            self._whitening, self._whitening_goal = whitening, np.array(goal, dtype=float)
+        elif len(whitening.steps) == len(steps):
+            whitening.redo_last(self._R / self._counts[steps[-1]])
+        else:
+            whitening.append(steps[-1], self._R / self._counts[steps[-1]])
+        return whitening
+
     def _result(self, goal, covariance, status: Status, message: str, iterations: int, t_begin: float) -> GoalEstimate:
         model, n = self.model, self.model.n
-        prediction = self._prediction(goal, derivative=False)
+        prediction = self._prediction(goal, order=0)
         grid = self._last_time / model.h
         before = min(model.H, int(math.floor(grid * (1 + 1e-9))))
         fraction = 0.0 if before == model.H else min(max(grid - before, 0.0), 1.0)
@@ -264,88 +309,154 @@ class OnlineGoalEstimator:
                                observation_residual=predicted - self._last_observation, prior_goal=self.prior_goal,
                                method="online", goal_covariance=np.array(covariance, dtype=float))
 
-    def _prediction(self, goal, derivative: bool = True) -> ReachPrediction:
-        """The plan from the start to ``goal``: from the family, or holding still for a goal at the start."""
+    def _prediction(self, goal, *, order: int = 1, covariance: bool = True) -> ReachPrediction:
+        """The plan from the start to ``goal`` (:meth:`ReachFamily.prediction`), or holding still for a goal at
+        the start (the plan there: zero torque, no noise)."""
         if np.linalg.norm(np.asarray(goal) - self.start_position) == 0.0:
             model = self.model
-            H, nx = model.H, model.state_size
+            H, nx, d = model.H, model.state_size, model.d
             return ReachPrediction(mean=np.tile(self.start, (H + 1, 1)), cov=np.zeros((H + 1, nx, nx)),
-                                   torque=np.zeros((H, model.n)), objective=0.0,
-                                   mean_jacobian=np.zeros((H + 1, nx, model.d)))
-        return self.family.prediction(self.start_position, goal, derivative=derivative)
+                                   torque=np.zeros((H, model.n)), objective=0.0, mean_jacobian=np.zeros((H + 1, nx, d)),
+                                   direction=np.eye(d)[0], curvature=np.zeros((H + 1, nx // model.n)),
+                                   mixed=np.zeros((H + 1, nx // model.n)))
+        return self.family.prediction(self.start_position, goal, order=order, covariance=covariance)
 
 
 class _Problem:
-    """One update's MAP problem: the averaged observations at ``steps`` and the Gauss–Newton iteration."""
+    """One update's MAP problem: the averaged observations at ``steps`` (S,) (observed (S, 2n), interpolation
+    ``weights`` (S, H+1) of the grid means), Newton's method and the cold start."""
 
-    def __init__(self, estimator: OnlineGoalEstimator, steps, observed, weights, noise):
-        self.e, self.steps, self.observed, self.weights, self.noise = estimator, steps, observed, weights, noise
+    def __init__(self, estimator: OnlineGoalEstimator, steps, observed, weights):
+        self.e, self.steps, self.observed, self.weights = estimator, steps, observed, weights
         self.m = observed.shape[1]
+        self._predicted: tuple[bytes, ReachPrediction] | None = None    # the last goal's prediction (rounds share it)
 
-    def _columns(self, prediction: ReachPrediction) -> np.ndarray:
-        """[r, d mu / d g] at the observed steps (S, 2n, 1 + d), r the averaged residual y - mu."""
-        mean = self.weights @ prediction.mean[:, :self.m]
-        jacobian = np.einsum("sj,jkd->skd", self.weights, prediction.mean_jacobian[:, :self.m])
-        return np.concatenate([(self.observed - mean)[:, :, None], jacobian], axis=2)
+    def _prediction(self, goal: np.ndarray) -> ReachPrediction:
+        key = goal.tobytes()
+        if self._predicted is None or self._predicted[0] != key:
+            self._predicted = key, self.e._prediction(goal, order=2, covariance=False)
+        return self._predicted[1]
 
     def _terms(self, whitening: ObservationWhitening, goal):
-        """(objective, G^T G + P0^-1, G^T e - P0^-1 (g - g_bar)) at ``goal`` under ``whitening``."""
-        e = self.e
-        whitened = whitening.apply(self._columns(e._prediction(goal)))
+        """(objective, Hessian (d, d), Gauss–Newton matrix (d, d), minus the gradient (d,)) at ``goal``."""
+        e, m = self.e, self.m
         d = len(goal)
-        residual, G = whitened[:, :, 0].ravel(), whitened[:, :, 1:].reshape(-1, d)
+        prediction = self._prediction(goal)
+        H1, nx = prediction.mean.shape
+        grid = np.concatenate([prediction.mean[:, :m, None], prediction.mean_jacobian[:, :m]], axis=2)
+        columns = (self.weights @ grid.reshape(H1, -1)).reshape(len(self.steps), m, 1 + d)
+        columns[:, :, 0] = self.observed - columns[:, :, 0]
+        flat = whitening.apply(columns).reshape(-1, 1 + d)
+        residual, G = flat[:, 0], flat[:, 1:]
         offset = goal - e.prior_mean
         objective = 0.5 * float(residual @ residual + offset @ e._prior_precision @ offset)
-        return objective, G.T @ G + e._prior_precision, G.T @ residual - e._prior_precision @ offset
+        gauss_newton = G.T @ G + e._prior_precision
+        # Newton's Hessian adds -sum_j e_j (L^-1 d²mu/dg²)_j, the residuals pulled back onto the grid's means
+        z = np.zeros((H1, nx))
+        z[:, :m] = self.weights.T @ whitening.transpose_apply(residual)
+        newton = gauss_newton - prediction.hessian_contraction(z)
+        return objective, 0.5 * (newton + newton.T), gauss_newton, G.T @ residual - e._prior_precision @ offset
 
     def _projected(self, goal: np.ndarray) -> np.ndarray:
         """The goal moved into the family's range of distances from the start."""
         e = self.e
         offset = goal - e.start_position
-        D = np.linalg.norm(offset)
+        D = math.sqrt(float(offset @ offset))
         low, high = e.family.distances[0], e.family.distances[-1]
         if D == 0:
             return e.start_position + low * np.eye(len(goal))[0]
-        return e.start_position + offset * (np.clip(D, low, high) / D)
+        if low <= D <= high:
+            return goal
+        return e.start_position + offset * (min(max(D, low), high) / D)
 
-    def gauss_newton(self, goal: np.ndarray):
-        """Gauss–Newton from ``goal`` with the covariance of the plan to it held fixed: (goal, information
-        matrix (d, d) m^-2, status, message, iterations)."""
+    def distance_spread(self, goal: np.ndarray, covariance: np.ndarray, whitening: ObservationWhitening) -> np.ndarray:
+        """The covariance with its variance along the reach replaced by the posterior's along the line through
+        the start and ``goal`` (1-D quadrature on a grid of distances), and the spread across it scaled by the
+        root mean square distance over D_hat, where the Laplace approximation's relative std along the reach
+        exceeds :data:`_SKEWED`: early in a reach the distance's posterior has a long tail towards far goals
+        that the curvature at the mode does not see."""
         e = self.e
+        offset = goal - e.start_position
+        D = float(np.linalg.norm(offset))
+        u = offset / D
+        variance = float(u @ covariance @ u)
+        spread = math.sqrt(variance) / D
+        if spread < _SKEWED:
+            return covariance
+        family = e.family
+        low = max(math.log(D) - 6 * spread, math.log(family.distances[0]))
+        high = min(math.log(D) + 6 * spread, math.log(family.distances[-1]))
+        if high - low < 1e-6:
+            return covariance
+        distances = np.exp(np.linspace(low, high, _QUADRATURE_POINTS))
+        n, m = e.model.n, self.m
+        means = (family.along(distances)[:, :, :, None] * u).reshape(len(distances), e.model.H + 1, -1)[:, :, :m]
+        means[:, :, :n] += e.start_position
+        residuals = self.observed[None] - np.einsum("sj,kjm->ksm", self.weights, means)
+        whitened = whitening.matrix @ residuals.reshape(len(distances), -1).T
+        goals = e.start_position + distances[:, None] * u
+        offsets = goals - e.prior_mean
+        energy = 0.5 * (np.sum(whitened**2, axis=0) + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
+        weights = np.exp(-(energy - energy.min())) * np.gradient(distances)
+        weights /= weights.sum()
+        along = float(weights @ (distances - D) ** 2)
+        # across the reach the direction's uncertainty spreads the goal in proportion to its distance
+        across = np.eye(len(u)) - np.outer(u, u)
+        stretch = math.sqrt(max(1.0, float(weights @ distances**2) / D**2))
+        scale = across * stretch + np.outer(u, u)
+        return scale @ covariance @ scale + max(0.0, along - variance) * np.outer(u, u)
+
+    def _at_range_end(self, goal: np.ndarray) -> bool:
+        return bool(np.linalg.norm(goal - self.e.start_position) >= self.e.family.distances[-1] * (1 - 1e-9))
+
+    def _range_message(self) -> str:
+        return (f"the estimate sits at the largest distance the reach family covers ({self.e.family.distances[-1]:g} m): "
+                "the observations point farther than the model's plans reach")
+
+    def newton(self, goal: np.ndarray, whitening: ObservationWhitening):
+        """Newton's method from ``goal`` under a fixed ``whitening`` (the Gauss–Newton matrix where the Hessian
+        is not positive definite), a backtracking line search on the objective: (goal, covariance (d, d) m²,
+        status, message, iterations). The covariance is the inverse Hessian at the result (Laplace)."""
+        e, options = self.e, self.e.options
         goal = self._projected(np.asarray(goal, dtype=float))
-        whitening = ObservationWhitening(e._prediction(goal, derivative=False).cov, self.steps, self.noise, e._powers, self.m)
-        objective, info, gradient = self._terms(whitening, goal)
-        options = e.options
+        terms = self._terms(whitening, goal)
         for iteration in range(1, options.max_iterations + 1):
-            step = np.linalg.solve(info, gradient)
-            limit = options.step_fraction * max(np.linalg.norm(goal - e.start_position), e.width)
-            length = np.linalg.norm(step)
+            objective, newton, gauss_newton, descent = terms
+            step = _solve_positive(newton, gauss_newton, descent)
+            if 0.5 * float(step @ descent) <= _DECREMENT or math.sqrt(float(step @ step)) <= options.tolerance:
+                # the Newton step would lower -log p by less than _DECREMENT: take it and stop
+                goal = self._projected(goal + step)
+                if self._at_range_end(goal):
+                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
+                return goal, _covariance(terms), Status.SOLVED, f"converged in {iteration} Newton iterations", iteration
+            limit = options.step_fraction * max(math.sqrt(float((goal - e.start_position) @ (goal - e.start_position))), e.width)
+            length = math.sqrt(float(step @ step))
             if length > limit:
                 step *= limit / length
-            for _ in range(10):
+            for _ in range(_BACKTRACKS):
                 trial = self._projected(goal + step)
-                trial_objective, trial_info, trial_gradient = self._terms(whitening, trial)
-                if trial_objective <= objective + 1e-12 * abs(objective):
+                trial_terms = self._terms(whitening, trial)
+                if trial_terms[0] <= objective + 1e-12 * abs(objective):
                     break
                 step *= 0.5
             else:
-                return goal, info, Status.SOLVED_ACCEPTABLE, "no Gauss–Newton step lowers the objective", iteration
-            moved = np.linalg.norm(trial - goal)
-            goal, objective, info, gradient = trial, trial_objective, trial_info, trial_gradient
-            if moved <= options.tolerance:
-                D = np.linalg.norm(goal - e.start_position)
-                if D >= e.family.distances[-1] * (1 - 1e-9):
-                    return goal, info, Status.MAX_ITERATIONS, (f"the estimate sits at the largest distance the reach "
-                                                               f"family covers ({e.family.distances[-1]:g} m)"), iteration
-                return goal, info, Status.SOLVED, f"converged in {iteration} Gauss–Newton iterations", iteration
-        return goal, info, Status.MAX_ITERATIONS, f"no convergence in {options.max_iterations} Gauss–Newton iterations", options.max_iterations
+                if self._at_range_end(goal):
+                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
+                decrement = 0.5 * float(_solve_positive(newton, gauss_newton, descent) @ descent)
+                if decrement <= _ACCEPTABLE_DECREMENT * max(1.0, abs(objective)):
+                    return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, (
+                        f"no Newton step lowers the objective any more (decrement {decrement:.2g})"), iteration
+                return goal, _covariance(terms), Status.FAILED, (
+                    f"no Newton step lowers the objective, though it predicts a decrease of {decrement:.2g}"), iteration
+            goal, terms = trial, trial_terms
+        return goal, _covariance(terms), Status.MAX_ITERATIONS, f"no convergence in {options.max_iterations} Newton iterations", options.max_iterations
 
     def cold_goal(self) -> np.ndarray | None:
         """The best member of the family along the observed directions (latest velocity, latest displacement
         from the start, and the prior's direction), scored by the observations' likelihood with each step's
-        error taken independently, plus the prior; None when nothing moved and the prior sits at the start."""
+        error taken independently, plus the prior; None when no observation shows movement beyond its noise."""
         e = self.e
-        n, d = e.model.n, e.model.d
+        n = e.model.n
         sigma_q, sigma_v = e.options.observation_std
         latest = e._last_observation
         directions = []
@@ -354,26 +465,51 @@ class _Problem:
         displacement = latest[:n] - e.start_position
         if np.linalg.norm(displacement) > _MOVEMENT_SIGMAS * sigma_q:
             directions.append(displacement / np.linalg.norm(displacement))
+        if not directions:
+            return None
         prior_offset = e.prior_mean - e.start_position
         if np.linalg.norm(prior_offset) > 0:
             directions.append(prior_offset / np.linalg.norm(prior_offset))
-        if not directions:
-            return None
-        family = e.family
+        family, m = e.family, self.m
+        noise = e._R[None] / e._counts[self.steps][:, None, None]
         best, best_score = None, math.inf
         for u in directions:
             goals = e.start_position + family.distances[:, None] * u
-            scores = [self._independent_score(family.prediction(e.start_position, g, derivative=False), g) for g in goals]
+            K = len(goals)
+            means = (family.member_along[:, :, :, None] * u).reshape(K, e.model.H + 1, -1)[:, :, :m]
+            means[:, :, :n] += e.start_position
+            r = self.observed - np.einsum("sj,kjm->ksm", self.weights, means)
+            T = family.frame(u)[:m, :m]
+            S = T @ family.member_cov[:, self.steps, :m, :m] @ T.T + noise
+            solved = np.linalg.solve(S, r[..., None])[..., 0]
+            _, log_det = np.linalg.slogdet(S)
+            offsets = goals - e.prior_mean
+            scores = 0.5 * (np.sum(r * solved, axis=(1, 2)) + log_det.sum(axis=1)
+                            + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
             k = int(np.argmin(scores))
             if scores[k] < best_score:
                 best, best_score = goals[k], scores[k]
         return best
 
-    def _independent_score(self, prediction: ReachPrediction, goal) -> float:
-        e = self.e
-        r = self.observed - self.weights @ prediction.mean[:, :self.m]
-        S = prediction.cov[self.steps][:, :self.m, :self.m] + self.noise
-        solved = np.linalg.solve(S, r[:, :, None])[:, :, 0]
-        _, log_det = np.linalg.slogdet(S)
-        offset = goal - e.prior_mean
-        return 0.5 * float(np.sum(r * solved) + log_det.sum() + offset @ e._prior_precision @ offset)
+
+def _factor(newton: np.ndarray, gauss_newton: np.ndarray) -> np.ndarray:
+    """Cholesky factor of the Hessian when it is positive definite, else of the Gauss–Newton matrix (positive
+    definite by construction). LAPACK directly: numpy's wrappers cost more than these d×d solves."""
+    factor, info = lapack.dpotrf(newton, lower=1)
+    if info != 0:
+        factor, info = lapack.dpotrf(gauss_newton, lower=1)
+        if info != 0:
+            raise np.linalg.LinAlgError("the Gauss–Newton matrix is not positive definite")
+    return factor
+
+
+def _solve_positive(newton: np.ndarray, gauss_newton: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """The Newton step: (Hessian or Gauss–Newton matrix)^-1 rhs (:func:`_factor`)."""
+    return lapack.dpotrs(_factor(newton, gauss_newton), rhs, lower=1)[0]
+
+
+def _covariance(terms) -> np.ndarray:
+    """The Laplace covariance: the inverse of the Hessian at the estimate (:func:`_factor`)."""
+    _, newton, gauss_newton, _ = terms
+    inverse, _ = lapack.dpotri(_factor(newton, gauss_newton), lower=1)
+    return np.tril(inverse) + np.tril(inverse, -1).T

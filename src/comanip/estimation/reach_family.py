@@ -19,6 +19,8 @@ anisotropic mass) raises ValueError.
 
 from __future__ import annotations
 
+import bisect
+import math
 import time
 from dataclasses import dataclass
 
@@ -39,14 +41,34 @@ class ReachPrediction:
 
     mean: np.ndarray
     """Mean state mu_i (H+1, nx)."""
-    cov: np.ndarray
-    """State covariance Sigma_i (H+1, nx, nx)."""
+    cov: np.ndarray | None
+    """State covariance Sigma_i (H+1, nx, nx); None when not asked for."""
     torque: np.ndarray
     """Command tau_i (H, n)."""
     objective: float
     """J of the plan (SPEC §4 units)."""
-    mean_jacobian: np.ndarray
-    """d mu_i / d g (H+1, nx, d): how the mean moves with the goal (m per m, ...)."""
+    mean_jacobian: np.ndarray | None = None
+    """d mu_i / d g (H+1, nx, d): how the mean moves with the goal (m per m, ...); None when not asked for."""
+    direction: np.ndarray | None = None
+    """u (d,), the unit vector from the start to the goal."""
+    curvature: np.ndarray | None = None
+    """d²a/dD² (H+1, blocks) of the mean along u (per m); with ``mixed``, the second derivatives of the mean
+    (order 2; :meth:`hessian_contraction`)."""
+    mixed: np.ndarray | None = None
+    """a'/D - a/D² (H+1, blocks) (per m)."""
+
+    def hessian_contraction(self, z: np.ndarray) -> np.ndarray:
+        """sum_ik z_ik d² mu_ik / d g² (d, d) for weights z (H+1, nx): with P = I - u u^T the second derivative
+        of the entry u_c a_b is a'' u_c u u^T + (a'/D - a/D²)(P_c u^T + u P_c^T + u_c P), P_c P's row c."""
+        u = self.direction
+        d = u.size
+        z = z.reshape(-1, d)                                 # (H+1 · blocks, d)
+        radial = u[:, None] * u
+        across = np.eye(d) - radial
+        zeta = self.mixed.ravel() @ z
+        pz = across @ zeta
+        outer = pz[:, None] * u
+        return float(self.curvature.ravel() @ (z @ u)) * radial + outer + outer.T + float(zeta @ u) * across
 
 
 def householder(u: np.ndarray) -> np.ndarray:
@@ -70,7 +92,8 @@ class ReachFamily:
         size: number of members to start from (geometrically spaced over the range).
         tolerance: largest acceptable difference (m) between the interpolated mean position and a real plan;
             the plan at the midpoint (in log D) of every pair of neighbouring members is solved and compared,
-            and where it differs by more, it joins the family (``refinements`` rounds at most).
+            and where it differs by more, it joins the family (``refinements`` rounds at most); the range ends
+            below an interval that is still off (e.g. where plans of a short horizon have several optima).
 
     Raises ValueError when the model is not rotation-invariant (see the module docstring), or when the
     plan to D_min does not converge.
@@ -99,7 +122,8 @@ class ReachFamily:
         self._fit(plans)
         self.interpolation_error = self._refine(tolerance, refinements)
         """Largest |mean position| difference (m) between the spline and a real plan at the midpoints (in log D)
-        of the members checked last: the tolerance of every prediction within the range."""
+        of the intervals between members: the accuracy of every prediction within the range (at most the
+        tolerance; the range ends where that cannot be reached)."""
         self.invariance_error = self._invariance_error(planner)
         """Largest |mean| difference between an oblique plan and the turned member (state units)."""
         if self.invariance_error > INVARIANCE_TOLERANCE:
@@ -117,36 +141,44 @@ class ReachFamily:
         return plan if plan.success and np.all(np.isfinite(plan.mean)) and np.all(np.isfinite(plan.cov)) else None
 
     def _fit(self, plans: list[Plan]) -> None:
-        """The spline in log D through ``plans`` (sorted by distance)."""
+        """The splines in log D through ``plans`` (sorted by distance): one for the mean, torque and J, one for
+        the covariance (read only when asked for)."""
         self.plans = plans
         self.distances = np.array([p.goal[0] for p in plans])
         """Member distances D_k (K,), m."""
         K, H, nb, n = len(plans), self.H, self.blocks, self.n
-        along = np.array([p.mean.reshape(H + 1, nb, n)[:, :, 0] for p in plans])     # (K, H+1, blocks)
-        torque = np.array([p.torque[:, 0] for p in plans])                          # (K, H)
-        cov = np.array([p.cov for p in plans])                                      # (K, H+1, nx, nx)
+        self.member_along = np.array([p.mean.reshape(H + 1, nb, n)[:, :, 0] for p in plans])
+        """Each member's mean along its axis, per state block (K, H+1, blocks)."""
+        self.member_cov = np.array([p.cov for p in plans])
+        """Each member's state covariance in its own frame (K, H+1, nx, nx)."""
+        torque = np.array([p.torque[:, 0] for p in plans])
         objective = np.array([p.objective for p in plans])
-        self._sizes = [along[0].size, torque[0].size, cov[0].size, 1]
-        stacked = np.column_stack([along.reshape(K, -1), torque.reshape(K, -1), cov.reshape(K, -1), objective])
-        self._spline = CubicSpline(np.log(self.distances), stacked, axis=0)
-        self._derivative = self._spline.derivative()
+        log_D = np.log(self.distances)
+        self._path = CubicSpline(log_D, np.column_stack([self.member_along.reshape(K, -1), torque, objective]), axis=0)
+        self._cov = CubicSpline(log_D, self.member_cov.reshape(K, -1), axis=0)
+        self._knots = log_D.tolist()
+        self._low, self._high = float(self.distances[0]), float(self.distances[-1])
+        self._eye = np.eye(self.model.d)
 
     def _refine(self, tolerance: float, rounds: int) -> float:
-        """Check the spline at the midpoints of the intervals not yet known to be fine; add the plans that
-        differ by more than ``tolerance`` (m); return the largest difference found in the last round."""
+        """Check the spline at the midpoint (in log D) of every interval between members; where a real plan
+        differs by more than ``tolerance`` (m), add it to the family and check the two halves in the next
+        round. After ``rounds`` rounds, intervals still off (or whose midpoint plan does not succeed) end the
+        family's range below them. Returns the largest difference (m) over the intervals kept."""
         d = self.model.d
+        errors: dict[float, float] = {}                 # lower member's distance -> midpoint error of its interval
         unchecked = set(range(len(self.plans) - 1))
-        worst = np.inf
-        for _ in range(rounds):
-            added, worst = [], 0.0
+        for round_ in range(rounds + 1):
+            added = []
             for k in sorted(unchecked):
                 D = float(np.sqrt(self.distances[k] * self.distances[k + 1]))
                 plan = self._plan(D, self.plans[k])
                 if plan is None:
+                    errors[float(self.distances[k])] = np.inf
                     continue
-                error = float(np.abs(self.prediction(np.zeros(d), plan.goal, derivative=False).mean[:, :d] - plan.mean[:, :d]).max())
-                worst = max(worst, error)
-                if error > tolerance:
+                predicted = self.prediction(np.zeros(d), plan.goal, order=0, covariance=False).mean[:, :d]
+                errors[float(self.distances[k])] = error = float(np.abs(predicted - plan.mean[:, :d]).max())
+                if error > tolerance and round_ < rounds:
                     added.append(plan)
             if not added:
                 break
@@ -154,7 +186,17 @@ class ReachFamily:
             self._fit(plans)
             new = {float(p.goal[0]) for p in added}
             unchecked = {k for k in range(len(plans) - 1) if float(plans[k].goal[0]) in new or float(plans[k + 1].goal[0]) in new}
-        return worst
+        kept = len(self.plans)
+        for k in range(len(self.plans) - 1):
+            if errors.get(float(self.distances[k]), 0.0) > tolerance:
+                kept = k + 1
+                break
+        if kept < len(self.plans):
+            if kept < 4:
+                raise ValueError(f"the reach family is not accurate to {tolerance:g} m even at short distances "
+                                 f"(interval from {self.distances[0]:g} m); raise the tolerance or the size")
+            self._fit(self.plans[:kept])
+        return max((e for D, e in errors.items() if D < self.distances[-1]), default=0.0)
 
     def _invariance_error(self, planner: Planner) -> float:
         if self.model.d == 1:
@@ -162,34 +204,61 @@ class ReachFamily:
         k = len(self.plans) // 2
         u = np.ones(self.model.d) / np.sqrt(self.model.d)
         plan = planner.solve(np.zeros(self.nx), self.distances[k] * u, self.width)
-        turned = self.prediction(np.zeros(self.model.d), self.distances[k] * u, derivative=False)
+        turned = self.prediction(np.zeros(self.model.d), self.distances[k] * u, order=0, covariance=False)
         return float(np.abs(plan.mean - turned.mean).max())
 
-    def _unpack(self, values: np.ndarray):
-        H, nb, nx = self.H, self.blocks, self.nx
-        a, b, c = np.cumsum(self._sizes[:3])
-        return values[:a].reshape(H + 1, nb), values[a:b], values[b:c].reshape(H + 1, nx, nx), float(values[c])
+    def along(self, distances: np.ndarray) -> np.ndarray:
+        """The mean along the axis per state block, a_b,i(D) (M, H+1, blocks), at distances (M,) m within the range."""
+        x = np.log(np.clip(distances, self._low, self._high))
+        k = np.clip(np.searchsorted(self._path.x, x) - 1, 0, len(self._knots) - 2)
+        dx = (x - self._path.x[k])[:, None]
+        size = (self.H + 1) * self.blocks
+        c = self._path.c[:, k, :size]
+        return (((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]).reshape(len(distances), self.H + 1, self.blocks)
 
-    def prediction(self, start_position: np.ndarray, goal: np.ndarray, *, derivative: bool = True) -> ReachPrediction:
-        """The plan from rest at ``start_position`` (d,) m to ``goal`` (d,) m; ``derivative`` False leaves
-        ``mean_jacobian`` zero (cheaper). The distance is clipped to the family's range."""
-        d, n, nb = self.model.d, self.n, self.blocks
+    def frame(self, u: np.ndarray) -> np.ndarray:
+        """T (nx, nx): the orthogonal map Q (Q e_1 = u) applied to every state block."""
+        Q, n = householder(u), self.n
+        T = np.zeros((self.nx, self.nx))
+        for b in range(self.blocks):
+            T[b * n:(b + 1) * n, b * n:(b + 1) * n] = Q
+        return T
+
+    def prediction(self, start_position: np.ndarray, goal: np.ndarray, *, order: int = 1, covariance: bool = True) -> ReachPrediction:
+        """The plan from rest at ``start_position`` (d,) m to ``goal`` (d,) m, with derivatives of its mean in
+        the goal up to ``order`` (0, 1 or 2) and its covariance when ``covariance`` (else ``cov`` is None).
+        A distance outside the family's range is read at the nearest end (the mean then moves only across)."""
+        d, n, nb, H = self.model.d, self.n, self.blocks, self.H
         offset = np.asarray(goal, dtype=float) - start_position
-        D_raw = float(np.linalg.norm(offset))
-        u = offset / D_raw if D_raw > 0 else np.eye(d)[0]
-        D = float(np.clip(D_raw, self.distances[0], self.distances[-1]))
-        along, torque, cov_frame, objective = self._unpack(self._spline(np.log(D)))
-        Q = householder(u)
-        mean = (along[:, :, None] * u).reshape(self.H + 1, nb * n)
+        D_raw = math.sqrt(float(offset @ offset))
+        u = offset / D_raw if D_raw > 0 else self._eye[0]
+        D = min(max(D_raw, self._low), self._high)
+        inside = D == D_raw
+        x = math.log(D)
+        k = min(max(bisect.bisect_left(self._knots, x) - 1, 0), len(self._knots) - 2)
+        dx = x - self._knots[k]
+        c = self._path.c[:, k]
+        values = ((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]
+        size = (H + 1) * nb
+        along = values[:size].reshape(H + 1, nb)
+        mean = (along[:, :, None] * u).reshape(H + 1, nb * n)
         mean[:, :n] += start_position
-        T = np.kron(np.eye(nb), Q)
-        cov = T @ cov_frame @ T.T
-        jacobian = np.zeros((self.H + 1, nb * n, d))
-        if derivative:
-            slope = self._derivative(np.log(D))[:self._sizes[0]].reshape(self.H + 1, nb) / D   # da/dD
-            radial = np.outer(u, u)
-            if D_raw < self.distances[0] or D_raw > self.distances[-1]:
-                slope = np.zeros_like(slope)   # clipped: the mean does not move along u
-            across = (np.eye(d) - radial) / max(D_raw, 1e-12)
-            jacobian = (slope[:, :, None, None] * radial + along[:, :, None, None] * across).reshape(self.H + 1, nb * n, d)
-        return ReachPrediction(mean=mean, cov=cov, torque=np.outer(torque, u), objective=objective, mean_jacobian=jacobian)
+        cov = None
+        if covariance:
+            cc = self._cov.c[:, k]
+            T = self.frame(u)
+            cov = T @ (((cc[0] * dx + cc[1]) * dx + cc[2]) * dx + cc[3]).reshape(H + 1, self.nx, self.nx) @ T.T
+        jacobian = curvature = mixed = None
+        if order >= 1:
+            radial = u[:, None] * u
+            across = self._eye - radial
+            first = ((3 * c[0] * dx + 2 * c[1]) * dx + c[2])[:size].reshape(H + 1, nb)      # da/dlog D
+            slope = first / D if inside else np.zeros_like(first)                            # da/dD
+            D_safe = max(D_raw, 1e-12)
+            jacobian = (slope[:, :, None, None] * radial + (along / D_safe)[:, :, None, None] * across).reshape(H + 1, nb * n, d)
+            if order >= 2:
+                second = (6 * c[0] * dx + 2 * c[1])[:size].reshape(H + 1, nb)
+                curvature = (second - first) / D**2 if inside else np.zeros_like(first)      # d²a/dD²
+                mixed = slope / D_safe - along / D_safe**2
+        return ReachPrediction(mean=mean, cov=cov, torque=values[size:size + H, None] * u, objective=float(values[-1]),
+                               mean_jacobian=jacobian, direction=u, curvature=curvature, mixed=mixed)

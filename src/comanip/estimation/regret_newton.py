@@ -17,12 +17,13 @@ score better. Observing a planar plan at 0.2 s and solving eq. 11 from the true 
 
 **Regret.** Subtract what reaching g costs without the observation, V*(g) = min_tau J(tau, g) (the plan):
 
-    min_g  R(g) = Jc(g) - V*(g) + (g - g_bar)^T W^-1 (g - g_bar),    Jc(g) = min_{tau: mu_no(tau) = s_o} J(tau, g).
+    min_g  R(g) = Jc(g) - V*(g) + (g - g_bar)^T P0^-1 (g - g_bar),    Jc(g) = min_{tau: mu_no(tau) = s_o} J(tau, g).
 
 Jc ≥ V*, with equality exactly when the plan to g passes through s_o: the regret is the extra cost the
 observation forces on a person heading to g, zero at the goal a plan was made for, so an exact observation
 of a plan gives back its goal. It keeps eq. 11's objective and constraint and only removes the term V*(g)
-that biases it; the regulariser is the paper's.
+that biases it; the regulariser is the paper's with the prior's own covariance P0 in place of W
+(:mod:`comanip.estimation.goal_prior`; ``prior_std="width"`` gives the paper's P0 = W).
 
 **First-order conditions.** By the envelope theorem dJc/dg = dJ/dg at tau_c and dV*/dg = dJ/dg at tau_s, so
 the optimum is a root of
@@ -32,7 +33,8 @@ the optimum is a root of
     F3 = grad_tau J(tau_s, g)                  (H·n)   tau_s the plan to g
     F4 = grad_g J(tau_c, g) - grad_g J(tau_s, g) + 2 P (g - g_bar)   (d)
 
-with A = dmu_no/dtau and P = W^-1 / |J_best| (zero without a prior). For an arm both plans also keep the
+with A = dmu_no/dtau and P = P0^-1 / |J_best| (zero without a prior; P0 the prior's covariance, the paper's W
+with ``prior_std="width"``). For an arm both plans also keep the
 joint position and velocity limits the planner keeps (the wrist's velocity limits bind in most Panda
 reaches): the binding ones are held as equalities with their own multipliers, so that the plan tau_s is
 the planner's plan, and the active sets are updated once F is solved (a violated limit joins, one with a
@@ -64,6 +66,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from comanip.estimation.goal_prior import GoalPrior
 from comanip.estimation.regret_system import Linearisation, RegretPoint, RegretSystem
 from comanip.optim import SolverResult, Status, backtrack
 from comanip.planning.path_limits import LIMIT_TOLERANCE
@@ -181,7 +184,7 @@ class _Problem:
     observed: np.ndarray
     n_o: int
     observed_rows: np.ndarray
-    prior: np.ndarray | None
+    prior: GoalPrior | None
     width: float
     count: int = 0
     """Linearisations at moved points (the iterations reported)."""

@@ -25,7 +25,7 @@ import casadi as ca
 import numpy as np
 import scipy.linalg
 
-from comanip.objectives.reward import goal_covariance
+from comanip.estimation.goal_prior import GoalPrior
 from comanip.optim import decade_shifts, shifted_cholesky
 from comanip.planning.compiled import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
@@ -102,7 +102,6 @@ class RegretSystem:
         """True when F's Jacobian is exact (point masses)."""
         self.path_limits = PathLimits.of(model)
         self._limits = self.path_limits.for_newton(self.curvature) if self.path_limits.active else None
-        self._goal_covariance_form = model.goal_covariance
         self._observed: dict[int, tuple[BufferedFunction, np.ndarray]] = {}
 
     def derivatives(self, tau: np.ndarray, goal: np.ndarray, start: np.ndarray, width: float) -> Derivatives:
@@ -155,9 +154,9 @@ class RegretSystem:
         entries = (step - 1) * 2 * self.n + np.arange(2 * self.n)
         return np.r_[entries, per_side + entries]
 
-    def prior_weight(self, width: float) -> np.ndarray:
-        """P = W^-1 / |J_best| (d, d) for width w (m)."""
-        return np.linalg.inv(goal_covariance(width, self.d, self._goal_covariance_form)) / self.normaliser(width)
+    def prior_weight(self, prior: GoalPrior, width: float) -> np.ndarray:
+        """P = P0^-1 / |J_best| (d, d) for the prior's covariance P0 (the paper's: W) and width w (m)."""
+        return prior.precision / self.normaliser(width)
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: J divided by it is what the iteration works with (m^-d)."""
@@ -165,16 +164,16 @@ class RegretSystem:
 
     def linearise(self, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, prior, width) -> "Linearisation":
         """F and its Jacobian blocks at an iterate; ``observed_rows`` are the entries of s_o the constrained
-        plan must meet; ``prior`` None drops the regulariser."""
+        plan must meet; ``prior`` (a :class:`GoalPrior`) None drops the regulariser."""
         c = self.derivatives(point.tau_c, point.goal, start, width)
         s = self.derivatives(point.tau_s, point.goal, start, width)
         mu, A_observed = self.observed_mean(n_o, point.tau_c, start, c.data)
         limits_c, rows_c = self.limits(point.tau_c, c.data, point.active_c)
         limits_s, rows_s = self.limits(point.tau_s, s.data, point.active_s)
         A_c = np.vstack([A_observed[observed_rows], rows_c])
-        P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(width)
-        pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior)
-        regulariser = 0.0 if prior is None else float((point.goal - prior) @ P @ (point.goal - prior))
+        P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(prior, width)
+        pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior.mean)
+        regulariser = 0.0 if prior is None else float((point.goal - prior.mean) @ P @ (point.goal - prior.mean))
         return Linearisation(
             J_c=c.f, J_s=s.f, regulariser=regulariser, grad_c=c.grad, grad_s=s.grad, H_c=c.hess, H_s=s.hess,
             F1=c.grad + A_c.T @ np.r_[point.lam, point.nu_c],
@@ -282,6 +281,11 @@ class Linearisation:
         n_lam = len(point.lam)
         return replace(point, tau_c=d_c[:Hn], lam=d_c[Hn:Hn + n_lam], nu_c=d_c[Hn + n_lam:],
                        tau_s=d_s[:Hn], nu_s=d_s[Hn:], goal=d_goal)
+
+    def plan_goal_sensitivity(self) -> np.ndarray:
+        """d tau_s / d g (H·n, d): how the plan to the goal (its active limits held) moves with the goal."""
+        Xs = self._solves[1]
+        return -Xs[:len(self.F3), :self.Hc_gg.shape[0]]
 
     def reduced_hessian(self) -> np.ndarray:
         """d²R/dg² (d, d): the regret's Hessian in the goal with the inner problems kept optimal."""

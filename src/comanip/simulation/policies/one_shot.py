@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from comanip.estimation.goal_prior import PAPER_PRIOR
 from comanip.simulation.policies.protocol import PolicyContext, Prediction
 from comanip.simulation.rest_trajectory import RestTrajectory
 
@@ -32,6 +33,7 @@ class OneShotPolicy:
 
     def predict(self, t: float) -> Prediction:
         c = self.context
+        # the paper's estimate: its prior weighted by W from the width (paper VI-A)
         estimate = c.estimator.estimate(c.start, self.observed, self.observation_time, c.prior_goal, c.width,
-                                        warm_start=c.warm_start)
+                                        prior_std=PAPER_PRIOR, warm_start=c.warm_start)
         return Prediction(np.array(estimate.goal), RestTrajectory.from_plan(estimate, 0.0, c.dt, c.duration), estimate)
