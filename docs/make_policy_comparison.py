@@ -9,6 +9,8 @@ On a busy machine the goals can run in separate processes and be merged afterwar
     PYTHONPATH=src python docs/make_policy_comparison.py --goals right,high --save /tmp/b.pkl
     PYTHONPATH=src python docs/make_policy_comparison.py --load /tmp/a.pkl /tmp/b.pkl
 
+(--policies re-runs some policies only; a later pickle's runs replace an earlier one's for the same goal and policy.)
+
 Runs every robot policy (:data:`comanip.simulation.policies.POLICIES`) on the synchronisation scenario for
 the near and far goals and two more (GOALS), ``--trials`` trials each with the same person seeds for every
 policy, and writes docs/policy_comparison_sync.csv and .md (median [q25, q75] over the trials),
@@ -70,13 +72,18 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--trials", type=int, default=20, help="trials per goal and policy (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial's person (default: %(default)s)")
     parser.add_argument("--goals", default=",".join(GOALS), help="comma-separated labels of GOALS (default: all)")
+    parser.add_argument("--policies", default=",".join(POLICIES), help="comma-separated policies (default: all)")
     parser.add_argument("--save", type=Path, help="only simulate, and pickle the results here (for --load)")
     parser.add_argument("--load", type=Path, nargs="+", help="merge pickled results instead of simulating")
     parser.add_argument("--readme", type=Path, default=DOCS.parent / "README.md")
     args = parser.parse_args(argv)
     if args.load:
         runs = [pickle.loads(path.read_bytes()) for path in args.load]
-        results = {label: by_policy for run in runs for label, by_policy in run["results"].items()}
+        results = {}
+        for run in runs:
+            for label, by_policy in run["results"].items():
+                results.setdefault(label, {}).update(by_policy)
+        results = {label: {name: by_policy[name] for name in POLICIES if name in by_policy} for label, by_policy in results.items()}
         wall, trials, seed = sum(run["wall_s"] for run in runs), runs[0]["trials"], runs[0]["seed"]
         settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in results}
     else:
@@ -87,7 +94,8 @@ def main(argv: list[str] | None = None) -> int:
         trials, seed = args.trials, args.seed
         settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in labels}
         began = time.perf_counter()
-        results = compare_sync_policies(settings, list(POLICIES), ScenarioSetup(next(iter(settings.values()))), progress=True)
+        policies = [name for name in args.policies.split(",") if name]
+        results = compare_sync_policies(settings, policies, ScenarioSetup(next(iter(settings.values()))), progress=True)
         wall = time.perf_counter() - began
         if args.save:
             args.save.write_bytes(pickle.dumps({"results": results, "wall_s": wall, "trials": trials, "seed": seed}))

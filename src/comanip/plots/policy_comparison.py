@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import matplotlib.pyplot as plt
+from matplotlib.patches import Patch
 import numpy as np
 
 from comanip.plots.figure_file import save_figure
@@ -59,6 +60,7 @@ def plot_policy_comparison(results: dict[str, dict[str, list[SyncTrial]]], path:
         ax.set_xticks(np.arange(len(goals)), goals)
         ax.set(ylabel=label)
         ax.grid(alpha=0.3, axis="y")
+    axes[1, 0].legend(handles=[Patch(facecolor=colors[name], alpha=0.7, label=name) for name in policies], fontsize=8)
     for ax in axes[1, len(BOXED):]:
         ax.set_visible(False)
     return save_figure(fig, path, title or "robot policies on the synchronisation scenario (simulated person, same seeds)")
