@@ -33,6 +33,8 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                        *(f"docs/variants/human_{name}.yaml" for name in ("paper_damping", "hit_reward", "effective_width",
                                                                           "stopping", "hyperbolic")),
                        "--trials", "20"]),
+    "policy-comparison": ("robot policies compared on the sync scenario, 20 trials × 4 goals (about 10 min idle, an hour loaded)",
+                          ["docs/make_policy_comparison.py", "--trials", "20"]),
     "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
                "planar,planar_cold,cartesian,cartesian_cold,human,human_cold,human_cartesian,human_cartesian_cold,"
