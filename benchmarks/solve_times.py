@@ -1,17 +1,26 @@
 """Solve-time benchmark: median and p90 wall time of repeated solves, one row per case.
 
-    .venv/bin/python benchmarks/solve_times.py [--repeats 50] [--only planar,cartesian,franka]
+    .venv/bin/python benchmarks/solve_times.py [--repeats 50] [--only planar,cartesian,franka] [--compare REF]
 
 Each case builds its solver once (build time reported apart), runs one cold solve, then times `repeats`
-warm solves with varied goals. Add a case by adding to CASES a key (used by --only) and a function that
-returns a Case.
+warm solves with varied goals (cold cases: `repeats` cold solves to new goals). Add a case by adding to
+CASES a key (used by --only) and a function that returns a Case.
+
+``--compare REF``: REF is another checkout (e.g. a worktree at main); every case runs twice in the same run,
+each in its own process, first with this checkout's src/ then with REF's (same script, same problems), and
+the two rows are printed one under the other ('new' and 'ref').
 """
 
 from __future__ import annotations
 
 import argparse
+import json
+import os
+import subprocess
+import sys
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -64,9 +73,11 @@ def reach_case(preset: str, paper_time: float, options: SolverOptions | None = N
     return make
 
 
-def cold_case(preset: str, paper_time: float | None = None) -> Callable[[], Case]:
-    """Cold solves (no warm start: the model's multi-start guesses) from rest at the home position to goals
-    0.1–0.4 m away in uniformly drawn directions, a new goal each time (a user's first plan for a goal)."""
+def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4), moving: bool = False) -> Callable[[], Case]:
+    """Cold solves (no warm start) from the home position to goals ``distances`` (m; 0.1–0.4 m) away in
+    uniformly drawn directions, a new goal each time (a user's first plan for a goal), at the model's width;
+    from rest, or (``moving``) with start velocities uniform in ±0.3 m/s per axis. The planner is fresh: its
+    first solves also fill its reach library (comanip.planning.reach_library)."""
 
     def make() -> Case:
         model = comanip.presets.load(preset)
@@ -79,11 +90,13 @@ def cold_case(preset: str, paper_time: float | None = None) -> Callable[[], Case
 
         def solve(k: int) -> tuple[float, bool]:
             direction = rng.normal(size=model.d)
-            goal = origin + rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
-            plan = planner.solve(start, goal, model.width)
+            goal = origin + rng.uniform(*distances) * direction / np.linalg.norm(direction)
+            velocity = rng.uniform(-0.3, 0.3, model.n) if moving else np.zeros(model.n)
+            plan = planner.solve(np.r_[start[: model.n], velocity], goal, model.width)
             return plan.solve_time, plan.success
 
-        return Case(f"{preset} cold (H={model.H}, n={model.n})", build, solve, paper_time)
+        label = "cold, moving start" if moving else "cold"
+        return Case(f"{preset} {label} (H={model.H}, n={model.n})", build, solve, paper_time)
 
     return make
 
@@ -211,12 +224,19 @@ CASES: dict[str, Callable[[], Case]] = {
     "planar_ipopt": reach_case("planar", 0.04, SolverOptions(method="ipopt"), " IPOPT"),
     "cartesian_ipopt": reach_case("cartesian", 0.20, SolverOptions(method="ipopt"), " IPOPT"),
     "franka": reach_case("franka", 1.3, reach=(0.15, 0.1, -0.1)),
+    "franka_cold": cold_case("franka", 1.3, distances=(0.15, 0.3)),
+    "franka_rest": reach_case("franka_rest", 1.3, reach=(0.15, 0.1, -0.1)),
+    "franka_rest_cold": cold_case("franka_rest", 1.3, distances=(0.15, 0.3)),
     "planar_cold": cold_case("planar", 0.04),
     "cartesian_cold": cold_case("cartesian", 0.20),
     "human": reach_case("human", None),
     "human_cold": cold_case("human"),
     "human_cartesian": reach_case("human_cartesian", None),
     "human_cartesian_cold": cold_case("human_cartesian"),
+    "planar_cold_moving": cold_case("planar", moving=True),
+    "cartesian_cold_moving": cold_case("cartesian", moving=True),
+    "human_cold_moving": cold_case("human", moving=True),
+    "human_cartesian_cold_moving": cold_case("human_cartesian", moving=True),
     "closed_loop": closed_loop_reach_case,
     "franka_replan": franka_replan_case,
     "estimate_planar": estimate_case("planar"),
@@ -227,24 +247,80 @@ CASES: dict[str, Callable[[], Case]] = {
 }
 
 
+HEADER = f"{'case':<50} {'build s':>8} {'median ms':>10} {'p90 ms':>8} {'ok':>6} {'paper ms':>9} {'speed-up':>9}"
+
+
+def measure_case(key: str, repeats: int) -> dict:
+    """The case timed in this process: name, build_s, median_s, p90_s, ok, runs, paper_s."""
+    case = CASES[key]()
+    runs = [case.solve(k) for k in range(repeats)]
+    times = np.array([t for t, _ in runs])
+    return {"name": case.name, "build_s": case.build_time, "median_s": float(np.median(times)),
+            "p90_s": float(np.percentile(times, 90)), "ok": int(sum(s for _, s in runs)), "runs": len(runs),
+            "paper_s": case.paper_time}
+
+
+def text_row(row: dict) -> str:
+    paper = row["paper_s"]
+    return (f"{row['name']:<50} {row['build_s']:8.2f} {1e3 * row['median_s']:10.2f} {1e3 * row['p90_s']:8.2f} "
+            f"{row['ok']:>3}/{row['runs']:<2} " + (f"{1e3 * paper:9.0f} {paper / row['median_s']:8.1f}x" if paper else f"{'-':>9} {'-':>9}"))
+
+
+def _time(seconds: float) -> str:
+    return f"{seconds:.2f} s" if seconds >= 0.1 else f"{1e3 * seconds:.1f} ms"
+
+
+def markdown_table(rows: list[dict], repeats: int) -> str:
+    """The README's speed block: one row per case, medians of ``repeats`` solves."""
+    lines = [f"Measured by `benchmarks/solve_times.py --markdown --repeats {repeats} --only …` (median and p90 of "
+             f"{repeats} solves per case; successes count plans that reach their goal):", "",
+             "| case | median | p90 | succeeded | paper |", "|---|---|---|---|---|"]
+    for row in rows:
+        lines.append(f"| {row['name']} | {_time(row['median_s'])} | {_time(row['p90_s'])} | {row['ok']}/{row['runs']} | "
+                     f"{_time(row['paper_s']) if row['paper_s'] else '–'} |")
+    return "\n".join(lines)
+
+
+def measure_elsewhere(src: Path, key: str, repeats: int) -> dict:
+    """The case timed in a fresh process importing comanip from ``src``."""
+    done = subprocess.run([sys.executable, __file__, "--only", key, "--repeats", str(repeats), "--row"],
+                          env={**os.environ, "PYTHONPATH": str(src)}, check=True, capture_output=True, text=True)
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=50)
     parser.add_argument("--only", default="", help=f"comma-separated case keys to run, of: {', '.join(CASES)}")
+    parser.add_argument("--compare", type=Path, default=None, help="another checkout to time side by side (its src/)")
+    parser.add_argument("--markdown", action="store_true", help="print the README's markdown table instead (no --compare)")
+    parser.add_argument("--row", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     wanted = [w for w in args.only.split(",") if w]
-    print(f"{'case':<42} {'build s':>8} {'median ms':>10} {'p90 ms':>8} {'ok':>6} {'paper ms':>9} {'speed-up':>9}")
-    for key, make in CASES.items():
-        if wanted and key not in wanted:
-            continue
-        case = make()
-        runs = [case.solve(k) for k in range(args.repeats)]
-        times = np.array([t for t, _ in runs])
-        ok = sum(s for _, s in runs)
-        median, p90 = np.median(times), np.percentile(times, 90)
-        paper = f"{1e3 * case.paper_time:9.0f}" if case.paper_time else f"{'-':>9}"
-        speedup = f"{case.paper_time / median:8.1f}x" if case.paper_time else f"{'-':>9}"
-        print(f"{case.name:<42} {case.build_time:8.2f} {1e3 * median:10.2f} {1e3 * p90:8.2f} {ok:>3}/{len(runs):<2} {paper} {speedup}", flush=True)
+    unknown = [w for w in wanted if w not in CASES]
+    if unknown:
+        raise SystemExit(f"unknown case keys {unknown}; the cases are {', '.join(CASES)}")
+    keys = [key for key in CASES if not wanted or key in wanted]
+    if args.row:
+        print(json.dumps(measure_case(keys[0], args.repeats)))
+        return
+    if args.markdown:
+        rows = []
+        for key in keys:
+            rows.append(measure_case(key, args.repeats))
+            print(text_row(rows[-1]), file=sys.stderr, flush=True)   # progress
+        print(markdown_table(rows, args.repeats).replace("--only …", "--only " + ",".join(keys)))
+        return
+    if args.compare is None:
+        print(HEADER)
+        for key in keys:
+            print(text_row(measure_case(key, args.repeats)), flush=True)
+        return
+    here = Path(__file__).resolve().parents[1] / "src"
+    print(f"{'code':<5}{HEADER}")
+    for key in keys:
+        for label, src in (("new", here), ("ref", args.compare.resolve() / "src")):
+            print(f"{label:<5}{text_row(measure_elsewhere(src, key, args.repeats))}", flush=True)
 
 
 if __name__ == "__main__":

@@ -1,13 +1,12 @@
-"""Rewrite the human-likeness table in README.md from a fresh measurement, so that no number in it is typed
-by hand.
+"""Print the README's human-likeness block from a fresh measurement (``docs/make_readme_numbers.py
+human-targets`` puts it in the README).
 
-    PYTHONPATH=src python docs/make_calibration_table.py [PRESET ...] [--readme README.md] [--samples 2000] [--seed 0]
+    PYTHONPATH=src python docs/make_calibration_table.py [PRESET ...] [--samples 2000] [--seed 0] [--trials 20]
 
 Scores each preset (a built-in name or a model YAML; default: ``human`` when that preset exists, then
 ``planar``) on the human-likeness targets (:func:`comanip.analysis.measure_human_targets`, the grid
-D ∈ {0.15, 0.3, 0.45} m × w ∈ {0.005, 0.01, 0.02, 0.04} m) and replaces everything between the markers
-``<!-- human-targets:begin -->`` and ``<!-- human-targets:end -->`` in the README with the verdict table,
-the presets side by side, as ``comanip validate`` reports it.
+D ∈ {0.15, 0.3, 0.45} m × w ∈ {0.005, 0.01, 0.02, 0.04} m) and prints how it was measured and the verdict
+table, the presets side by side, as ``comanip validate`` reports it.
 """
 
 from __future__ import annotations
@@ -15,25 +14,11 @@ from __future__ import annotations
 import argparse
 import sys
 import time
-from pathlib import Path
 
 from comanip import presets
 from comanip.analysis import measure_closed_loop_targets, measure_human_targets
 from comanip.validation.human_section import human_section
 from comanip.validation.markdown import verdict_table
-
-BEGIN = "<!-- human-targets:begin -->"
-END = "<!-- human-targets:end -->"
-
-
-def replace_block(text: str, block: str) -> str:
-    """text with the lines between the BEGIN and END markers (each once, in that order) replaced by block."""
-    if text.count(BEGIN) != 1 or text.count(END) != 1 or text.index(BEGIN) > text.index(END):
-        raise ValueError(f"the README must hold {BEGIN} once, followed by {END} once")
-    head, rest = text.split(BEGIN)
-    _, tail = rest.split(END)
-    return f"{head}{BEGIN}\n{block.strip()}\n{END}{tail}"
-
 
 def measured_block(names: list[str], samples: int, seed: int, trials: int) -> str:
     """The block's markdown: how it was measured, the definition of w and ID, and the verdict table."""
@@ -55,16 +40,13 @@ def measured_block(names: list[str], samples: int, seed: int, trials: int) -> st
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("presets", nargs="*", help="presets or model YAML files (default: human if it exists, then planar)")
-    parser.add_argument("--readme", type=Path, default=Path(__file__).resolve().parent.parent / "README.md")
     parser.add_argument("--samples", type=int, default=2000, help="Monte Carlo executions per condition (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the Monte Carlo draws (default: %(default)s)")
     parser.add_argument("--trials", type=int, default=20,
                         help="closed-loop executions per condition of a model with feedback (default: %(default)s)")
     args = parser.parse_args(argv)
     names = args.presets or [name for name in ("human", "planar") if name in presets.names()]
-    text = args.readme.read_text()
-    args.readme.write_text(replace_block(text, measured_block(names, args.samples, args.seed, args.trials)))
-    print(f"{args.readme}: human-likeness table rewritten for {', '.join(names)}")
+    print(measured_block(names, args.samples, args.seed, args.trials))
     return 0
 
 

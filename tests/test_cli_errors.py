@@ -92,3 +92,17 @@ def test_help_has_no_literal_double_backticks(capsys):
     for argv in (["--help"], ["fit", "--help"], ["transition", "--help"], ["estimate", "--help"]):
         assert main(argv) == 0
         assert "``" not in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("argv, fragments", [
+    (["handover", "--goal", "0.3,0.1,0.2", "--goal", "0.3,0.1"], ["goal must have shape (3,)"]),
+    (["handover", "--max-wall-time", "-1"], ["max_wall_time", "> 0"]),
+    (["transition", "generate", "--widths", "0.01,-0.02"], ["widths must be > 0"]),
+    (["transition", "generate", "--workers", "0"], ["workers must be an integer ≥ 1"]),
+])
+def test_long_commands_check_inputs_before_making_their_folder(tmp_path, capsys, argv, fragments):
+    """A mistake in any goal or sweep setting is found before the first plan is solved or the folder is made."""
+    out = tmp_path / "out"
+    target = out / "data.csv" if argv[0] == "transition" else out
+    assert_one_line_error(*run_cli([*argv, "--out", str(target)], capsys), *fragments)
+    assert not out.exists()

@@ -118,7 +118,8 @@ def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(t
 
 
 @pytest.mark.parametrize("kwargs, word", [(dict(method="lbfgs"), "method"), (dict(tolerance=0.0), "tolerance"),
-                                          (dict(max_iterations=0), "max_iterations"), (dict(n_starts=1.5), "n_starts")])
+                                          (dict(max_iterations=0), "max_iterations"), (dict(n_starts=1.5), "n_starts"),
+                                          (dict(cold_search="best"), "cold_search"), (dict(narrow_ratio=0.0), "narrow_ratio")])
 def test_bad_solver_options_name_the_field(kwargs, word):
     with pytest.raises(ValueError, match=word):
         SolverOptions(**kwargs)

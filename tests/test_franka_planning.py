@@ -19,6 +19,11 @@ def franka_planner():
 
 
 @pytest.fixture(scope="module")
+def franka_rest_planner():
+    return comanip.Planner(comanip.presets.load("franka_rest"))
+
+
+@pytest.fixture(scope="module")
 def short_franka():
     """The Franka preset with a 5-step horizon: small enough for CasADi's exact derivatives."""
     model = comanip.presets.load("franka").replace(H=5)
@@ -104,6 +109,103 @@ def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
                     expected[k * n + j, k * n + m] += np.sum(Lambda * (G_k @ second[j][m] @ G_k.T))
     expected += 2 * model.nu / curvature.normaliser(p[-1]) * np.eye(H * n)
     np.testing.assert_allclose(curvature.hessian(data), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
+SPEED_COST = dict(stop_weight=0.7, joint_velocity_weight=0.3)
+"""Speed-cost weights for the derivative tests, (s/rad)² (larger than franka_rest's so the terms matter)."""
+
+
+@pytest.fixture(scope="module")
+def short_franka_rest():
+    """A 3-step Franka problem with the speed cost, and the same problem without it."""
+    model = comanip.presets.load("franka").replace(H=3, **SPEED_COST)
+    problem = ReachProblem(model)
+    bare = LinearisedCurvature(ReachProblem(model.replace(stop_weight=0.0, joint_velocity_weight=0.0)), compile=False)
+    return model, problem, LinearisedCurvature(problem, compile=False), bare
+
+
+def test_speed_cost_value_and_gradient_are_exact(short_franka_rest, rng):
+    """f with the speed cost against the SPEC §4 J of CasADi's expanded rollout (which adds
+    |J_best| (c_s E||qdot_H||² + c_v mean_i E||qdot_i||²)), the gradient against its central differences, and
+    the cost itself against a NumPy rollout of the belief (an independent construction)."""
+    from comanip.belief.propagation import propagate_belief
+
+    model, problem, curvature, bare = short_franka_rest
+    tau, p = _point(model, rng)
+    f, g, _ = curvature.evaluate(tau, p)
+    J = lambda x: problem.objective_value(x, p[:14], p[14:17], p[17]) / curvature.normaliser(p[17])  # noqa: E731
+    assert f == pytest.approx(J(tau), rel=1e-12)
+    mean, cov = propagate_belief(model.body, model.h, model.kappa, p[:14], tau.reshape(model.H, 7), model.noise)
+    energies = np.sum(mean[1:, 7:] ** 2, axis=1) + np.trace(cov[1:, 7:, 7:], axis1=1, axis2=2)
+    expected = SPEED_COST["stop_weight"] * energies[-1] + SPEED_COST["joint_velocity_weight"] * energies.mean()
+    assert f - bare.value(tau, p) == pytest.approx(expected, rel=1e-9)
+    eps = 1e-6
+    fd = np.array([(J(tau + eps * e) - J(tau - eps * e)) / (2 * eps) for e in np.eye(tau.size)])
+    np.testing.assert_allclose(g, fd, rtol=1e-5, atol=1e-7 * np.abs(g).max())
+
+
+def test_speed_cost_hessian_is_the_gauss_newton_term_and_close_to_the_exact_one(short_franka_rest, rng):
+    """The speed cost's share of the structured Hessian equals its Gauss–Newton form along the mean,
+    Σ_i 2 c_i T_v,iᵀ T_v,i + blockdiag_k Σ_i c_i <T_v,ikᵀ T_v,ik, ∂²N>, built from explicit rows (N's second
+    derivatives by central differences, exact: N is quadratic); and it is within 10 % of CasADi's exact Hessian
+    of the speed cost alone (the rest is the dynamics' curvature, left out as for the reward)."""
+    from comanip.belief.noise import noise_covariance
+    from comanip.objectives.reach_objective import velocity_cost
+
+    model, problem, curvature, bare = short_franka_rest
+    n, H = 7, model.H
+    c = np.full(H + 1, SPEED_COST["joint_velocity_weight"] / H)
+    c[0], c[-1] = 0.0, c[-1] + SPEED_COST["stop_weight"]
+    unit = np.eye(n)
+    N_of = lambda t: noise_covariance(t, model.kappa, model.noise)  # noqa: E731
+    second = [[(N_of(unit[j] + unit[m]) - N_of(unit[j] - unit[m])) / 2 for m in range(n)] for j in range(n)]
+    x = ca.vec(problem.tau)
+    cost = velocity_cost([m[n:2 * n] for m in problem.means[1:]], [S[n:2 * n, n:2 * n] for S in problem.covs[1:]],
+                         SPEED_COST["stop_weight"], SPEED_COST["joint_velocity_weight"])
+    exact = ca.Function("speed_hessian", [x, problem.s0], [ca.hessian(cost, x)[0]])
+    for _ in range(3):
+        tau, p = _point(model, rng)
+        data = curvature.evaluate(tau, p)[2]
+        share = curvature.hessian(data) - bare.hessian(bare.evaluate(tau, p)[2])
+        Tv = curvature.mean_sensitivities(data)[:, n:].reshape(H + 1, n, H * n)
+        expected = sum(2 * c[i] * Tv[i].T @ Tv[i] for i in range(H + 1))
+        for k in range(H):
+            S_k = sum(c[i] * Tv[i][:, k * n:(k + 1) * n].T @ Tv[i][:, k * n:(k + 1) * n] for i in range(H + 1))
+            expected[k * n:(k + 1) * n, k * n:(k + 1) * n] += [[np.sum(S_k * second[j][m]) for m in range(n)] for j in range(n)]
+        np.testing.assert_allclose(share, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+        H_exact = np.asarray(exact(tau, p[:14]))
+        assert np.linalg.norm(share - H_exact, 2) < 0.1 * np.linalg.norm(H_exact, 2)
+
+
+@pytest.mark.parametrize("offset", [[0.15, 0.1, -0.1], [0.0, -0.2, 0.1], [-0.1, 0.15, 0.15]])
+def test_franka_rest_plans_end_at_rest_without_whipping(franka_rest_planner, offset):
+    """The ``franka_rest`` preset (speed cost on): every joint ends slower than 0.05 rad/s and none runs at its
+    speed limit once the hand has stopped. The paper's ``franka`` preset fails both on the first goal
+    (test_paper_franka_plan_ends_moving)."""
+    from comanip.analysis import settling_motion
+
+    planner = franka_rest_planner
+    model = planner.model
+    start = np.r_[model.body.home_position, np.zeros(7)]
+    goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + offset
+    plan = planner.solve(start, goal)
+    assert plan.success, (plan.status, plan.message)
+    motion = settling_motion(model, plan)
+    assert motion.final_joint_speed < 0.05
+    assert motion.time_at_velocity_limit == 0.0
+
+
+def test_paper_franka_plan_ends_moving(franka_planner):
+    """What franka_rest removes: the paper's plan to [0.15, 0.1, -0.1] m from the ready pose keeps a wrist joint at
+    its speed limit after the hand has stopped and ends with a joint faster than 1 rad/s."""
+    from comanip.analysis import settling_motion
+
+    model = franka_planner.model
+    start = np.r_[model.body.home_position, np.zeros(7)]
+    goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
+    plan = franka_planner.solve(start, goal)
+    motion = settling_motion(model, plan)
+    assert plan.success and motion.final_joint_speed > 1.0 and motion.time_at_velocity_limit > 0.1
 
 
 def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(franka_planner):

@@ -64,7 +64,7 @@ def test_planner_solve_extreme_but_valid(small_planner, goal, width):
 model_fields = st.fixed_dictionaries({}, optional={
     "h": numbers, "H": st.one_of(st.integers(-5, 12), numbers), "gamma": numbers, "nu": numbers, "kappa": numbers,
     "width": numbers, "noise": st.text(max_size=8), "reward": st.sampled_from(["gaussian", "hit", "bogus", ""]),
-    "effective_k": numbers, "stop_weight": numbers, "activation": st.lists(numbers, max_size=2),
+    "effective_k": numbers, "stop_weight": numbers, "joint_velocity_weight": numbers, "activation": st.lists(numbers, max_size=2),
     "discount": st.sampled_from(["exponential", "hyperbolic", "x"])})
 
 
@@ -129,3 +129,111 @@ def test_goal_estimate(small_estimator, observed, t_obs, prior, width):
 def test_found_by_fuzzing_a_huge_activation_time_constant_is_refused():
     with pytest.raises(ValueError, match="activation time constants must be ≤ 1000 h"):
         comanip.presets.planar().replace(activation=[3.6e14])
+
+
+# --- the Panda: any start pose, singular and beyond the joint limits included ------------------------------------
+
+@pytest.fixture(scope="module")
+def franka_planner():
+    return comanip.Planner(comanip.presets.franka())
+
+
+def franka_poses():
+    """q (7,) rad: the home pose, singular poses (arm stretched: q4 at its upper limit, q6 at 0 or pi; every
+    joint at 0), joints at and beyond their limits, or anything finite or not."""
+    body = comanip.presets.franka().body
+    q_min, q_max = np.asarray(body.q_min, float), np.asarray(body.q_max, float)
+    stretched = np.array([0, 0, 0, q_max[3], 0, 0, 0])
+    special = [np.asarray(body.home_position, float), np.zeros(7), stretched, stretched + [0, 0, 0, 0, 0, np.pi, 0],
+               q_min, q_max, q_max + 0.5]
+    joint = st.one_of(st.floats(-4.0, 4.0), st.sampled_from([math.nan, math.inf, 0.0]))
+    return st.one_of(st.sampled_from(special), st.lists(joint, min_size=7, max_size=7).map(np.array),
+                     st.lists(joint, min_size=0, max_size=9))
+
+
+@settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck), database=None,
+          derandomize=os.environ.get("CI") == "true")
+@given(q=franka_poses(), qdot=st.one_of(st.just(np.zeros(7)), st.lists(st.floats(-5.0, 5.0), min_size=7, max_size=7).map(np.array)),
+       goal=st.one_of(st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3), vectors))
+def test_franka_any_pose(franka_planner, q, qdot, goal):
+    """A plan with a status and finite arrays within its wall-time budget, or a ValueError: never a crash or a NaN."""
+    start = np.r_[np.ravel(np.asarray(q, float)), qdot] if np.size(q) == 7 else q
+    check_plan_or_value_error(lambda: franka_planner.solve(start, goal, max_wall_time=0.5))
+
+
+# --- the long-running commands: every input is checked before any work ------------------------------------------
+
+class InputsAccepted(BaseException):
+    """Raised where a command would start its work: every argument got past the checks (BaseException, so the
+    CLI's handler of user errors does not catch it)."""
+
+
+def _accept(*args, **kwargs):
+    raise InputsAccepted
+
+
+numbers_text = st.text(alphabet="0123456789.,;-e naif", max_size=10)
+SCALARS = ["1", "3", "0.3", "0.05", "0", "-1", "1e9", "1e-9", "nan", "inf", "2.5"]
+VECTORS = ["0.3,0.1", "0.3,0,0.2", "0.45,0.15,0.2", "0,0,0,0", "0,0,0,0,0,0", "0.2,0.4", "0.2,-0.4", "nan,0,0",
+           "1e9,0,0", "0.3"]
+#: option: values a user might plausibly type (in range or not); random text is drawn too
+LONG_COMMANDS = {
+    "simulate": (["simulate"], {"--trials": SCALARS, "--goal": ["near", "far", *VECTORS], "--width": SCALARS,
+                                "--kappa": SCALARS, "--seed": SCALARS, "--duration": SCALARS},
+                 ("comanip.simulation", "ScenarioSetup")),
+    "handover": (["handover"], {"--start": VECTORS, "--goal": VECTORS, "--width": SCALARS, "--ramp-time": SCALARS,
+                                "--stiffness": SCALARS, "--rate": SCALARS, "--arm-length": SCALARS,
+                                "--max-wall-time": SCALARS, "--preset": ["planar", "cartesian", "human", "nope"]},
+                 ("comanip.cli.handover_command", "Planner")),
+    "transition generate": (["transition", "generate"], {"--distances": VECTORS, "--widths": VECTORS, "--trials": SCALARS,
+                                                         "--arm-length": SCALARS, "--steps": SCALARS, "--seed": SCALARS,
+                                                         "--workers": SCALARS, "--preset": ["planar", "cartesian", "franka"]},
+                            ("comanip.cli.transition_command", "generate_transition_data")),
+}
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), database=None,
+          derandomize=os.environ.get("CI") == "true")
+@given(command=st.sampled_from(sorted(LONG_COMMANDS)), data=st.data())
+def test_long_commands_give_one_line_errors(tmp_path_factory, capsys, monkeypatch, command, data):
+    """simulate, handover and transition generate: a user mistake is one line and exit status 2, never a
+    traceback. Inputs that pass every check reach the command's work, replaced here by InputsAccepted so that
+    the suite does not wait for simulations (about one input in ten gets there)."""
+    import importlib
+
+    FUZZ_COUNT["inputs"] += 1
+    words, options, (module, work) = LONG_COMMANDS[command]
+    scenario = [data.draw(st.sampled_from(["sync", "handover", "bogus", ""]))] if command == "simulate" else []
+    names = data.draw(st.lists(st.sampled_from(sorted(options)), max_size=4))
+    argv = [word for name in names for word in (name, data.draw(st.one_of(st.sampled_from(options[name]), numbers_text)))]
+    argv += data.draw(st.lists(numbers_text, max_size=1))
+    out = tmp_path_factory.mktemp("out") / ("data.csv" if command == "transition generate" else "")
+    with monkeypatch.context() as patch:
+        patch.setattr(importlib.import_module(module), work, _accept)
+        try:
+            code = main([*words, *scenario, *argv, "--out", str(out)])
+        except InputsAccepted:
+            return
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    assert code == 2, (argv, code, err)
+    assert err.count("\n") == 1 and "error:" in err, err
+
+
+@FAST
+@given(text=st.one_of(st.text(max_size=80), st.sampled_from([
+    "", "distance_over_arm_length,width_m\n", "distance_over_arm_length,width_m,transition_distance_m\n0.2,0.01,nan\n",
+    "distance_over_arm_length,width_m,transition_distance_m\n0.2,0.01\n", "a,b,c\n1,2,3\n", "\x00\x01"])),
+       command=st.sampled_from(["fit", "plot"]))
+def test_transition_data_files(tmp_path_factory, capsys, text, command):
+    """transition fit/plot --data with an empty, malformed or half-filled CSV: one line, status 2."""
+    FUZZ_COUNT["inputs"] += 1
+    folder = tmp_path_factory.mktemp("data")
+    data = folder / "transition.csv"
+    data.write_text(text)
+    out = folder / ("out" if command == "fit" else "out/figure.png")
+    code = main(["transition", command, "--data", str(data), "--out", str(out)])
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    if code != 0:
+        assert code == 2 and err.count("\n") == 1 and "error:" in err, err

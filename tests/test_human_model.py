@@ -84,7 +84,9 @@ def test_effective_width_spans_k_standard_deviations():
 
 
 @pytest.mark.parametrize("changes", [dict(FILTERED), dict(reward="hit"), dict(stop_weight=2e-3),
-                                     dict(FILTERED, reward="hit", stop_weight=1e-3, goal_covariance="effective")])
+                                     dict(joint_velocity_weight=0.5, stop_weight=0.1),
+                                     dict(FILTERED, reward="hit", stop_weight=1e-3, goal_covariance="effective"),
+                                     dict(FILTERED, joint_velocity_weight=0.2)])
 def test_structured_hessian_is_exact_with_the_extensions(changes, rng):
     model = comanip.presets.planar().replace(H=10, **changes)
     problem = ReachProblem(model)
@@ -120,8 +122,17 @@ def test_stopping_cost_slows_the_end_of_the_horizon():
     assert final[1] < 0.8 * final[0]
 
 
+def test_running_speed_cost_slows_the_reach():
+    """joint_velocity_weight penalises speed all along: the peak hand speed drops and the plan still reaches."""
+    model = comanip.presets.planar()
+    plans = [comanip.Planner(model.replace(joint_velocity_weight=w)).solve(np.zeros(4), [0.3, 0.0], 0.02) for w in (0.0, 0.2)]
+    assert all(p.success for p in plans)
+    assert plans[1].ee_speed.max() < 0.9 * plans[0].ee_speed.max()
+
+
 def test_model_options_round_trip_through_yaml(tmp_path):
-    model = comanip.presets.planar().replace(**FILTERED, reward="hit", goal_covariance="effective", effective_k=3.0, stop_weight=1e-3)
+    model = comanip.presets.planar().replace(**FILTERED, reward="hit", goal_covariance="effective", effective_k=3.0, stop_weight=1e-3,
+                                            joint_velocity_weight=0.1)
     again = comanip.presets.load(comanip.presets.save(model, tmp_path / "m.yaml"))
     assert again.config() == model.config() and isinstance(again.body, MuscleActuatedBody) and again.state_size == 8
     bare = again.replace(activation=())

@@ -158,14 +158,3 @@ def test_validate_rejects_a_bad_targets_reference_before_any_work(tmp_path, caps
     with pytest.raises(ValueError, match="point-mass"):
         run_validation(comanip.presets.planar(), tmp_path / "w", ValidationSettings(human_reference="franka", franka=False))
     assert not (tmp_path / "v").exists() and not (tmp_path / "w").exists()
-
-
-def test_calibration_table_script_rewrites_only_the_marked_block():
-    path = Path(__file__).resolve().parent.parent / "docs" / "make_calibration_table.py"
-    spec = importlib.util.spec_from_file_location("make_calibration_table", path)
-    script = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(script)
-    text = f"intro\n{script.BEGIN}\nold table\n{script.END}\noutro\n"
-    assert script.replace_block(text, "new table\n") == f"intro\n{script.BEGIN}\nnew table\n{script.END}\noutro\n"
-    with pytest.raises(ValueError, match="once"):
-        script.replace_block("no markers", "table")

@@ -34,3 +34,20 @@ def test_a_file_given_as_the_output_folder_is_one_line(tmp_path, capsys):
     (tmp_path / "taken").write_text("x")
     assert main(["plan", "--out", str(tmp_path / "taken")]) == 2
     assert "is a file; expected a folder" in capsys.readouterr().err
+
+
+def test_manifest_describes_simulated_handover_trials_as_trials(tmp_path):
+    """'simulate handover' writes handover_<goal>_trial<k>.csv and handover_summary.json: they are trials and a
+    summary, not the schedules 'comanip handover' writes as handover_<k>.csv/json."""
+    import json
+
+    from comanip.cli.outputs import write_manifest
+
+    names = ["handover_near_trial0.csv", "handover_summary.json", "handover_0.csv", "handover_0.json"]
+    for name in names:
+        (tmp_path / name).write_text("x")
+    write_manifest(tmp_path, "simulate", [tmp_path / n for n in names])
+    text = json.loads((tmp_path / "manifest.json").read_text())["files"]
+    assert "simulated trial" in text["handover_near_trial0.csv"]
+    assert "per-trial metrics" in text["handover_summary.json"]
+    assert "schedule" in text["handover_0.csv"] and "schedule" in text["handover_0.json"]

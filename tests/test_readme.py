@@ -140,3 +140,63 @@ def test_readme_needs_nothing_outside_the_repository():
         path = (root / target).resolve()
         assert path.exists(), f"README links to {target}, which is not in the repository"
         assert root.resolve() in path.parents, f"README links outside the repository: {target}"
+
+
+def _numbers_script():
+    """docs/make_readme_numbers.py as a module (a script, not part of the package)."""
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("make_readme_numbers", README.parent / "docs" / "make_readme_numbers.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+#: first lines of README tables that define settings or vocabulary rather than report measurements
+DEFINITION_TABLES = {"| option | default (paper) | what it adds |", "| status | where | meaning |",
+                     "| folder (`src/comanip/`) | what lives there |"}
+
+
+def markdown_tables(text: str) -> list[tuple[int, list[str]]]:
+    """(first line number, lines) of every markdown table (a run of lines starting with '|') outside code blocks."""
+    tables, current, fenced = [], None, False
+    for number, line in enumerate(text.splitlines(), start=1):
+        if line.strip().startswith("```"):
+            fenced = not fenced
+        if not fenced and line.startswith("|"):
+            current = current or (number, [])
+            current[1].append(line)
+        elif current is not None:
+            tables.append(current)
+            current = None
+    return tables + ([current] if current else [])
+
+
+def test_every_table_of_measured_numbers_is_a_marked_block_with_its_script():
+    """A table with a digit in its body is measured: it sits between <!-- NAME:begin/end --> markers that
+    docs/make_readme_numbers.py knows (and rewrites by running the script it names), unless it is one of the
+    tables of settings above. Every block has a script that exists, and every script's block is in the README."""
+    script = _numbers_script()
+    text = README.read_text(encoding="utf-8")
+    names = script.block_names(text)
+    assert sorted(names) == sorted(script.BLOCKS), "README blocks and docs/make_readme_numbers.py's BLOCKS differ"
+    for name, (_, command) in script.BLOCKS.items():
+        for word in command:
+            if word.endswith((".py", ".yaml")):
+                assert (README.parent / word).is_file(), f"block {name}: {word} does not exist"
+    spans = script.block_spans(text)
+    for first, lines in markdown_tables(text):
+        if lines[0] in DEFINITION_TABLES or not any(ch.isdigit() for line in lines[2:] for ch in line):
+            continue
+        inside = [name for name, (begin, end) in spans.items() if begin <= first and first + len(lines) - 1 <= end]
+        assert inside, f"README line {first}: a table of numbers outside any marked block: {lines[0][:80]}"
+
+
+def test_replace_block_rewrites_only_its_block():
+    script = _numbers_script()
+    text = "intro\n<!-- a:begin -->\nold\n<!-- a:end -->\nmiddle\n<!-- b:begin -->\nkeep\n<!-- b:end -->\n"
+    assert script.replace_block(text, "a", "new\n") == text.replace("old", "new")
+    with pytest.raises(ValueError, match="no block"):
+        script.replace_block(text, "c", "x")
+    with pytest.raises(ValueError, match="no <!-- a:end -->"):
+        script.block_names("<!-- a:begin -->\n")

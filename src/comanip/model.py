@@ -59,8 +59,13 @@ class ReachingModel:
     stop_weight: float = 0.0
     """Weight of the terminal stopping cost |J_best(w)| · stop_weight · E||qdot_H||², in (s/m)² or (s/rad)², ≥ 0:
     asks the hand to be still at the end of the horizon. Relative to the best attainable reward |J_best|, so a
-    final RMS speed of 1/sqrt(stop_weight) costs as much as the whole reward, whatever the width.
-    0 (default, the paper): none."""
+    final RMS speed of 1/sqrt(stop_weight) costs as much as the whole reward, whatever the width. Every body
+    (for an arm, qdot are the joint speeds in rad/s). 0 (default, the paper): none."""
+    joint_velocity_weight: float = 0.0
+    """Weight c_v of the running speed cost |J_best(w)| · c_v · (1/H) Σ_{i=1..H} E||qdot_i||², in (s/rad)² for an
+    arm's joints or (s/m)² for a point mass, ≥ 0: the body moves no more than the reach needs (an arm's motion in
+    its null space, which the reward does not see, costs). A time-averaged RMS speed of 1/sqrt(c_v) costs as much
+    as the whole reward. 0 (default, the paper): none; the ``franka_rest`` preset uses it with stop_weight."""
     observation: tuple = ()
     """What the person sees when executing in closed loop (comanip.execution): (position SD in m, velocity
     SD in m/s, delay in s), each finite and ≥ 0; the replans then start from a Kalman estimate made from those
@@ -92,7 +97,8 @@ class ReachingModel:
         check_reward_form(self.reward)
         check_discount_form(self.discount)
         as_positive("effective_k", self.effective_k, "standard deviations")
-        as_nonnegative("stop_weight", self.stop_weight, "(s/m)²")
+        as_nonnegative("stop_weight", self.stop_weight, "(s/m)² or (s/rad)²")
+        as_nonnegative("joint_velocity_weight", self.joint_velocity_weight, "(s/m)² or (s/rad)²")
         if not isinstance(self.observation, (tuple, list, np.ndarray)) or len(self.observation) not in (0, 3):
             raise ValueError(f"observation must be () or (position SD m, velocity SD m/s, delay s), got {self.observation!r}")
         object.__setattr__(self, "observation", tuple(as_nonnegative(f"observation[{i}]", v, unit)
@@ -150,6 +156,11 @@ class ReachingModel:
         """Horizon length H·h (s)."""
         return self.H * self.h
 
+    @property
+    def has_velocity_cost(self) -> bool:
+        """The objective holds a speed cost (stop_weight or joint_velocity_weight > 0)."""
+        return self.stop_weight > 0 or self.joint_velocity_weight > 0
+
     def replace(self, **changes) -> "ReachingModel":
         """A copy with some fields changed (checked again); ``activation=()`` removes the activation stages."""
         if "activation" in changes and "body" not in changes and isinstance(self.body, MuscleActuatedBody):
@@ -174,6 +185,7 @@ class ReachingModel:
             "reward": self.reward,
             "activation": list(self.activation),
             "stop_weight": self.stop_weight,
+            "joint_velocity_weight": self.joint_velocity_weight,
             "observation": list(self.observation),
             "discount": self.discount,
         }

@@ -2,7 +2,15 @@
 and executions that return numbers (dataclasses), which :mod:`comanip.plots` draws and ``comanip validate``
 reports."""
 
-from comanip.analysis.arm_reaches import ArmReach, LimitUsage, arm_reaches, joint_limit_usage, summarise_reaches
+from comanip.analysis.arm_reaches import (
+    ArmReach,
+    LimitUsage,
+    SettlingMotion,
+    arm_reaches,
+    joint_limit_usage,
+    settling_motion,
+    summarise_reaches,
+)
 from comanip.analysis.ball_probability import ball_probability
 from comanip.analysis.calibration import (
     CalibrationResult,
@@ -35,7 +43,7 @@ from comanip.analysis.speed_profile import SETTLING_FRACTION, SpeedMetrics, spee
 from comanip.analysis.target_verdicts import HumanTargets, TargetVerdict, target_verdicts
 
 __all__ = [
-    "ArmReach", "LimitUsage", "arm_reaches", "joint_limit_usage", "summarise_reaches",
+    "ArmReach", "LimitUsage", "SettlingMotion", "arm_reaches", "joint_limit_usage", "settling_motion", "summarise_reaches",
     "ball_probability",
     "CalibrationResult", "Configuration", "measure_grid", "run_calibration", "study_configurations",
     "EndpointDispersion", "endpoint_dispersion",

@@ -73,6 +73,31 @@ def _velocity_usage_after(model, plan: Plan, time: float) -> float:
     return float(np.max(np.abs(plan.mean[after, model.n:2 * model.n]) / model.body.qdot_max))
 
 
+#: A joint counts as at its velocity limit at |qdot| ≥ this fraction of qdot_max.
+AT_VELOCITY_LIMIT = 0.95
+
+
+@dataclass(frozen=True)
+class SettlingMotion:
+    """How an arm moves once its hand has stopped (after MT, SPEC §6), and how it ends."""
+
+    final_joint_speed: float
+    """Largest |qdot_H| over the joints at the end of the plan, rad/s."""
+    time_at_velocity_limit: float
+    """Time (s) after MT during which some joint runs at ≥ AT_VELOCITY_LIMIT of its speed limit (steps × h);
+    NaN when the hand never settles."""
+
+
+def settling_motion(model, plan: Plan) -> SettlingMotion:
+    """:class:`SettlingMotion` of plan, a plan of model's arm (a body with joint velocity limits)."""
+    n, qdot_max = model.n, model.body.qdot_max
+    movement_time = speed_metrics(plan.t, plan.ee_speed).movement_time
+    qdot = np.abs(plan.mean[:, n:2 * n])
+    at_limit = np.any(qdot >= AT_VELOCITY_LIMIT * qdot_max, axis=1) & (plan.t > movement_time)
+    return SettlingMotion(float(np.max(qdot[-1])),
+                          float(np.sum(at_limit) * model.h) if np.isfinite(movement_time) else float("nan"))
+
+
 @dataclass
 class ArmReach:
     """One planned reach of an arm from its home pose; T = H+1 steps."""

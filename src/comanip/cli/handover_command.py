@@ -14,12 +14,12 @@ import warnings
 
 import numpy as np
 
-from comanip.arguments import as_positive
+from comanip.arguments import as_optional_positive, as_positive
 from comanip.cli.options import add_model_arguments, input_file, load_model, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH
-from comanip.planning.planner import Planner
+from comanip.planning.planner import Planner, reach_inputs
 
 #: A near and a far goal from the origin (m), as in the paper's experiment (Fig. 8).
 DEFAULT_GOALS = ("0.2,0.1,0", "0.4,0.25,-0.1")
@@ -56,9 +56,12 @@ def run(args) -> int:
     transition = TransitionModel.load(args.transition_model) if args.transition_model else TransitionModel()
     if arm_length is not None:
         transition.arm_length = arm_length
-    planner = Planner(model)
     start = np.zeros(2 * model.n) if args.start is None else args.start
     goals = args.goal or [vector(g) for g in DEFAULT_GOALS]
+    as_optional_positive("max_wall_time", args.max_wall_time, "s")
+    for goal in goals:  # every input checked before a planner is built or the output folder made
+        reach_inputs(model, start, goal, args.width)
+    planner = Planner(model)
     out = output_dir(args.out, "handover", args.force)
     plans, schedules, report = [], [], []
     for k, goal in enumerate(goals):

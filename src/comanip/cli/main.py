@@ -23,6 +23,7 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.estimate_command",
     "comanip.cli.simulate_command",
     "comanip.cli.fit_command",
+    "comanip.cli.ros_command",
 ]
 
 #: errors that mean the user gave something wrong (an argument, a file): one line, exit status 2

@@ -1,6 +1,8 @@
 """``comanip simulate sync|handover``: the paper's collaborative scenarios (Section VI) with a simulated Panda
 under impedance control and a simulated person, in MuJoCo. Writes a figure, one CSV per trial, a summary
-JSON and (where offscreen rendering works) a frame strip per goal."""
+JSON and (where offscreen rendering works) a frame strip per goal. For sync, ``--policy NAME|all`` chooses
+the robot (default: the paper's one-shot estimate) and writes a table (CSV and markdown, median and IQR
+over trials) and a figure comparing the policies over the same trials and person seeds."""
 
 from __future__ import annotations
 
@@ -21,6 +23,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--kappa", type=float, help="the person's motor-noise variance (default: the preset's)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial (default: %(default)s)")
     parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
+    parser.add_argument("--policy", help="sync only: the robot policy, one of passive, prior-only, constant-velocity, "
+                                         "minimum-jerk, one-shot (default), continuous, or all of them")
     add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
@@ -30,25 +34,51 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     from comanip.simulation import SCENARIOS, ScenarioSetup, resolve_goal, scenario
 
+    from comanip.simulation.policies import POLICIES, check_policy
+
     settings_class, runner = scenario(args.scenario)
     goals = args.goal or ["near", "far"]
     common = {"trials": args.trials, "width": args.width, "kappa": args.kappa, "seed": args.seed, "duration": args.duration}
+    policies = None
+    if args.policy is not None:
+        if args.scenario != "sync":
+            raise ValueError(f"--policy applies to the sync scenario only, got scenario {args.scenario!r}")
+        policies = list(POLICIES) if args.policy == "all" else [check_policy(args.policy)]
+        common["policy"] = "one-shot" if "one-shot" in policies else policies[0]
     # every setting is checked here, before any solver or model is built
     all_settings = {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in goals}
     setup = ScenarioSetup(next(iter(all_settings.values())))
     out = output_dir(args.out, "simulate", args.force)
 
-    results, timing = {}, {}
+    results, timing, by_policy = {}, {}, {}
     for label, settings in all_settings.items():
         begin = time.perf_counter()
-        results[label] = runner(settings, setup)
+        if policies is None:
+            results[label] = runner(settings, setup)
+        else:
+            from comanip.simulation.policy_comparison import compare_sync_policies
+
+            by_policy[label] = compare_sync_policies({label: settings}, policies, setup, progress=True)[label]
+            results[label] = by_policy[label][settings.policy]
         wall = time.perf_counter() - begin
-        simulated = settings.trials * setup.duration
+        simulated = settings.trials * setup.duration * (1 if policies is None else len(policies))
         timing[label] = {"wall_s": wall, "simulated_s": simulated, "real_time_factor": simulated / wall}
 
     from comanip.simulation.report import settings_dict, summarise, write_summary, write_trials
 
     files, goals_out, strips = [], {}, {}
+    if by_policy:
+        from comanip.plots.policy_comparison import plot_policy_comparison
+        from comanip.simulation.policy_comparison import comparison_rows, write_comparison
+
+        rows = comparison_rows(by_policy)
+        files += write_comparison(rows, out / "sync_policies")
+        files.append(plot_policy_comparison(by_policy, out / "sync_policies.png"))
+        for label, runs in by_policy.items():
+            for name, trials in runs.items():
+                if name != all_settings[label].policy:
+                    files += write_trials([trial.record for trial in trials], out, f"sync_{label}_{name}")
+        print((out / "sync_policies.md").read_text())
     for label, result in results.items():
         trials = result if args.scenario == "sync" else result.trials
         stem = f"{args.scenario}_{label}"
@@ -58,6 +88,16 @@ def run(args) -> int:
                             "timing": timing[label]}
         if args.scenario == "handover":
             goals_out[label]["schedule"] = result.schedule.summary()
+            if result.dispersion is not None:
+                # the lead at 400 N/m holds the spread down until the release, so this peak lies inside T by
+                # construction; the person's own transition is measured with a passive robot
+                # (docs/measure_handover_transition.py)
+                goals_out[label]["transition"] = {
+                    "predicted_distance_m": result.schedule.transition_distance,
+                    "handover_spread_peak_distance_m": result.dispersion.transition_distance}
+        if label in by_policy:
+            goals_out[label]["policies"] = {name: summarise([trial.metrics for trial in trials])
+                                            for name, trials in by_policy[label].items()}
         if not args.no_frames:
             from comanip.simulation.rendering import frame_strip
 

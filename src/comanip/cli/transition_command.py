@@ -20,7 +20,7 @@ from pathlib import Path
 from comanip.cli.options import add_model_arguments, input_file, load_model, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.multicomponent.transition_csv import read_transition_metadata, shipped_dataset_path, write_transition_csv
-from comanip.multicomponent.transition_data import ARM_LENGTH, default_steps, generate_transition_data
+from comanip.multicomponent.transition_data import ARM_LENGTH, checked_sweep, generate_transition_data
 
 DEFAULT_DISTANCES = "0.2,0.3,0.4,0.5,0.6,0.7,0.8"
 DEFAULT_WIDTHS = "0.005,0.01,0.02,0.03,0.04,0.05"
@@ -59,12 +59,13 @@ def add_parser(subparsers) -> None:
 
 
 def run_generate(args) -> int:
-    model = load_model(args)
-    steps = default_steps(model) if args.steps is None else args.steps
+    sweep = checked_sweep(args.distances, args.widths, args.trials, model=load_model(args), arm_length=args.arm_length,
+                          steps=args.steps, seed=args.seed, workers=args.workers)
+    model, steps = sweep.model, sweep.steps
     folder = output_dir(Path(args.out).parent, "transition", args.force)
     began = time.perf_counter()
-    rows = generate_transition_data(args.distances, args.widths, args.trials, model=model, arm_length=args.arm_length,
-                                    steps=steps, seed=args.seed, workers=args.workers)
+    rows = generate_transition_data(*sweep[:3], model=model, arm_length=sweep.arm_length, steps=steps, seed=sweep.seed,
+                                    workers=sweep.workers)
     metadata = {
         "command": "comanip " + shlex.join(sys.argv[1:]) if Path(sys.argv[0]).name == "comanip" else shlex.join(sys.argv),
         "seed": args.seed, "model": model.config(), "arm_length_m": args.arm_length, "steps": steps,

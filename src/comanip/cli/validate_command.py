@@ -45,7 +45,7 @@ def run(args) -> int:
     if "fitts_grid" in report:
         grid = report["fitts_grid"]
         summary |= {"fitts_r2": grid["fits"]["fitts"]["r2"], "shannon_r2": grid["fits"]["shannon"]["r2"],
-                    "calibration_both": report["calibration"]["both"]}
+                    "configurations_with_fitts_law_and_early_peak": report["calibration"]["both"]}
     if "human_targets" in report:
         summary["human_targets_passed"] = {m["model"]: f"{m['passed']}/{m['targets']}" for m in report["human_targets"]["models"]}
     if "franka" in report:

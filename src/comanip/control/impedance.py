@@ -113,6 +113,9 @@ class CartesianImpedanceController:
         self._stiffness = np.r_[gains.translational_stiffness, np.full(3, gains.rotational_stiffness)]
         self._damping = None
         self._designed_at = np.full(n, np.inf)
+        self.last_force = np.zeros(3)
+        """The translational part of the last commanded wrench K e + D e_dot (3,), N: the force the
+        impedance applies at the TCP (before any torque clipping)."""
 
     @property
     def translational_stiffness(self) -> np.ndarray:
@@ -128,6 +131,13 @@ class CartesianImpedanceController:
             self._stiffness[:3] = stiffness
             self._damping = None
 
+    def reset(self) -> None:
+        """Forget the configuration-dependent design (the next call redesigns at its state), so runs that
+        start from the same state compute the same torques whatever ran before."""
+        self._damping = None
+        self._designed_at = np.full(len(self.rest_posture), np.inf)
+        self.last_force = np.zeros(3)
+
     def __call__(self, state: RobotState, position_rest, rotation_rest, velocity_rest=None) -> np.ndarray:
         """Joint torques (n,), N·m, for the rest pose (position_rest (3,) m, rotation_rest (3, 3)) moving at
         velocity_rest (3,) m/s (zero when None)."""
@@ -140,6 +150,7 @@ class CartesianImpedanceController:
         if velocity_rest is not None:
             twist_error[:3] += velocity_rest
         wrench = self._stiffness * error + self._damping @ twist_error
+        self.last_force = wrench[:3].copy()
         tau_0 = g.nullspace_stiffness * (self.rest_posture - q) - self._nullspace_damping * qdot
         tau = state.gravity + J.T @ wrench + self._nullspace_projector @ tau_0
         if self.torque_limit is not None:

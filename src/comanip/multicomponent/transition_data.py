@@ -16,6 +16,7 @@ progress bar.
 
 from __future__ import annotations
 
+from typing import NamedTuple
 
 import numpy as np
 from tqdm import tqdm
@@ -83,6 +84,43 @@ def simulate_condition(planner: Planner, distance_over_arm_length: float, width:
     }
 
 
+class TransitionSweep(NamedTuple):
+    """The validated inputs of :func:`generate_transition_data` (see its arguments)."""
+
+    distances: np.ndarray
+    """D/L (R,), dimensionless."""
+    widths: np.ndarray
+    """w (K,), m."""
+    n_trials: int
+    model: ReachingModel
+    arm_length: float
+    """L, m."""
+    steps: int
+    seed: int
+    workers: int
+
+
+def checked_sweep(distances_over_arm_length, widths, n_trials: int, *, model: ReachingModel | None, arm_length: float,
+                  steps: int | None, seed: int, workers: int) -> TransitionSweep:
+    """The inputs of :func:`generate_transition_data` validated before any work (ValueError naming the argument)."""
+    model = presets.planar() if model is None else model
+    if not isinstance(model, ReachingModel):
+        raise ValueError(f"model must be a comanip.ReachingModel, got {type(model).__name__}")
+    if not model.body.is_linear:
+        raise ValueError(f"model must be a point-mass model (the person starts at rest at the origin and reaches along x), "
+                         f"got {model.name!r}, an arm ({model.body.name})")
+    distances = np.ravel(as_positive_array("distances_over_arm_length", distances_over_arm_length, "D/L"))
+    widths = np.ravel(as_positive_array("widths", widths, "goal width, m"))
+    if distances.size == 0 or widths.size == 0:
+        raise ValueError(f"distances_over_arm_length and widths must not be empty, got {distances.size} and {widths.size} values")
+    arm_length = as_positive("arm_length", arm_length, "m")
+    n_trials = as_count("n_trials", n_trials, 3)
+    steps = default_steps(model) if steps is None else as_count("steps", steps, 1)
+    workers = as_count("workers", workers, 1)
+    seed = as_count("seed", seed, 0)
+    return TransitionSweep(distances, widths, n_trials, model, arm_length, steps, seed, workers)
+
+
 def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 40, *,
                              model: ReachingModel | None = None, arm_length: float = ARM_LENGTH,
                              steps: int | None = None, seed: int = 0, workers: int = 2,
@@ -102,21 +140,8 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
             a script that calls this with workers > 1 needs the ``if __name__ == "__main__":`` guard.
         progress: show a tqdm bar over conditions.
     """
-    model = presets.planar() if model is None else model
-    if not isinstance(model, ReachingModel):
-        raise ValueError(f"model must be a comanip.ReachingModel, got {type(model).__name__}")
-    if not model.body.is_linear:
-        raise ValueError(f"model must be a point-mass model (the person starts at rest at the origin and reaches along x), "
-                         f"got {model.name!r}, an arm ({model.body.name})")
-    distances = np.ravel(as_positive_array("distances_over_arm_length", distances_over_arm_length, "D/L"))
-    widths = np.ravel(as_positive_array("widths", widths, "goal width, m"))
-    if distances.size == 0 or widths.size == 0:
-        raise ValueError(f"distances_over_arm_length and widths must not be empty, got {distances.size} and {widths.size} values")
-    arm_length = as_positive("arm_length", arm_length, "m")
-    n_trials = as_count("n_trials", n_trials, 3)
-    steps = default_steps(model) if steps is None else as_count("steps", steps, 1)
-    workers = as_count("workers", workers, 1)
-    seed = as_count("seed", seed, 0)
+    distances, widths, n_trials, model, arm_length, steps, seed, workers = checked_sweep(
+        distances_over_arm_length, widths, n_trials, model=model, arm_length=arm_length, steps=steps, seed=seed, workers=workers)
 
     conditions = [(float(r), float(w)) for r in distances for w in widths]
     seeds = np.random.SeedSequence(seed).spawn(len(conditions))

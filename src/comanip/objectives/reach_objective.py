@@ -24,10 +24,16 @@ def reach_objective(ee_means, ee_covs, torques, goal, width, weights, nu, reward
     return total + nu * effort
 
 
-def stopping_cost(mean_velocity, velocity_cov, stop_weight: float):
-    """stop_weight · E||qdot||² = stop_weight (||mu_qdot||² + tr Sigma_qdot) of the final state (the
-    model's stopping requirement, which the planner scales by |J_best|): mean_velocity (n,), velocity_cov (n, n),
-    CasADi or NumPy."""
-    if isinstance(mean_velocity, (ca.SX, ca.MX)):
-        return stop_weight * (ca.sumsqr(mean_velocity) + ca.trace(velocity_cov))
-    return stop_weight * float(np.sum(np.square(mean_velocity)) + np.trace(velocity_cov))
+def velocity_cost(velocity_means, velocity_covs, stop_weight, joint_velocity_weight):
+    """The model's speed cost before its |J_best| scale (SPEC §4 options ``stop_weight`` c_s and
+    ``joint_velocity_weight`` c_v), over the velocity beliefs of steps i = 1..H:
+
+        c_s E||qdot_H||² + c_v (1/H) Σ_{i=1..H} E||qdot_i||²,   E||qdot_i||² = ||mu_qdot,i||² + tr Sigma_qdot,i.
+
+    velocity_means[i] (n,) and velocity_covs[i] (n, n), i = 0..H-1 for steps 1..H, CasADi or NumPy (the weights
+    may be CasADi symbols); returns an expression or a float. Speeds in rad/s or m/s, weights in (s/rad)² or (s/m)².
+    """
+    symbolic = isinstance(velocity_means[0], (ca.SX, ca.MX))
+    energies = [(ca.sumsqr(m) + ca.trace(S)) if symbolic else float(np.sum(np.square(m)) + np.trace(S))
+                for m, S in zip(velocity_means, velocity_covs)]
+    return stop_weight * energies[-1] + joint_velocity_weight * sum(energies) / len(energies)

@@ -33,30 +33,41 @@ def minimum_jerk(x0, v0, x1, duration: float, t) -> tuple[np.ndarray, np.ndarray
     return pos, vel, acc
 
 
-def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration: float) -> np.ndarray:
+def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration: float,
+                         linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Commands (H, n) that make the mean follow a joint-space minimum-jerk reach from start (nx,) to goal_q (n,)
-    (through the body's activation stages, if it has them)."""
+    (through the body's activation stages, if it has them).
+
+    ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics`, evaluated
+    once by a caller that makes many guesses; None evaluates them here."""
     t = h * np.arange(H)
     q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n:2 * body.n], goal_q, duration, t)
     if body.is_linear:  # constant M and G: inverse dynamics of all steps at once
-        M = np.asarray(body.mass_matrix_function(q[0]))
-        G = np.asarray(body.gravity_function(q[0])).ravel()
+        M, G = linear_dynamics or linear_dynamics_of(body)
         return body.command_for_force(qddot @ M.T + qdot @ body.damping.T + G, h)
     return body.command_for_force(np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(H)]), h)
 
 
+def linear_dynamics_of(body: Body) -> tuple[np.ndarray, np.ndarray]:
+    """(M (n, n), G (n,)) of a linear body: the same at every q."""
+    q = np.zeros(body.n)
+    return np.asarray(body.mass_matrix_function(q)), np.asarray(body.gravity_function(q)).ravel()
+
+
 def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations,
-                       mean: np.ndarray | None = None) -> list[np.ndarray]:
+                       mean: np.ndarray | None = None,
+                       linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> list[np.ndarray]:
     """A plan's torques (H, n) with a rest-to-rest minimum-jerk move by shift_q (n,) superposed, one result
     per duration (s): delta tau = M(q_i) delta qddot_i + D delta qdot_i along the plan's mean (H+1, 2n).
 
     For a linear body the mean is affine in the torques, so each result moves the whole planned mean path
     by a smooth reach of shift_q: a plan for one goal becomes a good start for a nearby goal (three to
     four times fewer Newton iterations than the unmodified plan, benchmarks/README.md). For a nonlinear
-    body (M evaluated along ``mean``, required then) it holds to first order.
+    body (M evaluated along ``mean``, required then) it holds to first order. ``linear_dynamics``: as for
+    :func:`minimum_jerk_torques`.
     """
     if body.is_linear:
-        inertia = np.broadcast_to(np.asarray(body.mass_matrix_function(np.zeros(body.n))), (H, body.n, body.n))
+        inertia = np.broadcast_to((linear_dynamics or linear_dynamics_of(body))[0], (H, body.n, body.n))
     elif mean is None:
         raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
     else:

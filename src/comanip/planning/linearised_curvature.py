@@ -10,6 +10,9 @@ dynamics along all of it (CasADi's: about 20 s per evaluation for the Panda). Th
   on q_i (d vech(J Sigma_qq Jᵀ)/dq_i · T_i);
 - the curvature of the kinematics, Σ_i T_iᵀ ∇²_q [∇_mu phi_i · x_ee(q) + <Λ_i, J(q) Sigma_qq J(q)ᵀ>] T_i;
 - the noise's own curvature and the effort, as for linear bodies;
+- the model's speed cost (``stop_weight``, ``joint_velocity_weight``) in the same way: its mean part
+  Σ_i c_i ||mu_qdot,i||² through the joint-velocity rows of T_i (Gauss–Newton), its covariance part
+  Σ_i c_i tr Sigma_qdot,i through the noise injected at each step (A, B held);
 
 and leaves out the curvature of the dynamics and the dependence of A_i, B_i on the mean path. Along the
 eigenvectors of the exact Hessian it agrees to a few per cent except in a handful of directions of
@@ -27,6 +30,7 @@ import casadi as ca
 import numpy as np
 
 from comanip.belief.propagation import belief_step_function, linearised_step_function
+from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
 from comanip.planning.curvature import _causal_gram, _noise_second_derivatives, _reward_derivatives_function
@@ -60,6 +64,9 @@ class LinearisedCurvature:
         self._terms = BufferedFunction(compiled(terms) if compile else terms)
         self._value = BufferedFunction(compiled(value) if compile else value)
         self._noise_hessian = _noise_second_derivatives(model)
+        # the speed cost's weights enter the compiled functions as an input, so every weight shares one build
+        self._speed_weights = ((np.array([model.stop_weight, model.joint_velocity_weight]),)
+                               if model.has_velocity_cost else ())
 
     def _functions(self, problem: ReachProblem) -> tuple[ca.Function, ca.Function]:
         """The per-solve functions, both ``(x, s0, goal, width) -> ...`` with per-step outputs stacked horizontally:
@@ -68,6 +75,8 @@ class LinearisedCurvature:
           :class:`~comanip.planning.terms.ArmTerms` (W its ``kinematic_hessian``);
         - value: ``(f, mean)``, the forward rollout alone (0.4 ms against the terms' 2.4 ms on the Panda), for line-search
           trials and comparisons of initial guesses.
+
+        A model with a speed cost adds a fifth input, its weights [stop_weight, joint_velocity_weight] (2,).
         """
         model, body = problem.model, problem.model.body
         n, d, H = model.n, model.d, model.H
@@ -85,10 +94,14 @@ class LinearisedCurvature:
             cov.append(Sigma)
         means, covs = ca.horzcat(*mean), ca.horzcat(*cov)
         f = ca.sum2(cost.map(H + 1)(means, covs, goal, width, weights)) + model.nu * ca.sumsqr(x) / scale
+        inputs, input_names = [x, s0, goal, width], ["x", "s0", "goal", "width"]
+        if model.has_velocity_cost:  # scaled by |J_best| in J, so unscaled in f = J / |J_best|
+            speed_weights = ca.MX.sym("speed_weights", 2)
+            f += velocity_cost([m[n:] for m in mean[1:]], [S[n:, n:] for S in cov[1:]], speed_weights[0], speed_weights[1])
+            inputs, input_names = inputs + [speed_weights], input_names + ["speed_weights"]
         _, A, B = linearised_step_function(body, model.h).map(H)(means[:, :H], tau)
         J, phi_hess, phi_grad, W, dvech = _stage_curvature_function(model, self._triangle).map(H + 1)(
             means, covs, goal, width, weights)
-        inputs, input_names = [x, s0, goal, width], ["x", "s0", "goal", "width"]
         terms = ca.Function("arm_reach_terms", inputs,
                             [f, ca.gradient(f, x), means, covs, A, B, J, phi_hess, phi_grad, W, dvech], input_names,
                             ["f", "grad", "mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "W", "dvech"])
@@ -102,7 +115,7 @@ class LinearisedCurvature:
     def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ArmTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""
         n2, d = 2 * self.model.n, self.model.d
-        f, grad, *terms = self._terms(x, params[:n2], params[n2:n2 + d], params[-1])
+        f, grad, *terms = self._terms(x, params[:n2], params[n2:n2 + d], params[-1], *self._speed_weights)
         return float(f.item()), grad.ravel(), ArmTerms(x=np.array(x, dtype=float), width=params[-1],
                                                        **dict(zip(_TERM_FIELDS, terms)))
 
@@ -112,7 +125,7 @@ class LinearisedCurvature:
     def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, Rollout]:
         """(f, data for :meth:`mean_path`) at torques x: the forward rollout alone, without derivatives."""
         n2, d = 2 * self.model.n, self.model.d
-        f, means = self._value(x, params[:n2], params[n2:n2 + d], params[-1])
+        f, means = self._value(x, params[:n2], params[n2:n2 + d], params[-1], *self._speed_weights)
         return float(f.item()), Rollout(np.array(x, dtype=float), params[-1], means)
 
     @staticmethod
@@ -168,6 +181,9 @@ class LinearisedCurvature:
         QX = Q @ X
         S = np.zeros((H + 1, 2 * n, 2 * n))
         S[:, :n, :n] = np.swapaxes(X, 1, 2) @ QX + W
+        speed = self._speed_weights_per_step()
+        if speed is not None:  # the speed cost's mean part, Σ_i c_i ||mu_qdot,i||²: 2 c_i I on the velocities
+            S[:, n:, n:] += 2 * speed[:, None, None] * np.eye(n)
         for i in range(H - 1, 0, -1):
             S[i] += A[i].T @ S[i + 1] @ A[i]
         upper = (np.swapaxes(T[1:].reshape(H, 2 * n, H * n), 1, 2) @ (S[1:] @ B))  # (l, (k, r), s), zero for k > l
@@ -181,10 +197,23 @@ class LinearisedCurvature:
         Lambda = np.zeros((H + 1, d, d))
         Lambda[:, a, b] = Lambda[:, b, a] = (phi_grad[d:] * np.where(a == b, 1.0, 0.5)[:, None]).T
         weighted = np.einsum("iakr,iab,ibks->krs", G, Lambda, G, optimize=True)
+        if speed is not None:  # its covariance part Σ_i c_i tr Sigma_qdot,i = Σ_k <Σ_i c_i T_v,ikᵀ T_v,ik, N(tau_k)>
+            weighted += np.einsum("i,iakr,iaks->krs", speed, T[:, n:], T[:, n:], optimize=True)
         blocks = np.einsum("krs,jlrs->kjl", weighted, self._noise_hessian)
         hessian.reshape(H, n, H, n)[diagonal, :, diagonal, :] += blocks
         hessian[np.diag_indices(H * n)] += 2 * model.nu / self.normaliser(width)
         return hessian
+
+    def _speed_weights_per_step(self) -> np.ndarray | None:
+        """c_i (H+1,) of the speed cost Σ_i c_i E||qdot_i||² (c_0 = 0: the start is given); None without one."""
+        if not self._speed_weights:
+            return None
+        stop, running = self._speed_weights[0]
+        H = self.model.H
+        c = np.full(H + 1, running / H)
+        c[0] = 0.0
+        c[-1] += stop
+        return c
 
     def goal_derivatives(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned.

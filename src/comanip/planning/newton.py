@@ -76,7 +76,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         hessian: data -> ∇²f (N, N), symmetric.
         x0: start (N,), projected onto the box; lb, ub: bounds (N,), ±inf allowed.
         tolerance: on max |gradient of the Lagrangian|.
-        max_iterations: Hessian evaluations allowed.
+        max_iterations: iterations allowed (each evaluates the Hessian, except a last one that only finds the
+            point converged).
         secant: add symmetric rank-one corrections to an approximate Hessian.
         constraints: (x, data) -> (c (m,), rows), rows(indices) -> dc_indices/dx (len(indices), N); None
             for none. Entries of c may be -inf (no constraint).
@@ -88,8 +89,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             is accepted. None: trials use ``evaluate``.
 
     Returns:
-        A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the Hessian
-        evaluations, optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included.
+        A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
+        optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included.
     """
     solver = _ActiveSetNewton(evaluate, hessian, _Constraints(lb, ub, constraints), value, tolerance=tolerance,
                               constraint_tolerance=constraint_tolerance, margin=margin)
@@ -142,8 +143,15 @@ class _ActiveSetNewton:
                 return result(Status.MAX_ITERATIONS, f"{iterations} iterations", np.inf)
             if expired():
                 return result(Status.MAX_WALL_TIME, "wall-time budget spent", np.inf)
-            hessian = self.hessian(point.data)
             iterations += 1
+            if not np.any(point.c > -self.margin):
+                # no constraint in the working set: the Lagrangian's gradient is the gradient, and a converged
+                # point needs no Hessian (a warm point-mass solve's last of about five)
+                optimality = float(np.max(np.abs(point.g)))
+                converged = self._converged(optimality, point, history)
+                if converged is not None:
+                    return result(*converged, optimality)
+            hessian = self.hessian(point.data)
             if not np.all(np.isfinite(hessian)):
                 return result(Status.FAILED, "Hessian not finite", np.inf)
             if secant:

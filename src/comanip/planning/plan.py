@@ -42,9 +42,9 @@ class Plan:
     t: np.ndarray
     """Times (H+1,), s."""
     mean: np.ndarray
-    """Mean state mu_i = [q; qdot] (H+1, 2n)."""
+    """Mean state mu_i = [q; qdot; activation forces] (H+1, nx): nx = 2n, plus n per activation stage."""
     cov: np.ndarray
-    """State covariance Sigma_i (H+1, 2n, 2n)."""
+    """State covariance Sigma_i (H+1, nx, nx)."""
     torque: np.ndarray
     """Planned command tau_i (H, n); tau_i acts from t_i to t_{i+1}."""
     ee_mean: np.ndarray
@@ -54,7 +54,7 @@ class Plan:
     ee_velocity: np.ndarray
     """End-effector mean velocity J(mu_q) mu_qdot (H+1, d), m/s."""
     start: np.ndarray
-    """Start state s_0 (2n,)."""
+    """Start state s_0 (nx,)."""
     goal: np.ndarray
     """Goal position (d,), m."""
     width: float

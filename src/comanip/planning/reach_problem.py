@@ -14,8 +14,9 @@ import numpy as np
 from comanip.belief.propagation import belief_step_function, end_effector_belief_function
 from comanip.model import ReachingModel
 from comanip.objectives.discounting import discount_weights
-from comanip.objectives.reach_objective import reach_objective, stopping_cost
+from comanip.objectives.reach_objective import reach_objective, velocity_cost
 from comanip.objectives.reward import GoalReward
+from comanip.planning.compiled import BufferedFunction
 from comanip.planning.plan import Plan
 
 
@@ -51,9 +52,10 @@ class ReachProblem:
         self._weight_sum = float(np.sum(weights))
         self.normaliser_function = ca.Function("normaliser", [self.width], [-self.best_objective])
         """``width -> |J_best(w)|`` as a CasADi function (for building other functions of the width)."""
-        if model.stop_weight > 0:  # relative to the best reward, so it means the same for every width
-            self.objective += -self.best_objective * stopping_cost(self.means[-1][n:2 * n], self.covs[-1][n:2 * n, n:2 * n],
-                                                                   model.stop_weight)
+        if model.has_velocity_cost:  # relative to the best reward, so it means the same for every width
+            self.objective += -self.best_objective * velocity_cost(
+                [m[n:2 * n] for m in self.means[1:]], [S[n:2 * n, n:2 * n] for S in self.covs[1:]],
+                model.stop_weight, model.joint_velocity_weight)
 
         self.trajectory = ca.Function(
             "trajectory", [ca.vec(self.tau), self.s0, self.goal, self.width],
@@ -61,7 +63,9 @@ class ReachProblem:
              ca.horzcat(*self.ee_covs), self.objective],
             ["tau", "s0", "goal", "width"], ["mean", "cov", "ee_mean", "ee_cov", "J"])
         q, qdot = ca.SX.sym("q", n), ca.SX.sym("qdot", n)
-        self._ee_velocity = ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1)
+        self._ee_velocity = BufferedFunction(ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1))
+        # NumPy in and out without CasADi's DM conversions (they cost more than a point mass's rollout itself)
+        self._trajectory = BufferedFunction(self.trajectory)
         self._ee_belief = ee.map(H + 1)
 
     def normaliser(self, width: float) -> float:
@@ -71,12 +75,12 @@ class ReachProblem:
 
     def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
         """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
-        return float(np.asarray(self._rollout(torque, start, goal, width)["J"]).item())
+        return float(self._rollout(torque, start, goal, width)["J"].item())
 
-    def _rollout(self, torque: np.ndarray, start, goal, width) -> dict[str, ca.DM]:
+    def _rollout(self, torque: np.ndarray, start, goal, width) -> dict[str, np.ndarray]:
         """:attr:`trajectory`'s outputs by name: mean (nx, H+1), cov (nx, nx·(H+1)), ee_mean (d, H+1),
         ee_cov (d, d·(H+1)), J."""
-        return self.trajectory(tau=np.ravel(torque), s0=start, goal=goal, width=width)
+        return dict(zip(self.trajectory.name_out(), self._trajectory(np.ravel(torque), start, goal, width)))
 
     def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
                   solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
@@ -89,14 +93,14 @@ class ReachProblem:
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
         if belief is None:
-            rollout = {name: np.asarray(value) for name, value in self._rollout(torque, start, goal, width).items()}
+            rollout = self._rollout(torque, start, goal, width)
             ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
             mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
         else:
             mean, cov = belief
             ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
             J = np.asarray(objective, dtype=float)
-        ee_velocity = np.asarray(self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)).T
+        ee_velocity = self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)[0].T
         return Plan(
             success=bool(success), status=status, message=message, objective=float(J.item()),
             solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),

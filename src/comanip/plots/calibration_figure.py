@@ -16,7 +16,7 @@ def plot_calibration(rows: list[dict], path: str | Path, title: str = "") -> Pat
     """Save a PNG from calibration summary rows (:meth:`CalibrationResult.summary`): left, t_peak/MT over the
     grid (bar from min to max, dot at the median) with the 0.5 claim and the minimum-jerk value; right, the
     better of the Fitts and Shannon R². Green rows get Fitts' law (every criterion), grey rows do not."""
-    fig, (ax_ratio, ax_r2) = plt.subplots(1, 2, figsize=(12, 0.32 * len(rows) + 1.6), sharey=True,
+    fig, (ax_ratio, ax_r2) = plt.subplots(1, 2, figsize=(12, 0.32 * len(rows) + 2.4), sharey=True,
                                           gridspec_kw={"width_ratios": [3, 2]})
     y = np.arange(len(rows))[::-1]
     for yi, row in zip(y, rows):
@@ -31,7 +31,8 @@ def plot_calibration(rows: list[dict], path: str | Path, title: str = "") -> Pat
     ax_ratio.plot([], [], "ok", ms=4, label="median (open loop)")
     ax_ratio.plot([], [], "sk", ms=4, label="median (closed loop)")
     ax_ratio.set(yticks=y, yticklabels=[f"{r['configuration']}" for r in rows], xlabel="t_peak / MT over the grid (min–max)")
-    ax_ratio.legend(fontsize=7, loc="lower right")
+    # below the axes, where it cannot cover a bar
+    ax_ratio.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=4, frameon=False)
     ax_ratio.grid(alpha=0.3, axis="x")
     ax_r2.axvline(FITTS_R2_MIN, color="C3", ls="--", lw=1)
     ax_r2.set(xlabel="best R² (Fitts or Shannon); green: Fitts' law holds", xlim=(0, 1))

@@ -93,3 +93,9 @@ def human_cartesian() -> ReachingModel:
 def franka() -> ReachingModel:
     """Franka Emika Panda (n = 7 joints, d = 3), H = 50, h = 0.035 s; start from ``model.body.home_position``."""
     return load("franka")
+
+
+def franka_rest() -> ReachingModel:
+    """The franka preset with the speed costs (stop_weight 1, joint_velocity_weight 0.02 (s/rad)²): the arm ends
+    at rest and does not swing its wrist after the hand has stopped (benchmarks/franka_rest.py)."""
+    return load("franka_rest")

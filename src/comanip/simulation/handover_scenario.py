@@ -61,6 +61,7 @@ class HandoverRobot:
         self.controller, self.schedule, self.dt = controller, schedule, dt
         self.switch_time: float | None = None
         self.switch_position: np.ndarray | None = None
+        self.goal_estimate = schedule.goal          # the robot leads to the nominal goal it was given
         self.controller.translational_stiffness = np.full(3, schedule.leading_stiffness)
 
     def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
@@ -139,7 +140,7 @@ def handover_metrics(record: TrialRecord, robot: HandoverRobot, width: float) ->
         "within_width": final_error <= width,
         "person_goal_m": record.goal.tolist(),
         "replans": record.replans,
-        "failed_replans": record.failed_replans,
+        "iteration_capped_replans": record.iteration_capped_replans,
     }
 
 

@@ -13,8 +13,8 @@ from comanip.simulation.scenario import ScenarioSettings, TrialRecord
 
 
 def summarise(metrics: list[dict]) -> dict:
-    """Mean, std (ddof 1 when ≥ 2 trials), min and max over trials of every numeric scalar measure;
-    booleans give the fraction of trials where they hold."""
+    """Mean, std (ddof 1 when ≥ 2 trials), median, quartiles (q25, q75), min and max over the trials where
+    each numeric scalar measure is finite; booleans give the fraction of trials where they hold."""
     out = {}
     for key in metrics[0]:
         values = [m[key] for m in metrics]
@@ -25,6 +25,9 @@ def summarise(metrics: list[dict]) -> dict:
             finite = array[np.isfinite(array)]
             out[key] = {"mean": _number(np.mean(finite)) if len(finite) else None,
                         "std": _number(np.std(finite, ddof=1)) if len(finite) > 1 else None,
+                        "median": _number(np.median(finite)) if len(finite) else None,
+                        "q25": _number(np.percentile(finite, 25)) if len(finite) else None,
+                        "q75": _number(np.percentile(finite, 75)) if len(finite) else None,
                         "min": _number(np.min(finite)) if len(finite) else None,
                         "max": _number(np.max(finite)) if len(finite) else None,
                         "finite_trials": int(len(finite))}

@@ -17,22 +17,31 @@ from comanip.planning.plan import Plan
 
 
 class RestTrajectory:
-    """Rest position and velocity of a plan, sampled once on a fine time grid and looked up per control step.
+    """A rest motion sampled on a fine time grid and looked up per control step.
 
     Args:
-        plan: a plan in task space (d = 3).
-        time_offset: real time (s) of the plan's step 0; the rest at time t is the plan at t - time_offset.
-        dt: control period (s) of the lookup grid.
-        duration: real time (s) the grid must cover from time_offset on.
+        position: rest positions (N, 3), m, at times time_offset + k·dt.
+        velocity: rest velocities (N, 3), m/s, at the same times.
+        time_offset: real time (s) of sample 0.
+        dt: control period (s) of the grid.
     """
 
-    def __init__(self, plan: Plan, time_offset: float, dt: float, duration: float):
-        spline = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
+    def __init__(self, position, velocity, time_offset: float, dt: float):
+        self.position, self.velocity = np.array(position, dtype=float), np.array(velocity, dtype=float)
+        if self.position.ndim != 2 or self.position.shape != self.velocity.shape or len(self.position) == 0:
+            raise ValueError(f"position and velocity must be (N, d) arrays of one shape, got "
+                             f"{self.position.shape} and {self.velocity.shape}")
         self.time_offset, self.dt = float(time_offset), float(dt)
+
+    @classmethod
+    def from_plan(cls, plan: Plan, time_offset: float, dt: float, duration: float) -> "RestTrajectory":
+        """A plan in task space (d = 3) as the rest motion: the plan at t - time_offset for real time t (s),
+        sampled every dt (s) over duration (s) from time_offset on."""
+        spline = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
         tau = np.arange(int(np.ceil(duration / dt)) + 2) * dt
         inside = np.minimum(tau, plan.t[-1])
-        self.position = spline(inside)
-        self.velocity = np.where((tau <= plan.t[-1])[:, None], spline(inside, 1), 0.0)
+        velocity = np.where((tau <= plan.t[-1])[:, None], spline(inside, 1), 0.0)
+        return cls(spline(inside), velocity, time_offset, dt)
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:
         """(rest position (3,) m, rest velocity (3,) m/s) at real time t (s), held at the ends."""

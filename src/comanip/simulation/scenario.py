@@ -122,6 +122,9 @@ class ScenarioSettings:
 class RobotBehaviour(Protocol):
     """What a scenario's robot does every control step: sets the controller's stiffness, returns its rest motion."""
 
+    goal_estimate: np.ndarray | None
+    """Where the robot currently thinks the goal is (3,), m; None while it has no estimate."""
+
     def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray | None]:
         """(rest position (3,) m, rest velocity (3,) m/s or None) at time t (s) for the arm in ``state``."""
 
@@ -146,20 +149,27 @@ class TrialRecord:
     """The controller's translational stiffness (K, 3)."""
     person_force: np.ndarray
     """The person's force on the handle (K, 3)."""
+    robot_force: np.ndarray
+    """The impedance's translational force on the handle over the step from each sample (K, 3): K e + D e_dot."""
     goal: np.ndarray
     """The person's goal (3,)."""
+    goal_estimate: np.ndarray | None = None
+    """The robot's goal estimate at each sample (K, 3), m; NaN rows before it has one (None: never)."""
     qpos: np.ndarray | None = None
     """Joint positions (K, 7), rad: for replays and pictures."""
     replans: int = 0
     """Re-plans the person made."""
-    failed_replans: int = 0
-    """Re-plans that stopped at their iteration limit before converging (the refined plan was still used)."""
+    iteration_capped_replans: int = 0
+    """The person's re-plans that used all their solver iterations (:attr:`PersonParameters.iterations_per_replan`)
+    before the convergence test passed: not a failure, a refinement of the previous plan that was still
+    improving when the person acted on it (as intended: a person refines, they do not re-optimise)."""
     wall_time: float = 0.0
     """Wall time of the trial (s), robot solves and the person's re-plans included."""
     replan_time: float = 0.0
     """Wall time of the person's re-plans (s) within wall_time."""
 
-    COLUMNS = ("position", "velocity", "intended_position", "intended_velocity", "rest_position", "stiffness", "person_force")
+    COLUMNS = ("position", "velocity", "intended_position", "intended_velocity", "rest_position", "stiffness", "person_force",
+               "robot_force")
 
     def save_csv(self, path, every: int = 5) -> None:
         """Write every ``every``-th sample (5 ms at 1 kHz) with one column per axis."""
@@ -212,6 +222,7 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
     steps = int(round(duration / dt)) + 1
     record = {name: np.zeros((steps, 3)) for name in TrialRecord.COLUMNS}
     qpos = np.zeros((steps, world.model.nq))
+    goal_estimate = np.full((steps, 3), np.nan)
     t = np.arange(steps) * dt
     for k in range(steps):
         state = world.observe()
@@ -220,6 +231,8 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
         record["intended_position"][k] = person.intended_position
         record["intended_velocity"][k] = person.intended_velocity
         rest_position, rest_velocity = robot.command(t[k], state)
+        if robot.goal_estimate is not None:
+            goal_estimate[k] = robot.goal_estimate
         record["position"][k], record["velocity"][k] = position, velocity
         record["rest_position"][k] = rest_position
         record["stiffness"][k] = world.controller.translational_stiffness
@@ -227,9 +240,11 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
         qpos[k] = state.q
         if k < steps - 1:
             world.step(state, force, rest_position, rest_velocity)
+        record["robot_force"][k] = world.controller.last_force if k < steps - 1 else record["robot_force"][k - 1]
     replans = person.plans[1:]      # the first plan is made before the trial (shared by trials alike)
-    return TrialRecord(t=t, goal=person.goal.copy(), qpos=qpos, replans=len(person.plans),
-                       failed_replans=sum(not plan.converged for plan in replans), wall_time=time.perf_counter() - begin,
+    return TrialRecord(t=t, goal=person.goal.copy(), goal_estimate=goal_estimate, qpos=qpos, replans=len(person.plans),
+                       iteration_capped_replans=sum(not plan.converged for plan in replans),
+                       wall_time=time.perf_counter() - begin,
                        replan_time=sum(plan.solve_time for plan in replans), **record)
 
 

@@ -50,11 +50,13 @@ class CoManipulationWorld:
         return float(self.data.time)
 
     def reset(self, qpos=None, qvel=None) -> None:
-        """Back to time 0 at joints qpos (default: the start posture) with velocities qvel (default: rest)."""
+        """Back to time 0 at joints qpos (default: the start posture) with velocities qvel (default: rest);
+        the controller forgets its damping design (its stiffness is kept)."""
         mujoco.mj_resetData(self.model, self.data)
         self.data.qpos[:] = self.start_posture if qpos is None else qpos
         self.data.qvel[:] = 0.0 if qvel is None else qvel
         mujoco.mj_forward(self.model, self.data)
+        self.controller.reset()
 
     def joint_state(self) -> tuple[np.ndarray, np.ndarray]:
         """Copies of (qpos (7,), qvel (7,)), e.g. to restore a settled state with :meth:`reset`."""

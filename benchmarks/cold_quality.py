@@ -1,0 +1,151 @@
+"""Cold-solve quality: random cold problems per point-mass preset, the current planner against a reference.
+
+    .venv/bin/python benchmarks/cold_quality.py [--problems 200] [--presets planar,cartesian,human,human_cartesian]
+                                                [--compare /path/to/worktree-at-main]
+
+Problems (the same for both sides, seeded): goals 0.1–0.4 m from the start in uniformly drawn directions,
+widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per axis).
+The reference is the code of another checkout (``--compare``: its src/ is imported in a separate process)
+or, without it, this code with ``SolverOptions(cold_search="all")`` (every minimum-jerk guess solved to
+convergence, the best kept). Each side runs in its own process, the presets alternating between them.
+
+Prints per preset and kind of start (rest, moving, all): objectives of the current code worse / better /
+equal (relative 1e-6) than the reference, successes, median and p90 solve times, median iterations; writes
+every problem's row to benchmarks/results/cold_quality.csv (``--summarise CSV`` prints a CSV's table again).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+PRESETS = ("planar", "cartesian", "human", "human_cartesian")
+RELATIVE = 1e-6
+"""Objectives within this relative difference count as equal."""
+
+
+def problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """(start (2n,), goal (d,), width) for ``count`` random cold problems of a point-mass model."""
+    rng = np.random.default_rng(seed)
+    out = []
+    for k in range(count):
+        start = np.zeros(2 * model.n)
+        if k % 2:
+            start[model.n:] = rng.uniform(-0.3, 0.3, model.n)
+        direction = rng.normal(size=model.d)
+        goal = rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+        width = float(np.exp(rng.uniform(np.log(0.005), np.log(0.05))))
+        out.append((start, goal, width))
+    return out
+
+
+def worker(preset: str, count: int, cold_search: str | None) -> None:
+    """Solve the preset's problems with the comanip on sys.path; one JSON line per problem on stdout."""
+    import comanip
+    from comanip.planning.planner import SolverOptions
+
+    model = comanip.presets.load(preset)
+    options = SolverOptions(cold_search=cold_search) if cold_search else SolverOptions()
+    planner = comanip.Planner(model, options)
+    planner.solve(np.zeros(2 * model.n), 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
+    for start, goal, width in problems(model, count):
+        plan = planner.solve(start, goal, width)
+        print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
+                          "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal) / width),
+                          "moving": bool(np.any(start))}), flush=True)
+
+
+def run_side(src: Path, cold_search: str | None, preset: str, count: int) -> list[dict]:
+    """The worker's rows for one preset, run in a fresh process importing comanip from ``src``."""
+    env = {**os.environ, "PYTHONPATH": str(src)}
+    command = [sys.executable, __file__, "--worker", preset, "--problems", str(count)]
+    if cold_search:
+        command += ["--cold-search", cold_search]
+    done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
+    return [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
+
+
+HEADER = (f"{'preset':<16} {'start':<7} {'worse':>6} {'better':>7} {'equal':>6} {'ok new':>7} {'ok ref':>7} "
+          f"{'new ms':>8} {'ref ms':>8} {'new p90':>8} {'ref p90':>8} {'new it':>7} {'ref it':>7}")
+
+
+def summary(rows: list[dict]) -> list[str]:
+    """Table lines: per preset and start (rest, moving, all), the verdict counts, successes, median and p90
+    times and median iterations of both sides."""
+    lines = [HEADER]
+    for preset in dict.fromkeys(row["preset"] for row in rows):
+        for start, keep in (("rest", False), ("moving", True), ("all", None)):
+            part = [r for r in rows if r["preset"] == preset and (keep is None or r["moving"] == keep)]
+            counts = {v: sum(r["verdict"] == v for r in part) for v in ("worse", "better", "equal")}
+            t_new, t_ref = (np.array([float(r[key]) for r in part]) for key in ("new_ms", "ref_ms"))
+            it_new, it_ref = (np.median([int(r[key]) for r in part]) for key in ("new_iterations", "ref_iterations"))
+            ok_new, ok_ref = (sum(r[key] for r in part) for key in ("new_success", "ref_success"))
+            lines.append(f"{preset:<16} {start:<7} {counts['worse']:>6} {counts['better']:>7} {counts['equal']:>6} {ok_new:>7} {ok_ref:>7} "
+                         f"{np.median(t_new):8.2f} {np.median(t_ref):8.2f} {np.percentile(t_new, 90):8.2f} "
+                         f"{np.percentile(t_ref, 90):8.2f} {it_new:7.0f} {it_ref:7.0f}")
+    return lines
+
+
+def read_rows(path: Path) -> list[dict]:
+    """The rows of a CSV this script wrote, typed back."""
+    with open(path) as file:
+        rows = list(csv.DictReader(file))
+    for row in rows:
+        for key in ("moving", "new_success", "ref_success"):
+            row[key] = row[key] == "True"
+    return rows
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--problems", type=int, default=200)
+    parser.add_argument("--presets", default=",".join(PRESETS))
+    parser.add_argument("--compare", type=Path, default=None, help="checkout of the reference code (its src/ is used)")
+    parser.add_argument("--summarise", type=Path, default=None, help="print the table of a CSV written before, solve nothing")
+    parser.add_argument("--worker", default=None, help=argparse.SUPPRESS)
+    parser.add_argument("--cold-search", default=None, help=argparse.SUPPRESS)
+    args = parser.parse_args(argv)
+    if args.worker:
+        worker(args.worker, args.problems, args.cold_search)
+        return
+    if args.summarise:
+        print("\n".join(summary(read_rows(args.summarise))))
+        return
+    here = Path(__file__).resolve().parents[1] / "src"
+    reference = (args.compare.resolve() / "src", None) if args.compare else (here, "all")
+    label = f"{args.compare}" if args.compare else "cold_search='all'"
+    print(f"reference: {label}; {args.problems} problems per preset; equal = within {RELATIVE:g} relative", flush=True)
+    rows = []
+    for preset in args.presets.split(","):
+        new = run_side(here, None, preset, args.problems)
+        ref = run_side(*reference, preset, args.problems)
+        for k, (a, b) in enumerate(zip(new, ref)):
+            relative = (a["objective"] - b["objective"]) / abs(b["objective"])
+            verdict = "worse" if relative > RELATIVE else "better" if relative < -RELATIVE else "equal"
+            rows.append({"preset": preset, "problem": k, "distance_over_width": a["distance_over_width"],
+                         "moving": a["moving"], "new_objective": a["objective"], "ref_objective": b["objective"],
+                         "relative": relative, "verdict": verdict, "new_success": a["success"], "ref_success": b["success"],
+                         "new_ms": 1e3 * a["time"], "ref_ms": 1e3 * b["time"], "new_iterations": a["iterations"],
+                         "ref_iterations": b["iterations"]})
+            if verdict == "worse":
+                print(f"  {preset} worse: problem {k}, D/w {a['distance_over_width']:.1f}, moving {a['moving']}, "
+                      f"relative {relative:.2e}", flush=True)
+    print("\n".join(summary(rows)))
+    out = Path(__file__).resolve().parent / "results" / "cold_quality.csv"
+    out.parent.mkdir(exist_ok=True)
+    with open(out, "w", newline="") as file:
+        writer = csv.DictWriter(file, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()

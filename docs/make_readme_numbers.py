@@ -1,0 +1,78 @@
+"""Rewrite the measured blocks of README.md, so that no number in them is typed by hand.
+
+    PYTHONPATH=src python docs/make_readme_numbers.py [NAME ...] [--list] [--readme README.md]
+
+Each block between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` has one script below that measures it and
+prints the block's markdown on stdout; this runs the scripts of the blocks named (default: all, in order;
+the slow ones take minutes) and replaces each block's text with the output. ``tests/test_readme.py`` checks
+that every table of numbers in the README sits in such a block and that every block has its script here.
+Numbers in the prose name their command in the README's "Where the numbers come from".
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from readme_blocks import block_names, block_spans, replace_block  # noqa: E402  (a sibling script, not a package)
+
+#: block name: (what it shows, the command that prints it, run from the repository root)
+BLOCKS: dict[str, tuple[str, list[str]]] = {
+    "calibration-study": ("the calibration study of the planar preset's family (about 10 min)",
+                          ["docs/print_calibration_study.py"]),
+    "human-targets": ("the human-likeness targets, paper preset beside the human one and its variants (about 30 min)",
+                      ["docs/make_calibration_table.py", "planar", "human",
+                       *(f"docs/variants/human_{name}.yaml" for name in ("paper_damping", "hit_reward", "effective_width",
+                                                                          "stopping", "hyperbolic")),
+                       "--trials", "20"]),
+    "policy-comparison": ("robot policies compared on the sync scenario, 20 trials × 4 goals (about 10 min idle, an hour loaded)",
+                          ["docs/make_policy_comparison.py", "--trials", "20"]),
+    "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
+              ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
+               "planar,planar_cold,cartesian,cartesian_cold,human,human_cold,human_cartesian,human_cartesian_cold,"
+               "franka,franka_cold,franka_rest,franka_rest_cold,franka_replan"]),
+    "transition-trends": ("Peternel & Babič's trends in the shipped transition data and the fitted model (seconds)",
+                          ["docs/print_transition_trends.py"]),
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("names", nargs="*", help=f"blocks to rewrite (default: all): {', '.join(BLOCKS)}")
+    parser.add_argument("--list", action="store_true", help="list the blocks and their commands, and stop")
+    parser.add_argument("--readme", type=Path, default=ROOT / "README.md")
+    args = parser.parse_args(argv)
+    if args.list:
+        for name, (what, command) in BLOCKS.items():
+            print(f"{name}: {what}\n    {' '.join(command)}")
+        return 0
+    unknown = sorted(set(args.names) - set(BLOCKS))
+    if unknown:
+        parser.error(f"unknown blocks {unknown}; known: {', '.join(BLOCKS)}")
+    text = args.readme.read_text(encoding="utf-8")
+    missing = sorted(set(BLOCKS) - set(block_names(text)))
+    if missing:
+        parser.error(f"{args.readme} lacks the blocks {missing}")
+    for name in args.names or list(BLOCKS):
+        command = [sys.executable, *BLOCKS[name][1]]
+        began = time.perf_counter()
+        print(f"{name}: {' '.join(BLOCKS[name][1])} …", file=sys.stderr, flush=True)
+        # the script's progress goes to stderr, shown as it runs; its stdout is the block
+        block = subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.PIPE, text=True,
+                               env={**os.environ, "PYTHONPATH": str(ROOT / "src")}).stdout
+        text = replace_block(text, name, block)
+        args.readme.write_text(text, encoding="utf-8")   # after each block: a later failure keeps the earlier ones
+        print(f"{name}: rewritten ({time.perf_counter() - began:.0f} s)", file=sys.stderr, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,55 @@
+"""``comanip ros``: run the ROS 2 goal node, or replay a recording of hand states through it.
+
+``comanip ros --params config.yaml`` starts the node (topics, rates, model and frame from the YAML, a flat
+mapping of the node's parameters or ROS 2's ``node: {ros__parameters: ...}`` layout; ``--ros-args ...``
+passes the rest to ROS, e.g. remappings). ``--replay hand.csv`` instead feeds a CSV of hand states (the
+format ``comanip estimate --observations`` reads) through the node in-process, at ``--speed`` times real
+time or in lock step with it (the default), and writes what it published to ``--out``. Needs the optional
+extra: pip install -e ".[ros]".
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from comanip.arguments import as_positive
+from comanip.cli.options import input_file
+from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
+
+
+def add_parser(subparsers) -> None:
+    parser = subparsers.add_parser("ros", help="the ROS 2 goal node (needs the 'ros' extra)", description=__doc__,
+                                   formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--params", type=input_file, help="the node's parameters, a YAML file (default: the defaults)")
+    parser.add_argument("--replay", type=input_file, help="replay this CSV of hand states (t_s, q0.., qdot0..) through the node")
+    parser.add_argument("--speed", type=float, help="replay at this multiple of real time (default: in lock step with the node)")
+    add_output_arguments(parser, "out/ros", "replay output folder")
+    parser.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="everything after it goes to ROS (remappings, -p name:=value)")
+    parser.set_defaults(func=run)
+
+
+def run(args) -> int:
+    from comanip.ros.settings import NodeSettings
+
+    settings = NodeSettings.from_yaml(args.params) if args.params is not None else NodeSettings()
+    speed = None if args.speed is None else as_positive("--speed", args.speed, "times real time")
+    try:
+        import rclpy  # noqa: F401 - only to say what is missing
+    except ImportError as error:
+        raise ValueError(f"the ROS 2 node needs the 'ros' extra: pip install -e \".[ros]\" (rclpy: {error})") from None
+    if args.replay is not None:
+        from comanip.ros.replay import replay_csv
+
+        out = output_dir(args.out, "ros", args.force)
+        recording, written = replay_csv(settings, args.replay, out, speed)
+        write_manifest(out, "ros", written)
+        last = recording.statuses[-1][3] if recording.statuses else {}
+        print(json.dumps({"estimates": len(recording.goals), "last_goal_m": recording.goals[-1][1].tolist() if recording.goals else None,
+                          "rejected": int(last.get("rejected", 0)), "failed": int(last.get("failed", 0)),
+                          "wall_time_s": recording.wall_time,
+                          "files": [str(p) for p in written]}, indent=1))
+        return 0 if recording.goals else 1
+    from comanip.ros.node import spin
+
+    return spin(settings, args.ros_args)

@@ -1,0 +1,405 @@
+"""The ROS 2 goal node: online goal estimation, prediction and the handover's impedance schedule, in a robot's loop.
+
+Inputs (topic names are parameters, :class:`~comanip.ros.settings.NodeSettings`): the hand's pose and twist,
+a prior goal, a reset. A reach starts at the first hand pose (after startup, a reset, or a gap in the input
+longer than ``input_timeout``): that pose and the twist paired with it are the start s_0 = [x; xdot], and its
+stamp is t = 0. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
+t = stamp - start stamp; at most ``estimation_rate`` of them per second of input time go to the estimator.
+
+The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
+far, any time; the reach starts at rest at the first pose's position) and run in a worker thread, so the
+executor's callbacks only check and queue messages and never wait for a solve; when the worker falls behind,
+the newest observation replaces one still queued (counted as skipped). An estimate is a few Gauss–Newton steps
+on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes longer than
+``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in time.
+Each successful estimate is published at once: g_hat with covariance,
+the predicted hand path, and the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover`
+on the predicted reach (the robot's impedance rest position follows the predicted hand, and its stiffness
+ramps to 0 where the transition model predicts the person takes over). Timers republish the last good
+estimate and the status (``status_rate``), and sample the schedule at the node's clock into the equilibrium
+pose and stiffness (``command_rate``). The status is also published after every estimate and every
+rejected input.
+
+Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed
+or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep
+being published.
+Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped, TwistStamped
+from nav_msgs.msg import Path
+import rclpy
+from rcl_interfaces.msg import ParameterDescriptor
+from rclpy.node import Node
+from rclpy.parameter import Parameter
+from std_msgs.msg import Empty, Float64MultiArray
+
+from comanip.estimation import GoalEstimate, OnlineGoalEstimator
+from comanip.estimation.online_estimator import FamilyCache
+from comanip.estimation.shared import estimation_planner
+from comanip.multicomponent.handover import HandoverSchedule, plan_handover
+from comanip.multicomponent.transition_model import TransitionModel
+from comanip.planning.planner import Planner
+from comanip.ros.messages import (RejectedMessage, Sample, goal_message, path_message, pose_of, read_vector, schedule_message,
+                                  stamp_of, status_message)
+from comanip.ros.settings import NodeSettings
+
+QUEUE_DEPTH = 50
+"""Depth of every subscription and publisher queue (messages)."""
+
+
+def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width) -> OnlineGoalEstimator:
+    """The goal estimator of one reach from ``start`` (2n,), at rest: the one place that names the estimator."""
+    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families)
+
+
+@dataclass
+class Reach:
+    """The reach in progress: its number, start stamp (s), start state s_0 (2n,) (at rest at the first pose's
+    position: the estimator's plans start from rest) and prior goal (d,) or None."""
+
+    number: int
+    start_stamp: float
+    start: np.ndarray
+    prior_goal: np.ndarray | None
+
+
+@dataclass
+class Observation:
+    """A queued observation of ``reach`` at ``t`` s after its start: position (d,) m, velocity (d,) m/s."""
+
+    reach: Reach
+    t: float
+    stamp: float
+    position: np.ndarray
+    velocity: np.ndarray
+    received: float
+    """time.perf_counter() when the pose arrived (s), for the latency."""
+
+
+@dataclass
+class GoodEstimate:
+    """The last successful estimate, the schedule built on it, when (stamps in s), and its three messages
+    (built once, republished as they are)."""
+
+    estimate: GoalEstimate
+    schedule: HandoverSchedule
+    reach: Reach
+    stamp: float
+    messages: tuple
+
+
+class GoalNode(Node):
+    """The node; ``settings`` as checked NodeSettings (ROS parameters given with --ros-args override them),
+    ``transition_model`` the fitted :class:`TransitionModel` of the handover (None: fit on the shipped data, ~5 s)."""
+
+    def __init__(self, settings: NodeSettings, *, transition_model: TransitionModel | None = None, node_name: str = "comanip_goal",
+                 use_sim_time: bool = False, **node_kwargs):
+        super().__init__(node_name, parameter_overrides=[Parameter("use_sim_time", value=use_sim_time)], **node_kwargs)
+        self._lock = threading.Condition()
+        self._stopping = False
+        self._worker: threading.Thread | None = None
+        self.settings = self._declared(settings)
+        s = self.settings
+        model = s.model()
+        self._d = model.d
+        self._horizon = model.H * model.h
+        self._planner = estimation_planner(model)
+        self._families = FamilyCache(size=1)
+        reach_estimator(self._planner, self._families, np.zeros(model.state_size), None, s.width)  # builds the reach family once
+        self._transition = transition_model if transition_model is not None else TransitionModel()
+        self._reach: Reach | None = None
+        self._reach_estimator = None
+        self._prior = None if s.prior_goal is None else np.array(s.prior_goal)
+        self._last_pose: float | None = None
+        self._last_twist: float | None = None
+        self._twists: list[Sample] = []
+        self._unpaired: list[tuple[Sample, float | None, float]] = []
+        """Checked hand poses waiting for their twists: (sample, the previous pose's stamp, when it arrived)."""
+        self._last_input_clock: float | None = None
+        self._last_queued: float | None = None
+        self._pending: Observation | None = None
+        self._busy = False
+        self._good: GoodEstimate | None = None
+        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, estimates=0, failed=0, late=0)
+        self._last = dict(solve_ok=True, solve_status="none", solve_time_s=float("nan"), latency_s=float("nan"), rejection="", event="started")
+
+        self._goal_pub = self.create_publisher(PoseWithCovarianceStamped, s.goal_topic, QUEUE_DEPTH)
+        self._path_pub = self.create_publisher(Path, s.path_topic, QUEUE_DEPTH)
+        self._schedule_pub = self.create_publisher(Float64MultiArray, s.schedule_topic, QUEUE_DEPTH)
+        self._equilibrium_pub = self.create_publisher(PoseStamped, s.equilibrium_topic, QUEUE_DEPTH)
+        self._stiffness_pub = self.create_publisher(Float64MultiArray, s.stiffness_topic, QUEUE_DEPTH)
+        self._status_pub = self.create_publisher(DiagnosticArray, s.status_topic, QUEUE_DEPTH)
+        self.create_subscription(PoseStamped, s.hand_pose_topic, self._on_pose, QUEUE_DEPTH)
+        self.create_subscription(TwistStamped, s.hand_twist_topic, self._on_twist, QUEUE_DEPTH)
+        self.create_subscription(PointStamped, s.prior_goal_topic, self._on_prior, QUEUE_DEPTH)
+        self.create_subscription(Empty, s.reset_topic, self._on_reset, QUEUE_DEPTH)
+        self.create_timer(1.0 / s.command_rate, self._publish_command)
+        self.create_timer(1.0 / s.status_rate, self._republish)
+        self._worker = threading.Thread(target=self._work, name="comanip-goal-estimates", daemon=True)
+        self._worker.start()
+
+    def _declared(self, settings: NodeSettings) -> NodeSettings:
+        """Declare every setting as a ROS parameter and return the settings with the overrides given to the
+        node (``--ros-args -p name:=value``) applied, checked again."""
+        descriptor = ParameterDescriptor(dynamic_typing=True)
+        values = {name: self.declare_parameter(name, value, descriptor).value for name, value in settings.to_mapping().items()}
+        return NodeSettings.from_mapping(values)
+
+    # ---- the executor's callbacks: check, queue, never solve
+    def now(self) -> float:
+        """The node's clock (s): ROS time, or the replay's /clock under use_sim_time."""
+        return self.get_clock().now().nanoseconds * 1e-9
+
+    def _on_twist(self, message: TwistStamped) -> None:
+        with self._lock:
+            try:
+                sample = read_vector("hand twist", message.header, message.twist.linear, self._d, self.settings.frame_id, self._last_twist)
+            except RejectedMessage as error:
+                self._reject(error)
+                return
+            self._last_twist = sample.stamp
+            self._twists = self._twists[-(QUEUE_DEPTH - 1):] + [sample]
+            self._pair()
+
+    def _on_pose(self, message: PoseStamped) -> None:
+        received = time.perf_counter()
+        with self._lock:
+            try:
+                sample = read_vector("hand pose", message.header, message.pose.position, self._d, self.settings.frame_id, self._last_pose)
+            except RejectedMessage as error:
+                self._counts["inputs"] += 1
+                self._reject(error)
+                return
+            self._unpaired.append((sample, self._last_pose, received))
+            self._last_pose = sample.stamp
+            self._last_input_clock = self.now()
+            self._pair()
+
+    def _pair(self) -> None:
+        """Pair each pose waiting for its twist with the twist stamped nearest it (within twist_tolerance) and
+        observe it, in stamp order; a pose older than the newest twist by more than the tolerance never will
+        be paired (twists arrive in stamp order) and is rejected."""
+        tolerance = self.settings.twist_tolerance + 1e-9
+        waiting = []
+        for sample, previous, received in self._unpaired:
+            nearest = min(self._twists, key=lambda twist: abs(twist.stamp - sample.stamp)) if self._twists else None
+            if nearest is not None and abs(nearest.stamp - sample.stamp) <= tolerance:
+                self._counts["inputs"] += 1
+                self._observe(sample, nearest.vector, previous, received)
+            elif self._last_twist is not None and sample.stamp < self._last_twist - tolerance or len(self._unpaired) > QUEUE_DEPTH:
+                self._counts["inputs"] += 1
+                self._reject(RejectedMessage(f"hand pose rejected: no hand twist within {self.settings.twist_tolerance:g} s "
+                                             f"of its stamp {sample.stamp:.6f} s"))
+            else:
+                waiting.append((sample, previous, received))
+        self._unpaired = waiting
+
+    def _observe(self, sample: Sample, velocity: np.ndarray, previous: float | None, received: float) -> None:
+        """Start a reach (after none, a reset or a gap since the ``previous`` pose stamp), or queue the
+        observation, or count it skipped or ignored."""
+        s = self.settings
+        reach = self._reach
+        if reach is None or (previous is not None and sample.stamp - previous > s.input_timeout):
+            number = 1 if reach is None else reach.number + 1
+            self._reach = Reach(number, sample.stamp, np.r_[sample.vector, np.zeros_like(velocity)], self._prior)
+            self._last_queued = sample.stamp
+            self._last["event"] = f"reach {number} started at stamp {sample.stamp:.6f} s"
+            self.get_logger().info(self._last["event"])
+            return
+        t = sample.stamp - reach.start_stamp
+        if t >= self._horizon:
+            self._counts["ignored"] += 1
+            self._last["event"] = f"pose at t = {t:.3f} s is past the model's horizon {self._horizon:g} s; waiting for a reset"
+            return
+        if sample.stamp - self._last_queued < (1.0 - 1e-6) / s.estimation_rate:
+            self._counts["skipped"] += 1
+            return
+        if self._pending is not None:
+            self._counts["skipped"] += 1
+        self._pending = Observation(reach, t, sample.stamp, sample.vector, velocity, received)
+        self._last_queued = sample.stamp
+        self._lock.notify()
+
+    def _on_prior(self, message: PointStamped) -> None:
+        with self._lock:
+            try:
+                sample = read_vector("prior goal", message.header, message.point, self._d, self.settings.frame_id, None)
+            except RejectedMessage as error:
+                self._reject(error)
+                return
+            self._prior = sample.vector
+            self._last["event"] = f"prior goal {sample.vector.tolist()} m, for the next reach"
+            self.get_logger().info(self._last["event"])
+
+    def _on_reset(self, _message: Empty) -> None:
+        with self._lock:
+            self._reach, self._pending, self._good, self._last_queued, self._unpaired = None, None, None, None, []
+            self._last["event"] = "reset: the next hand pose starts a reach"
+            self.get_logger().info(self._last["event"])
+
+    def _reject(self, error: RejectedMessage) -> None:
+        """Count and log a rejected input, and say so in a status at once (called holding the lock)."""
+        self._counts["rejected"] += 1
+        self._last["rejection"] = str(error)
+        self.get_logger().warning(str(error))
+        self._publish_status()
+
+    # ---- the worker: one estimate at a time, the newest observation first
+    def _work(self) -> None:
+        while True:
+            with self._lock:
+                while self._pending is None and not self._stopping:
+                    self._lock.wait()
+                if self._stopping:
+                    return
+                job, self._pending, self._busy = self._pending, None, True
+            try:
+                self._estimate(job)
+            except Exception as error:  # noqa: BLE001 - the node must outlive any solver fault; it is logged
+                self._last.update(solve_ok=False, solve_status=f"error: {type(error).__name__}: {error}")
+                self._counts["failed"] += 1
+                self.get_logger().error(f"estimate at t = {job.t:.3f} s raised {type(error).__name__}: {error}")
+            with self._lock:
+                self._busy = False
+            self._publish_status()
+
+    def _estimate(self, job: Observation) -> None:
+        s = self.settings
+        if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
+            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width)
+            self._reach_estimator = (job.reach, estimator)
+        estimator = self._reach_estimator[1]
+        try:
+            estimate = estimator.update(job.t, job.position, job.velocity)
+        except ValueError as error:
+            self._last["solve_status"] = f"refused: {error}"
+            self.get_logger().info(f"observation at t = {job.t:.3f} s not used: {error}")
+            return
+        if estimate.status == "uninformative":  # the hand has not moved yet: nothing to estimate, nothing failed
+            self._last.update(solve_status=estimate.status, event=f"waiting for movement at t = {job.t:.3f} s")
+            return
+        ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.ee_mean)))
+        self._last.update(solve_ok=ok, solve_status=estimate.status, solve_time_s=estimate.solve_time)
+        if estimate.solve_time > s.max_wall_time:
+            self._counts["late"] += 1
+        if not ok:
+            self._counts["failed"] += 1
+            self.get_logger().warning(f"estimate at t = {job.t:.3f} s failed ({estimate.status}: {estimate.message}); "
+                                      "keeping the last good one, marked stale")
+            return
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
+            schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
+        frame = s.frame_id
+        messages = (goal_message(estimate.goal, estimate.goal_covariance, job.stamp, frame),
+                    path_message(estimate, job.reach.start_stamp, frame), schedule_message(schedule, job.reach.start_stamp))
+        good = GoodEstimate(estimate, schedule, job.reach, job.stamp, messages)
+        with self._lock:
+            if self._reach is not job.reach:
+                return  # a reset or a new reach came while solving
+            self._good = good
+            self._counts["estimates"] += 1
+            self._last["latency_s"] = time.perf_counter() - job.received
+        self._publish_estimate(good)
+
+    # ---- publishing
+    def _publish_estimate(self, good: GoodEstimate) -> None:
+        goal, path, schedule = good.messages
+        self._goal_pub.publish(goal)
+        self._path_pub.publish(path)
+        self._schedule_pub.publish(schedule)
+
+    def _publish_command(self) -> None:
+        good = self._good
+        if good is None:
+            return
+        now = self.now()
+        schedule, t = good.schedule, now - good.reach.start_stamp
+        rest = [np.interp(t, schedule.t, schedule.rest_position[:, k]) for k in range(schedule.rest_position.shape[1])]
+        stiffness = float(np.interp(t, schedule.t, schedule.stiffness))
+        pose = PoseStamped()
+        pose.header.stamp, pose.header.frame_id = stamp_of(now), self.settings.frame_id
+        pose.pose = pose_of(rest, self.settings.equilibrium_orientation)
+        self._equilibrium_pub.publish(pose)
+        rotational = self.settings.rotational_stiffness
+        self._stiffness_pub.publish(Float64MultiArray(data=[stiffness] * 3 + [rotational] * 3))
+
+    def _republish(self) -> None:
+        good = self._good
+        if good is not None:
+            self._publish_estimate(good)
+        self._publish_status()
+
+    def stale_reason(self) -> str:
+        """Why the published estimate is stale ('' when it is fresh)."""
+        if self._good is None:
+            return "no estimate yet"
+        if not self._last["solve_ok"]:
+            return f"last solve: {self._last['solve_status']}"
+        if self._last["solve_time_s"] > self.settings.max_wall_time:
+            return f"last estimate took {self._last['solve_time_s']:.3g} s, over max_wall_time {self.settings.max_wall_time:g} s"
+        if self._last_input_clock is not None and self.now() - self._last_input_clock > self.settings.input_timeout:
+            return f"no input for more than {self.settings.input_timeout:g} s"
+        return ""
+
+    def status(self) -> tuple[str, dict]:
+        """(why the estimate is stale, '' when fresh; the status values: counts, last solve, last rejection, ...)."""
+        with self._lock:
+            reason = self.stale_reason()
+            good, reach = self._good, self._reach
+            return reason, dict(stale=bool(reason), stale_reason=reason, **self._counts,
+                                pending=bool(self._pending is not None or self._busy or self._unpaired),
+                                reach=0 if reach is None else reach.number,
+                                reach_start_stamp_s=float("nan") if reach is None else reach.start_stamp,
+                                estimate_stamp_s=float("nan") if good is None else good.stamp,
+                                goal_m=[] if good is None else good.estimate.goal.tolist(),
+                                transition_time_s=float("nan") if good is None else good.schedule.transition_time,
+                                last_solve_status=self._last["solve_status"], last_solve_time_s=self._last["solve_time_s"],
+                                last_latency_s=self._last["latency_s"], last_rejection=self._last["rejection"],
+                                last_event=self._last["event"])
+
+    def _publish_status(self) -> None:
+        reason, values = self.status()
+        level = DiagnosticStatus.WARN if reason else DiagnosticStatus.OK
+        self._status_pub.publish(status_message(level, reason or "estimating", values, self.now()))
+
+    def destroy_node(self):
+        with self._lock:
+            self._stopping = True
+            self._lock.notify()
+        if self._worker is not None:
+            self._worker.join(timeout=5.0)
+        return super().destroy_node()
+
+
+def spin(settings: NodeSettings, ros_args: list[str]) -> int:
+    """Run the node until Ctrl-C or a ROS shutdown; ``ros_args`` follow ``--ros-args`` (remappings, parameters)."""
+    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+
+    rclpy.init(args=["comanip", "--ros-args", *ros_args] if ros_args else None)
+    node = None
+    try:
+        node = GoalNode(settings)
+        used = node.settings
+        node.get_logger().info(f"estimating from {node.resolve_topic_name(used.hand_pose_topic)} in frame "
+                               f"{used.frame_id!r} with the {used.preset!r} model")
+        executor = SingleThreadedExecutor()
+        executor.add_node(node)
+        executor.spin()
+    except (KeyboardInterrupt, ExternalShutdownException):
+        pass
+    finally:
+        if node is not None:
+            node.destroy_node()
+        rclpy.try_shutdown()
+    return 0

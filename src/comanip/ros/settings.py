@@ -1,0 +1,141 @@
+"""Settings of the ROS 2 goal node: a frozen dataclass with one documented field per ROS parameter, built
+from a YAML file (a flat mapping, or ROS 2's ``node_name: {ros__parameters: {...}}`` layout) and checked at
+construction with the library's own validators (:mod:`comanip.arguments`,
+:func:`comanip.multicomponent.handover.check_schedule_arguments`), so a bad value is the same one-line
+ValueError as on the command line, naming the parameter. Needs no ROS installation.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+from pathlib import Path
+
+import yaml
+
+from comanip import presets
+from comanip.arguments import as_goal_width, as_nonnegative, as_positive, as_vector
+from comanip.bodies.point_mass import PointMass
+from comanip.model import ReachingModel
+from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments
+
+
+@dataclass(frozen=True)
+class NodeSettings:
+    """Everything the node is told (ROS parameters of the same names). Units: m, s, Hz, N/m, N·m/rad."""
+
+    preset: str = "cartesian"
+    """Model: a built-in preset name or a model YAML path. Its body must be a point mass, whose state is the
+    hand's task-space [x; xdot] (the Cartesian preset: x, y, z; the planar one: x, y)."""
+    width: float | None = None
+    """Goal width w (m); None: the preset's."""
+    prior_goal: tuple[float, ...] | None = None
+    """Prior goal g_bar (d,) m until a message on ``prior_goal_topic`` replaces it; None: no prior."""
+    frame_id: str = "world"
+    """Frame of every input and output; an input in another frame is rejected."""
+    hand_pose_topic: str = "hand/pose"
+    """geometry_msgs/PoseStamped of the hand (or the co-manipulated object); its position is used."""
+    hand_twist_topic: str = "hand/twist"
+    """geometry_msgs/TwistStamped of the same; its linear velocity is used."""
+    prior_goal_topic: str = "goal/prior"
+    """geometry_msgs/PointStamped: the prior goal for the next reach."""
+    reset_topic: str = "reset"
+    """std_msgs/Empty: the next hand pose starts a new reach."""
+    goal_topic: str = "goal/estimate"
+    """geometry_msgs/PoseWithCovarianceStamped: g_hat and its covariance (position block, m²)."""
+    path_topic: str = "hand/predicted_path"
+    """nav_msgs/Path: the predicted hand path from the start to g_hat, stamped on the model's grid."""
+    equilibrium_topic: str = "equilibrium_pose"
+    """geometry_msgs/PoseStamped: the impedance rest position x_r(now) (the handover schedule sampled)."""
+    stiffness_topic: str = "stiffness"
+    """std_msgs/Float64MultiArray [Kx, Ky, Kz, Krx, Kry, Krz]: the impedance stiffness at now."""
+    schedule_topic: str = "handover/schedule"
+    """std_msgs/Float64MultiArray: the whole handover schedule, one row per sample (columns in its layout)."""
+    status_topic: str = "status"
+    """diagnostic_msgs/DiagnosticArray: stale flag, solve status, counts, last rejection."""
+    max_wall_time: float = 0.25
+    """Wall-time budget of one estimate (s): one that takes longer is still published but marks the status stale
+    (the estimate runs in a worker thread, so the node's callbacks are never held up by it)."""
+    estimation_rate: float = 20.0
+    """Most estimates per second of input time (Hz); hand poses in between are skipped."""
+    command_rate: float = 100.0
+    """Rate of the equilibrium pose and stiffness (Hz)."""
+    status_rate: float = 10.0
+    """Rate at which the last good estimate and the status are republished (Hz)."""
+    input_timeout: float = 0.25
+    """Input older than this (s) makes the estimate stale; a pose after a longer gap starts a new reach."""
+    twist_tolerance: float = 0.005
+    """Largest stamp difference (s) between a pose and the twist paired with it."""
+    ramp_time: float = DEFAULT_RAMP_TIME
+    """Stiffness ramp to 0 at the handover (s), :func:`comanip.multicomponent.handover.plan_handover`."""
+    leading_stiffness: float = LEADING_STIFFNESS
+    """Translational stiffness while the robot leads (N/m)."""
+    rotational_stiffness: float = 30.0
+    """Rotational stiffness sent with it (N·m/rad), constant."""
+    equilibrium_orientation: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)
+    """Orientation quaternion (x, y, z, w) of the equilibrium pose (default: a Panda's hand pointing down)."""
+
+    def __post_init__(self):
+        for name in ("preset", "frame_id") + TOPICS:
+            value = getattr(self, name)
+            if not isinstance(value, str) or not value.strip():
+                raise ValueError(f"{name} must be a non-empty string, got {value!r}")
+        model = self.model()  # the preset's own ValueError, prefixed with the parameter's name
+        if not isinstance(model.body, PointMass):
+            raise ValueError(f"preset: the node estimates a hand in task space and needs a point-mass model "
+                             f"(e.g. 'cartesian' or 'planar'), got the {type(model.body).__name__} body of {self.preset!r}")
+        if self.width is not None:
+            object.__setattr__(self, "width", as_goal_width("width", self.width))
+        if self.prior_goal is not None:
+            object.__setattr__(self, "prior_goal", tuple(as_vector("prior_goal", self.prior_goal, model.d, "m").tolist()))
+        for name in ("max_wall_time", "estimation_rate", "command_rate", "status_rate", "input_timeout", "rotational_stiffness"):
+            object.__setattr__(self, name, as_positive(name, getattr(self, name), UNITS[name]))
+        object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
+        check_schedule_arguments(self.ramp_time, self.leading_stiffness, None)
+        quaternion = as_vector("equilibrium_orientation", self.equilibrium_orientation, 4, "quaternion x, y, z, w")
+        if abs(float(quaternion @ quaternion) - 1.0) > 1e-6:
+            raise ValueError(f"equilibrium_orientation must be a unit quaternion (x, y, z, w), got {quaternion.tolist()}")
+        object.__setattr__(self, "equilibrium_orientation", tuple(quaternion.tolist()))
+
+    def model(self) -> ReachingModel:
+        """The model named by ``preset``; a ValueError names the parameter."""
+        try:
+            return presets.load(self.preset)
+        except ValueError as error:
+            raise ValueError(f"preset: {error}") from None
+
+    @classmethod
+    def from_mapping(cls, values: dict) -> "NodeSettings":
+        """Settings from a mapping of parameter names to values; an unknown name is a ValueError listing the known ones."""
+        if not isinstance(values, dict):
+            raise ValueError(f"the node's parameters must be a mapping of names to values, got a {type(values).__name__}")
+        known = [f.name for f in fields(cls)]
+        unknown = sorted(set(values) - set(known))
+        if unknown:
+            raise ValueError(f"unknown parameter(s) {unknown}; the node's parameters are {known}")
+        return cls(**{k: tuple(v) if isinstance(v, list) else v for k, v in values.items()})
+
+    @classmethod
+    def from_yaml(cls, path: str | Path) -> "NodeSettings":
+        """Settings from a YAML file: a flat mapping, or ``<node name>: {ros__parameters: {...}}``."""
+        path = Path(path)
+        try:
+            values = yaml.safe_load(path.read_text()) or {}
+        except yaml.YAMLError as error:
+            raise ValueError(f"--params: {str(path)!r} is not valid YAML: {str(error).splitlines()[0]}") from None
+        if isinstance(values, dict) and len(values) == 1:
+            (inner,) = values.values()
+            if isinstance(inner, dict) and "ros__parameters" in inner:
+                values = inner["ros__parameters"] or {}
+        return cls.from_mapping(values)
+
+    def to_mapping(self) -> dict:
+        """The settings as plain values (tuples as lists), e.g. to declare them as ROS parameters."""
+        return {f.name: list(v) if isinstance(v := getattr(self, f.name), tuple) else v for f in fields(self)}
+
+
+#: the topic-name fields
+TOPICS = ("hand_pose_topic", "hand_twist_topic", "prior_goal_topic", "reset_topic", "goal_topic", "path_topic",
+          "equilibrium_topic", "stiffness_topic", "schedule_topic", "status_topic")
+
+UNITS = {"max_wall_time": "s", "estimation_rate": "Hz", "command_rate": "Hz", "status_rate": "Hz", "input_timeout": "s",
+         "rotational_stiffness": "N·m/rad"}

@@ -1,0 +1,39 @@
+"""(e) comanip's continuous estimate: the robot feeds every observation of the handle, one every
+``update_interval`` from the start of the reach, to an :class:`comanip.estimation.OnlineGoalEstimator`
+(warm-started from its previous estimate) and, from t_o on, leads along the latest estimate's predicted
+reach, replanned at every update."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from comanip.estimation import OnlineGoalEstimator
+from comanip.simulation.policies.protocol import PolicyContext, Prediction
+from comanip.simulation.rest_trajectory import RestTrajectory
+
+
+class ContinuousPolicy:
+    """The online MAP goal and its predicted reach, revised with each observation.
+
+    prior_std: the prior goal's standard deviation (m), as :class:`OnlineGoalEstimator` takes it (None: its
+    weak default). observe_from: time (s) of the first observation fed (default: one update_interval after
+    the start).
+    """
+
+    name = "continuous"
+
+    def __init__(self, context: PolicyContext, prior_std=None, observe_from: float | None = None):
+        self.context = context
+        self.update_interval = context.update_interval
+        self.estimator = OnlineGoalEstimator(context.model, context.start, prior_goal=context.prior_goal,
+                                             prior_std=prior_std, width=context.width)
+        self._next_observation = context.update_interval if observe_from is None else observe_from
+
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+        if t >= self._next_observation - 1e-9:
+            self.estimator.update(t, position, velocity)
+            self._next_observation += self.update_interval
+
+    def predict(self, t: float) -> Prediction:
+        c, estimate = self.context, self.estimator.latest
+        return Prediction(np.array(estimate.goal), RestTrajectory.from_plan(estimate, 0.0, c.dt, c.duration), estimate)

@@ -1,0 +1,101 @@
+"""What every robot policy of the synchronisation scenario shares: its inputs, its prediction, its protocol.
+
+A policy watches the handle (position m, velocity m/s, robot base frame, time s from the start of the
+person's reach) at every control step, and from t_o on predicts the person's goal and a rest motion for
+the axes the robot leads. The scenario's robot (:class:`comanip.simulation.sync_scenario.PolicyRobot`)
+asks for a prediction at t_o and then every ``update_interval`` seconds, and drives the controller.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Protocol
+
+import numpy as np
+
+from comanip.analysis.speed_profile import speed_metrics
+from comanip.estimation import GoalEstimator
+from comanip.model import ReachingModel
+from comanip.planning.plan import Plan
+from comanip.simulation.rest_trajectory import RestTrajectory
+
+#: Time between a continuously updating policy's predictions (s): 20 ms, 50 Hz.
+DEFAULT_UPDATE_INTERVAL = 0.02
+
+
+@dataclass(frozen=True)
+class PolicyContext:
+    """What a policy knows before the reach: the same for every policy and trial of one goal."""
+
+    start: np.ndarray
+    """The handle's state at the start of the reach, [x; v] (6,), m and m/s (at rest: v = 0)."""
+    prior_goal: np.ndarray
+    """The robot's prior goal g_bar (3,), m."""
+    width: float
+    """The goal width w (m) the robot assumes."""
+    observation_time: float
+    """t_o (s): when the robot first predicts and starts leading."""
+    dt: float
+    """Control period (s)."""
+    duration: float
+    """Simulated time of a trial from the start (s): how far rest motions must reach."""
+    model: ReachingModel
+    """The reaching model the model-based policies use (the Cartesian preset)."""
+    estimator: GoalEstimator
+    """The one-shot goal estimator (built once per scenario)."""
+    prior_plan: Plan
+    """The model's converged reach from the start to the prior goal."""
+    update_interval: float = DEFAULT_UPDATE_INTERVAL
+    """Time between predictions of the continuously updating policies (s)."""
+    warm_start: Plan | None = None
+    """A previous trial's one-shot estimate to start that solver from (None: the estimator's own search)."""
+
+    @cached_property
+    def expected_movement_time(self) -> float:
+        """The movement time (SPEC §6) of the model's reach to the prior goal (s): how long the robot
+        expects a reach to take before it has seen one."""
+        timing = speed_metrics(self.prior_plan.t, self.prior_plan.ee_speed)
+        return float(timing.movement_time if timing.settled else self.prior_plan.t[-1])
+
+    def rest_from(self, t: float, position: np.ndarray, velocity: np.ndarray) -> RestTrajectory:
+        """A rest motion sampled from real time t (s) to the trial's end: position (N, 3) m, velocity
+        (N, 3) m/s at t + k·dt; shorter arrays are held at their last sample."""
+        steps = int(np.ceil(max(self.duration - t, 0.0) / self.dt)) + 2
+        position, velocity = np.asarray(position, dtype=float), np.asarray(velocity, dtype=float)
+        if len(position) < steps:
+            extra = steps - len(position)
+            position = np.vstack([position, np.repeat(position[-1:], extra, axis=0)])
+            velocity = np.vstack([velocity, np.zeros((extra, velocity.shape[1]))])
+        return RestTrajectory(position[:steps], velocity[:steps], t, self.dt)
+
+    def rest_times(self, t: float) -> np.ndarray:
+        """The times (N,), s, from t to the trial's end every dt, on which :meth:`rest_from` samples."""
+        return t + self.dt * np.arange(int(np.ceil(max(self.duration - t, 0.0) / self.dt)) + 2)
+
+
+@dataclass
+class Prediction:
+    """A policy's answer at one update."""
+
+    goal: np.ndarray
+    """The predicted goal g_hat (3,), m."""
+    rest: RestTrajectory
+    """The rest motion the robot leads along (its z is used in the sync scenario), real time."""
+    plan: Plan | None = None
+    """The model's estimate behind the prediction, for the model-based policies."""
+
+
+class RobotPolicy(Protocol):
+    """A robot policy: sees the handle every step, predicts at t_o and then every update_interval."""
+
+    name: str
+    """The policy's name in :data:`comanip.simulation.policies.POLICIES`."""
+    update_interval: float | None
+    """Time between predictions after t_o (s); None: one prediction, at t_o."""
+
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+        """The handle at time t (s): position (3,) m, velocity (3,) m/s; called at every control step."""
+
+    def predict(self, t: float) -> Prediction | None:
+        """The goal and rest motion from what was observed up to time t (s); None: do not lead."""

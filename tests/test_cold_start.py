@@ -1,0 +1,84 @@
+"""Cold solves of the point masses: the ranked start from a solved, turned reach gives the plan of the full
+search over minimum-jerk guesses, and the symmetry it rests on holds."""
+
+import numpy as np
+import pytest
+
+import comanip
+from comanip.planning.planner import SolverOptions
+from comanip.planning.reach_library import is_symmetric, reflection_onto
+
+RELATIVE = 1e-6
+"""Objectives of the ranked and the full search agree to this (relative)."""
+
+
+def _problems(model, count: int, seed: int):
+    """(start (2n,), goal (d,), width): goals 0.1–0.4 m away, widths 5–50 mm, every other start moving."""
+    rng = np.random.default_rng(seed)
+    for k in range(count):
+        start = np.zeros(2 * model.n)
+        if k % 2:
+            start[model.n:] = rng.uniform(-0.3, 0.3, model.n)
+        start[: model.n] = rng.uniform(-0.1, 0.1, model.n)
+        direction = rng.normal(size=model.d)
+        goal = start[: model.n] + rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+        yield start, goal, float(np.exp(rng.uniform(np.log(0.005), np.log(0.05))))
+
+
+@pytest.mark.parametrize("preset, seed", [("planar", 0), ("cartesian", 1), ("human", 2)])
+def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
+    model = comanip.presets.load(preset)
+    ranked, full = comanip.Planner(model), comanip.Planner(model, SolverOptions(cold_search="all"))
+    assert ranked._library is not None
+    for start, goal, width in _problems(model, 4, seed):
+        fast, reference = ranked.solve(start, goal, width), full.solve(start, goal, width)
+        assert fast.success and reference.success
+        assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
+        if not np.any(start[model.n:]):  # from rest: one solve from a near-optimal start (moving: every guess too)
+            assert fast.iterations < reference.iterations
+
+
+def test_library_entries_do_not_depend_on_the_order_of_the_solves():
+    model = comanip.presets.planar()
+    problems = list(_problems(model, 3, 3))
+    forward = [comanip.Planner(model).solve(*p) for p in [problems[0], problems[1], problems[2]]]
+    backward = comanip.Planner(model)
+    for p, plan in zip(problems[::-1], forward[::-1]):
+        np.testing.assert_array_equal(backward.solve(*p).torque, plan.torque)
+
+
+@pytest.mark.parametrize("preset", ["planar", "human_cartesian"])
+def test_a_turned_and_shifted_plan_has_the_original_objective(preset):
+    model = comanip.presets.load(preset)
+    planner = comanip.Planner(model)
+    plan = planner.solve(np.zeros(2 * model.n), 0.25 * np.eye(model.d)[0], 0.02)
+    rng = np.random.default_rng(4)
+    turn = np.linalg.qr(rng.normal(size=(model.n, model.n)))[0]
+    shift = rng.normal(scale=0.1, size=model.n)
+    start = np.r_[shift, np.zeros(model.state_size - model.n)]
+    turned = planner.problem.objective_value(plan.torque @ turn.T, start, turn @ plan.goal + shift, 0.02)
+    np.testing.assert_allclose(turned, plan.objective, rtol=1e-9)
+    # and the planner, asked the turned problem cold, finds that objective (it starts from a turned library reach)
+    resolved = planner.solve(start[: 2 * model.n], turn @ plan.goal + shift, 0.02)
+    np.testing.assert_allclose(resolved.objective, plan.objective, rtol=RELATIVE)
+
+
+def test_reflection_onto_is_orthogonal_and_takes_e1_to_the_direction():
+    rng = np.random.default_rng(5)
+    for d in (2, 3):
+        for direction in [np.eye(d)[0], -np.eye(d)[0], rng.normal(size=d)]:
+            direction = direction / np.linalg.norm(direction)
+            R = reflection_onto(direction)
+            np.testing.assert_allclose(R @ R.T, np.eye(d), atol=1e-12)
+            np.testing.assert_allclose(R @ np.eye(d)[0], direction, atol=1e-12)
+
+
+@pytest.mark.parametrize("change", [dict(noise="per_channel"), dict(goal_covariance="std")])
+def test_only_symmetric_models_get_a_library(change):
+    model = comanip.presets.cartesian().replace(**change)
+    planner = comanip.Planner(model)
+    symmetric = change.get("noise") != "per_channel"
+    assert (planner._library is not None) == symmetric
+    assert is_symmetric(planner.problem) == symmetric
+    plan = planner.solve(np.zeros(6), [0.2, 0.1, 0.0], 0.02)
+    assert plan.success

@@ -1,0 +1,175 @@
+"""The ROS 2 goal node in-process (no robot, no ROS installation): a planned reach replayed through it gives
+the library's own estimates, predictions and handover schedule; bad messages are logged and rejected; an
+estimate over its budget or a silent input leaves the last good estimate published and marked stale."""
+
+import numpy as np
+import pytest
+
+rclpy = pytest.importorskip("rclpy", reason="the ROS 2 node needs the 'ros' extra: pip install -e '.[test,ros]'")
+
+from geometry_msgs.msg import PointStamped  # noqa: E402
+
+from comanip.estimation.online_estimator import FamilyCache  # noqa: E402
+from comanip.estimation.shared import estimation_planner  # noqa: E402
+from comanip.multicomponent.handover import plan_handover  # noqa: E402
+from comanip.multicomponent.transition_model import TransitionModel  # noqa: E402
+from comanip.ros.node import reach_estimator  # noqa: E402
+from comanip.ros.replay import BASE_STAMP, Replay, replay_csv  # noqa: E402
+from comanip.ros.settings import NodeSettings  # noqa: E402
+
+GOAL = np.array([0.4, 0.25, -0.1])
+
+
+@pytest.fixture(scope="module")
+def reach():
+    """The Cartesian model's plan from rest at the origin to GOAL: the synthetic hand."""
+    settings = NodeSettings()
+    planner = estimation_planner(settings.model())
+    return settings, planner, planner.solve(np.zeros(6), GOAL)
+
+
+@pytest.fixture(scope="module")
+def transition():
+    return TransitionModel()
+
+
+@pytest.fixture(scope="module")
+def replayed(reach, transition, tmp_path_factory):
+    """The reach written as a CSV in the format `comanip estimate` reads, replayed through the node in lock step."""
+    settings, _, plan = reach
+    path = tmp_path_factory.mktemp("ros") / "hand.csv"
+    header = "t_s,q0,q1,q2,qdot0,qdot1,qdot2"
+    np.savetxt(path, np.c_[plan.t, plan.mean], delimiter=",", header=header, comments="")
+    recording, files = replay_csv(settings, path, path.parent / "out", transition_model=transition)
+    return recording, files
+
+
+@pytest.fixture(scope="module")
+def library(reach):
+    """What the library gives for the same observations fed to the same estimator in the same order."""
+    settings, planner, plan = reach
+    estimator = reach_estimator(planner, FamilyCache(), plan.mean[0], None, settings.width)
+    horizon = plan.t[-1]
+    estimates = [estimator.update(t, s[:3], s[3:]) for t, s in zip(plan.t[1:], plan.mean[1:]) if t < horizon]
+    return [(t, e) for t, e in zip(plan.t[1:], estimates) if e.success]
+
+
+def test_the_published_estimates_are_the_librarys(replayed, library):
+    recording, _ = replayed
+    assert len(recording.goals) == len(library) > 40
+    for (stamp, goal, covariance, _), (t, estimate) in zip(recording.goals, library):
+        assert stamp - BASE_STAMP == pytest.approx(t, abs=1e-9)
+        np.testing.assert_allclose(goal, estimate.goal, atol=1e-9)
+        np.testing.assert_allclose(covariance, estimate.goal_covariance, atol=1e-12)
+    # exact observations of a plan give its goal back (to the reach family's interpolation, ~1e-4 m or less)
+    np.testing.assert_allclose(recording.goals[-1][1], GOAL, atol=1e-4)
+
+
+def test_the_published_prediction_and_schedule_are_the_librarys(reach, replayed, library, transition):
+    settings, _, plan = reach
+    recording, _ = replayed
+    last = library[-1][1]
+    path = recording.paths[max(recording.paths)]
+    np.testing.assert_allclose(path[:, 0] - BASE_STAMP, plan.t, atol=1e-9)
+    np.testing.assert_allclose(path[:, 1:], last.ee_mean, atol=1e-9)
+    schedule = plan_handover(last, transition, ramp_time=settings.ramp_time, leading_stiffness=settings.leading_stiffness)
+    rows = recording.schedules[-1]
+    np.testing.assert_allclose(rows[:, 1], schedule.t, atol=1e-9)
+    np.testing.assert_allclose(rows[:, 2:5], schedule.rest_position, atol=1e-9)
+    np.testing.assert_allclose(rows[:, 8], schedule.stiffness, atol=1e-9)
+    assert schedule.status == "within_plan" and 0 < schedule.transition_time < plan.t[-1]
+
+
+def test_the_commands_sample_a_published_schedule_at_the_nodes_clock(reach, replayed):
+    settings, _, _ = reach
+    recording, _ = replayed
+    assert len(recording.commands) > 40
+    for stamp, rest, stiffness in recording.commands:
+        t = stamp - BASE_STAMP
+        sampled = [np.r_[[np.interp(t, rows[:, 1], rows[:, k]) for k in (2, 3, 4, 8)]] for rows in recording.schedules]
+        error = min(np.max(np.abs(np.r_[rest, stiffness[0]] - row)) for row in sampled)
+        assert error < 1e-9
+        np.testing.assert_allclose(stiffness[:3], stiffness[0])
+        np.testing.assert_allclose(stiffness[3:], settings.rotational_stiffness)
+    stiffness = np.array([c[2][0] for c in recording.commands])
+    assert stiffness[0] == settings.leading_stiffness and stiffness[-1] == 0.0  # the robot led, then handed over
+
+
+def test_the_replay_writes_what_was_published(replayed):
+    recording, files = replayed
+    assert {f.name for f in files} == {"goals.csv", "prediction.csv", "schedule.csv", "commands.csv", "status.csv"}
+    goals = np.genfromtxt(files[0], delimiter=",", names=True)
+    np.testing.assert_allclose(goals["goal_x_m"][-1], recording.goals[-1][1][0])
+    assert np.all(goals["latency_s"] > 0)
+
+
+def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, transition, capfd):
+    settings, _, plan = reach
+    nan = np.full(3, np.nan)
+    with Replay(settings, transition) as replay:
+        poses = 0
+
+        def send(k, position=None, velocity=None, *, t=None, frame=None, handled=True):
+            nonlocal poses
+            t = plan.t[k] if t is None else t
+            replay.set_clock(t)
+            replay.publish(t, plan.mean[k, :3] if position is None else position, plan.mean[k, 3:] if velocity is None else velocity,
+                           frame_id=frame)
+            poses += 1
+            if handled:
+                replay.wait_handled(poses)
+
+        prior = replay.player.create_publisher(PointStamped, settings.prior_goal_topic, 10)
+        for frame in ("camera", settings.frame_id):            # a prior in another frame, then a good one
+            message = PointStamped()
+            message.header.frame_id, (message.point.x, message.point.y, message.point.z) = frame, GOAL.tolist()
+            prior.publish(message)
+            replay.drain(0.2)
+        assert replay.node.status()[1]["last_event"] == f"prior goal {GOAL.tolist()} m, for the next reach"
+        for k in range(6):
+            send(k)
+        assert np.array_equal(replay.node._reach.prior_goal, GOAL)
+        send(6, position=nan)                          # a NaN position (its twist is fine)
+        send(6, frame="camera")                        # another frame: pose and twist
+        send(4)                                        # stamps before the last accepted pose and twist
+        send(6, velocity=nan, t=plan.t[6] + 0.01, handled=False)   # a NaN twist: its pose finds no twist
+        for k in range(7, len(plan.t)):
+            send(k)
+        values = replay.recording.statuses[-1][3]
+        goal = replay.recording.goals[-1][1]
+    log = capfd.readouterr().err
+    assert int(values["rejected"]) == 8
+    for line in ("prior goal rejected: frame 'camera'", "hand pose rejected: non-finite values", "hand pose rejected: frame 'camera' is not the node's frame 'world'",
+                 "hand twist rejected: frame 'camera'", "hand pose rejected: stamp 1000.220000 s is not after the previous one",
+                 "hand twist rejected: non-finite values", "hand pose rejected: no hand twist within 0.005 s of its stamp 1000.340000 s"):
+        assert line in log
+    np.testing.assert_allclose(goal, GOAL, atol=1e-4)  # and it went on estimating
+
+
+def test_stale_when_input_stops_with_the_last_estimate_still_published(reach, transition):
+    settings, _, plan = reach
+    with Replay(settings, transition) as replay:
+        for k in range(12):
+            replay.set_clock(plan.t[k])
+            replay.publish(plan.t[k], plan.mean[k, :3], plan.mean[k, 3:])
+            values = replay.wait_handled(k + 1)
+        assert values["stale"] == "false" and int(values["estimates"]) > 0
+        republished = replay.recording.republished
+        for t in np.arange(plan.t[11], plan.t[11] + 1.0, 0.02):  # the clock runs on, the hand is not seen
+            replay.set_clock(float(t))
+            replay.drain(0.005)
+        replay.drain(0.1)
+        level, values = replay.recording.statuses[-1][1], replay.recording.statuses[-1][3]
+        assert values["stale"] == "true" and values["stale_reason"].startswith("no input for more than") and level == 1
+        assert replay.recording.republished > republished
+
+
+def test_stale_when_estimates_overrun_the_budget_and_still_published(reach, transition):
+    _, _, plan = reach
+    with Replay(NodeSettings(max_wall_time=1e-9), transition) as replay:
+        for k in range(8):
+            replay.set_clock(plan.t[k])
+            replay.publish(plan.t[k], plan.mean[k, :3], plan.mean[k, 3:])
+            values = replay.wait_handled(k + 1)
+        assert values["stale"] == "true" and values["stale_reason"].startswith("last estimate took")
+        assert int(values["late"]) == int(values["estimates"]) == len(replay.recording.goals) > 0
