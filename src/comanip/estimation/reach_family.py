@@ -29,6 +29,7 @@ from scipy.interpolate import CubicSpline
 
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
+from comanip.planning.reach_library import reflection_onto
 
 #: Largest difference (m, m/s, ...) between an oblique plan and the turned member for the model to count as
 #: rotation-invariant: well above the planner's convergence noise, far below any model asymmetry.
@@ -69,16 +70,6 @@ class ReachPrediction:
         pz = across @ zeta
         outer = pz[:, None] * u
         return float(self.curvature.ravel() @ (z @ u)) * radial + outer + outer.T + float(zeta @ u) * across
-
-
-def householder(u: np.ndarray) -> np.ndarray:
-    """Orthogonal (d, d) Q with Q e_1 = u for a unit vector u (d,): the reflection across the bisector of e_1 and u."""
-    v = -u.copy()
-    v[0] += 1.0
-    norm2 = float(v @ v)
-    if norm2 < 1e-24:
-        return np.eye(u.size)
-    return np.eye(u.size) - 2.0 * np.outer(v, v) / norm2
 
 
 class ReachFamily:
@@ -218,7 +209,7 @@ class ReachFamily:
 
     def frame(self, u: np.ndarray) -> np.ndarray:
         """T (nx, nx): the orthogonal map Q (Q e_1 = u) applied to every state block."""
-        Q, n = householder(u), self.n
+        Q, n = reflection_onto(u), self.n
         T = np.zeros((self.nx, self.nx))
         for b in range(self.blocks):
             T[b * n:(b + 1) * n, b * n:(b + 1) * n] = Q
