@@ -59,7 +59,6 @@ from comanip.estimation.regret_newton import newton_solve
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
-from comanip.objectives.reward import goal_covariance
 from comanip.optim import CONVERGED, Status
 from comanip.planning.cache import ModelCache
 from comanip.planning.plan import Plan

@@ -125,7 +125,7 @@ _MOVEMENT_SIGMAS = 3.0
 _COVARIANCE_ROUNDS = 3
 #: Relative std along the reach above which the goal's variance there comes from a quadrature, and its points.
 _SKEWED = 0.05
-_QUADRATURE_POINTS = 200
+_QUADRATURE_POINTS = 80
 #: Halvings of a Newton step before the iteration gives up.
 _BACKTRACKS = 12
 #: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
@@ -389,11 +389,11 @@ class _Problem:
         if high - low < 1e-6:
             return covariance
         distances = np.exp(np.linspace(low, high, _QUADRATURE_POINTS))
-        n, m = e.model.n, self.m
-        means = (family.along(distances)[:, :, :, None] * u).reshape(len(distances), e.model.H + 1, -1)[:, :, :m]
+        n, m, M = e.model.n, self.m, len(distances)
+        along = self.weights @ family.along(distances)[:, :, :m // n]               # (M, S, 2): position, velocity
+        means = (along[:, :, :, None] * u).reshape(M, len(self.steps), m)
         means[:, :, :n] += e.start_position
-        residuals = self.observed[None] - np.einsum("sj,kjm->ksm", self.weights, means)
-        whitened = whitening.matrix @ residuals.reshape(len(distances), -1).T
+        whitened = whitening.matrix @ (self.observed[None] - means).reshape(M, -1).T
         goals = e.start_position + distances[:, None] * u
         offsets = goals - e.prior_mean
         energy = 0.5 * (np.sum(whitened**2, axis=0) + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
