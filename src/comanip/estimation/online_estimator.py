@@ -41,6 +41,7 @@ from threadpoolctl import ThreadpoolController
 from comanip.arguments import as_count, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.estimate import GoalEstimate
+from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
@@ -74,6 +75,14 @@ class OnlineOptions:
     covariance_tolerance: float = 0.05
     """The belief covariance that weighs the observations is the plan's to a goal within this fraction of the
     distance (start to goal) of the estimate; it is recomputed when the estimate moves farther."""
+    correction_time: float | None = None
+    """Time constant (s) with which the person corrects a deviation from their plan
+    (:mod:`comanip.estimation.corrected_deviation`); None: the plan's open-loop belief, a deviation persists.
+    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module."""
+    deviation_time: float = 0.0
+    """With a correction time: the person strays from the plan by about this many seconds (s) of their motion,
+    in any direction (ahead, behind, across; :mod:`comanip.estimation.corrected_deviation`); 0: only motor noise.
+    The sync scenario's continuous policy uses DEVIATION_TIME (0.15 s) of that module."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
@@ -86,6 +95,10 @@ class OnlineOptions:
         as_count("max_iterations", self.max_iterations)
         as_positive("step_fraction", self.step_fraction, "fraction")
         as_positive("covariance_tolerance", self.covariance_tolerance, "fraction of the distance")
+        if self.correction_time is not None:
+            as_positive("correction_time", self.correction_time, "s (or None: open loop)")
+        if not (math.isfinite(self.deviation_time) and self.deviation_time >= 0):
+            raise ValueError(f"deviation_time must be a finite time ≥ 0 s, got {self.deviation_time!r}")
 
 
 class ModelFamilies:
@@ -178,7 +191,10 @@ class OnlineGoalEstimator:
         self.family = families.family(width, self.options)
         _, A, _ = linearised_step_function(model.body, model.h)(np.zeros(model.state_size), np.zeros(n))
         A = np.asarray(A)
-        self._powers = np.array([np.linalg.matrix_power(A, k) for k in range(model.H + 1)])
+        correction_time = self.options.correction_time
+        self._rho = 1.0 if correction_time is None else correction_factor(correction_time, model.h)
+        self._A = A
+        self._powers = corrected_powers(A, self._rho, model.H)
         self._R = observation_covariance(self.options.observation_std, n)
         H = model.H
         self._counts = np.zeros(H + 1)
@@ -283,7 +299,12 @@ class OnlineGoalEstimator:
         steps = np.flatnonzero(self._counts)
         whitening = self._whitening
         if self._stale(goal):
-            whitening = ObservationWhitening(self._prediction(goal, order=0).cov, self._powers, 2 * self.model.n, steps,
+            prediction = self._prediction(goal, order=0)
+            cov = prediction.cov
+            if self._rho < 1.0:
+                cov = corrected_covariance(cov, self._A, self._rho, prediction.mean, self.options.deviation_time, self.model.h,
+                                           self.model.n)
+            whitening = ObservationWhitening(cov, self._powers, 2 * self.model.n, steps,
                                              self._R[None] / self._counts[steps][:, None, None])
             self._whitening, self._whitening_goal = whitening, np.array(goal, dtype=float)
         elif len(whitening.steps) == len(steps):
