@@ -8,7 +8,8 @@ goal g_hat under the model and its covariance, with the model's predicted reach 
 
 where mu(g) stacks the plan's predicted mean [q; qdot] at the observation times (linearly interpolated
 between grid steps), L is the factor of the observations' joint covariance under the plan's open-loop belief
-plus the observation noise R (:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
+(or that of a person who corrects deviations, ``OnlineOptions.correction_time``:
+:mod:`comanip.estimation.corrected_deviation`) plus the observation noise R (:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
 (:mod:`comanip.estimation.goal_prior`). Every observation so far enters. The covariance is held at the
 previous estimate's plan during an update (its dependence on g is left out of the objective, as in iteratively
 reweighted least squares: an exact observation of a plan then gives back its goal), and the minimum is
@@ -40,8 +41,8 @@ from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
-from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
+from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
