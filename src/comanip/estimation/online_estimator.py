@@ -9,7 +9,8 @@ goal g_hat under the model and its covariance, with the model's predicted reach 
 where mu(g) stacks the plan's predicted mean [q; qdot] at the observation times (linearly interpolated
 between grid steps), L is the factor of the observations' joint covariance under the plan's open-loop belief
 (or that of a person who corrects deviations, ``OnlineOptions.correction_time``:
-:mod:`comanip.estimation.corrected_deviation`) plus the observation noise R (:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
+:mod:`comanip.estimation.corrected_deviation`) plus the observation noise R
+(:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
 (:mod:`comanip.estimation.goal_prior`). Every observation so far enters. The covariance is held at the
 previous estimate's plan during an update (its dependence on g is left out of the objective, as in iteratively
 reweighted least squares: an exact observation of a plan then gives back its goal), and the minimum is
