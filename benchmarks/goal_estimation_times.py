@@ -14,7 +14,9 @@ on a shared machine inflate less):
 - one-shot cold: `estimate` from the state observed at 0.2 s, no warm start (its own search);
 - one-shot warm: from the state observed 10 ms later, warm-started from that cold estimate;
 - online first (cold): the first update whose observations show movement (the estimator's cold start);
-- online update (warm): every later update, each using all observations so far.
+- online update (warm): every later update, each using all observations so far;
+- ", corrected": the same with the options of a person who corrects deviations from their plan
+  (comanip.estimation.corrected_deviation, as the sync scenario's continuous policy uses them).
 
 The online estimator's reach family is built once per model and width (in the constructor, timed apart
 as "build"); the one-shot estimator's compiled planner likewise.
@@ -29,7 +31,8 @@ import numpy as np
 
 import comanip
 from comanip.belief import sample_trajectories
-from comanip.estimation import GoalEstimator, OnlineGoalEstimator
+from comanip.estimation import GoalEstimator, OnlineGoalEstimator, OnlineOptions
+from comanip.estimation.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
 
 OBSERVATION_STD = (1e-3, 1e-2)
 PRIOR_OFFSET = 0.1   # m, also the prior's std
@@ -66,7 +69,10 @@ def run_preset(preset: str, count: int) -> list[tuple]:
     one_shot, one_shot_build, _ = clocked(lambda: GoalEstimator(model))
     first, online_build, _ = clocked(lambda: OnlineGoalEstimator(model, start))
     rng = np.random.default_rng(0)
-    rows = {key: [] for key in ("one-shot cold", "one-shot warm", "online first (cold)", "online update (warm)")}
+    variants = {"": OnlineOptions(), ", corrected": OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME)}
+    rows = {key: [] for key in ("one-shot cold", "one-shot warm")}
+    for suffix in variants:
+        rows[f"online first (cold){suffix}"], rows[f"online update (warm){suffix}"] = [], []
     for goal, prior, times, observed in reaches(model, one_shot.planner, count, rng):
         k = int(np.argmin(np.abs(times - 0.2)))
         cold, wall, cpu = clocked(lambda: one_shot.estimate(start, observed[k], times[k], prior, prior_std=PRIOR_OFFSET))
@@ -74,14 +80,15 @@ def run_preset(preset: str, count: int) -> list[tuple]:
         warm, wall, cpu = clocked(lambda: one_shot.estimate(start, observed[k + 1], times[k + 1], prior, prior_std=PRIOR_OFFSET,
                                                             warm_start=cold))
         rows["one-shot warm"].append((wall, cpu, warm.success))
-        online = OnlineGoalEstimator(model, start, prior_goal=prior, prior_std=PRIOR_OFFSET)
-        started = False
-        for t, y in zip(times, observed):
-            estimate, wall, cpu = clocked(lambda: online.update(t, y[:n], y[n:]))
-            if estimate.status == "uninformative" and not started:
-                continue
-            rows["online update (warm)" if started else "online first (cold)"].append((wall, cpu, estimate.success))
-            started = True
+        for suffix, options in variants.items():
+            online = OnlineGoalEstimator(model, start, prior_goal=prior, prior_std=PRIOR_OFFSET, options=options)
+            started = False
+            for t, y in zip(times, observed):
+                estimate, wall, cpu = clocked(lambda: online.update(t, y[:n], y[n:]))
+                if estimate.status == "uninformative" and not started:
+                    continue
+                rows[f"online update (warm){suffix}" if started else f"online first (cold){suffix}"].append((wall, cpu, estimate.success))
+                started = True
     table = [(preset, "build", 1e3 * one_shot_build, None, None, 1, "one-shot: compiled planner"),
              (preset, "build", 1e3 * online_build, None, None, 1, "online: reach family "
               f"({len(first.family.distances)} plans, interpolation error {1e3 * first.family.interpolation_error:.3f} mm)")]

@@ -8,7 +8,9 @@ goal g_hat under the model and its covariance, with the model's predicted reach 
 
 where mu(g) stacks the plan's predicted mean [q; qdot] at the observation times (linearly interpolated
 between grid steps), L is the factor of the observations' joint covariance under the plan's open-loop belief
-plus the observation noise R (:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
+(or that of a person who corrects deviations, ``OnlineOptions.correction_time``:
+:mod:`comanip.estimation.corrected_deviation`) plus the observation noise R
+(:mod:`comanip.estimation.observation_whitening`), and (g_bar, P0) the prior
 (:mod:`comanip.estimation.goal_prior`). Every observation so far enters. The observations' covariance is that
 of the plan to a goal within 5 % of the distance of the estimate (``OnlineOptions.covariance_tolerance``; its
 dependence on g is left out of the objective, as in iteratively reweighted least squares: an exact
@@ -47,6 +49,7 @@ from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
+from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
 from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
@@ -81,6 +84,14 @@ class OnlineOptions:
     covariance_tolerance: float = 0.05
     """The belief covariance that weighs the observations is the plan's to a goal within this fraction of the
     distance (start to goal) of the estimate; it is recomputed when the estimate moves farther."""
+    correction_time: float | None = None
+    """Time constant (s) with which the person corrects a deviation from their plan
+    (:mod:`comanip.estimation.corrected_deviation`); None: the plan's open-loop belief, a deviation persists.
+    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module."""
+    deviation_time: float = 0.0
+    """With a correction time: the person strays from the plan by about this many seconds (s) of their motion,
+    in any direction (ahead, behind, across; :mod:`comanip.estimation.corrected_deviation`); 0: only motor noise.
+    The sync scenario's continuous policy uses DEVIATION_TIME (0.15 s) of that module."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
@@ -93,6 +104,10 @@ class OnlineOptions:
         as_count("max_iterations", self.max_iterations)
         as_positive("step_fraction", self.step_fraction, "fraction")
         as_positive("covariance_tolerance", self.covariance_tolerance, "fraction of the distance")
+        if self.correction_time is not None:
+            as_positive("correction_time", self.correction_time, "s (or None: open loop)")
+        if not (math.isfinite(self.deviation_time) and self.deviation_time >= 0):
+            raise ValueError(f"deviation_time must be a finite time ≥ 0 s, got {self.deviation_time!r}")
 
 
 class ModelFamilies:
@@ -185,7 +200,10 @@ class OnlineGoalEstimator:
         self.family = families.family(width, self.options)
         _, A, _ = linearised_step_function(model.body, model.h)(np.zeros(model.state_size), np.zeros(n))
         A = np.asarray(A)
-        self._powers = np.array([np.linalg.matrix_power(A, k) for k in range(model.H + 1)])
+        correction_time = self.options.correction_time
+        self._rho = 1.0 if correction_time is None else correction_factor(correction_time, model.h)
+        self._A = A
+        self._powers = corrected_powers(A, self._rho, model.H)
         self._R = observation_covariance(self.options.observation_std, n)
         H = model.H
         self._counts = np.zeros(H + 1)
@@ -291,7 +309,11 @@ class OnlineGoalEstimator:
         steps = np.flatnonzero(self._counts)
         whitening = self._whitening
         if self._stale(goal):
-            cov = self._prediction(goal, order=0).cov
+            prediction = self._prediction(goal, order=0)
+            cov = prediction.cov
+            if self._rho < 1.0:
+                cov = corrected_covariance(cov, self._A, self._rho, prediction.mean, self.options.deviation_time, self.model.h,
+                                           self.model.n)
             whitening = ObservationWhitening(cov, self._powers, 2 * self.model.n, steps,
                                              np.array([self._step_noise(i, cov) for i in steps]),
                                              self._fractions[steps] / self._counts[steps])
