@@ -34,3 +34,17 @@ def test_the_first_compile_of_a_function_is_announced(tmp_path, monkeypatch, cap
     assert "compiling progress_square to C" in err and "done in" in err
     compiled(square)                                   # cached: silent
     assert capsys.readouterr().err == ""
+
+
+def test_every_bar_of_the_package_goes_through_comanip_progress():
+    """A bar made with tqdm directly redraws with carriage returns in a log file; comanip.progress gives one line
+    per update there. Only comanip/progress.py may call tqdm itself."""
+    import re
+    from pathlib import Path
+
+    import comanip
+
+    root = Path(comanip.__file__).parent
+    direct = [str(path.relative_to(root)) for path in root.rglob("*.py")
+              if path.name != "progress.py" and re.search(r"\btqdm\s*\(", path.read_text(encoding="utf-8"))]
+    assert direct == [], f"these modules make tqdm bars themselves: {direct}"

@@ -27,7 +27,6 @@ from itertools import product
 
 import numpy as np
 from scipy.stats import linregress
-from tqdm import tqdm
 
 from comanip.analysis.fitts import FittsFit, fit_fitts, trend_fraction
 from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, open_loop_grid
@@ -35,6 +34,7 @@ from comanip.arguments import as_count
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
 from comanip.planning.cache import PlannerCache
+from comanip.progress import progress_bar
 
 #: Fitts' law holds when the better of the two fits has at least this R².
 FITTS_R2_MIN = 0.9
@@ -194,7 +194,7 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
              for i, c in enumerate(configurations) for j, (D, w) in enumerate(product(distances, widths))]
     workers = (os.cpu_count() or 1) if workers is None else workers
     as_count("workers", workers, 1, "processes")
-    bar = tqdm(total=len(tasks), desc="calibration", unit="reach", disable=not progress)
+    bar = progress_bar("calibration", len(tasks), "reach", progress)
     results: dict[int, list[ReachOutcome]] = {i: [] for i in range(len(configurations))}
     if workers == 1:
         planners = PlannerCache(size=1)

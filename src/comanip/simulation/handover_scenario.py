@@ -17,13 +17,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from tqdm import tqdm
 
 from comanip.control.impedance import CartesianImpedanceController, RobotState
 from comanip.multicomponent.dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan
+from comanip.progress import progress_bar
 from comanip.simulation.person import solve_to_convergence
 from comanip.simulation.scenario import ScenarioSettings, TrialRecord, run_trial
 from comanip.simulation.setup import ScenarioSetup
@@ -168,7 +168,7 @@ def run_handover(settings: HandoverSettings, setup: ScenarioSetup | None = None,
     plan = solve_to_convergence(setup.planner, start.state, goal, width)
     schedule = plan_handover(plan, transition_model, settings.ramp_time, settings.robot_stiffness, rate=1.0 / dt)
     trials = []
-    for k in tqdm(range(settings.trials), desc=f"handover to {np.round(goal, 2).tolist()}", disable=not progress):
+    for k in progress_bar(f"handover to {np.round(goal, 2).tolist()}", settings.trials, "trial", progress, iterable=range(settings.trials)):
         variation = np.random.default_rng((settings.seed + k, 1)).standard_normal(2)   # apart from the motor noise
         person_goal = goal + np.r_[settings.goal_variation * variation, 0.0]
         person = setup.person(start, person_goal, settings.seed + k)

@@ -18,12 +18,12 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-from tqdm import tqdm
 
 from comanip.analysis.speed_profile import speed_metrics
 from comanip.arguments import as_positive, as_vector
 from comanip.control.impedance import CartesianImpedanceController, RobotState
 from comanip.planning.plan import Plan
+from comanip.progress import progress_bar
 from comanip.simulation.measures import trial_measures
 from comanip.simulation.policies import POLICIES, PolicyContext, Prediction, RobotPolicy, check_policy
 from comanip.simulation.policies.protocol import DEFAULT_UPDATE_INTERVAL
@@ -183,7 +183,8 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
     first_plan = setup.person_first_plan(start, goal)
     context = policy_context(settings, setup, start)
     trials = []
-    for k in tqdm(range(settings.trials), desc=f"sync {settings.policy} to {np.round(goal, 2).tolist()}", disable=not progress):
+    for k in progress_bar(f"sync {settings.policy} to {np.round(goal, 2).tolist()}", settings.trials, "trial", progress,
+                           iterable=range(settings.trials)):
         person = setup.person(start, goal, settings.seed + k, first_plan)
         policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials)))
         robot = PolicyRobot(setup.world.controller, policy, settings)
