@@ -41,6 +41,8 @@ def spread_peak(paths: np.ndarray, goal: np.ndarray) -> tuple[float, float]:
 
 
 RELEASE_BEGIN, RELEASE_END = "<!-- release:begin -->", "<!-- release:end -->"
+#: The heading of docs/handover_transition.md's section on the release triggers, kept by the default mode.
+RELEASE_SECTION = "## What releases the robot"
 
 
 def _median_iqr(values, scale: float = 1.0, digits: int = 3) -> str:
@@ -90,7 +92,7 @@ def write_release_block(block: str) -> None:
     if RELEASE_BEGIN in text:
         text = text[: text.index(RELEASE_BEGIN)] + block + text[text.index(RELEASE_END) + len(RELEASE_END):]
     else:
-        text = text.rstrip("\n") + "\n\n" + block + "\n"
+        text = text.rstrip("\n") + f"\n\n{RELEASE_SECTION}\n\n{block}\n"
     path.write_text(text)
 
 
@@ -139,8 +141,8 @@ def main(argv: list[str] | None = None) -> int:
     suffix = "" if args.transition_data is None else "_" + args.transition_data.stem
     path = DOCS / f"handover_transition{suffix}.md"
     old = path.read_text() if path.exists() else ""
-    if RELEASE_BEGIN in old:      # the release triggers' block (--release) stays
-        text += "\n" + old[old.index(RELEASE_BEGIN): old.index(RELEASE_END) + len(RELEASE_END)] + "\n"
+    if RELEASE_SECTION in old:      # the release triggers' section (its table from --release) stays
+        text += "\n" + old[old.index(RELEASE_SECTION):]
     path.write_text(text)
     print(text)
     return 0
