@@ -47,6 +47,11 @@ class GoalDistanceRelease:
         self.schedule = schedule
         self.cause: str | None = None
 
+    @property
+    def goal_estimate(self) -> np.ndarray:
+        """Where the robot thinks the goal is (3,), m: the schedule's, which it knows."""
+        return self.schedule.goal
+
     def due(self, t: float, state: RobotState) -> bool:
         if np.linalg.norm(state.position - self.schedule.goal) <= self.schedule.transition_distance:
             self.cause = self.name
@@ -108,10 +113,10 @@ class EstimateRelease:
         return False
 
     @property
-    def goal_estimate(self) -> np.ndarray | None:
-        """The latest goal estimate (3,), m, or None before the first update."""
+    def goal_estimate(self) -> np.ndarray:
+        """The latest goal estimate (3,), m; the estimator's prior mean before the first update."""
         latest = self.estimator.latest
-        return None if latest is None else np.asarray(latest.goal)
+        return self.estimator.prior_mean if latest is None else np.asarray(latest.goal)
 
     def metrics(self, person_goal: np.ndarray) -> dict:
         """The estimate at the release (or at the end, if the robot never released): g_hat (m), its status,

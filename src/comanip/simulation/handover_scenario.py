@@ -9,7 +9,8 @@ predicted T of the online estimate of the goal), the stiffness ramps to 0 (raise
 reaches for their own goal (the nominal one moved by the trial's task variation), finishes alone.
 
 Per trial: when and where the switch happened against the prediction, the largest velocity change around
-the switch, and the final positioning error. Over trials: the perpendicular position spread and the
+the switch, the final positioning error, the person's RMS force, and what released the robot (with the
+estimate trigger: the estimate at the release, or the fallback at the plan's end). Over trials: the perpendicular position spread and the
 velocity mean ± std against the distance to the goal, with the transition marked (paper Fig. 8).
 """
 
@@ -84,15 +85,14 @@ class HandoverRobot:
         self.trigger = trigger or GoalDistanceRelease(schedule)
         self.switch_time: float | None = None
         self.switch_position: np.ndarray | None = None
-        self.goal_estimate = schedule.goal          # the robot leads to the nominal goal it was given
+        self.goal_estimate = self.trigger.goal_estimate
         self.controller.translational_stiffness = np.full(3, schedule.leading_stiffness)
 
     def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
         schedule = self.schedule
         if self.switch_time is None and self.trigger.due(t, state):
             self.switch_time, self.switch_position = t, state.position.copy()
-        if isinstance(self.trigger, EstimateRelease) and self.trigger.goal_estimate is not None:
-            self.goal_estimate = self.trigger.goal_estimate
+        self.goal_estimate = self.trigger.goal_estimate     # the known goal, or the latest online estimate
         if self.switch_time is not None and t <= self.switch_time + schedule.ramp_time + self.dt:
             stiffness = float(stiffness_profile(t, self.switch_time, schedule.ramp_time, schedule.leading_stiffness))
             self.controller.translational_stiffness = np.full(3, stiffness)
