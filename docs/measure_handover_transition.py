@@ -3,6 +3,7 @@ handover's predicted transition T (issue 12, item 6).
 
     PYTHONPATH=src python docs/measure_handover_transition.py [--trials 20] [--transition-data CSV]
         [--passive PKL ...]
+    PYTHONPATH=src python docs/measure_handover_transition.py --release [--trials 10]
 
 For the near and far goals: the transition distance T the handover predicts (:class:`TransitionModel` on the
 shipped planar data, or on --transition-data, e.g. made by ``comanip transition generate --preset
@@ -10,6 +11,11 @@ cartesian``), the distance at which the robot released, the peak of the perpendi
 paths in the handover run, and the same peak for the person alone (a passive robot in the sync scenario,
 same seeds: the person's own transition; --passive reuses pickles written by
 ``docs/make_policy_comparison.py --save``). Writes docs/handover_transition.md.
+
+With --release: the two release triggers (``HandoverSettings.release_trigger``) over the same trials and
+seeds, per goal: when and where the robot let go against the predicted transition and, paired by seed,
+against the goal-distance trigger; the estimate at the release; the final placement error and the person's
+RMS interaction force. Replaces the block between the release markers of docs/handover_transition.md.
 """
 
 from __future__ import annotations
@@ -34,13 +40,75 @@ def spread_peak(paths: np.ndarray, goal: np.ndarray) -> tuple[float, float]:
     return profile.transition_distance, profile.peak_dispersion
 
 
+RELEASE_BEGIN, RELEASE_END = "<!-- release:begin -->", "<!-- release:end -->"
+#: The heading of docs/handover_transition.md's section on the release triggers, kept by the default mode.
+RELEASE_SECTION = "## What releases the robot"
+
+
+def _median_iqr(values, scale: float = 1.0, digits: int = 3) -> str:
+    """'median [q25, q75]' of the finite values times scale."""
+    v = scale * np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if len(v) == 0:
+        return "–"
+    q25, q50, q75 = np.percentile(v, [25, 50, 75])
+    return f"{q50:.{digits}f} [{q25:.{digits}f}, {q75:.{digits}f}]"
+
+
+def release_table(trials: int, seed: int) -> str:
+    """The markdown block comparing the release triggers (module docstring)."""
+    setup = ScenarioSetup(HandoverSettings())
+    headings = ["goal", "trigger", "released (ms after predicted t_h)", "released − goal-distance trigger (ms, same seed)",
+                "released at (m from goal; predicted T)", "estimate: goal error (mm); T_hat (m)", "fallback",
+                "final error (mm)", "RMS force (N); its change (N)"]
+    rows = []
+    for goal in GOALS:
+        runs = {trigger: run_handover(HandoverSettings(goal=goal, trials=trials, seed=seed, release_trigger=trigger), setup,
+                                      progress=False) for trigger in ("goal_distance", "estimate")}
+        reference = np.array([t.metrics["switch_time_s"] for t in runs["goal_distance"].trials])
+        for trigger, run in runs.items():
+            m = {key: np.array([t.metrics[key] for t in run.trials], dtype=float)
+                 for key in ("switch_time_s", "switch_delay_s", "switch_distance_m", "final_error_m", "rms_force_N",
+                             "rms_force_change_N", "estimate_goal_error_m", "estimated_transition_distance_m")}
+            fallback = sum(t.metrics["release_fallback"] for t in run.trials)
+            estimate = "–" if trigger == "goal_distance" else \
+                f"{_median_iqr(m['estimate_goal_error_m'], 1e3, 0)}; {_median_iqr(m['estimated_transition_distance_m'])}"
+            rows.append([goal, trigger, _median_iqr(m["switch_delay_s"], 1e3, 0),
+                         _median_iqr(m["switch_time_s"] - reference, 1e3, 0),
+                         f"{_median_iqr(m['switch_distance_m'])}; {run.schedule.transition_distance:.3f}", estimate,
+                         f"{fallback}/{len(run.trials)}", _median_iqr(m["final_error_m"], 1e3, 1),
+                         f"{_median_iqr(m['rms_force_N'], 1, 1)}; {_median_iqr(m['rms_force_change_N'], 1, 1)}"])
+    table = "\n".join(["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)] +
+                      ["| " + " | ".join(row) + " |" for row in rows])
+    command = f"PYTHONPATH=src python docs/measure_handover_transition.py --release --trials {trials}"
+    return (f"{RELEASE_BEGIN}\nMedian [quartiles] over {trials} trials per goal (seeds {seed}–{seed + trials - 1}, the same "
+            f"for both triggers); measured by `{command}`.\n\n{table}\n{RELEASE_END}")
+
+
+def write_release_block(block: str) -> None:
+    """Put block in place of the release markers' block of docs/handover_transition.md (or at its end)."""
+    path = DOCS / "handover_transition.md"
+    text = path.read_text()
+    if RELEASE_BEGIN in text:
+        text = text[: text.index(RELEASE_BEGIN)] + block + text[text.index(RELEASE_END) + len(RELEASE_END):]
+    else:
+        text = text.rstrip("\n") + f"\n\n{RELEASE_SECTION}\n\n{block}\n"
+    path.write_text(text)
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--trials", type=int, default=20, help="trials per goal (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--transition-data", type=Path, help="transition CSV for the TransitionModel (default: shipped)")
     parser.add_argument("--passive", type=Path, nargs="*", help="pickles of make_policy_comparison.py --save to reuse")
+    parser.add_argument("--release", action="store_true", help="compare the release triggers instead (module docstring)")
     args = parser.parse_args(argv)
+    if args.release:
+        block = release_table(args.trials, args.seed)
+        write_release_block(block)
+        print(block)
+        return 0
     model = TransitionModel() if args.transition_data is None else TransitionModel(data=args.transition_data)
     passive = {}
     for path in args.passive or []:
@@ -71,7 +139,11 @@ def main(argv: list[str] | None = None) -> int:
               (f" --transition-data {args.transition_data}" if args.transition_data else "")
     text = f"Distances from the goal; measured by `{command}` (seeds {args.seed}–{args.seed + args.trials - 1}).\n\n{table}"
     suffix = "" if args.transition_data is None else "_" + args.transition_data.stem
-    (DOCS / f"handover_transition{suffix}.md").write_text(text)
+    path = DOCS / f"handover_transition{suffix}.md"
+    old = path.read_text() if path.exists() else ""
+    if RELEASE_SECTION in old:      # the release triggers' section (its table from --release) stays
+        text += "\n" + old[old.index(RELEASE_SECTION):]
+    path.write_text(text)
     print(text)
     return 0
 

@@ -118,3 +118,60 @@ def test_handover_command_writes_the_schedule(tmp_path, capsys):
     assert saved["transition_time_s"] == report[0]["transition_time_s"]
     rows = np.genfromtxt(tmp_path / "handover_0.csv", delimiter=",", names=True)
     assert np.allclose(np.diff(rows["t_s"]), 2e-3) and rows["stiffness_N_per_m"][0] == 400.0
+
+
+def _release_on_the_exact_path(schedule, trigger):
+    """Drive a HandoverRobot with the schedule's own rest motion at 1 kHz (noiseless, exact hand states)."""
+    from types import SimpleNamespace
+
+    from comanip.simulation.handover_scenario import HandoverRobot
+
+    robot = HandoverRobot(SimpleNamespace(translational_stiffness=None), schedule, 1e-3, trigger)
+    for t, position, velocity in zip(schedule.t, schedule.rest_position, schedule.rest_velocity):
+        robot.command(t, SimpleNamespace(position=position, velocity=velocity))
+    return robot
+
+
+def _estimate_release(plan, transition_model, settle_fraction, fallback_time):
+    from comanip.estimation import OnlineGoalEstimator, OnlineOptions
+    from comanip.simulation.handover_release import EstimateRelease
+
+    estimator = OnlineGoalEstimator(comanip.presets.cartesian(), plan.start, prior_goal=GOAL, width=plan.width,
+                                    options=OnlineOptions(correction_time=0.3, deviation_time=0.15))
+    return EstimateRelease(estimator, transition_model, plan.width, 0.02, settle_fraction, fallback_time)
+
+
+def test_estimate_triggered_release_follows_the_goal_distance_one_on_an_exact_reach(plan, transition_model):
+    from comanip.simulation.handover_release import GoalDistanceRelease
+
+    schedule = plan_handover(plan, transition_model, rate=1000.0)
+    known = _release_on_the_exact_path(schedule, GoalDistanceRelease(schedule))
+    estimated = _release_on_the_exact_path(schedule, _estimate_release(plan, transition_model, 0.25, plan.t[-1]))
+    assert known.trigger.cause == "goal_distance" and estimated.trigger.cause == "estimate"
+    assert abs(known.switch_time - schedule.transition_time) <= 1e-3
+    # exact estimate of the goal from ~0.52 s on, but the corrected-deviation belief keeps its std above
+    # 0.25 T until ~0.6 s: the release comes 43 ms later, about two 20 ms updates
+    assert 0.0 <= estimated.switch_time - known.switch_time <= 0.05
+    metrics = estimated.trigger.metrics(np.asarray(GOAL))
+    assert not metrics["release_fallback"] and metrics["estimate_status"] is not None
+    assert metrics["estimate_goal_error_m"] < 0.1 * schedule.goal_distance
+    assert metrics["estimate_goal_std_m"] <= 0.25 * metrics["estimated_transition_distance_m"]
+    assert metrics["estimated_transition_distance_m"] == pytest.approx(schedule.transition_distance, rel=0.1)
+
+
+def test_an_estimate_that_never_settles_releases_at_the_fallback_time_and_says_so(plan, transition_model):
+    schedule = plan_handover(plan, transition_model, rate=1000.0)
+    robot = _release_on_the_exact_path(schedule, _estimate_release(plan, transition_model, 1e-9, plan.t[-1]))
+    assert robot.switch_time == pytest.approx(plan.t[-1], abs=1e-3)
+    metrics = robot.trigger.metrics(np.asarray(GOAL))
+    assert metrics["release_cause"] == "fallback_plan_end" and metrics["release_fallback"]
+    assert metrics["estimate_updates"] > 0
+
+
+def test_unknown_release_trigger_is_rejected():
+    from comanip.simulation import HandoverSettings
+
+    with pytest.raises(ValueError, match="release_trigger must be one of goal_distance, estimate"):
+        HandoverSettings(release_trigger="time")
+    with pytest.raises(ValueError, match="settle_fraction"):
+        HandoverSettings(release_trigger="estimate", settle_fraction=0.0)

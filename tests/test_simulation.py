@@ -25,6 +25,14 @@ def handover_runs():
             for goal in ("near", "far")}, setup
 
 
+@pytest.fixture(scope="module")
+def estimate_release_runs(handover_runs):
+    """The first 3 trials of handover_runs (same seeds), released on the online goal estimate instead."""
+    _, setup = handover_runs
+    return {goal: run_handover(HandoverSettings(goal=goal, trials=3, release_trigger="estimate"), setup, progress=False)
+            for goal in ("near", "far")}
+
+
 def _mean(trials, key):
     return float(np.mean([trial.metrics[key] for trial in trials]))
 
@@ -94,6 +102,24 @@ def test_handover_profiles_mark_a_transition_farther_out_for_the_far_goal(handov
     assert runs["far"].dispersion.transition_distance > runs["near"].dispersion.transition_distance
 
 
+@pytest.mark.slow
+def test_handover_released_on_the_estimate_lets_go_near_the_goal_distance_release(handover_runs, estimate_release_runs):
+    """Released on a settled online estimate (never the fallback) within 0.1 s of the goal-distance trigger's
+    release of the same seed, with a velocity change during the ramp under 0.1 m/s, and the person still
+    lands within the width."""
+    runs, setup = handover_runs
+    for label, run in estimate_release_runs.items():
+        for trial, reference in zip(run.trials, runs[label].trials):
+            m = trial.metrics
+            assert m["release_trigger"] == "estimate" and m["release_cause"] == "estimate", (label, m["release_cause"])
+            assert not m["release_fallback"] and m["estimate_updates"] > 10
+            assert m["estimate_goal_std_m"] <= 0.25 * m["estimated_transition_distance_m"]
+            assert abs(m["switch_time_s"] - reference.metrics["switch_time_s"]) <= 0.1, label
+            assert m["velocity_jump_at_switch_m_per_s"] < 0.1, label
+            assert m["final_error_m"] <= setup.width, label
+            assert np.all(np.isfinite(trial.record.goal_estimate[-1]))
+
+
 @pytest.mark.parametrize("goal, message", [
     ((0.1, 0.0, 0.3), "horizontal distance"),
     ((1.2, 0.0, 0.3), "beyond the arm"),
@@ -123,3 +149,7 @@ def test_cli_rejects_bad_input_before_building_anything(capsys):
     assert "trials" in capsys.readouterr().err
     assert main(["simulate", "handover", "--goal", "2,0,0.3"]) == 2
     assert "workspace" in capsys.readouterr().err
+    assert main(["simulate", "handover", "--trigger", "time"]) == 2
+    assert "release_trigger must be one of goal_distance, estimate, got 'time'" in capsys.readouterr().err
+    assert main(["simulate", "sync", "--trigger", "estimate"]) == 2
+    assert "--trigger applies to the handover scenario only" in capsys.readouterr().err

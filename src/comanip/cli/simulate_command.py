@@ -25,6 +25,8 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
     parser.add_argument("--policy", help="sync only: the robot policy, one of passive, prior-only, constant-velocity, "
                                          "minimum-jerk, one-shot (default), continuous, or all of them")
+    parser.add_argument("--trigger", help="handover only: what releases the robot, goal_distance (default: the handle "
+                                          "within T of the known goal) or estimate (within T of the online goal estimate)")
     add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
@@ -45,6 +47,10 @@ def run(args) -> int:
             raise ValueError(f"--policy applies to the sync scenario only, got scenario {args.scenario!r}")
         policies = list(POLICIES) if args.policy == "all" else [check_policy(args.policy)]
         common["policy"] = "one-shot" if "one-shot" in policies else policies[0]
+    if args.trigger is not None:
+        if args.scenario != "handover":
+            raise ValueError(f"--trigger applies to the handover scenario only, got scenario {args.scenario!r}")
+        common["release_trigger"] = args.trigger
     # every setting is checked here, before any solver or model is built
     all_settings = {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in goals}
     setup = ScenarioSetup(next(iter(all_settings.values())))

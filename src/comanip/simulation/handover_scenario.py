@@ -3,12 +3,14 @@
 The robot plans a reach to the nominal goal with the Cartesian preset and holds the handle to it at
 400 N/m (:func:`comanip.multicomponent.handover.plan_handover` gives the rest motion and the predicted
 transition point: the distance T from the goal where a person would switch from the fast initial
-sub-movement to the corrective one). When the handle itself comes within T of the goal, the stiffness
-ramps to 0 (raised cosine) and the person, who reaches for their own goal (the nominal one moved by the
-trial's task variation), finishes alone.
+sub-movement to the corrective one). When the release trigger fires (:mod:`comanip.simulation.handover_release`:
+by default the handle itself comes within T of the goal; or, with ``release_trigger="estimate"``, within the
+predicted T of the online estimate of the goal), the stiffness ramps to 0 (raised cosine) and the person, who
+reaches for their own goal (the nominal one moved by the trial's task variation), finishes alone.
 
 Per trial: when and where the switch happened against the prediction, the largest velocity change around
-the switch, and the final positioning error. Over trials: the perpendicular position spread and the
+the switch, the final positioning error, the person's RMS force, and what released the robot (with the
+estimate trigger: the estimate at the release, or the fallback at the plan's end). Over trials: the perpendicular position spread and the
 velocity mean ± std against the distance to the goal, with the transition marked (paper Fig. 8).
 """
 
@@ -18,12 +20,19 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from comanip.arguments import as_positive
 from comanip.control.impedance import CartesianImpedanceController, RobotState
+from comanip.estimation import OnlineGoalEstimator, OnlineOptions
+from comanip.estimation.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
 from comanip.multicomponent.dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan
 from comanip.progress import progress_bar
+from comanip.simulation.handover_release import (DEFAULT_SETTLE_FRACTION, EstimateRelease, GoalDistanceRelease,
+                                                 check_release_trigger)
+from comanip.simulation.measures import trial_measures
+from comanip.simulation.policies.protocol import DEFAULT_UPDATE_INTERVAL
 from comanip.simulation.person import solve_to_convergence
 from comanip.simulation.scenario import ScenarioSettings, TrialRecord, run_trial
 from comanip.simulation.setup import ScenarioSetup
@@ -45,9 +54,21 @@ class HandoverSettings(ScenarioSettings):
     person's fine positioning to absorb. 0 (default): the person's own motor noise is the only variation,
     so the position spread shows where their reaches disperse (a variation of 1 cm outgrows it and moves
     the spread's peak onto the goal)."""
+    release_trigger: str = "goal_distance"
+    """What makes the robot let go (:mod:`comanip.simulation.handover_release`): "goal_distance" (default,
+    the paper's: the handle within T of the goal the robot planned to, which it knows here) or "estimate"
+    (the handle within T of the online goal estimate, once settled; the plan's end as a fallback)."""
+    settle_fraction: float = DEFAULT_SETTLE_FRACTION
+    """With the "estimate" trigger: the largest goal std an estimate may have to release, as a fraction of
+    its predicted transition distance."""
+    estimate_interval: float = DEFAULT_UPDATE_INTERVAL
+    """With the "estimate" trigger: time between the observations fed to the estimator (s)."""
 
     def __post_init__(self):
         super().__post_init__()
+        check_release_trigger(self.release_trigger)
+        as_positive("settle_fraction", self.settle_fraction, "fraction of the transition distance")
+        as_positive("estimate_interval", self.estimate_interval, "s")
         if not (isinstance(self.ramp_time, (int, float)) and np.isfinite(self.ramp_time) and self.ramp_time >= 0):
             raise ValueError(f"ramp_time must be a finite number ≥ 0 (s), got {self.ramp_time!r}")
         if not (isinstance(self.goal_variation, (int, float)) and np.isfinite(self.goal_variation) and self.goal_variation >= 0):
@@ -55,19 +76,23 @@ class HandoverSettings(ScenarioSettings):
 
 
 class HandoverRobot:
-    """Leads along the schedule's rest motion at 400 N/m; ramps to 0 once the handle is within T of the goal."""
+    """Leads along the schedule's rest motion at 400 N/m; ramps to 0 once the release trigger fires
+    (default: the handle within T of the schedule's goal)."""
 
-    def __init__(self, controller: CartesianImpedanceController, schedule: HandoverSchedule, dt: float):
+    def __init__(self, controller: CartesianImpedanceController, schedule: HandoverSchedule, dt: float,
+                 trigger: GoalDistanceRelease | EstimateRelease | None = None):
         self.controller, self.schedule, self.dt = controller, schedule, dt
+        self.trigger = trigger or GoalDistanceRelease(schedule)
         self.switch_time: float | None = None
         self.switch_position: np.ndarray | None = None
-        self.goal_estimate = schedule.goal          # the robot leads to the nominal goal it was given
+        self.goal_estimate = self.trigger.goal_estimate
         self.controller.translational_stiffness = np.full(3, schedule.leading_stiffness)
 
     def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
         schedule = self.schedule
-        if self.switch_time is None and np.linalg.norm(state.position - schedule.goal) <= schedule.transition_distance:
+        if self.switch_time is None and self.trigger.due(t, state):
             self.switch_time, self.switch_position = t, state.position.copy()
+        self.goal_estimate = self.trigger.goal_estimate     # the known goal, or the latest online estimate
         if self.switch_time is not None and t <= self.switch_time + schedule.ramp_time + self.dt:
             stiffness = float(stiffness_profile(t, self.switch_time, schedule.ramp_time, schedule.leading_stiffness))
             self.controller.translational_stiffness = np.full(3, stiffness)
@@ -120,12 +145,16 @@ def velocity_jump(record: TrialRecord, start: float, end: float) -> float:
 
 def handover_metrics(record: TrialRecord, robot: HandoverRobot, width: float) -> dict:
     """Measures of one trial: switch time and distance against the prediction, the largest velocity change
-    during the ramp (and, for comparison, over the same time just before it), and the final error."""
+    during the ramp (and, for comparison, over the same time just before it), the final error, the person's
+    RMS interaction force (N, and its change from the holding force), and what released the robot: the
+    trigger, the cause and, with the estimate trigger, the estimate at the release
+    (:meth:`EstimateRelease.metrics`)."""
     schedule = robot.schedule
     switched = robot.switch_time is not None
     t_s = robot.switch_time if switched else float("nan")
     ramp_end = t_s + max(schedule.ramp_time, 2 * JUMP_HALF_WINDOW)
     final_error = float(np.linalg.norm(record.position[-1] - record.goal))
+    forces = trial_measures(record, width, robot_axes=())
     return {
         "switched": switched,
         "switch_time_s": t_s,
@@ -139,9 +168,11 @@ def handover_metrics(record: TrialRecord, robot: HandoverRobot, width: float) ->
         "final_error_m": final_error,
         "within_width": final_error <= width,
         "person_goal_m": record.goal.tolist(),
+        "rms_force_N": forces["rms_force_N"],
+        "rms_force_change_N": forces["rms_force_change_N"],
         "replans": record.replans,
         "iteration_capped_replans": record.iteration_capped_replans,
-    }
+    } | robot.trigger.metrics(record.goal)
 
 
 def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -152,6 +183,20 @@ def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid:
     along = (paths - start) @ u
     at_grid = np.stack([values_at_first_passage(a, v[:, None], grid)[:, 0] for a, v in zip(along, speeds)])
     return np.nanmean(at_grid, axis=0), np.nanstd(at_grid, axis=0, ddof=1)
+
+
+def release_trigger(settings: HandoverSettings, setup: ScenarioSetup, start: np.ndarray, transition_model: TransitionModel,
+                    schedule: HandoverSchedule, plan: Plan) -> GoalDistanceRelease | EstimateRelease:
+    """One trial's release trigger as the settings ask. The estimate trigger's estimator starts from the
+    settled start [x; 0] (6,) with the robot's goal as its prior mean (weak default std) and assumes a person
+    who corrects deviations from their plan (CORRECTION_TIME, DEVIATION_TIME, as the sync scenario's
+    continuous policy); it falls back to releasing at the plan's end."""
+    if settings.release_trigger == "goal_distance":
+        return GoalDistanceRelease(schedule)
+    estimator = OnlineGoalEstimator(setup.model, start, prior_goal=schedule.goal, width=setup.width,
+                                    options=OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME))
+    return EstimateRelease(estimator, transition_model, setup.width, settings.estimate_interval, settings.settle_fraction,
+                           fallback_time=float(plan.t[-1]))
 
 
 def run_handover(settings: HandoverSettings, setup: ScenarioSetup | None = None, transition_model: TransitionModel | None = None,
@@ -172,7 +217,8 @@ def run_handover(settings: HandoverSettings, setup: ScenarioSetup | None = None,
         variation = np.random.default_rng((settings.seed + k, 1)).standard_normal(2)   # apart from the motor noise
         person_goal = goal + np.r_[settings.goal_variation * variation, 0.0]
         person = setup.person(start, person_goal, settings.seed + k)
-        robot = HandoverRobot(setup.world.controller, schedule, dt)
+        robot = HandoverRobot(setup.world.controller, schedule, dt, release_trigger(settings, setup, start.state,
+                                                                                   transition_model, schedule, plan))
         record = run_trial(setup.world, start, person, robot, duration)
         trials.append(HandoverTrial(record, handover_metrics(record, robot, width)))
     paths = np.stack([trial.record.position for trial in trials])
