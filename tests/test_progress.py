@@ -48,3 +48,14 @@ def test_every_bar_of_the_package_goes_through_comanip_progress():
     direct = [str(path.relative_to(root)) for path in root.rglob("*.py")
               if path.name != "progress.py" and re.search(r"\btqdm\s*\(", path.read_text(encoding="utf-8"))]
     assert direct == [], f"these modules make tqdm bars themselves: {direct}"
+
+
+def test_nested_bars_in_a_log_have_no_cursor_movements(capsys):
+    """Two bars at once (a model build around a compile) make tqdm move the cursor up to redraw; a log gets none."""
+    with progress_bar("outer", 2, "step") as outer:
+        with progress_bar("inner", 3, "step") as inner:
+            inner.update(3)
+        outer.update(2)
+    err = capsys.readouterr().err
+    assert "\x1b" not in err and "\r" not in err
+    assert any(line.startswith("inner: 100%") for line in err.splitlines())

@@ -7,6 +7,7 @@ the first and the last), so a log never gets one long line of carriage-return re
 
 from __future__ import annotations
 
+import re
 import sys
 import threading
 from contextlib import contextmanager
@@ -19,15 +20,20 @@ TERMINAL_INTERVAL = 0.5
 """Seconds between the redraws of one bar in a terminal."""
 
 
+#: Terminal control sequences (tqdm moves the cursor up with ESC [ A to redraw nested bars in place)
+_CONTROL = re.compile(r"\x1b\[[0-9;]*[A-Za-z]")
+
+
 class _LineWriter:
-    """A file for tqdm that turns every redraw ('\\r' + status) into one line on ``stream``, repeats dropped."""
+    """A file for tqdm that turns every redraw ('\\r' + status) into one line on ``stream``, repeats and
+    cursor movements dropped."""
 
     def __init__(self, stream):
         self.stream = stream
         self.last = ""
 
     def write(self, text: str) -> None:
-        for part in text.replace("\n", "\r").split("\r"):
+        for part in _CONTROL.sub("", text).replace("\n", "\r").split("\r"):
             part = part.strip()
             if part and part != self.last:
                 self.stream.write(part + "\n")
