@@ -49,7 +49,8 @@ from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
-from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
+from comanip.estimation.corrected_deviation import (CORRECTION_TIME, DEVIATION_TIME, corrected_covariance, corrected_powers,
+                                                   correction_factor)
 from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
@@ -108,6 +109,11 @@ class OnlineOptions:
             as_positive("correction_time", self.correction_time, "s (or None: open loop)")
         if not (math.isfinite(self.deviation_time) and self.deviation_time >= 0):
             raise ValueError(f"deviation_time must be a finite time ≥ 0 s, got {self.deviation_time!r}")
+
+
+CORRECTING_PERSON = OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME)
+"""The options for a person who corrects deviations from their plan (:mod:`comanip.estimation.corrected_deviation`):
+what the sync scenario's continuous policy, the handover's estimate trigger and the ROS node use."""
 
 
 class ModelFamilies:

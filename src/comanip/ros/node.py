@@ -44,7 +44,7 @@ from rclpy.parameter import Parameter
 from std_msgs.msg import Empty, Float64MultiArray
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator
-from comanip.estimation.online_estimator import FamilyCache
+from comanip.estimation.online_estimator import CORRECTING_PERSON, FamilyCache
 from comanip.estimation.shared import estimation_planner
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
@@ -58,8 +58,9 @@ QUEUE_DEPTH = 50
 
 
 def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width) -> OnlineGoalEstimator:
-    """The goal estimator of one reach from ``start`` (2n,), at rest: the one place that names the estimator."""
-    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families)
+    """The goal estimator of one reach from ``start`` (2n,), at rest: the one place that names the estimator. The
+    person in a robot's loop corrects deviations from their plan (CORRECTING_PERSON, as in the simulated scenarios)."""
+    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=CORRECTING_PERSON)
 
 
 @dataclass

@@ -22,8 +22,8 @@ import numpy as np
 
 from comanip.arguments import as_positive
 from comanip.control.impedance import CartesianImpedanceController, RobotState
-from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
+from comanip.estimation import OnlineGoalEstimator
+from comanip.estimation.online_estimator import CORRECTING_PERSON
 from comanip.multicomponent.dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel
@@ -189,12 +189,12 @@ def release_trigger(settings: HandoverSettings, setup: ScenarioSetup, start: np.
                     schedule: HandoverSchedule, plan: Plan) -> GoalDistanceRelease | EstimateRelease:
     """One trial's release trigger as the settings ask. The estimate trigger's estimator starts from the
     settled start [x; 0] (6,) with the robot's goal as its prior mean (weak default std) and assumes a person
-    who corrects deviations from their plan (CORRECTION_TIME, DEVIATION_TIME, as the sync scenario's
+    who corrects deviations from their plan (CORRECTING_PERSON, as the sync scenario's
     continuous policy); it falls back to releasing at the plan's end."""
     if settings.release_trigger == "goal_distance":
         return GoalDistanceRelease(schedule)
     estimator = OnlineGoalEstimator(setup.model, start, prior_goal=schedule.goal, width=setup.width,
-                                    options=OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME))
+                                    options=CORRECTING_PERSON)
     return EstimateRelease(estimator, transition_model, setup.width, settings.estimate_interval, settings.settle_fraction,
                            fallback_time=float(plan.t[-1]))
 

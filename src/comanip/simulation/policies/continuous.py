@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
+from comanip.estimation.online_estimator import CORRECTING_PERSON
 from comanip.simulation.policies.protocol import PolicyContext, Prediction
 from comanip.simulation.rest_trajectory import RestTrajectory
 
@@ -19,7 +19,7 @@ class ContinuousPolicy:
     prior_std: the prior goal's standard deviation (m), as :class:`OnlineGoalEstimator` takes it (None: its
     weak default). observe_from: time (s) of the first observation fed (default: one update_interval after
     the start). options: the estimator's :class:`OnlineOptions`; default: a person who corrects deviations from
-    their plan (:mod:`comanip.estimation.corrected_deviation`, CORRECTION_TIME and DEVIATION_TIME), as the
+    their plan (``CORRECTING_PERSON``: :mod:`comanip.estimation.corrected_deviation`), as the
     simulated person does by replanning.
     """
 
@@ -30,8 +30,7 @@ class ContinuousPolicy:
         self.context = context
         self.update_interval = context.update_interval
         self.estimator = OnlineGoalEstimator(context.model, context.start, prior_goal=context.prior_goal,
-                                             prior_std=prior_std, width=context.width, options=options or OnlineOptions(
-                                                 correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME))
+                                             prior_std=prior_std, width=context.width, options=options or CORRECTING_PERSON)
         self._next_observation = context.update_interval if observe_from is None else observe_from
 
     def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
