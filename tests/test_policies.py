@@ -162,3 +162,21 @@ def test_continuous_estimate_is_revised_at_every_update(runs):
     revisions = np.count_nonzero(np.any(np.diff(record.goal_estimate[after], axis=0) != 0, axis=1))
     assert trials["continuous"].metrics["predictions"] == trials["constant-velocity"].metrics["predictions"]
     assert revisions == trials["continuous"].metrics["predictions"] - 1      # a new goal at every update after the first
+
+
+def test_continuous_policy_does_not_lead_before_its_first_observation():
+    """With its first observation after t_o (a long update_interval) the continuous policy has no estimate at
+    t_o: it must not lead (None), and it predicts once an observation came."""
+    from comanip import presets
+    from comanip.simulation.policies import ContinuousPolicy, PolicyContext
+
+    model = presets.cartesian()
+    start = np.r_[0.4, 0.0, 0.3, np.zeros(3)]
+    context = PolicyContext(start=start, prior_goal=np.array([0.6, 0.1, 0.3]), width=model.width, observation_time=0.2,
+                            dt=0.01, duration=1.5, model=model, estimator=None, prior_plan=None, update_interval=0.5)
+    policy = ContinuousPolicy(context)
+    policy.observe(0.2, start[:3], np.zeros(3))
+    assert policy.predict(0.2) is None
+    policy.observe(0.5, start[:3] + [0.02, 0.0, 0.0], np.array([0.2, 0.0, 0.0]))
+    prediction = policy.predict(0.5)
+    assert prediction is not None and np.all(np.isfinite(prediction.goal))

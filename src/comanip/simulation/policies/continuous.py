@@ -38,6 +38,10 @@ class ContinuousPolicy:
             self.estimator.update(t, position, velocity)
             self._next_observation += self.update_interval
 
-    def predict(self, t: float) -> Prediction:
+    def predict(self, t: float) -> Prediction | None:
+        """The latest estimate's goal and predicted reach; None (do not lead yet) before the first observation,
+        e.g. when update_interval or observe_from is later than t_o."""
         c, estimate = self.context, self.estimator.latest
+        if estimate is None:
+            return None
         return Prediction(np.array(estimate.goal), RestTrajectory.from_plan(estimate, 0.0, c.dt, c.duration), estimate)
