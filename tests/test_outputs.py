@@ -51,3 +51,11 @@ def test_manifest_describes_simulated_handover_trials_as_trials(tmp_path):
     assert "simulated trial" in text["handover_near_trial0.csv"]
     assert "per-trial metrics" in text["handover_summary.json"]
     assert "schedule" in text["handover_0.csv"] and "schedule" in text["handover_0.json"]
+
+
+def test_file_kinds_name_each_pattern_once():
+    """FILE_KINDS is first-match-wins: a pattern listed twice has a description nothing can reach."""
+    from comanip.cli.outputs import FILE_KINDS
+
+    patterns = [pattern for pattern, _ in FILE_KINDS]
+    assert len(patterns) == len(set(patterns)), sorted(p for p in set(patterns) if patterns.count(p) > 1)
