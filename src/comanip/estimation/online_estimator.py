@@ -256,9 +256,7 @@ class OnlineGoalEstimator:
         position = as_vector("position", position, model.d, "hand position, m")
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
         observation = np.r_[position, velocity]
-        grid = time_s / model.h
-        before = min(model.H, int(math.floor(grid * (1 + 1e-9))))
-        fraction = 0.0 if before == model.H else min(max(grid - before, 0.0), 1.0)
+        before, fraction = _grid_position(time_s, model.h, model.H)
         self._counts[before] += 1
         self._sums[before] += observation
         self._fractions[before] += fraction
@@ -348,9 +346,7 @@ class OnlineGoalEstimator:
     def _result(self, goal, covariance, status: Status, message: str, iterations: int, t_begin: float) -> GoalEstimate:
         model, n = self.model, self.model.n
         prediction = self._prediction(goal, order=0)
-        grid = self._last_time / model.h
-        before = min(model.H, int(math.floor(grid * (1 + 1e-9))))
-        fraction = 0.0 if before == model.H else min(max(grid - before, 0.0), 1.0)
+        before, fraction = _grid_position(self._last_time, model.h, model.H)
         predicted = (1 - fraction) * prediction.mean[before, :2 * n] + fraction * prediction.mean[min(before + 1, model.H), :2 * n]
         plan = Plan(success=status in CONVERGED, status=status, message=message, objective=prediction.objective,
                     solve_time=time.perf_counter() - t_begin, iterations=iterations, t=model.h * np.arange(model.H + 1),
@@ -543,6 +539,14 @@ class _Problem:
             if scores[k] < best_score:
                 best, best_score = goals[k], scores[k]
         return best
+
+
+def _grid_position(time_s: float, h: float, H: int) -> tuple[int, float]:
+    """Where time_s (s, ≥ 0) falls on the grid of step h (s): the step i ≤ H at or before it and the fraction
+    of a step (in [0, 1]) it lies after t_i; times at or after the horizon H·h read as (H, 0)."""
+    grid = time_s / h
+    before = min(H, int(math.floor(grid * (1 + 1e-9))))
+    return before, (0.0 if before == H else min(max(grid - before, 0.0), 1.0))
 
 
 def _factor(newton: np.ndarray, gauss_newton: np.ndarray) -> np.ndarray:
