@@ -180,3 +180,11 @@ def test_continuous_policy_does_not_lead_before_its_first_observation():
     policy.observe(0.5, start[:3] + [0.02, 0.0, 0.0], np.array([0.2, 0.0, 0.0]))
     prediction = policy.predict(0.5)
     assert prediction is not None and np.all(np.isfinite(prediction.goal))
+
+
+@pytest.mark.parametrize("options, name", [(dict(observation_std=0.0), "observation_std"), (dict(prior_std=-1.0), "prior_std"),
+                                           (dict(duration_bounds=(2.0, 1.0)), "duration_bounds"),
+                                           (dict(duration_bounds=(0.0, 1.0)), "duration_bounds")])
+def test_minimum_jerk_fit_refuses_bad_options_with_a_value_error_naming_them(options, name):
+    with pytest.raises(ValueError, match=name):
+        fit_minimum_jerk(np.zeros(3), [0.1, 0.2], np.full((2, 3), 0.01), np.full(3, 0.3), **options)

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import minimize_scalar
 
+from comanip.arguments import as_positive
 from comanip.planning.initial_guess import minimum_jerk
 from comanip.simulation.policies.protocol import PolicyContext, Prediction
 
@@ -36,6 +37,11 @@ def fit_minimum_jerk(start, times, positions, prior_goal, *, observation_std: fl
     times, positions = np.asarray(times, dtype=float), np.asarray(positions, dtype=float)
     if times.ndim != 1 or positions.shape != (len(times), len(start)):
         raise ValueError(f"times must be (K,) and positions (K, {len(start)}), got {times.shape} and {positions.shape}")
+    as_positive("observation_std", observation_std, "m")
+    as_positive("prior_std", prior_std, "m")
+    low, high = (as_positive(f"duration_bounds[{k}]", v, "s") for k, v in enumerate(duration_bounds))
+    if low >= high:
+        raise ValueError(f"duration_bounds must be (T_min, T_max) with 0 < T_min < T_max (s), got {duration_bounds!r}")
     offsets, prior_offset = positions - start, prior_goal - start
     a, b = 1.0 / observation_std**2, 1.0 / prior_std**2
 
@@ -45,7 +51,6 @@ def fit_minimum_jerk(start, times, positions, prior_goal, *, observation_std: fl
         residual = offsets - np.outer(sigma, offset)
         return offset, float(a * np.sum(residual**2) + b * np.sum((offset - prior_offset) ** 2))
 
-    low, high = duration_bounds
     grid = np.geomspace(low, high, 25)
     k = int(np.argmin([solve(T)[1] for T in grid]))
     bracket = (grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)])
