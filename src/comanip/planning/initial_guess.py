@@ -38,7 +38,7 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
     """Commands (H, n) that make the mean follow a joint-space minimum-jerk reach from start (nx,) to goal_q (n,)
     (through the body's activation stages, if it has them).
 
-    ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics`, evaluated
+    ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics_of`, evaluated
     once by a caller that makes many guesses; None evaluates them here."""
     t = h * np.arange(H)
     q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n:2 * body.n], goal_q, duration, t)
