@@ -134,6 +134,8 @@ def test_measures_match_hand_computations_on_a_synthetic_record():
     assert later["work_against_robot_J"] == 0.0
     with pytest.raises(ValueError, match="from_time"):
         trial_measures(record, width=0.02, from_time=3.0)
+    with pytest.raises(ValueError, match="width"):
+        trial_measures(record, width=0.0)
 
 
 @pytest.mark.slow

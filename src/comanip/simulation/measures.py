@@ -28,6 +28,7 @@ from __future__ import annotations
 import numpy as np
 
 from comanip.analysis.speed_profile import speed_metrics
+from comanip.arguments import as_positive
 from comanip.simulation.scenario import TrialRecord, reach_times
 
 #: Fractions of the movement time at which the goal-estimate error is reported.
@@ -62,6 +63,7 @@ def trial_measures(record: TrialRecord, width: float, person_axes=(0, 1), robot_
     from_time (s) where the force and work measures start.
     person_axes and robot_axes: indices of the axes each leads (the sync scenario's x–y and z); with
     robot_axes empty the synchronisation measures are NaN."""
+    as_positive("width", width, "m")
     t, dt = record.t, float(record.t[1] - record.t[0])
     if not (np.isfinite(from_time) and t[0] <= from_time < t[-1]):
         raise ValueError(f"from_time must lie within the trial, [{t[0]}, {t[-1]}) s, got {from_time!r}")
