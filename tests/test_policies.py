@@ -190,3 +190,17 @@ def test_continuous_policy_does_not_lead_before_its_first_observation():
 def test_minimum_jerk_fit_refuses_bad_options_with_a_value_error_naming_them(options, name):
     with pytest.raises(ValueError, match=name):
         fit_minimum_jerk(np.zeros(3), [0.1, 0.2], np.full((2, 3), 0.01), np.full(3, 0.3), **options)
+
+
+def test_sync_metrics_of_a_movement_that_ends_before_the_observation_time_are_nan_not_an_error():
+    from comanip.simulation.sync_scenario import sync_metrics
+
+    t = np.arange(0.0, 2.0001, 0.001)
+    s = np.clip(t / 0.5, 0.0, 1.0)                                      # done in 0.5 s, before t_o = 1 s
+    start, goal = np.array([0.3, 0.0, 0.5]), np.array([0.5, 0.2, 0.2])
+    position = start + np.outer(s, goal - start)
+    record = _synthetic_record(t, position, np.zeros_like(position), np.zeros_like(position), goal)
+    metrics, _, _ = sync_metrics(record, goal, position, 0.02, observation_time=1.0)
+    assert metrics["movement_time_s"] < 1.0
+    assert np.isnan(metrics["rms_error_xy_m"]) and np.isnan(metrics["max_error_z_m"])
+    assert metrics["goal_error_m"] == 0.0

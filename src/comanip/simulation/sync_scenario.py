@@ -134,7 +134,8 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
     errors), and the tracking error on the normalised-time grid (P,), (P, 3).
 
     goal_estimate: the robot's last goal estimate (3,), m, or None. The tracking errors are taken from t_o
-    (when the first estimate exists) to MT and reported on a grid of t / MT; force and work from t_o on.
+    (when the first estimate exists) to MT and reported on a grid of t / MT (NaN when MT < t_o); force and
+    work from t_o on.
     """
     measures = trial_measures(record, width, from_time=observation_time)
     speed = np.linalg.norm(record.velocity, axis=1)
@@ -152,9 +153,10 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
         "goal_error_z_m": float(abs(goal_error[2])),
         "peak_time_s": timing.t_peak,
         "asymmetry": timing.asymmetry,
-        "rms_error_xy_m": float(np.sqrt(np.mean(np.sum(error[after, :2] ** 2, axis=1)))),
-        "rms_error_z_m": float(np.sqrt(np.mean(error[after, 2] ** 2))),
-        "max_error_z_m": float(np.max(np.abs(error[after, 2]))),
+        # NaN when the movement ended before t_o (nothing was predicted during it)
+        "rms_error_xy_m": float(np.sqrt(np.mean(np.sum(error[after, :2] ** 2, axis=1)))) if after.any() else float("nan"),
+        "rms_error_z_m": float(np.sqrt(np.mean(error[after, 2] ** 2))) if after.any() else float("nan"),
+        "max_error_z_m": float(np.max(np.abs(error[after, 2]))) if after.any() else float("nan"),
         "reach_time_x_s": float(axis_times[0]),
         "reach_time_y_s": float(axis_times[1]),
         "reach_time_z_s": float(axis_times[2]),
