@@ -99,6 +99,7 @@ def test_help_has_no_literal_double_backticks(capsys):
     (["handover", "--max-wall-time", "-1"], ["max_wall_time", "> 0"]),
     (["transition", "generate", "--widths", "0.01,-0.02"], ["widths must be > 0"]),
     (["transition", "generate", "--workers", "0"], ["workers must be an integer ≥ 1"]),
+    (["ros", "--speed", "2"], ["--speed", "--replay"]),
 ])
 def test_long_commands_check_inputs_before_making_their_folder(tmp_path, capsys, argv, fragments):
     """A mistake in any goal or sweep setting is found before the first plan is solved or the folder is made."""

@@ -34,6 +34,8 @@ def run(args) -> int:
 
     settings = NodeSettings.from_yaml(args.params) if args.params is not None else NodeSettings()
     speed = None if args.speed is None else as_positive("--speed", args.speed, "times real time")
+    if speed is not None and args.replay is None:
+        raise ValueError("--speed sets the pace of a --replay; give --replay CSV with it (the live node runs at its inputs' pace)")
     try:
         import rclpy  # noqa: F401 - only to say what is missing
     except ImportError as error:
