@@ -37,8 +37,10 @@ class GoalEstimate(Plan):
     unconstrained_torque: np.ndarray | None = None
     """The plan to the estimated goal, not held to the observation (H, n) ('regret' method)."""
     goal_covariance: np.ndarray = field(default_factory=lambda: np.zeros((0, 0)))
-    """Covariance of the estimated goal (d, d), m²: the Laplace approximation of the posterior (the Gauss–Newton
-    curvature of the observations' negative log-likelihood under the model's belief, plus the prior's)."""
+    """Covariance of the estimated goal (d, d), m²: the Laplace approximation of the posterior ('regret' and
+    'paper': the Gauss–Newton curvature of the observation's negative log-likelihood under the model's belief,
+    plus the prior's; 'online': the inverse Hessian, its spread along the reach from a quadrature early on,
+    :mod:`comanip.estimation.online_estimator`)."""
     plan_status: str | None = None
     """For an 'uninformative' estimate (observation at step 0): the status of the plan to the prior goal."""
 
