@@ -17,21 +17,19 @@ class ContinuousPolicy:
     """The online MAP goal and its predicted reach, revised with each observation.
 
     prior_std: the prior goal's standard deviation (m), as :class:`OnlineGoalEstimator` takes it (None: its
-    weak default). observe_from: time (s) of the first observation fed (default: one update_interval after
-    the start). options: the estimator's :class:`OnlineOptions`; default: a person who corrects deviations from
+    weak default). options: the estimator's :class:`OnlineOptions`; default: a person who corrects deviations from
     their plan (``CORRECTING_PERSON``: :mod:`comanip.estimation.corrected_deviation`), as the
     simulated person does by replanning.
     """
 
     name = "continuous"
 
-    def __init__(self, context: PolicyContext, prior_std=None, observe_from: float | None = None,
-                 options: OnlineOptions | None = None):
+    def __init__(self, context: PolicyContext, prior_std=None, options: OnlineOptions | None = None):
         self.context = context
         self.update_interval = context.update_interval
         self.estimator = OnlineGoalEstimator(context.model, context.start, prior_goal=context.prior_goal,
                                              prior_std=prior_std, width=context.width, options=options or CORRECTING_PERSON)
-        self._next_observation = context.update_interval if observe_from is None else observe_from
+        self._next_observation = context.update_interval
 
     def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
         if t >= self._next_observation - 1e-9:
@@ -40,7 +38,7 @@ class ContinuousPolicy:
 
     def predict(self, t: float) -> Prediction | None:
         """The latest estimate's goal and predicted reach; None (do not lead yet) before the first observation,
-        e.g. when update_interval or observe_from is later than t_o."""
+        e.g. when update_interval is longer than t_o."""
         c, estimate = self.context, self.estimator.latest
         if estimate is None:
             return None
