@@ -82,3 +82,16 @@ def test_only_symmetric_models_get_a_library(change):
     assert is_symmetric(planner.problem) == symmetric
     plan = planner.solve(np.zeros(6), [0.2, 0.1, 0.0], 0.02)
     assert plan.success
+
+
+def test_a_budgeted_cold_solve_does_not_solve_a_new_library_reach():
+    """Solving a library entry is a whole cold search outside max_wall_time: a budgeted solve uses only entries
+    solved before (and still converges from the minimum-jerk guesses), an unbudgeted one adds the entry."""
+    model = comanip.presets.cartesian()
+    planner = comanip.Planner(model)
+    start, goal = np.zeros(6), np.array([0.1, 0.2, 0.0])
+    budgeted = planner.solve(start, goal, 0.02, max_wall_time=60.0)
+    assert budgeted.success and not planner._library._entries
+    plan = planner.solve(start, goal, 0.02)
+    assert plan.success and len(planner._library._entries) == 1
+    np.testing.assert_allclose(budgeted.objective, plan.objective, rtol=RELATIVE)

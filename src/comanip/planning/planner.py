@@ -208,7 +208,8 @@ class Planner:
             width: goal width w (m) > 0; the model's default when None.
             warm_start: a previous :class:`Plan` or torques (H, n) to start from; cold multi-start when None.
             max_wall_time: wall-time budget (s) for the whole solve; the best plan so far is returned with
-                status 'max_wall_time' when it runs out.
+                status 'max_wall_time' when it runs out. A budgeted cold solve starts only from reach-library
+                entries solved before (:meth:`_cold_start`): a new one would be a whole solve outside the budget.
 
         Returns:
             A :class:`Plan`; never raises on a failed solve (check ``plan.success``: converged and reaching).
@@ -219,7 +220,7 @@ class Planner:
         unreachable = self._unreachable_plan(start, goal, width, warm_start, t_begin)
         if unreachable is not None:
             return unreachable
-        guesses = self._initial_guesses(start, goal, width, warm_start)
+        guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None)
         return with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time))
 
     def _unreachable_plan(self, start, goal, width, warm_start, t_begin: float) -> Plan | None:
@@ -244,10 +245,10 @@ class Planner:
         return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
-    def _initial_guesses(self, start, goal, width, warm_start) -> list[np.ndarray]:
+    def _initial_guesses(self, start, goal, width, warm_start, budgeted: bool = False) -> list[np.ndarray]:
         model, body = self.model, self.model.body
         if warm_start is None:
-            return self._cold_start(start, goal, width)
+            return self._cold_start(start, goal, width, budgeted)
         torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
         torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
         if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
@@ -266,7 +267,7 @@ class Planner:
         low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
         return [min((np.clip(c, low, high) for c in candidates), key=lambda c: self._objective(c, params))]
 
-    def _cold_start(self, start, goal, width) -> list[np.ndarray]:
+    def _cold_start(self, start, goal, width, budgeted: bool = False) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
         'all', or a nonlinear body: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
@@ -278,7 +279,8 @@ class Planner:
         the best minimum-jerk guess, and a start whose motion alone would carry the hand farther than the goal
         within the horizon runs every minimum-jerk guess instead, as 'all' does (the plan can brake or ride the
         motion: the Cartesian preset's moving starts ended up to 0.1 % worse in 4 of 100 otherwise,
-        benchmarks/cold_quality.py).
+        benchmarks/cold_quality.py). A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
+        before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
         """
         if self._library is None:
             return self._searched_guesses(start, goal, width)
@@ -291,9 +293,9 @@ class Planner:
             return guesses
         params = np.concatenate([start, goal, [width]])
         best_guess = min(guesses, key=lambda guess: self._objective(guess, params))
-        turned = self._library.guess(start, goal, width)
-        if turned is None:
-            return [best_guess]
+        turned = self._library.guess(start, goal, width, solve_missing=not budgeted)
+        if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
+            return guesses if self._narrow(start, goal, width) else [best_guess]
         candidates = [turned]
         if moving:
             candidates = [turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n), T,

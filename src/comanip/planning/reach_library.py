@@ -82,10 +82,10 @@ class ReachLibrary:
         self._solve, self.n, self.state_size, self.width = solve, n, state_size, float(width)
         self._entries: dict[tuple[int, int], np.ndarray] = {}
 
-    def guess(self, start: np.ndarray, goal: np.ndarray, width: float) -> np.ndarray | None:
+    def guess(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> np.ndarray | None:
         """Torques (H, n) of the nearest entry turned towards goal (n,) and scaled to its distance from the
         start's position, for the start at rest there (a moving start adds its own correction); None when the
-        goal is at the start."""
+        goal is at the start, or when the entry is not solved yet and not ``solve_missing``."""
         offset = np.asarray(goal, dtype=float) - start[: self.n]
         distance = float(np.linalg.norm(offset))
         if distance == 0.0:
@@ -95,5 +95,7 @@ class ReachLibrary:
         entry_width = WIDTH_RATIO**key[1] * self.width
         entry_distance = GRID_RATIO**key[0] * entry_width
         if key not in self._entries:
+            if not solve_missing:
+                return None
             self._entries[key] = self._solve(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
         return (distance / entry_distance) * self._entries[key] @ reflection_onto(offset / distance).T
