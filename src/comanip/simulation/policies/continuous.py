@@ -17,7 +17,7 @@ PRIOR_STD = 0.25
 """The robot's prior goal's standard deviation per axis (m): things are placed within about ±0.5 m of the table
 centre (the scenario's goals lie 0.07–0.38 m from it). With the estimator's weak default (10 m) the first
 estimates, from 0.2 s of the reach, were farther off than the prior alone (medians 0.18–0.40 m over 20 trials
-per goal); with this prior 0.06–0.19 m, and the final error within 0.1 mm of before (README, policy comparison)."""
+per goal); with this prior 0.06–0.19 m, and the final error within 0.2 mm of before (README, policy comparison)."""
 
 
 class ContinuousPolicy:
