@@ -6,6 +6,7 @@ CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W (``docs/notatio
 
 from __future__ import annotations
 
+import json
 from dataclasses import MISSING, dataclass, field, replace
 
 import numpy as np
@@ -205,3 +206,14 @@ class ReachingModel:
         config["body"] = body_from_config(config["body"])
         return cls(**config)
 
+
+def config_key(config: dict) -> str:
+    """The key of a model given as its ``config()`` dict: its parameters, without the description."""
+    config = dict(config)
+    config.pop("description", None)
+    return json.dumps(config, sort_keys=True)
+
+
+def model_key(model: ReachingModel) -> str:
+    """A key equal for models with equal parameters (two loads of one preset share it)."""
+    return config_key(model.config())

@@ -23,6 +23,7 @@ SUBCOMMAND_MODULES = [
     "comanip.cli.estimate_command",
     "comanip.cli.simulate_command",
     "comanip.cli.fit_command",
+    "comanip.cli.library_command",
     "comanip.cli.ros_command",
 ]
 

@@ -8,27 +8,14 @@ caller, an object such as ``ConditionPlanner``, or a worker process (set up by i
 
 from __future__ import annotations
 
-import json
 import threading
 from collections import OrderedDict
 from typing import Callable, Generic, Hashable, TypeVar
 
-from comanip.model import ReachingModel
+from comanip.model import ReachingModel, config_key, model_key  # noqa: F401  (model_key: this module's key, re-exported)
 from comanip.planning.planner import Planner, SolverOptions
 
 T = TypeVar("T")
-
-
-def config_key(config: dict) -> str:
-    """The key of a model given as its ``config()`` dict: its parameters, without the description."""
-    config = dict(config)
-    config.pop("description", None)
-    return json.dumps(config, sort_keys=True)
-
-
-def model_key(model: ReachingModel) -> str:
-    """A key equal for models with equal parameters (two loads of one preset share it)."""
-    return config_key(model.config())
 
 
 class ModelCache(Generic[T]):

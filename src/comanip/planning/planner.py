@@ -47,6 +47,7 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
+from comanip.planning.arm_reach_library import ArmReachLibrary, bundled_library
 from comanip.planning.reach_library import ReachLibrary, is_symmetric
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import Curvature
@@ -79,9 +80,10 @@ class SolverOptions:
     solve uses the warm start only."""
     cold_search: str = "ranked"
     """How a cold solve starts. 'all': from each of the ``n_starts`` minimum-jerk guesses, keeping the best
-    converged plan. 'ranked' (point masses; arms always use 'all'): from the lowest-objective start among those
-    guesses and a solved reach turned to the goal (:meth:`Planner._cold_start`), about as fast as a warm solve,
-    with second solves where local optima compete. Against 'all' on 200 random cold problems per point-mass
+    converged plan. 'ranked': from the lowest-objective start among those guesses and, for a point mass, a solved
+    reach turned to the goal, for an arm at its ready pose, the nearest plans of its reach library
+    (:meth:`Planner._cold_start`), about as fast as a warm solve, with second solves where local optima compete
+    (point masses). An arm without a library, or away from its ready pose, runs every guess as 'all' does. Against 'all' on 200 random cold problems per point-mass
     preset: 0 worse, 11 better, 789 equal (1e-6 relative; benchmarks/cold_quality.py)."""
     narrow_ratio: float = 20.0
     """Reach distance over goal width beyond which a 'ranked' cold solve also solves from the best minimum-jerk
@@ -91,6 +93,10 @@ class SolverOptions:
     far_warm_start: float = 3.0
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it."""
+    arm_library: str | None = None
+    """An arm's reach library for 'ranked' cold solves from its ready pose: a file written by ``comanip library``
+    (.npz) for this model. None: the library shipped for the model (the Panda presets), if any
+    (:mod:`comanip.planning.arm_reach_library`)."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
@@ -145,6 +151,18 @@ class Planner:
         self._blas = ThreadpoolController()
         self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
         self._library = self._reach_library()
+        ranked_arm = self.options.cold_search == "ranked" and not body.is_linear
+        self._arm_library = self._arm_reach_library() if ranked_arm else None
+
+    def _arm_reach_library(self) -> ArmReachLibrary | None:
+        """The arm's reach library: ``options.arm_library`` (it must be this model's) or the shipped one."""
+        if self.options.arm_library is None:
+            return bundled_library(self.model)
+        library = ArmReachLibrary.load(self.options.arm_library)
+        if not library.is_for(self.model):
+            raise ValueError(f"arm_library {self.options.arm_library!r} was solved for another model; a library applies "
+                             f"to the model it was made for (comanip library --preset <this model's YAML>)")
+        return library
 
     def _reach_library(self) -> ReachLibrary | None:
         """Solved reaches to start 'ranked' cold solves from (:mod:`comanip.planning.reach_library`), for a
@@ -217,25 +235,33 @@ class Planner:
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
-        unreachable = self._unreachable_plan(start, goal, width, warm_start, t_begin)
+        goal_q = None if self.model.body.is_linear else self._goal_joints(start, goal, warm_start)
+        unreachable = self._unreachable_plan(start, goal, width, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
-        guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None)
-        return with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time))
+        guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
+                                        goal_q=goal_q if warm_start is None else None)
+        from_library = warm_start is None and self._arm_library is not None and self._arm_library.starts_at(start)
+        return with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
+                                                 until_converged=from_library))
 
-    def _unreachable_plan(self, start, goal, width, warm_start, t_begin: float) -> Plan | None:
-        """A plan with status 'unreachable' when no joint position within the limits puts the end effector
-        within the goal width of the goal (inverse-kinematics residual > w); None otherwise.
-
-        Point masses reach everywhere; an arm is checked before any solver work (about 10 ms for the Panda).
-        """
-        model, body = self.model, self.model.body
-        if body.is_linear:
-            return None
+    def _goal_joints(self, start, goal, warm_start) -> np.ndarray:
+        """An arm's joint position (n,) nearest the goal, by inverse kinematics from the warm start's final
+        position or else the start's (about 17 ms for the Panda)."""
+        model = self.model
         seed = warm_start.mean[-1, : model.n] if isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size) \
             else start[: model.n]
-        q = body.inverse_kinematics(goal, seed)
-        residual = float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - goal))
+        return model.body.inverse_kinematics(goal, seed)
+
+    def _unreachable_plan(self, start, goal, width, goal_q: np.ndarray | None, t_begin: float) -> Plan | None:
+        """A plan with status 'unreachable' when no joint position within the limits puts the end effector
+        within the goal width of the goal (the residual of ``goal_q`` (n,), the inverse kinematics, > w); None
+        otherwise, and for point masses (``goal_q`` None: they reach everywhere). An arm is checked before any
+        solver work."""
+        model, body = self.model, self.model.body
+        if goal_q is None:
+            return None
+        residual = float(np.linalg.norm(np.asarray(body.kinematics_function(goal_q)[0]).ravel() - goal))
         if residual <= width:
             return None
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
@@ -245,29 +271,52 @@ class Planner:
         return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
-    def _initial_guesses(self, start, goal, width, warm_start, budgeted: bool = False) -> list[np.ndarray]:
-        model, body = self.model, self.model.body
+    def _initial_guesses(self, start, goal, width, warm_start, budgeted: bool = False,
+                         goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """The starts of a solve; ``goal_q`` (n,): the goal's inverse kinematics from the start, if known."""
+        model = self.model
         if warm_start is None:
-            return self._cold_start(start, goal, width, budgeted)
+            return self._cold_start(start, goal, width, budgeted, goal_q)
         torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
         torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
         if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
                 and warm_start.mean.shape[0] == model.H + 1 and not np.array_equal(warm_start.goal, goal)):
             return [torque]
         # a plan for another goal: also try it moved onto the new goal, and start from the best
-        q_end = warm_start.mean[-1, : model.n]
-        J = np.asarray(body.kinematics_function(q_end)[1])
-        shift_q = np.linalg.lstsq(J, goal - warm_start.goal, rcond=None)[0]
-        candidates = [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q,
-                                                   guess_durations(model.duration, 4), warm_start.mean, self._linear_dynamics)
+        candidates = self._retargeted(torque, warm_start.mean, warm_start.goal, goal)
         if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
             # far beyond the goal's reward (it underflows there): fresh reaches compete too
             candidates += self._cold_guesses(start, goal, self.options.n_starts)
+        return [self._lowest_objective(candidates, start, goal, width)]
+
+    def _retargeted(self, torque: np.ndarray, mean: np.ndarray, planned_goal: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
+        """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
+        minimum-jerk corrections of four durations (:func:`retargeted_torques`, along its mean (H+1, nx))."""
+        model, body = self.model, self.model.body
+        J = np.asarray(body.kinematics_function(mean[-1, : model.n])[1])
+        shift_q = np.linalg.lstsq(J, goal - planned_goal, rcond=None)[0]
+        return [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q, guess_durations(model.duration, 4),
+                                             mean, self._linear_dynamics)
+
+    def _lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
+        """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
+        path keeps the joint limits (all candidates if none does)."""
+        model = self.model
         params = np.concatenate([start, goal, [width]])
         low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
-        return [min((np.clip(c, low, high) for c in candidates), key=lambda c: self._objective(c, params))]
+        return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._start_rank(c, params))
 
-    def _cold_start(self, start, goal, width, budgeted: bool = False) -> list[np.ndarray]:
+    def _start_rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
+        """(mean path beyond a joint limit, objective) of a start (H, n): its order among candidates. A start
+        beyond the limits can have the lowest objective and still be the worst: the solver must first bring it
+        back (on the Panda, starts retargeted far ended 'constraints_violated')."""
+        curvature = self._curvature
+        if curvature is None or not curvature.carries_belief or not self._limits.active:
+            return False, self._objective(torque, params)
+        f, data = curvature.value_and_data(np.ravel(torque), params)
+        return self._limits.violation(curvature.mean_path(data)) > LIMIT_TOLERANCE, f
+
+    def _cold_start(self, start, goal, width, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
         'all', or a nonlinear body: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
@@ -282,8 +331,10 @@ class Planner:
         benchmarks/cold_quality.py). A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
         before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
         """
+        if self._arm_library is not None and self._arm_library.starts_at(start):
+            return self._arm_library_starts(start, goal, width, goal_q)
         if self._library is None:
-            return self._searched_guesses(start, goal, width)
+            return self._searched_guesses(start, goal, width, goal_q)
         model = self.model
         motion = start.copy()
         motion[: model.n] = 0.0
@@ -304,15 +355,29 @@ class Planner:
         best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
         return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
 
+    def _arm_library_starts(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """An arm's cold starts from its ready pose (:mod:`comanip.planning.arm_reach_library`): first the
+        lowest-objective torques (H, n) among the minimum-jerk guesses and the plans of the nearest library
+        entries, each as solved and moved onto the goal; then the minimum-jerk guesses, which
+        :meth:`_solve_from` runs only if no start before them converged."""
+        library = self._arm_library
+        guesses = self._cold_guesses(start, goal, self.options.n_starts, goal_q)
+        candidates = list(guesses)
+        for entry_goal, torque in library.nearest(goal):
+            entry_params = np.concatenate([start, entry_goal, [library.width]])
+            mean = self._curvature.mean_path(self._curvature.value_and_data(np.ravel(torque), entry_params)[1])
+            candidates += self._retargeted(torque, mean, entry_goal, goal)
+        return [self._lowest_objective(candidates, start, goal, width)] + guesses
+
     def _drift(self, start, goal, width) -> float:
         """How far (m) the start's motion alone (zero commands) carries the hand within the horizon."""
         free = self.problem.trajectory(tau=np.zeros(self.model.H * self.model.n), s0=start, goal=goal, width=width)
         return float(np.max(np.linalg.norm(np.asarray(free["ee_mean"]).T - free["ee_mean"][:, 0].full().T, axis=1)))
 
-    def _searched_guesses(self, start, goal, width) -> list[np.ndarray]:
+    def _searched_guesses(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
         or a goal beyond ``narrow_ratio`` widths; otherwise the one of lowest objective."""
-        guesses = self._cold_guesses(start, goal, self.options.n_starts)
+        guesses = self._cold_guesses(start, goal, self.options.n_starts, goal_q)
         if self.options.cold_search == "all" or not self.model.body.is_linear or self._narrow(start, goal, width):
             return guesses
         params = np.concatenate([start, goal, [width]])
@@ -324,10 +389,11 @@ class Planner:
         position = np.asarray(model.body.kinematics_function(start[: model.n])[0]).ravel()
         return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
 
-    def _cold_guesses(self, start, goal, count: int) -> list[np.ndarray]:
-        """Minimum-jerk reaches to the inverse-kinematics solution, ``count`` durations."""
+    def _cold_guesses(self, start, goal, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """Minimum-jerk reaches to ``goal_q`` (n,), the inverse-kinematics solution from the start (computed
+        when None), ``count`` durations."""
         model = self.model
-        goal_q = model.body.inverse_kinematics(goal, start[: model.n])
+        goal_q = model.body.inverse_kinematics(goal, start[: model.n]) if goal_q is None else goal_q
         return [minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, T, self._linear_dynamics)
                 for T in guess_durations(model.duration, count)]
 
@@ -338,7 +404,10 @@ class Planner:
         n2, d = self.model.state_size, self.model.d
         return self.problem.objective_value(torque, params[:n2], params[n2:n2 + d], params[-1])
 
-    def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None) -> Plan:
+    def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None,
+                    until_converged: bool = False) -> Plan:
+        """The best plan from the guesses (each (H, n)), solved in turn; ``until_converged``: stop at the
+        first whose solve converges within the limits (later guesses are fallbacks)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         params = np.concatenate([start, goal, [width]])
         normaliser = self.problem.normaliser(width)
@@ -361,6 +430,8 @@ class Planner:
                 # zero-reward plateau (seen on the Panda), and the status then says it did not converge.
                 if best is None or _rank(candidate) < _rank(best):
                     best = candidate
+                if until_converged and best.success:
+                    break
         return self._make_plan(best.x, params, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
 
