@@ -1,10 +1,14 @@
-"""Cold-solve quality: random cold problems per point-mass preset, the current planner against a reference.
+"""Cold-solve quality: random cold problems per preset, the current planner against a reference.
 
     .venv/bin/python benchmarks/cold_quality.py [--problems 200] [--presets planar,cartesian,human,human_cartesian]
                                                 [--compare /path/to/worktree-at-main]
+    .venv/bin/python benchmarks/cold_quality.py --presets franka_rest,franka   # the Panda: minutes per problem set
 
-Problems (the same for both sides, seeded): goals 0.1–0.4 m from the start in uniformly drawn directions,
-widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per axis).
+Problems (the same for both sides, seeded): point masses: goals 0.1–0.4 m from the start in uniformly drawn
+directions, widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per
+axis); arms: from the ready pose, goals 0.15–0.3 m from its hand, widths log-uniform over 2.5–10 cm, every
+tenth start in motion (±0.3 rad/s per joint; the reach library applies only at rest, so these run the search
+of the reference).
 The reference is the code of another checkout (``--compare``: its src/ is imported in a separate process)
 or, without it, this code with ``SolverOptions(cold_search="all")`` (every minimum-jerk guess solved to
 convergence, the best kept). Each side runs in its own process, the presets alternating between them.
@@ -32,7 +36,9 @@ RELATIVE = 1e-6
 
 
 def problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray, float]]:
-    """(start (2n,), goal (d,), width) for ``count`` random cold problems of a point-mass model."""
+    """(start (2n,), goal (d,), width) for ``count`` random cold problems of a model (module docstring)."""
+    if not model.body.is_linear:
+        return arm_problems(model, count, seed)
     rng = np.random.default_rng(seed)
     out = []
     for k in range(count):
@@ -46,6 +52,23 @@ def problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndar
     return out
 
 
+def arm_problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """An arm's cold problems: from its ready pose, at rest except every tenth start (joint velocities uniform in
+    ±0.3 rad/s), to goals 0.15–0.3 m from its hand in uniform directions, widths log-uniform over 2.5–10 cm."""
+    rng = np.random.default_rng(seed)
+    hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
+    out = []
+    for k in range(count):
+        start = np.r_[model.body.home_position, np.zeros(model.n)]
+        if k % 10 == 9:
+            start[model.n:] = rng.uniform(-0.3, 0.3, model.n)
+        direction = rng.normal(size=model.d)
+        goal = hand + rng.uniform(0.15, 0.3) * direction / np.linalg.norm(direction)
+        width = float(np.exp(rng.uniform(np.log(0.025), np.log(0.1))))
+        out.append((start, goal, width))
+    return out
+
+
 def worker(preset: str, count: int, cold_search: str | None) -> None:
     """Solve the preset's problems with the comanip on sys.path; one JSON line per problem on stdout."""
     import comanip
@@ -54,12 +77,14 @@ def worker(preset: str, count: int, cold_search: str | None) -> None:
     model = comanip.presets.load(preset)
     options = SolverOptions(cold_search=cold_search) if cold_search else SolverOptions()
     planner = comanip.Planner(model, options)
-    planner.solve(np.zeros(2 * model.n), 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
+    rest = np.r_[model.body.home_position, np.zeros(model.n)]
+    hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
+    planner.solve(rest, hand + 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
     for start, goal, width in problems(model, count):
         plan = planner.solve(start, goal, width)
         print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
-                          "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal) / width),
-                          "moving": bool(np.any(start))}), flush=True)
+                          "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal - hand) / width),
+                          "moving": bool(np.any(start[model.n:]))}), flush=True)
 
 
 def run_side(src: Path, cold_search: str | None, preset: str, count: int) -> list[dict]:
@@ -108,6 +133,8 @@ def main(argv=None) -> None:
     parser.add_argument("--problems", type=int, default=200)
     parser.add_argument("--presets", default=",".join(PRESETS))
     parser.add_argument("--compare", type=Path, default=None, help="checkout of the reference code (its src/ is used)")
+    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results" / "cold_quality.csv",
+                        help="the CSV of every problem's row (default: %(default)s)")
     parser.add_argument("--summarise", type=Path, default=None, help="print the table of a CSV written before, solve nothing")
     parser.add_argument("--worker", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--cold-search", default=None, help=argparse.SUPPRESS)
@@ -138,8 +165,8 @@ def main(argv=None) -> None:
                 print(f"  {preset} worse: problem {k}, D/w {a['distance_over_width']:.1f}, moving {a['moving']}, "
                       f"relative {relative:.2e}", flush=True)
     print("\n".join(summary(rows)))
-    out = Path(__file__).resolve().parent / "results" / "cold_quality.csv"
-    out.parent.mkdir(exist_ok=True)
+    out = args.out
+    out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="") as file:
         writer = csv.DictWriter(file, fieldnames=list(rows[0]))
         writer.writeheader()

@@ -28,6 +28,7 @@ from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.estimate import GoalEstimate
 from comanip.fitting.movement_times import MT_COLUMNS
 from comanip.fitting.recordings import load_recordings
+from comanip.planning.arm_reach_library import bundled_library
 from comanip.fitting.result import FIT_STATUSES, FitResult
 from comanip.model import ReachingModel
 from comanip.multicomponent import transition_csv
@@ -197,6 +198,19 @@ def test_transition_model_json_keys(tmp_path):
     assert saved["kind"] == ticked(rows["kind"][1])[0]
     assert set(saved["training_data"]) <= set(transition_csv.COLUMNS)
     TransitionModel.load(tmp_path / "model.json")
+
+
+def test_arm_reach_library_arrays_are_the_saved_ones(tmp_path):
+    model = presets.load("franka_rest")
+    library = bundled_library(model)
+    rows = {ticked(row[0])[0]: row for row in table("Arm reach library (npz)")}
+    with np.load(library.save(tmp_path / "library.npz")) as saved:
+        assert list(rows) == list(saved.files)
+        E, H, n = len(library.goals), model.H, model.n
+        sizes = {"E": E, "H": H, "n": n, "2n": 2 * n, "3": 3}
+        for name, row in rows.items():
+            shape = tuple(sizes[part.strip()] for part in row[1].strip("()").split(",") if part.strip())
+            assert saved[name].shape == shape, name
 
 
 # ---- outputs --------------------------------------------------------------------------------------------------

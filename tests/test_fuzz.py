@@ -189,14 +189,19 @@ LONG_COMMANDS = {
                                                          "--arm-length": SCALARS, "--steps": SCALARS, "--seed": SCALARS,
                                                          "--workers": SCALARS, "--preset": ["planar", "cartesian", "franka"]},
                             ("comanip.cli.transition_command", "generate_transition_data")),
+    "library": (["library"], {"--spacing": SCALARS, "--shell": ["0.12 0.33", "0.3 0.1", "0.1", "-1 2", "0 nan"],
+                              "--preset": ["franka_rest", "planar", "nope"]},
+                ("comanip.cli.library_command", "Planner")),
 }
+#: the --out each command writes (a folder unless named here)
+OUT_FILES = {"transition generate": "data.csv", "library": "library.npz"}
 
 
 @settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), database=None,
           derandomize=os.environ.get("CI") == "true")
 @given(command=st.sampled_from(sorted(LONG_COMMANDS)), data=st.data())
 def test_long_commands_give_one_line_errors(tmp_path_factory, capsys, monkeypatch, command, data):
-    """simulate, handover and transition generate: a user mistake is one line and exit status 2, never a
+    """simulate, handover, transition generate and library: a user mistake is one line and exit status 2, never a
     traceback. Inputs that pass every check reach the command's work, replaced here by InputsAccepted so that
     the suite does not wait for simulations (about one input in ten gets there)."""
     import importlib
@@ -205,9 +210,10 @@ def test_long_commands_give_one_line_errors(tmp_path_factory, capsys, monkeypatc
     words, options, (module, work) = LONG_COMMANDS[command]
     scenario = [data.draw(st.sampled_from(["sync", "handover", "bogus", ""]))] if command == "simulate" else []
     names = data.draw(st.lists(st.sampled_from(sorted(options)), max_size=4))
-    argv = [word for name in names for word in (name, data.draw(st.one_of(st.sampled_from(options[name]), numbers_text)))]
+    # a value with spaces is several words (--shell takes two)
+    argv = [word for name in names for word in (name, *data.draw(st.one_of(st.sampled_from(options[name]), numbers_text)).split(" "))]
     argv += data.draw(st.lists(numbers_text, max_size=1))
-    out = tmp_path_factory.mktemp("out") / ("data.csv" if command == "transition generate" else "")
+    out = tmp_path_factory.mktemp("out") / OUT_FILES.get(command, "")
     with monkeypatch.context() as patch:
         patch.setattr(importlib.import_module(module), work, _accept)
         try:

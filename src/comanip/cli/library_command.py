@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -41,7 +42,9 @@ def run(args) -> int:
         raise ValueError(f"--spacing must be a positive distance in m, got {args.spacing}")
     if not (0 <= inner < outer and np.isfinite(outer)):
         raise ValueError(f"--shell must be two distances 0 ≤ INNER < OUTER (m), got {inner} {outer}")
-    out = args.out or f"{FILE_PREFIX}{model.name}.npz"
+    out = Path(args.out or f"{FILE_PREFIX}{model.name}.npz")
+    if out.suffix != ".npz" or out.is_dir() or not out.parent.is_dir():
+        raise ValueError(f"--out must be a .npz file in an existing folder, got {str(out)!r}")
     hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     goals = grid_goals(hand, args.spacing, (inner, outer))
     planner = Planner(model, SolverOptions(cold_search="all"))
