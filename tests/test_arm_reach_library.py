@@ -94,3 +94,18 @@ def test_cold_solves_from_a_small_library_reach_the_full_searchs_plans(tmp_path)
         assert fast.iterations < reference.iterations / 2
     with pytest.raises(ValueError, match="another model"):
         comanip.Planner(model.replace(kappa=2 * model.kappa), SolverOptions(arm_library=str(path)))
+
+
+@pytest.mark.slow
+def test_a_library_start_that_converges_beside_the_goal_falls_back_to_the_guesses():
+    """Found by benchmarks/cold_quality.py (franka_rest, problem 15): from the shipped library's best start the
+    solve converges on the zero-reward plateau with the arm at rest; the minimum-jerk guesses after it must run
+    and give the full search's plan."""
+    model = comanip.presets.load("franka_rest")
+    start = np.r_[model.body.home_position, np.zeros(model.n)]
+    hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
+    goal, width = hand + [-0.06353953, -0.18362716, -0.21501866], 0.02931813557924495
+    plan = comanip.Planner(model).solve(start, goal, width)
+    reference = comanip.Planner(model, SolverOptions(cold_search="all")).solve(start, goal, width)
+    assert plan.success and reference.success
+    assert abs(plan.objective - reference.objective) <= RELATIVE * abs(reference.objective)

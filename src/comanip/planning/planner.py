@@ -407,7 +407,7 @@ class Planner:
     def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
         """The best plan from the guesses (each (H, n)), solved in turn; ``until_converged``: stop at the
-        first whose solve converges within the limits (later guesses are fallbacks)."""
+        first whose solve converges within the limits and ends at the goal (later guesses are fallbacks)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         params = np.concatenate([start, goal, [width]])
         normaliser = self.problem.normaliser(width)
@@ -430,10 +430,19 @@ class Planner:
                 # zero-reward plateau (seen on the Panda), and the status then says it did not converge.
                 if best is None or _rank(candidate) < _rank(best):
                     best = candidate
-                if until_converged and best.success:
+                if until_converged and best.success and self._ends_at_goal(best.x, params):
                     break
         return self._make_plan(best.x, params, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
+
+    def _ends_at_goal(self, torque: np.ndarray, params: np.ndarray) -> bool:
+        """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
+        plan can rest on the zero-reward plateau instead)."""
+        model, curvature = self.model, self._curvature
+        n2, d = model.state_size, model.d
+        q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params)[1])[-1, : model.n]
+        end = np.asarray(model.body.kinematics_function(q_end)[0]).ravel()
+        return bool(np.linalg.norm(end - params[n2:n2 + d]) <= params[-1])
 
     def _make_plan(self, torque, params, **fields) -> Plan:
         n2, d = self.model.state_size, self.model.d
