@@ -31,7 +31,7 @@ GRID_SPACING = 0.07
 SHELL = (0.12, 0.33)
 """m: the entries' distances from the ready pose's hand (the benchmark's goals are 0.15–0.3 m away)."""
 CANDIDATE_ENTRIES = 2
-"""Nearest entries whose plans (and their retargeted variants) compete as a cold solve's start (on 55 franka_rest
+"""Nearest entries whose plans (and their retargeted variants) compete as a cold solve's start (on 54 franka_rest
 problems the start came from the nearest entry 33 times, the second 18, the third 3, a minimum-jerk guess never)."""
 START_TOLERANCE = 1e-9
 """rad, rad/s: largest difference from the library's start for which its entries apply."""
