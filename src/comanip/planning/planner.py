@@ -39,6 +39,7 @@ from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_goal_width, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.model import ReachingModel
+from comanip.planning.arm_reach_library import ArmReachLibrary, bundled_library
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import guess_durations, linear_dynamics_of, minimum_jerk_torques, retargeted_torques
 from comanip.optim import SolverResult, Status
@@ -47,7 +48,6 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
-from comanip.planning.arm_reach_library import ArmReachLibrary, bundled_library
 from comanip.planning.reach_library import ReachLibrary, is_symmetric
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import Curvature
@@ -83,8 +83,9 @@ class SolverOptions:
     converged plan. 'ranked': from the lowest-objective start among those guesses and, for a point mass, a solved
     reach turned to the goal, for an arm at its ready pose, the nearest plans of its reach library
     (:meth:`Planner._cold_start`), about as fast as a warm solve, with second solves where local optima compete
-    (point masses). An arm without a library, or away from its ready pose, runs every guess as 'all' does. Against 'all' on 200 random cold problems per point-mass
-    preset: 0 worse, 11 better, 789 equal (1e-6 relative; benchmarks/cold_quality.py)."""
+    (point masses) or the guesses as fallbacks (arms). An arm without a library, or away from its ready pose,
+    runs every guess as 'all' does. Against 'all' on 200 random cold problems per point-mass preset: 0 worse,
+    11 better, 789 equal (1e-6 relative; benchmarks/cold_quality.py)."""
     narrow_ratio: float = 20.0
     """Reach distance over goal width beyond which a 'ranked' cold solve also solves from the best minimum-jerk
     guess (without a reach library: from every guess): far, narrow goals of the planar preset have several
@@ -319,7 +320,8 @@ class Planner:
     def _cold_start(self, start, goal, width, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
-        'all', or a nonlinear body: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
+        An arm at the ready pose of its reach library: :meth:`_arm_library_starts`. 'all', or another nonlinear
+        body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
         candidate of lowest objective (evaluating one costs about a hundredth of solving from it) among the
         minimum-jerk guesses and the nearest solved reach of the planner's :class:`ReachLibrary` (from a moving
         start with minimum-jerk moves that bring the start's motion to rest superposed: the mean is affine in
