@@ -1,8 +1,8 @@
 """``comanip library``: solve an arm's reach library (plans from its ready pose to a grid of goals) and save it.
 
 Cold solves from the ready pose then start from the nearest entries (``comanip.planning.arm_reach_library``).
-The Panda presets' libraries ship with the package; this makes one for a model of your own (pass the file as
-``SolverOptions(arm_library=...)``) or remakes a shipped one:
+The ``franka_rest`` preset's library ships with the package; this makes one for another model (e.g. ``franka``,
+or a YAML of your own; pass the file as ``SolverOptions(arm_library=...)``) or remakes the shipped one:
 
     comanip library --preset franka_rest --out src/comanip/data/reach_library_franka_rest.npz
 """

@@ -7,11 +7,12 @@ hand (spacing 7 cm, between 0.12 and 0.33 m from it), so every goal 0.15–0.3 m
 6 cm. A cold solve from the ready pose then starts like a warm solve: from the nearest entries' plans, each
 also moved onto the new goal by a joint-space minimum-jerk correction (:func:`retargeted_torques`), ranked
 with the minimum-jerk guesses by their objective. On the Panda that is 12–30 Newton iterations instead of
-75–140 for three minimum-jerk starts, to the same plans (benchmarks/README.md, ``cold_quality.py``).
+75–140 for three minimum-jerk starts (median 14 against 93 on 200 random problems; benchmarks/README.md,
+``cold_quality.py``).
 
 A library belongs to one model (its :func:`~comanip.model.model_key`): entries are only initial
-guesses, but a guess from another model's optimum can lead to another local optimum. The libraries of the
-Panda presets are files in ``comanip/data/`` (``reach_library_<preset>.npz``, made by ``comanip library``);
+guesses, but a guess from another model's optimum can lead to another local optimum. The library of the
+``franka_rest`` preset is a file in ``comanip/data/`` (``reach_library_<preset>.npz``, made by ``comanip library``);
 :func:`bundled_library` finds the one of a model, if any.
 """
 

@@ -96,7 +96,7 @@ class SolverOptions:
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it."""
     arm_library: str | None = None
     """An arm's reach library for 'ranked' cold solves from its ready pose: a file written by ``comanip library``
-    (.npz) for this model. None: the library shipped for the model (the Panda presets), if any
+    (.npz) for this model. None: the library shipped for the model (``franka_rest``), if any
     (:mod:`comanip.planning.arm_reach_library`)."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
