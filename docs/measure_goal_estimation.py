@@ -25,7 +25,10 @@ from scipy.stats import chi2
 
 import comanip
 from comanip.belief import sample_trajectories
-from comanip.estimation import GoalEstimator, OnlineGoalEstimator
+from comanip.belief.propagation import linearised_step_function
+from comanip.estimation import GoalEstimator, OnlineGoalEstimator, OnlineOptions
+from comanip.estimation.corrected_deviation import correction_factor, sample_corrected_deviations
+from comanip.estimation.online_estimator import CORRECTING_PERSON
 
 CHECK_TIMES = (0.1, 0.2, 0.3, 0.5)   # s, within both presets' horizons (planar: 0.6 s)
 
@@ -35,32 +38,45 @@ def random_goal(rng, low: float, high: float, d: int) -> np.ndarray:
     return rng.uniform(low, high) * u / np.linalg.norm(u)
 
 
-def calibration(preset: str, reaches: int, seed: int = 1) -> dict:
+def calibration(preset: str, reaches: int, seed: int = 1, options: OnlineOptions | None = None,
+                check_times=CHECK_TIMES) -> dict:
+    """{t: (coverage of the 95 % ellipsoid, median goal error m)} over ``reaches`` noisy reaches sampled from
+    the belief of ``options`` (None: the open-loop model's own noisy dynamics; with a correction time: the
+    plan's mean plus errors of the corrected process, comanip.estimation.corrected_deviation), estimated with
+    those options and the default prior."""
     model = comanip.presets.load(preset)
     n, d = model.n, model.d
     start = np.zeros(model.state_size)
-    planner = OnlineGoalEstimator(model, start).planner
+    planner = OnlineGoalEstimator(model, start, options=options).planner
     rng = np.random.default_rng(seed)
     noise = np.r_[np.full(n, 1e-3), np.full(n, 1e-2)]
-    times = np.arange(0.011, max(CHECK_TIMES) + 0.012, 0.023)
-    inside = {t: [] for t in CHECK_TIMES}
-    errors = {t: [] for t in CHECK_TIMES}
+    times = np.arange(0.011, max(check_times) + 0.012, 0.023)
+    inside = {t: [] for t in check_times}
+    errors = {t: [] for t in check_times}
+    corrected = options is not None and options.correction_time is not None
+    if corrected:
+        A = np.asarray(linearised_step_function(model.body, model.h)(start, np.zeros(n))[1])
+        rho = correction_factor(options.correction_time, model.h)
     for _ in range(reaches):
         goal = random_goal(rng, 0.15, 0.45, d)
         plan = planner.solve(start, goal)
-        states = sample_trajectories(model.body, model.h, model.kappa, plan.start, plan.torque, 1, rng, model.noise)[0]
-        estimator = OnlineGoalEstimator(model, start)
+        if corrected:
+            states = plan.mean + sample_corrected_deviations(plan.cov, A, rho, plan.mean, options.deviation_time,
+                                                             model.h, n, 1, rng)[0]
+        else:
+            states = sample_trajectories(model.body, model.h, model.kappa, plan.start, plan.torque, 1, rng, model.noise)[0]
+        estimator = OnlineGoalEstimator(model, start, options=options)
         for t in times:
             i = min(int(t / model.h), model.H - 1)
             f = t / model.h - i
             y = ((1 - f) * states[i] + f * states[i + 1])[:2 * n] + rng.normal(size=2 * n) * noise
             estimate = estimator.update(t, y[:n], y[n:])
-            for at in CHECK_TIMES:
+            for at in check_times:
                 if abs(t - at) < 0.0115:
                     error = estimate.goal - goal
                     inside[at].append(error @ np.linalg.solve(estimate.goal_covariance, error) <= chi2.ppf(0.95, d))
                     errors[at].append(np.linalg.norm(error))
-    return {at: (float(np.mean(inside[at])), float(np.median(errors[at]))) for at in CHECK_TIMES}
+    return {at: (float(np.mean(inside[at])), float(np.median(errors[at]))) for at in check_times}
 
 
 def exact_observation(seed: int = 12) -> dict:

@@ -9,7 +9,7 @@ from scipy.stats import chi2
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.corrected_deviation import (CORRECTION_TIME, DEVIATION_TIME, corrected_covariance,
-                                                    corrected_powers, correction_factor)
+                                                    corrected_powers, correction_factor, sample_corrected_deviations)
 
 OBSERVATION_STD = np.r_[np.full(3, 1e-3), np.full(3, 1e-2)]   # the default R (m, m/s)
 CORRECTING = OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME)
@@ -22,19 +22,6 @@ def online(cartesian_planner):
 
 def transition(model):
     return np.asarray(linearised_step_function(model.body, model.h)(np.zeros(model.state_size), np.zeros(model.n))[1])
-
-
-def sample_deviations(cov, A, rho, mean, h, n, count, rng):
-    """Errors (count, H+1, nx) of the corrected process, drawn step by step with the increments the
-    covariance recursion implies (Sigma^c_{i+1} - rho² A Sigma^c_i A^T)."""
-    corrected = corrected_covariance(cov, A, rho, mean, DEVIATION_TIME, h, n)
-    decayed = rho * A
-    errors = np.zeros((count, len(cov), len(A)))
-    for i in range(len(cov) - 1):
-        increment = corrected[i + 1] - decayed @ corrected[i] @ decayed.T
-        factor = np.linalg.cholesky(0.5 * (increment + increment.T) + 1e-18 * np.eye(len(A)))
-        errors[:, i + 1] = errors[:, i] @ decayed.T + rng.normal(size=(count, len(A))) @ factor.T
-    return errors
 
 
 def test_corrected_covariance_is_the_open_loop_one_without_correction(online, cartesian_planner):
@@ -112,7 +99,7 @@ def test_goal_covariance_is_calibrated_for_a_person_who_corrects(online, cartesi
         u = rng.normal(size=3)
         goal = rng.uniform(0.15, 0.45) * u / np.linalg.norm(u)
         plan = cartesian_planner.solve(np.zeros(6), goal)
-        states = plan.mean + sample_deviations(plan.cov, A, rho, plan.mean, model.h, model.n, 1, rng)[0]
+        states = plan.mean + sample_corrected_deviations(plan.cov, A, rho, plan.mean, DEVIATION_TIME, model.h, model.n, 1, rng)[0]
         estimator = OnlineGoalEstimator(online.planner, np.zeros(6), options=CORRECTING)
         for t in times:
             i = min(int(t / model.h), model.H - 1)

@@ -73,6 +73,22 @@ def corrected_covariance(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.nd
     return corrected
 
 
+def sample_corrected_deviations(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.ndarray, deviation_time: float,
+                                h: float, n: int, count: int, rng: np.random.Generator) -> np.ndarray:
+    """Errors (count, H+1, nx) about a plan drawn from the corrected process of :func:`corrected_covariance`
+    (same arguments), starting at zero and stepped with the increments its recursion implies,
+    Sigma^c_{i+1} - rho² A Sigma^c_i A^T: reaches of a person who corrects, as the belief assumes."""
+    corrected = corrected_covariance(cov, A, rho, mean, deviation_time, h, n)
+    decayed = rho * np.asarray(A, dtype=float)
+    nx = len(decayed)
+    errors = np.zeros((count, len(corrected), nx))
+    for i in range(len(corrected) - 1):
+        increment = corrected[i + 1] - decayed @ corrected[i] @ decayed.T
+        factor = np.linalg.cholesky(0.5 * (increment + increment.T) + 1e-18 * np.eye(nx))
+        errors[:, i + 1] = errors[:, i] @ decayed.T + rng.normal(size=(count, nx)) @ factor.T
+    return errors
+
+
 CORRECTION_TIME = 0.3
 """tau (s) for a person who corrects, as the sync scenario's continuous policy takes it: about the simulated
 person's replanning interval (0.22 s) plus their arm's lag; chosen with DEVIATION_TIME on the sync scenario
