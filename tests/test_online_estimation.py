@@ -243,7 +243,7 @@ def test_bad_updates_raise(online, call, match):
     (dict(prior_std="wide"), "prior_std"),
     (dict(prior_goal=[0.3, 0.0]), "prior_goal"),
     (dict(options="fast"), "options"),
-    (dict(options=OnlineOptions(led_axes=(3,))), "led_axes"),
+    (dict(options=OnlineOptions(correction_time=0.3, led_axes=(3,))), "led_axes"),
 ])
 def test_bad_construction_raises(online, kwargs, match):
     arguments = dict(start=np.zeros(6)) | kwargs
@@ -252,10 +252,11 @@ def test_bad_construction_raises(online, kwargs, match):
 
 
 @pytest.mark.parametrize("options, match", [
-    (dict(led_axes=(-1,)), "led_axes"),
-    (dict(led_axes=(2, 2)), "led_axes"),
-    (dict(led_axes=(True,)), "led_axes"),
-    (dict(led_axes_std=(0.0, 0.3)), "led_axes_std"),
+    (dict(correction_time=0.3, led_axes=(-1,)), "led_axes"),
+    (dict(correction_time=0.3, led_axes=(2, 2)), "led_axes"),
+    (dict(correction_time=0.3, led_axes=(True,)), "led_axes"),
+    (dict(led_axes=(2,)), "correction_time"),
+    (dict(correction_time=0.3, led_axes=(2,), led_deviation_time=-0.1), "led_deviation_time"),
     (dict(covariance_scale=0.0), "covariance_scale"),
 ])
 def test_bad_options_raise(options, match):
@@ -265,16 +266,17 @@ def test_bad_options_raise(options, match):
 
 def test_an_axis_someone_else_leads_counts_for_less(online, cartesian_planner):
     """A plan's own states every 20 ms to 0.6 s, but from 0.2 s on someone else (the sync scenario's robot) has
-    pushed z 4 cm off the reach: with z among ``led_axes`` the estimate lands closer to the true goal than
-    when z is read as the person's (2-4x closer on these reaches); with exact observations it is unchanged
-    (within 1 % of the distance: the mean is the plan's)."""
+    pushed z 3 cm off the reach: with z among ``led_axes`` (a person who corrects) the estimate lands closer to
+    the true goal than when z is read as the person's; with exact observations it is unchanged (within 1 % of
+    the distance: the mean is the plan's)."""
     rng = np.random.default_rng(5)
-    led = OnlineOptions(led_axes=(2,))
+    person = OnlineOptions(correction_time=0.3, deviation_time=0.15)
+    led = OnlineOptions(correction_time=0.3, deviation_time=0.15, led_axes=(2,), led_deviation_time=0.5)
     for _ in range(3):
         goal = random_goal(rng, 0.25, 0.45)
         plan = cartesian_planner.solve(np.zeros(6), goal)
         errors = {}
-        for name, options, push in (("exact", led, 0.0), ("person's z", None, 0.04), ("led z", led, 0.04)):
+        for name, options, push in (("exact", led, 0.0), ("person's z", person, 0.03), ("led z", led, 0.03)):
             estimator = fresh(online, options=options)
             for t in np.arange(0.02, 0.61, 0.02):
                 y = state_at(plan.mean, plan.t[1], t)[:6].copy()
@@ -282,7 +284,7 @@ def test_an_axis_someone_else_leads_counts_for_less(online, cartesian_planner):
                 estimate = estimator.update(t, y[:3], y[3:])
             errors[name] = np.linalg.norm(estimate.goal - goal)
         assert errors["exact"] < 0.01 * np.linalg.norm(goal)
-        assert errors["led z"] < 0.5 * errors["person's z"], errors
+        assert errors["led z"] < 0.9 * errors["person's z"], errors
 
 
 def test_covariance_scale_scales_the_covariance_only(online, cartesian_planner):

@@ -49,22 +49,26 @@ def corrected_powers(A: np.ndarray, rho: float, steps: int) -> np.ndarray:
 
 
 def corrected_covariance(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.ndarray | None = None,
-                         deviation_time: float = 0.0, h: float = 1.0, n: int = 1) -> np.ndarray:
+                         deviation_time=0.0, h: float = 1.0, n: int = 1) -> np.ndarray:
     """Sigma^c_i (H+1, nx, nx) of a corrected deviation, from the plan's open-loop Sigma_i (H+1, nx, nx) and the
     transition A (nx, nx): the module docstring's recursion with the plan's noise increments Q_i (their
     negative eigenvalues, rounding in the plan's covariance, are dropped), plus, for ``deviation_time``
     sigma_t > 0 (s), the speed increments sigma_t² (1 - rho²) |mudot_b,i+1|² I of each state block b (n entries)
-    of the plan's mean ``mean`` (H+1, nx) on the grid of step ``h`` (s)."""
+    of the plan's mean ``mean`` (H+1, nx) on the grid of step ``h`` (s). ``deviation_time`` may also be one
+    sigma_t per axis (n,): diag(sigma_t,a²) in place of sigma_t² I (an axis along which the observed motion
+    strays more, e.g. one someone else moves)."""
     cov = np.asarray(cov, dtype=float)
     A = np.asarray(A, dtype=float)
     increments = cov[1:] - A @ cov[:-1] @ A.T
     increments = 0.5 * (increments + increments.transpose(0, 2, 1))
     values, vectors = np.linalg.eigh(increments)
     increments = (vectors * np.maximum(values, 0.0)[:, None, :]) @ vectors.transpose(0, 2, 1)
-    if deviation_time > 0:
+    deviation2 = np.broadcast_to(np.square(np.asarray(deviation_time, dtype=float)), (n,))
+    if np.any(deviation2 > 0):
         rate = np.gradient(np.asarray(mean, dtype=float), h, axis=0)[1:]
         speed2 = np.repeat(np.sum(rate.reshape(len(rate), -1, n) ** 2, axis=2), n, axis=1)      # (H, nx)
-        increments += deviation_time**2 * (1.0 - rho**2) * speed2[:, :, None] * np.eye(rate.shape[1])
+        speed2 *= np.tile(deviation2, rate.shape[1] // n)
+        increments += (1.0 - rho**2) * speed2[:, :, None] * np.eye(rate.shape[1])
     corrected = np.empty_like(cov)
     corrected[0] = cov[0]
     decayed = rho * A
@@ -73,7 +77,7 @@ def corrected_covariance(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.nd
     return corrected
 
 
-def sample_corrected_deviations(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.ndarray, deviation_time: float,
+def sample_corrected_deviations(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.ndarray, deviation_time,
                                 h: float, n: int, count: int, rng: np.random.Generator) -> np.ndarray:
     """Errors (count, H+1, nx) about a plan drawn from the corrected process of :func:`corrected_covariance`
     (same arguments), starting at zero and stepped with the increments its recursion implies,

@@ -96,11 +96,12 @@ class OnlineOptions:
     The sync scenario's continuous policy uses DEVIATION_TIME (0.15 s) of that module."""
     led_axes: tuple[int, ...] = ()
     """Axes (indices into the hand position, 0..d-1) along which someone else moves the hand, e.g. the robot
-    that leads z in the sync scenario: there the observed motion is partly theirs, not the person's reach, so
-    those axes are observed with the larger noise ``led_axes_std`` and count for less. Empty: every axis is
-    the person's."""
-    led_axes_std: tuple[float, float] = (0.03, 0.3)
-    """Observation noise of the ``led_axes``: standard deviation of a position (m) and velocity (m/s)."""
+    that leads z in the sync scenario: there the observed motion is partly theirs, not the person's reach, and
+    strays from the person's plan by ``led_deviation_time`` seconds of its motion instead of
+    ``deviation_time`` (it counts for less while the hand moves; at rest it still pins the goal). Needs a
+    correction time. Empty: every axis is the person's."""
+    led_deviation_time: float = 0.3
+    """sigma_t (s) along the ``led_axes`` (:mod:`comanip.estimation.corrected_deviation`)."""
     covariance_scale: float = 1.0
     """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
     is unchanged). 1: as computed, calibrated for the open-loop belief; the corrected belief's comes out too
@@ -108,13 +109,13 @@ class OnlineOptions:
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
-        if len(self.led_axes_std) != 2:
-            raise ValueError(f"led_axes_std must be a pair (position std m, velocity std m/s), got {self.led_axes_std!r}")
-        as_positive("led_axes_std[0]", self.led_axes_std[0], "m")
-        as_positive("led_axes_std[1]", self.led_axes_std[1], "m/s")
+        if not (math.isfinite(self.led_deviation_time) and self.led_deviation_time >= 0):
+            raise ValueError(f"led_deviation_time must be a finite time ≥ 0 s, got {self.led_deviation_time!r}")
         axes = tuple(self.led_axes)
         if any(isinstance(a, bool) or not isinstance(a, (int, np.integer)) or a < 0 for a in axes) or len(set(axes)) != len(axes):
             raise ValueError(f"led_axes must be distinct axis indices ≥ 0 of the hand position, got {self.led_axes!r}")
+        if axes and self.correction_time is None:
+            raise ValueError("led_axes need a correction_time (their motion strays as a person who corrects does), got None")
         as_positive("covariance_scale", self.covariance_scale, "factor")
         low, high = (as_positive(f"family_distances[{k}]", v, "m") for k, v in enumerate(self.family_distances))
         if low >= high:
@@ -233,9 +234,8 @@ class OnlineGoalEstimator:
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self._R = observation_covariance(self.options.observation_std, n)
-        led = list(self.options.led_axes)
-        if led:
-            self._R[np.r_[led, np.add(led, n)], np.r_[led, np.add(led, n)]] = np.repeat(np.square(self.options.led_axes_std), len(led))
+        self._deviation_times = np.full(n, self.options.deviation_time)
+        self._deviation_times[list(self.options.led_axes)] = self.options.led_deviation_time
         H = model.H
         self._counts = np.zeros(H + 1)
         self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations
@@ -341,7 +341,7 @@ class OnlineGoalEstimator:
             prediction = self._prediction(goal, order=0)
             cov = prediction.cov
             if self._rho < 1.0:
-                cov = corrected_covariance(cov, self._A, self._rho, prediction.mean, self.options.deviation_time, self.model.h,
+                cov = corrected_covariance(cov, self._A, self._rho, prediction.mean, self._deviation_times, self.model.h,
                                            self.model.n)
             whitening = ObservationWhitening(cov, self._powers, 2 * self.model.n, steps,
                                              np.array([self._step_noise(i, cov) for i in steps]),
