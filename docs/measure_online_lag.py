@@ -67,11 +67,11 @@ def replay(trial, prior_goal, prior_std, options: OnlineOptions, interval: float
     return at_times(record.t, errors)
 
 
-def progress(trial, model, estimator) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def progress(trial, model, planner) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Fraction of the reach done at TIMES: x-y of the hand, z of the hand, x-y and z of the model's plan."""
     record = trial.record
     start, offset = record.position[0], record.goal - record.position[0]
-    plan = estimator._prediction(record.goal, order=0, covariance=False).mean[:, :3] - start
+    plan = planner.solve(np.r_[start, np.zeros(model.state_size - 3)], record.goal).mean[:, :3] - start
     grid = model.h * np.arange(len(plan))
     hand = record.position - start
 
@@ -97,6 +97,7 @@ def main() -> None:
     setup = ScenarioSetup(next(iter(settings.values())))
     results = compare_sync_policies(settings, ["constant-velocity", "continuous"], setup)
     model = setup.model
+    planner = OnlineGoalEstimator(model, np.zeros(model.state_size)).planner
     out = [f"# Why the continuous goal estimate lags mid-reach (issue 12)\n",
            f"Measured by `PYTHONPATH=src python docs/measure_online_lag.py --trials {args.trials} --seed {args.seed}` "
            f"(sync scenario, person seeds {args.seed}–{args.seed + args.trials - 1}, medians over the trials; "
@@ -108,8 +109,7 @@ def main() -> None:
             np.where(np.isfinite(tr.record.goal_estimate), tr.record.goal_estimate, np.nan) - tr.record.goal, axis=1)) for tr in trials], axis=0)
             for name, trials in by_policy.items()}
         continuous = by_policy["continuous"]
-        estimator = OnlineGoalEstimator(model, np.r_[continuous[0].record.position[0], np.zeros(3)])
-        done = np.median([progress(tr, model, estimator) for tr in continuous], axis=0)
+        done = np.median([progress(tr, model, planner) for tr in continuous], axis=0)
         replays = {name: 1e3 * np.median([replay(tr, np.asarray(s.prior_goal), std, options, interval, model) for tr in continuous], axis=0)
                    for name, (std, options) in REPLAYS.items()}
         out += [f"## {label} (goal {np.round(s.goal, 2).tolist()} m)\n", "Goal error (mm) of the robots, closed loop:\n"]
