@@ -27,7 +27,7 @@ import numpy as np
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.online_estimator import CORRECTING_PERSON
 from comanip.simulation import ScenarioSetup, SyncSettings
-from comanip.simulation.policies.continuous import PRIOR_STD, ROBOT_LED_AXES
+from comanip.simulation.policies.continuous import PRIOR_STD, ROBOT_BELIEF
 from comanip.simulation.policy_comparison import compare_sync_policies
 from make_policy_comparison import GOALS
 
@@ -35,12 +35,12 @@ DOCS = Path(__file__).resolve().parent
 TIMES = (0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0, 1.2, 1.5, 2.0)
 #: label -> (prior std m, options) of the replayed estimator.
 REPLAYS = {
-    "the policy's (prior 0.25 m, person who corrects, robot-led z)": (PRIOR_STD, dataclasses.replace(CORRECTING_PERSON, led_axes=ROBOT_LED_AXES)),
-    "z read as the person's (the policy before)": (PRIOR_STD, CORRECTING_PERSON),
-    "weak prior (10 m)": (None, dataclasses.replace(CORRECTING_PERSON, led_axes=ROBOT_LED_AXES)),
-    "no straying (sigma_t = 0)": (PRIOR_STD, dataclasses.replace(CORRECTING_PERSON, deviation_time=0.0, led_axes=ROBOT_LED_AXES)),
-    "slower correction (tau = 0.6 s)": (PRIOR_STD, dataclasses.replace(CORRECTING_PERSON, correction_time=0.6, led_axes=ROBOT_LED_AXES)),
-    "open loop": (PRIOR_STD, OnlineOptions(led_axes=ROBOT_LED_AXES)),
+    "the policy's (ROBOT_BELIEF: prior 0.25 m, a person who corrects, robot-led z)": (PRIOR_STD, ROBOT_BELIEF),
+    "z read as the person's (CORRECTING_PERSON, the policy before)": (PRIOR_STD, CORRECTING_PERSON),
+    "weak prior (10 m)": (None, ROBOT_BELIEF),
+    "no straying on x-y (sigma_t = 0)": (PRIOR_STD, dataclasses.replace(ROBOT_BELIEF, deviation_time=0.0)),
+    "slower correction (tau = 0.6 s)": (PRIOR_STD, dataclasses.replace(ROBOT_BELIEF, correction_time=0.6)),
+    "open loop (no correction)": (PRIOR_STD, OnlineOptions()),
 }
 
 

@@ -21,7 +21,9 @@ distance is still poorly known (relative std along the reach above 5 %) its vari
 from a 1-D quadrature of the posterior along the line from the start through g_hat, and the spread across
 the reach is scaled by the root-mean-square distance over |g_hat - x_0| (the curvature at the mode misses the
 posterior's long tail towards far goals). Over reaches sampled from the model, the 95 % ellipsoid holds the
-true goal 93.5–98 % of the time from 0.1 s on (docs/measure_goal_estimation.py).
+true goal 93.5–98 % of the time from 0.1 s on (docs/measure_goal_estimation.py); under the belief of a person
+who corrects it needs ``OnlineOptions.covariance_scale`` for that (docs/formulation.md). Axes someone else
+moves (``OnlineOptions.led_axes``, the sync robot's z) count for less while they move.
 
 The plans come from a :class:`~comanip.estimation.reach_family.ReachFamily` of the model, built once per model
 and width: for a rotation-invariant point mass from rest, the plan to any goal is a 1-D reach turned onto its
@@ -89,7 +91,7 @@ class OnlineOptions:
     correction_time: float | None = None
     """Time constant (s) with which the person corrects a deviation from their plan
     (:mod:`comanip.estimation.corrected_deviation`); None: the plan's open-loop belief, a deviation persists.
-    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module."""
+    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module (ROBOT_BELIEF)."""
     deviation_time: float = 0.0
     """With a correction time: the person strays from the plan by about this many seconds (s) of their motion,
     in any direction (ahead, behind, across; :mod:`comanip.estimation.corrected_deviation`); 0: only motor noise.
@@ -104,8 +106,10 @@ class OnlineOptions:
     """sigma_t (s) along the ``led_axes`` (:mod:`comanip.estimation.corrected_deviation`)."""
     covariance_scale: float = 1.0
     """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
-    is unchanged). 1: as computed, calibrated for the open-loop belief; the corrected belief's comes out too
-    small late in the reach (CORRECTING_PERSON's value, docs/measure_goal_estimation.py --belief correcting)."""
+    is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time it is not: on
+    reaches sampled from that process most ellipsoids are too wide and about a tenth far too narrow (86–87 %
+    pooled coverage of the 95 % ellipsoid at 0.2–0.8 s); the sync robot's belief uses 3
+    (comanip.simulation.policies.continuous.ROBOT_BELIEF; docs/measure_goal_estimation.py --belief robot)."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
