@@ -104,7 +104,7 @@ def test_the_sync_robots_belief_is_calibrated(online, cartesian_planner):
     """Reaches whose errors follow the corrected process (every axis the person's), observed every 23 ms with
     the default noise up to 0.8 s, estimates at 0.2, 0.4, 0.6 and 0.8 s under the continuous policy's belief
     (ROBOT_BELIEF: covariance scaled by 3): the true goal lies inside the 95 % ellipsoid 90–98 % of the time.
-    Unscaled, this belief covered 86–87 % (78–83 % at 0.6–0.8 s): most ellipsoids are too wide, a tenth far too
+    Unscaled, this belief covered 87–88 % (78–82 % at 0.6–0.8 s): most ellipsoids are too wide, a tenth far too
     narrow (docs/formulation.md)."""
     model = online.model
     A = transition(model)

@@ -107,7 +107,7 @@ class OnlineOptions:
     covariance_scale: float = 1.0
     """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
     is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time it is not: on
-    reaches sampled from that process most ellipsoids are too wide and about a tenth far too narrow (86–87 %
+    reaches sampled from that process most ellipsoids are too wide and about a tenth far too narrow (87–88 %
     pooled coverage of the 95 % ellipsoid at 0.2–0.8 s); the sync robot's belief uses 3
     (comanip.simulation.policies.continuous.ROBOT_BELIEF; docs/measure_goal_estimation.py --belief robot)."""
 
