@@ -78,6 +78,11 @@ def test_deviation_time_per_axis(online, cartesian_planner):
     speed_only = corrected_covariance(np.zeros_like(plan.cov), A, rho, plan.mean, [0.0, 0.0, 1.0], model.h, model.n)
     np.testing.assert_allclose(wider - scalar, (0.5**2 - DEVIATION_TIME**2) * speed_only, rtol=1e-9, atol=1e-15)
     assert np.all(np.abs(speed_only[:, [0, 1, 3, 4]]) == 0) and speed_only[model.H // 2, 2, 2] > 0
+    per_step = np.tile([DEVIATION_TIME, DEVIATION_TIME, 0.5], (model.H, 1))
+    per_step[:10, 2] = DEVIATION_TIME              # z strays more only from step 10 on
+    later = corrected_covariance(plan.cov, A, rho, plan.mean, per_step, model.h, model.n)
+    np.testing.assert_allclose(later[:11], scalar[:11], rtol=1e-12, atol=1e-15)
+    assert later[20, 2, 2] > scalar[20, 2, 2]
 
 
 def test_exact_observations_give_back_their_goal(online, cartesian_planner):

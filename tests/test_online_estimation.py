@@ -258,6 +258,7 @@ def test_bad_construction_raises(online, kwargs, match):
     (dict(led_axes=(2,)), "correction_time"),
     (dict(correction_time=0.3, led_axes=(2,), led_deviation_time=-0.1), "led_deviation_time"),
     (dict(covariance_scale=0.0), "covariance_scale"),
+    (dict(correction_time=0.3, led_axes=(2,), led_from=-1.0), "led_from"),
 ])
 def test_bad_options_raise(options, match):
     with pytest.raises(ValueError, match=match):
@@ -285,6 +286,26 @@ def test_an_axis_someone_else_leads_counts_for_less(online, cartesian_planner):
             errors[name] = np.linalg.norm(estimate.goal - goal)
         assert errors["exact"] < 0.01 * np.linalg.norm(goal)
         assert errors["led z"] < 0.9 * errors["person's z"], errors
+
+
+def test_led_axes_are_the_persons_before_led_from(online, cartesian_planner):
+    """Observations up to 0.15 s with led_from = 0.2 s give the estimate of a belief without led axes (the
+    axes are the person's until then); with led_from = 0 the estimate differs."""
+    goal = np.array([0.3, 0.1, -0.15])
+    plan = cartesian_planner.solve(np.zeros(6), goal)
+    person = OnlineOptions(correction_time=0.3, deviation_time=0.15)
+    goals = {}
+    for name, options in (("person", person), ("led from 0.2 s", OnlineOptions(correction_time=0.3, deviation_time=0.15, led_axes=(2,),
+                                                                                led_deviation_time=0.5, led_from=0.2)),
+                          ("led from 0", OnlineOptions(correction_time=0.3, deviation_time=0.15, led_axes=(2,), led_deviation_time=0.5))):
+        estimator = fresh(online, options=options)
+        noise = np.random.default_rng(8)
+        for t in np.arange(0.01, 0.16, 0.01):
+            y = state_at(plan.mean, plan.t[1], t)[:6] + noise.normal(size=6) * np.r_[np.full(3, 1e-3), np.full(3, 1e-2)]
+            estimate = estimator.update(t, y[:3], y[3:])
+        goals[name] = estimate.goal
+    np.testing.assert_allclose(goals["led from 0.2 s"], goals["person"], rtol=0, atol=1e-9)
+    assert np.linalg.norm(goals["led from 0"] - goals["person"]) > 1e-4
 
 
 def test_covariance_scale_scales_the_covariance_only(online, cartesian_planner):

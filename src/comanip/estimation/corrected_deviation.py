@@ -55,15 +55,15 @@ def corrected_covariance(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.nd
     negative eigenvalues, rounding in the plan's covariance, are dropped), plus, for ``deviation_time``
     sigma_t > 0 (s), the speed increments sigma_t² (1 - rho²) |mudot_b,i+1|² I of each state block b (n entries)
     of the plan's mean ``mean`` (H+1, nx) on the grid of step ``h`` (s). ``deviation_time`` may also be one
-    sigma_t per axis (n,): diag(sigma_t,a²) in place of sigma_t² I (an axis along which the observed motion
-    strays more, e.g. one someone else moves)."""
+    sigma_t per axis (n,), or per step and axis (H, n) (step i's increment): diag(sigma_t,a²) in place of
+    sigma_t² I (an axis along which the observed motion strays more, e.g. one someone else moves from some time on)."""
     cov = np.asarray(cov, dtype=float)
     A = np.asarray(A, dtype=float)
     increments = cov[1:] - A @ cov[:-1] @ A.T
     increments = 0.5 * (increments + increments.transpose(0, 2, 1))
     values, vectors = np.linalg.eigh(increments)
     increments = (vectors * np.maximum(values, 0.0)[:, None, :]) @ vectors.transpose(0, 2, 1)
-    deviation2 = np.broadcast_to(np.square(np.asarray(deviation_time, dtype=float)), (n,))
+    deviation2 = np.broadcast_to(np.square(np.asarray(deviation_time, dtype=float)), (len(cov) - 1, n))
     if np.any(deviation2 > 0):
         rate = np.gradient(np.asarray(mean, dtype=float), h, axis=0)[1:]
         speed2 = np.repeat(np.sum(rate.reshape(len(rate), -1, n) ** 2, axis=2), n, axis=1)      # (H, nx)

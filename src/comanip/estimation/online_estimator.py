@@ -104,6 +104,9 @@ class OnlineOptions:
     correction time. Empty: every axis is the person's."""
     led_deviation_time: float = 0.3
     """sigma_t (s) along the ``led_axes`` (:mod:`comanip.estimation.corrected_deviation`)."""
+    led_from: float = 0.0
+    """Time (s since the reach's start) from which someone else leads the ``led_axes``; before it they are the
+    person's (the sync robot leads z from t_o)."""
     covariance_scale: float = 1.0
     """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
     is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time it is not: on
@@ -113,6 +116,8 @@ class OnlineOptions:
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
+        if not (math.isfinite(self.led_from) and self.led_from >= 0):
+            raise ValueError(f"led_from must be a finite time ≥ 0 s, got {self.led_from!r}")
         if not (math.isfinite(self.led_deviation_time) and self.led_deviation_time >= 0):
             raise ValueError(f"led_deviation_time must be a finite time ≥ 0 s, got {self.led_deviation_time!r}")
         axes = tuple(self.led_axes)
@@ -238,8 +243,10 @@ class OnlineGoalEstimator:
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self._R = observation_covariance(self.options.observation_std, n)
-        self._deviation_times = np.full(n, self.options.deviation_time)
-        self._deviation_times[list(self.options.led_axes)] = self.options.led_deviation_time
+        # sigma_t of each step's increment (H, n): led axes stray more from the step that ends after led_from on
+        self._deviation_times = np.full((model.H, n), self.options.deviation_time)
+        led_steps = model.h * np.arange(1, model.H + 1) > self.options.led_from
+        self._deviation_times[np.ix_(led_steps, list(self.options.led_axes))] = self.options.led_deviation_time
         H = model.H
         self._counts = np.zeros(H + 1)
         self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations

@@ -50,7 +50,7 @@ class ContinuousPolicy:
     estimator's weak default; default :data:`PRIOR_STD`). options: the estimator's :class:`OnlineOptions`;
     default :data:`ROBOT_BELIEF`: a person who corrects deviations from their plan (``CORRECTING_PERSON``:
     :mod:`comanip.estimation.corrected_deviation`), as the simulated person does by replanning, with the
-    robot-led z read as less informative (:data:`ROBOT_LED_AXES`).
+    robot-led z read as less informative (:data:`ROBOT_LED_AXES`) from t_o on, when the robot starts leading.
     """
 
     name = "continuous"
@@ -59,7 +59,7 @@ class ContinuousPolicy:
         self.context = context
         self.update_interval = context.update_interval
         self.estimator = OnlineGoalEstimator(context.model, context.start, prior_goal=context.prior_goal,
-                                             prior_std=prior_std, width=context.width, options=options or ROBOT_BELIEF)
+                                             prior_std=prior_std, width=context.width, options=options or dataclasses.replace(ROBOT_BELIEF, led_from=context.observation_time))
         self._next_observation = context.update_interval
 
     def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
