@@ -38,9 +38,10 @@ on reaches sampled from the corrected process, to 90–98 % (chosen on sampling 
 ``docs/measure_goal_estimation.py --belief robot`` reports seed 0)."""
 
 ROBOT_BELIEF = dataclasses.replace(CORRECTING_PERSON, led_axes=ROBOT_LED_AXES, led_deviation_time=ROBOT_LED_DEVIATION_TIME,
-                                   covariance_scale=ROBOT_COVARIANCE_SCALE)
+                                   led_from=0.2, covariance_scale=ROBOT_COVARIANCE_SCALE)
 """The continuous policy's default estimator options: a person who corrects (CORRECTING_PERSON), z led by the
-robot, the goal covariance calibrated."""
+robot from t_o (here the sync scenario's default 0.2 s; the policy sets its context's), the goal covariance
+calibrated."""
 
 
 class ContinuousPolicy:
