@@ -28,7 +28,7 @@ from readme_blocks import block_names, block_spans, replace_block  # noqa: E402 
 BLOCKS: dict[str, tuple[str, list[str]]] = {
     "calibration-study": ("the calibration study of the planar preset's family (about 10 min)",
                           ["docs/print_calibration_study.py"]),
-    "goal-calibration": ("coverage of the online goal estimate's 95 % ellipsoid and exact-observation errors (about 5 min)",
+    "goal-calibration": ("coverage of the online goal estimate's 95 % ellipsoid (open-loop belief, and the sync robot's) and exact-observation errors (about 10 min)",
                          ["docs/measure_goal_estimation.py", "--markdown", "--reaches", "200"]),
     "human-targets": ("the human-likeness targets, paper preset beside the human one and its variants (about 30 min)",
                       ["docs/make_calibration_table.py", "planar", "human",

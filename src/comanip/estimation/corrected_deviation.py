@@ -49,28 +49,48 @@ def corrected_powers(A: np.ndarray, rho: float, steps: int) -> np.ndarray:
 
 
 def corrected_covariance(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.ndarray | None = None,
-                         deviation_time: float = 0.0, h: float = 1.0, n: int = 1) -> np.ndarray:
+                         deviation_time=0.0, h: float = 1.0, n: int = 1) -> np.ndarray:
     """Sigma^c_i (H+1, nx, nx) of a corrected deviation, from the plan's open-loop Sigma_i (H+1, nx, nx) and the
     transition A (nx, nx): the module docstring's recursion with the plan's noise increments Q_i (their
     negative eigenvalues, rounding in the plan's covariance, are dropped), plus, for ``deviation_time``
     sigma_t > 0 (s), the speed increments sigma_t² (1 - rho²) |mudot_b,i+1|² I of each state block b (n entries)
-    of the plan's mean ``mean`` (H+1, nx) on the grid of step ``h`` (s)."""
+    of the plan's mean ``mean`` (H+1, nx) on the grid of step ``h`` (s). ``deviation_time`` may also be one
+    sigma_t per axis (n,), or per step and axis (H, n) (step i's increment): diag(sigma_t,a²) in place of
+    sigma_t² I (an axis along which the observed motion strays more, e.g. one someone else moves from some time on)."""
     cov = np.asarray(cov, dtype=float)
     A = np.asarray(A, dtype=float)
     increments = cov[1:] - A @ cov[:-1] @ A.T
     increments = 0.5 * (increments + increments.transpose(0, 2, 1))
     values, vectors = np.linalg.eigh(increments)
     increments = (vectors * np.maximum(values, 0.0)[:, None, :]) @ vectors.transpose(0, 2, 1)
-    if deviation_time > 0:
+    deviation2 = np.broadcast_to(np.square(np.asarray(deviation_time, dtype=float)), (len(cov) - 1, n))
+    if np.any(deviation2 > 0):
         rate = np.gradient(np.asarray(mean, dtype=float), h, axis=0)[1:]
         speed2 = np.repeat(np.sum(rate.reshape(len(rate), -1, n) ** 2, axis=2), n, axis=1)      # (H, nx)
-        increments += deviation_time**2 * (1.0 - rho**2) * speed2[:, :, None] * np.eye(rate.shape[1])
+        speed2 *= np.tile(deviation2, rate.shape[1] // n)
+        increments += (1.0 - rho**2) * speed2[:, :, None] * np.eye(rate.shape[1])
     corrected = np.empty_like(cov)
     corrected[0] = cov[0]
     decayed = rho * A
     for i in range(len(cov) - 1):
         corrected[i + 1] = decayed @ corrected[i] @ decayed.T + increments[i]
     return corrected
+
+
+def sample_corrected_deviations(cov: np.ndarray, A: np.ndarray, rho: float, mean: np.ndarray, deviation_time,
+                                h: float, n: int, count: int, rng: np.random.Generator) -> np.ndarray:
+    """Errors (count, H+1, nx) about a plan drawn from the corrected process of :func:`corrected_covariance`
+    (same arguments), starting at zero and stepped with the increments its recursion implies,
+    Sigma^c_{i+1} - rho² A Sigma^c_i A^T: reaches of a person who corrects, as the belief assumes."""
+    corrected = corrected_covariance(cov, A, rho, mean, deviation_time, h, n)
+    decayed = rho * np.asarray(A, dtype=float)
+    nx = len(decayed)
+    errors = np.zeros((count, len(corrected), nx))
+    for i in range(len(corrected) - 1):
+        increment = corrected[i + 1] - decayed @ corrected[i] @ decayed.T
+        factor = np.linalg.cholesky(0.5 * (increment + increment.T) + 1e-18 * np.eye(nx))
+        errors[:, i + 1] = errors[:, i] @ decayed.T + rng.normal(size=(count, nx)) @ factor.T
+    return errors
 
 
 CORRECTION_TIME = 0.3

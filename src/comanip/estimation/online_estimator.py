@@ -21,7 +21,9 @@ distance is still poorly known (relative std along the reach above 5 %) its vari
 from a 1-D quadrature of the posterior along the line from the start through g_hat, and the spread across
 the reach is scaled by the root-mean-square distance over |g_hat - x_0| (the curvature at the mode misses the
 posterior's long tail towards far goals). Over reaches sampled from the model, the 95 % ellipsoid holds the
-true goal 93.5–98 % of the time from 0.1 s on (docs/measure_goal_estimation.py).
+true goal 93.5–98 % of the time from 0.1 s on (docs/measure_goal_estimation.py); under the belief of a person
+who corrects it needs ``OnlineOptions.covariance_scale`` for that (docs/formulation.md). Axes someone else
+moves (``OnlineOptions.led_axes``, the sync robot's z) count for less while they move.
 
 The plans come from a :class:`~comanip.estimation.reach_family.ReachFamily` of the model, built once per model
 and width: for a rotation-invariant point mass from rest, the plan to any goal is a 1-D reach turned onto its
@@ -89,14 +91,41 @@ class OnlineOptions:
     correction_time: float | None = None
     """Time constant (s) with which the person corrects a deviation from their plan
     (:mod:`comanip.estimation.corrected_deviation`); None: the plan's open-loop belief, a deviation persists.
-    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module."""
+    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module (ROBOT_BELIEF)."""
     deviation_time: float = 0.0
     """With a correction time: the person strays from the plan by about this many seconds (s) of their motion,
     in any direction (ahead, behind, across; :mod:`comanip.estimation.corrected_deviation`); 0: only motor noise.
     The sync scenario's continuous policy uses DEVIATION_TIME (0.15 s) of that module."""
+    led_axes: tuple[int, ...] = ()
+    """Axes (indices into the hand position, 0..d-1) along which someone else moves the hand, e.g. the robot
+    that leads z in the sync scenario: there the observed motion is partly theirs, not the person's reach, and
+    strays from the person's plan by ``led_deviation_time`` seconds of its motion instead of
+    ``deviation_time`` (it counts for less while the hand moves; at rest it still pins the goal). Needs a
+    correction time. Empty: every axis is the person's."""
+    led_deviation_time: float = 0.3
+    """sigma_t (s) along the ``led_axes`` (:mod:`comanip.estimation.corrected_deviation`)."""
+    led_from: float = 0.0
+    """Time (s since the reach's start) from which someone else leads the ``led_axes``; before it they are the
+    person's (the sync robot leads z from t_o)."""
+    covariance_scale: float = 1.0
+    """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
+    is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time it is not: on
+    reaches sampled from that process most ellipsoids are too wide and about a tenth far too narrow (87–88 %
+    pooled coverage of the 95 % ellipsoid at 0.2–0.8 s); the sync robot's belief uses 3
+    (comanip.simulation.policies.continuous.ROBOT_BELIEF; docs/measure_goal_estimation.py --belief robot)."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
+        if not (math.isfinite(self.led_from) and self.led_from >= 0):
+            raise ValueError(f"led_from must be a finite time ≥ 0 s, got {self.led_from!r}")
+        if not (math.isfinite(self.led_deviation_time) and self.led_deviation_time >= 0):
+            raise ValueError(f"led_deviation_time must be a finite time ≥ 0 s, got {self.led_deviation_time!r}")
+        axes = tuple(self.led_axes)
+        if any(isinstance(a, bool) or not isinstance(a, (int, np.integer)) or a < 0 for a in axes) or len(set(axes)) != len(axes):
+            raise ValueError(f"led_axes must be distinct axis indices ≥ 0 of the hand position, got {self.led_axes!r}")
+        if axes and self.correction_time is None:
+            raise ValueError("led_axes need a correction_time (their motion strays as a person who corrects does), got None")
+        as_positive("covariance_scale", self.covariance_scale, "factor")
         low, high = (as_positive(f"family_distances[{k}]", v, "m") for k, v in enumerate(self.family_distances))
         if low >= high:
             raise ValueError(f"family_distances must be (D_min, D_max) with D_min < D_max (m), got {self.family_distances!r}")
@@ -211,7 +240,13 @@ class OnlineGoalEstimator:
         self._rho = 1.0 if correction_time is None else correction_factor(correction_time, model.h)
         self._A = A
         self._powers = corrected_powers(A, self._rho, model.H)
+        if any(a >= n for a in self.options.led_axes):
+            raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self._R = observation_covariance(self.options.observation_std, n)
+        # sigma_t of each step's increment (H, n): led axes stray more from the step that ends after led_from on
+        self._deviation_times = np.full((model.H, n), self.options.deviation_time)
+        led_steps = model.h * np.arange(1, model.H + 1) > self.options.led_from
+        self._deviation_times[np.ix_(led_steps, list(self.options.led_axes))] = self.options.led_deviation_time
         H = model.H
         self._counts = np.zeros(H + 1)
         self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations
@@ -291,7 +326,7 @@ class OnlineGoalEstimator:
                 iterations += used
                 if not self._stale(goal):
                     break
-            covariance = problem.distance_spread(goal, covariance, whitening)
+            covariance = self.options.covariance_scale * problem.distance_spread(goal, covariance, whitening)
             if not (np.all(np.isfinite(goal)) and np.all(np.isfinite(covariance))):
                 raise np.linalg.LinAlgError("non-finite estimate")
         except np.linalg.LinAlgError as error:
@@ -317,7 +352,7 @@ class OnlineGoalEstimator:
             prediction = self._prediction(goal, order=0)
             cov = prediction.cov
             if self._rho < 1.0:
-                cov = corrected_covariance(cov, self._A, self._rho, prediction.mean, self.options.deviation_time, self.model.h,
+                cov = corrected_covariance(cov, self._A, self._rho, prediction.mean, self._deviation_times, self.model.h,
                                            self.model.n)
             whitening = ObservationWhitening(cov, self._powers, 2 * self.model.n, steps,
                                              np.array([self._step_noise(i, cov) for i in steps]),
