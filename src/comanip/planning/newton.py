@@ -340,8 +340,9 @@ def _constrained_step(factor, g, c, A, margin: float, tolerance: float):
 
 def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> None:
     """correction += r rᵀ / (rᵀ s), r = y - (H + correction) s, in place; skipped when rᵀ s is tiny
-    (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|)."""
-    r = y - (H + correction) @ s
+    (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|). correction and H (N, N), s and y (N,)."""
+    r = y - H @ s - correction @ s
     denominator = r @ s
     if abs(denominator) > 1e-8 * np.linalg.norm(r) * np.linalg.norm(s):
-        correction += np.outer(r, r) / denominator
+        u = r / np.sqrt(abs(denominator))  # u_i u_j = u_j u_i: the correction stays exactly symmetric
+        correction += np.outer(u, np.sign(denominator) * u)
