@@ -227,15 +227,12 @@ class LinearisedCurvature:
         forming them. ∂f/∂g, ∂²f/∂g² and the mean rows' part of ∂²f/∂x∂g are exact; the covariance rows'
         part carries the Hessian's approximation (A_i, B_i held along the path).
         """
-        x, J, phi_hess, phi_grad, dvech = data.x, data.J, data.phi_hess, data.phi_grad, data.dvech
+        x, phi_grad = data.x, data.phi_grad
         model = self.model
         n, d, H = model.n, model.d, model.H
-        nv, nz = len(self._triangle), phi_hess.shape[0]
         a, b = self._triangle.T
-        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
+        J, Q, dvech = (_per_step(v, H + 1) for v in (data.J, data.phi_hess, data.dvech))
         c_mean, c_vech = -Q[:, :d, :d], -Q[:, d:, :d]  # ∂²phi_i/∂mu_x∂g (H+1, d, d), ∂²phi_i/∂vech∂g (H+1, nv, d)
-        J = J.reshape(d, H + 1, n).transpose(1, 0, 2)
-        dvech = dvech.reshape(nv, H + 1, n).transpose(1, 0, 2)
         Tq = self.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
         # mean rows J_i T_i and the rows of J(q_i)'s effect on Sigma_x, d vech/dq_i T_i, share T_i
         per_q = np.swapaxes(J, 1, 2) @ c_mean + np.swapaxes(dvech, 1, 2) @ c_vech  # (H+1, n, d)
