@@ -6,10 +6,11 @@ For each preset (the point masses uncompiled and with ``SolverOptions(compile=Tr
 as it always is): the best of repeated timings (ms) of one terms evaluation (f, its gradient and the per-step
 pieces), one value-only evaluation (line searches, ranking of initial guesses), one Hessian (for the Panda
 with the sensitivities d mu / d tau it starts from), one Cholesky factorisation, one secant (SR1) update
-(approximate Hessians only), building the returned Plan, and of a whole warm solve (goal moved within ±5 cm
-per axis), with the mean iterations of such solves and the warm solve's time per iteration. Start at the
-body's home position, at rest; base goal 0.3 m along x for the point masses, [0.15, 0.1, -0.1] m from the
-ready pose for the Panda (as in solve_times.py). BLAS is held to one thread, as the planner does.
+(approximate Hessians only) and building the returned Plan; then 15 warm solves (goal moved within ±5 cm per
+axis, each from the same plan): the median ``solve_time``, the mean iterations and the median of each solve's
+time over its iterations (solves of different lengths compare per iteration). Start at the body's home
+position, at rest; base goal 0.3 m along x for the point masses, [0.15, 0.1, -0.1] m from the ready pose for
+the Panda (as in solve_times.py). BLAS is held to one thread, as the planner does.
 
 ``--compare REF``: every preset runs a second time, in its own process, with the code of the checkout REF
 (e.g. a worktree at main), rows side by side, so both see the same machine load.
@@ -65,7 +66,7 @@ def measure(preset: str, compile: bool) -> dict:
     def warm():
         return planner.solve(start, goal + rng.uniform(-0.05, 0.05, model.d), model.width, warm_start=plan)
 
-    iterations = float(np.mean([warm().iterations for _ in range(10)]))
+    solves = [warm() for _ in range(15)]
     correction, step = np.zeros_like(matrix), rng.normal(scale=1e-3, size=x.size)
     times = {"terms evaluation": best_ms(lambda: curvature.evaluate(x, params)),
              "value only": best_ms(lambda: curvature.value(x, params)),
@@ -75,8 +76,10 @@ def measure(preset: str, compile: bool) -> dict:
                                if not curvature.exact else float("nan")),
              "make_plan": best_ms(lambda: planner._make_plan(plan.torque, params, status="solved", success=True,
                                                              message="", solve_time=0.0, iterations=0)),
-             "warm solve": best_ms(warm, number=1 if curvature.carries_belief else 5, repeat=15)}
-    return {**times, "iterations": iterations, "warm solve / iteration": times["warm solve"] / iterations}
+             "warm solve": 1e3 * float(np.median([s.solve_time for s in solves])),
+             "iterations": float(np.mean([s.iterations for s in solves])),
+             "warm solve / iteration": 1e3 * float(np.median([s.solve_time / s.iterations for s in solves]))}
+    return times
 
 
 def variants(preset: str) -> list[bool]:
