@@ -7,8 +7,9 @@ warm solves with varied goals (cold cases: `repeats` cold solves to new goals). 
 CASES a key (used by --only) and a function that returns a Case.
 
 ``--compare REF``: REF is another checkout (e.g. a worktree at main); every case runs twice in the same run,
-each in its own process, first with this checkout's src/ then with REF's (same script, same problems), and
-the two rows are printed one under the other ('new' and 'ref').
+each in its own process, one with this checkout's src/ and one with REF's (same script, same problems), the
+two processes taking turns solve by solve so that both see the same machine load; the two rows are printed
+one under the other ('new' and 'ref').
 """
 
 from __future__ import annotations
@@ -253,11 +254,15 @@ HEADER = f"{'case':<50} {'build s':>8} {'median ms':>10} {'p90 ms':>8} {'ok':>6}
 def measure_case(key: str, repeats: int) -> dict:
     """The case timed in this process: name, build_s, median_s, p90_s, ok, runs, paper_s."""
     case = CASES[key]()
-    runs = [case.solve(k) for k in range(repeats)]
+    return summary(case.name, case.build_time, case.paper_time, [case.solve(k) for k in range(repeats)])
+
+
+def summary(name: str, build_time: float, paper_time: float | None, runs: list[tuple[float, bool]]) -> dict:
+    """A row from the (seconds, success) of its solves."""
     times = np.array([t for t, _ in runs])
-    return {"name": case.name, "build_s": case.build_time, "median_s": float(np.median(times)),
+    return {"name": name, "build_s": build_time, "median_s": float(np.median(times)),
             "p90_s": float(np.percentile(times, 90)), "ok": int(sum(s for _, s in runs)), "runs": len(runs),
-            "paper_s": case.paper_time}
+            "paper_s": paper_time}
 
 
 def text_row(row: dict) -> str:
@@ -281,11 +286,42 @@ def markdown_table(rows: list[dict], repeats: int) -> str:
     return "\n".join(lines)
 
 
-def measure_elsewhere(src: Path, key: str, repeats: int) -> dict:
-    """The case timed in a fresh process importing comanip from ``src``."""
-    done = subprocess.run([sys.executable, __file__, "--only", key, "--repeats", str(repeats), "--row"],
-                          env={**os.environ, "PYTHONPATH": str(src)}, check=True, capture_output=True, text=True)
-    return json.loads(done.stdout.strip().splitlines()[-1])
+def measure_side_by_side(sources: list[Path], key: str, repeats: int) -> list[dict]:
+    """The case timed once per checkout, each in a fresh process importing comanip from its ``src``; the
+    processes take turns solve by solve (solve k of every checkout, then solve k + 1)."""
+    workers = [subprocess.Popen([sys.executable, __file__, "--only", key, "--serve"], stdin=subprocess.PIPE,
+                                stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(src)})
+               for src in sources]
+    heads = [_reply(worker) for worker in workers]  # each has built its case
+    runs = [[] for _ in workers]
+    for k in range(repeats):
+        for worker, run in zip(workers, runs):
+            worker.stdin.write(f"{k}\n")
+            worker.stdin.flush()
+            run.append(tuple(_reply(worker)))
+    for worker in workers:
+        worker.stdin.close()
+        worker.wait()
+    return [summary(head["name"], head["build_s"], head["paper_s"], run) for head, run in zip(heads, runs)]
+
+
+def _reply(worker: subprocess.Popen):
+    """The next JSON line a ``--serve`` process writes (other output on its stdout is skipped)."""
+    while True:
+        line = worker.stdout.readline()
+        if not line:
+            raise RuntimeError(f"benchmark process {worker.args} ended early (exit code {worker.wait()})")
+        if line.startswith(("{", "[")):
+            return json.loads(line)
+
+
+def serve(key: str) -> None:
+    """Build the case, write its name and build time, then time solve k for every k read from stdin."""
+    case = CASES[key]()
+    print(json.dumps({"name": case.name, "build_s": case.build_time, "paper_s": case.paper_time}), flush=True)
+    for line in sys.stdin:
+        seconds, success = case.solve(int(line))
+        print(json.dumps([seconds, bool(success)]), flush=True)
 
 
 def main(argv=None) -> None:
@@ -294,15 +330,15 @@ def main(argv=None) -> None:
     parser.add_argument("--only", default="", help=f"comma-separated case keys to run, of: {', '.join(CASES)}")
     parser.add_argument("--compare", type=Path, default=None, help="another checkout to time side by side (its src/)")
     parser.add_argument("--markdown", action="store_true", help="print the README's markdown table instead (no --compare)")
-    parser.add_argument("--row", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     wanted = [w for w in args.only.split(",") if w]
     unknown = [w for w in wanted if w not in CASES]
     if unknown:
         raise SystemExit(f"unknown case keys {unknown}; the cases are {', '.join(CASES)}")
     keys = [key for key in CASES if not wanted or key in wanted]
-    if args.row:
-        print(json.dumps(measure_case(keys[0], args.repeats)))
+    if args.serve:
+        serve(keys[0])
         return
     if args.markdown:
         rows = []
@@ -319,8 +355,9 @@ def main(argv=None) -> None:
     here = Path(__file__).resolve().parents[1] / "src"
     print(f"{'code':<5}{HEADER}")
     for key in keys:
-        for label, src in (("new", here), ("ref", args.compare.resolve() / "src")):
-            print(f"{label:<5}{text_row(measure_elsewhere(src, key, args.repeats))}", flush=True)
+        rows = measure_side_by_side([here, args.compare.resolve() / "src"], key, args.repeats)
+        for label, row in zip(("new", "ref"), rows):
+            print(f"{label:<5}{text_row(row)}", flush=True)
 
 
 if __name__ == "__main__":

@@ -83,6 +83,25 @@ def test_newton_matches_scipy_on_a_bounded_rosenbrock():
     assert result.fun <= reference.fun + 1e-12
 
 
+def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
+    """After the update in place, (H + C) s = y, C stays symmetric and C's change is rank one; a residual r
+    orthogonal to s (no finite update meets the equation) leaves C alone."""
+    from comanip.planning.newton import _symmetric_rank_one_update
+
+    size = 40
+    H, C = (lambda M: M + M.T)(rng.normal(size=(size, size))), (lambda M: M + M.T)(rng.normal(size=(size, size)))
+    s, y = rng.normal(size=size), rng.normal(size=size)
+    before = C.copy()
+    _symmetric_rank_one_update(C, H, s, y)
+    np.testing.assert_allclose((H + C) @ s, y, atol=1e-10 * np.abs(y).max())
+    np.testing.assert_array_equal(C, C.T)
+    assert np.linalg.matrix_rank(C - before, tol=1e-8 * np.abs(C - before).max()) == 1
+    unchanged = C.copy()
+    w = rng.normal(size=size)
+    _symmetric_rank_one_update(C, H, s, (H + C) @ s + w - (w @ s) / (s @ s) * s)  # r ⟂ s: no finite update
+    np.testing.assert_array_equal(C, unchanged)
+
+
 def test_newton_stops_at_the_deadline():
     calls = []
 

@@ -108,7 +108,7 @@ def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
                 for m in range(n):
                     expected[k * n + j, k * n + m] += np.sum(Lambda * (G_k @ second[j][m] @ G_k.T))
     expected += 2 * model.nu / curvature.normaliser(p[-1]) * np.eye(H * n)
-    np.testing.assert_allclose(curvature.hessian(data), expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+    np.testing.assert_allclose(curvature.hessian(data), expected, rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
 SPEED_COST = dict(stop_weight=0.7, joint_velocity_weight=0.3)
@@ -172,7 +172,7 @@ def test_speed_cost_hessian_is_the_gauss_newton_term_and_close_to_the_exact_one(
         for k in range(H):
             S_k = sum(c[i] * Tv[i][:, k * n:(k + 1) * n].T @ Tv[i][:, k * n:(k + 1) * n] for i in range(H + 1))
             expected[k * n:(k + 1) * n, k * n:(k + 1) * n] += [[np.sum(S_k * second[j][m]) for m in range(n)] for j in range(n)]
-        np.testing.assert_allclose(share, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+        np.testing.assert_allclose(share, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
         H_exact = np.asarray(exact(tau, p[:14]))
         assert np.linalg.norm(share - H_exact, 2) < 0.1 * np.linalg.norm(H_exact, 2)
 

@@ -33,7 +33,7 @@ from comanip.belief.propagation import belief_step_function, linearised_step_fun
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.planning.compiled import BufferedFunction, compiled
-from comanip.planning.curvature import _causal_gram, _noise_second_derivatives, _reward_derivatives_function
+from comanip.planning.curvature import _noise_second_derivatives, _reward_derivatives_function
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ArmTerms, Rollout
 
@@ -64,6 +64,10 @@ class LinearisedCurvature:
         self._terms = BufferedFunction(compiled(terms) if compile else terms)
         self._value = BufferedFunction(compiled(value) if compile else value)
         self._noise_hessian = _noise_second_derivatives(model)
+        # D[j, l, r, s] as a matrix ((r, s), (j, l)): <S, ∂²N/∂tau_j ∂tau_l> for every (j, l) is S.ravel() @ it
+        self._noise_hessian_matrix = self._noise_hessian.reshape(model.n ** 2, model.n ** 2).T.copy()
+        # Λ from d phi / d vech Sigma_x: an off-diagonal vech entry stands for Λ_ab and Λ_ba, each getting half
+        self._vech_weights = np.where(self._triangle[:, 0] == self._triangle[:, 1], 1.0, 0.5)
         # the speed cost's weights enter the compiled functions as an input, so every weight shares one build
         self._speed_weights = ((np.array([model.stop_weight, model.joint_velocity_weight]),)
                                if model.has_velocity_cost else ())
@@ -140,68 +144,67 @@ class LinearisedCurvature:
         """
         if data.sensitivities is not None:
             return data.sensitivities
-        model = self.model
-        n, H = model.n, model.H
-        A = data.A.reshape(2 * n, H, 2 * n).transpose(1, 0, 2)
-        B = data.B.reshape(2 * n, H, n).transpose(1, 0, 2)
-        T = np.zeros((H + 1, 2 * n, H, n))
-        for i in range(H):
-            T[i + 1, :, :i] = (A[i] @ T[i, :, :i].reshape(2 * n, -1)).reshape(2 * n, i, n)
-            T[i + 1, :, i] = B[i]
-        data.sensitivities = T
-        return T
+        n, H = self.model.n, self.model.H
+        A, B = _per_step(data.A, H), _per_step(data.B, H)
+        T = np.zeros((H + 1, 2 * n, H * n))
+        steps = np.arange(H)
+        T.reshape(H + 1, 2 * n, H, n)[steps + 1, :, steps] = B  # T_{k+1,k} = B_k
+        for i in range(1, H):  # T_{i+1,k} = A_i T_ik for k < i; the blocks k ≥ i+1 stay zero
+            np.matmul(A[i], T[i, :, :i * n], out=T[i + 1, :, :i * n])
+        data.sensitivities = T.reshape(H + 1, 2 * n, H, n)
+        return data.sensitivities
 
     def hessian(self, data: ArmTerms) -> np.ndarray:
         """Approximate ∇²f (H·n, H·n) from the data :meth:`evaluate` returned.
 
         The rows of step i are Z_i = [X_i T_i; N_i] with X_i = [J_i; d vech/dq_i] acting on the joint
-        sensitivities T_i and N_i the noise rows (:meth:`_noise_row_terms`). The part X_iᵀ Q_i X_i + W_i is a
-        cost on the state, so its sum over steps is condensed by a backward recursion
-        S_i = M_i + A_iᵀ S_{i+1} A_i with block (k, l ≥ k) = T_{l+1,k}ᵀ S_{l+1} B_l (O(H²) products of
-        (2n, n) blocks) in place of a Gram product over 16 rows per step; the noise rows and their cross terms
-        are contracted apart (4.1 → 2.7 ms per Hessian on the Panda, benchmarks/README.md).
+        sensitivities T_i and N_i the noise rows (:meth:`_noise_rows`). What acts on the mean path is condensed
+        by backward recursions along the linearised dynamics (:func:`_costs_to_go`) instead of summed as Gram
+        products over per-step rows:
+
+        - the state cost M_i = X_iᵀ Q_i X_i + W_i (and the speed cost's mean part, 2 c_i I on the velocities):
+          with S_i = M_i + A_iᵀ S_{i+1} A_i, block (k, l ≥ k) is T_{l+1,k}ᵀ S_{l+1} B_l (:func:`_condensed_upper`);
+        - the noise rows' cross terms N_iᵀ Q_cz,i X_i T_i: with P_i = [X_iᵀ Q_zc,i N_i; 0] + A_iᵀ P_{i+1},
+          column block l is P_{l+1}ᵀ B_l;
+        - the noise's own curvature, blockdiag_k ∇²_tau_k <S'_k, N(tau_k)> with S'_k = Σ_i G_ikᵀ Λ_i G_ik
+          (Λ_i = d phi_i / d Sigma_x,i) = B_kᵀ S'_{k+1} B_k, the cost-to-go of M'_i = J_iᵀ Λ_i J_i (and of the
+          speed cost's covariance part, c_i I on the velocities: Σ_i c_i tr Sigma_qdot,i).
+
+        The noise rows' Gram product Σ_i N_iᵀ Q_cc,i N_i is formed from their factored form
+        (:meth:`_noise_row_terms`).
         """
-        x, width, A, B, J, phi_hess, phi_grad, W, dvech = (data.x, data.width, data.A, data.B, data.J, data.phi_hess,
-                                                           data.phi_grad, data.kinematic_hessian, data.dvech)
         model = self.model
         n, d, H = model.n, model.d, model.H
-        nv, nz = len(self._triangle), phi_hess.shape[0]
-        a, b = self._triangle.T
-        tau = x.reshape(H, n)
-        J = J.reshape(d, H + 1, n).transpose(1, 0, 2)
-        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
-        W = W.reshape(n, H + 1, n).transpose(1, 0, 2)
-        dvech = dvech.reshape(nv, H + 1, n).transpose(1, 0, 2)
-        A = A.reshape(2 * n, H, 2 * n).transpose(1, 0, 2)
-        B = B.reshape(2 * n, H, n).transpose(1, 0, 2)
+        size = H * n
+        tau = data.x.reshape(H, n)
+        J, Q, W, dvech = (_per_step(v, H + 1) for v in (data.J, data.phi_hess, data.kinematic_hessian, data.dvech))
+        A, B = _per_step(data.A, H), _per_step(data.B, H)
         T = self.mean_sensitivities(data)
-        Tq = T[:, :n].reshape(H + 1, n, H * n)
         X = np.concatenate([J, dvech], axis=1)  # (H+1, nz, n): z_i's rows per joint position
-        # the state cost: M_i = X_iᵀ Q_i X_i + W_i on the joint positions, condensed backwards
         QX = Q @ X
-        S = np.zeros((H + 1, 2 * n, 2 * n))
-        S[:, :n, :n] = np.swapaxes(X, 1, 2) @ QX + W
-        speed = self._speed_weights_per_step()
-        if speed is not None:  # the speed cost's mean part, Σ_i c_i ||mu_qdot,i||²: 2 c_i I on the velocities
-            S[:, n:, n:] += 2 * speed[:, None, None] * np.eye(n)
-        for i in range(H - 1, 0, -1):
-            S[i] += A[i].T @ S[i + 1] @ A[i]
-        upper = (np.swapaxes(T[1:].reshape(H, 2 * n, H * n), 1, 2) @ (S[1:] @ B))  # (l, (k, r), s), zero for k > l
-        upper = upper.transpose(1, 0, 2).reshape(H * n, H * n)
-        hessian = upper + upper.T
-        diagonal = np.arange(H)
-        hessian.reshape(H, n, H, n)[diagonal, :, diagonal, :] *= 0.5
-        G = (J @ Tq).reshape(H + 1, d, H, n)
-        hessian += self._noise_row_terms(G, tau, Q[:, d:, d:], QX[:, d:] @ Tq)
-        # the noise's own curvature: Σ_i <Λ_i, G_ik ∂²N G_ikᵀ>, block-diagonal in k
+        rows, scale = self._noise_rows(J @ T[:, :n].reshape(H + 1, n, size), tau)
+        a, b = self._triangle.T
         Lambda = np.zeros((H + 1, d, d))
-        Lambda[:, a, b] = Lambda[:, b, a] = (phi_grad[d:] * np.where(a == b, 1.0, 0.5)[:, None]).T
-        weighted = np.einsum("iakr,iab,ibks->krs", G, Lambda, G, optimize=True)
-        if speed is not None:  # its covariance part Σ_i c_i tr Sigma_qdot,i = Σ_k <Σ_i c_i T_v,ikᵀ T_v,ik, N(tau_k)>
-            weighted += np.einsum("i,iakr,iaks->krs", speed, T[:, n:], T[:, n:], optimize=True)
-        blocks = np.einsum("krs,jlrs->kjl", weighted, self._noise_hessian)
-        hessian.reshape(H, n, H, n)[diagonal, :, diagonal, :] += blocks
-        hessian[np.diag_indices(H * n)] += 2 * model.nu / self.normaliser(width)
+        Lambda[:, a, b] = Lambda[:, b, a] = (data.phi_grad[d:] * self._vech_weights[:, None]).T
+        quadratic = np.zeros((H + 1, 2, 2 * n, 2 * n))  # per step: the state cost M_i and the noise's M'_i
+        quadratic[:, 0, :n, :n] = np.swapaxes(X, 1, 2) @ QX + W
+        quadratic[:, 1, :n, :n] = np.swapaxes(J, 1, 2) @ Lambda @ J
+        speed = self._speed_weights_per_step()
+        if speed is not None:
+            quadratic[:, 0, n:, n:] = 2 * speed[:, None, None] * np.eye(n)
+            quadratic[:, 1, n:, n:] = speed[:, None, None] * np.eye(n)
+        linear = np.zeros((H + 1, 2 * n, rows.shape[2]))
+        linear[:, :n] = np.swapaxes(QX[:, d:], 1, 2) @ rows
+        _costs_to_go(quadratic, linear, A)
+        SB = quadratic[1:] @ B[:, None]  # (H, 2, 2n, n): S_{l+1} B_l and S'_{l+1} B_l
+        cross = (np.swapaxes(linear[1:], 1, 2) @ B).transpose(1, 0, 2).reshape(-1, size)  # Σ_i N_iᵀ Q_cz,i X_i T_i
+        half = _condensed_upper(T, SB[:, 0])
+        half += self._noise_row_terms(rows, scale, Q[:, d:, d:], cross)
+        hessian = half + half.T
+        noise_curvature = (np.swapaxes(B, 1, 2) @ SB[:, 1]).reshape(H, n * n) @ self._noise_hessian_matrix
+        diagonal = np.arange(H)
+        hessian.reshape(H, n, H, n)[diagonal, :, diagonal, :] += noise_curvature.reshape(H, n, n)
+        hessian[np.diag_indices(size)] += 2 * model.nu / self.normaliser(data.width)
         return hessian
 
     def _speed_weights_per_step(self) -> np.ndarray | None:
@@ -224,15 +227,12 @@ class LinearisedCurvature:
         forming them. ∂f/∂g, ∂²f/∂g² and the mean rows' part of ∂²f/∂x∂g are exact; the covariance rows'
         part carries the Hessian's approximation (A_i, B_i held along the path).
         """
-        x, J, phi_hess, phi_grad, dvech = data.x, data.J, data.phi_hess, data.phi_grad, data.dvech
+        x, phi_grad = data.x, data.phi_grad
         model = self.model
         n, d, H = model.n, model.d, model.H
-        nv, nz = len(self._triangle), phi_hess.shape[0]
         a, b = self._triangle.T
-        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
+        J, Q, dvech = (_per_step(v, H + 1) for v in (data.J, data.phi_hess, data.dvech))
         c_mean, c_vech = -Q[:, :d, :d], -Q[:, d:, :d]  # ∂²phi_i/∂mu_x∂g (H+1, d, d), ∂²phi_i/∂vech∂g (H+1, nv, d)
-        J = J.reshape(d, H + 1, n).transpose(1, 0, 2)
-        dvech = dvech.reshape(nv, H + 1, n).transpose(1, 0, 2)
         Tq = self.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
         # mean rows J_i T_i and the rows of J(q_i)'s effect on Sigma_x, d vech/dq_i T_i, share T_i
         per_q = np.swapaxes(J, 1, 2) @ c_mean + np.swapaxes(dvech, 1, 2) @ c_vech  # (H+1, n, d)
@@ -249,30 +249,43 @@ class LinearisedCurvature:
         cross += (E @ S).reshape(H * n, d)
         return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
 
-    def _noise_row_terms(self, G: np.ndarray, tau: np.ndarray, Q_cc: np.ndarray, R: np.ndarray) -> np.ndarray:
-        """The Hessian's terms in the noise rows N_i = d vech Sigma_x,i / d tau through the noise injected at
-        each step (A, B held): Σ_i N_iᵀ Q_cc,i N_i + N_iᵀ R_i + R_iᵀ N_i, (H·n, H·n).
+    def _noise_rows(self, G: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
+        """The noise rows N_i = d vech Sigma_x,i / d tau through the noise injected at each step (A, B held), in
+        factored form (rows (H+1, nv, c), scale): N_i = rows_i (c = H·n) when scale is None, otherwise
+        N_i[:, (k, j)] = rows_i[:, k] scale[k, j] (c = H, scale (H, n)).
 
-        G (H+1, d, H, n); Q_cc (H+1, nv, nv) the reward's curvature in vech Sigma_x; R (H+1, nv, H·n) the
-        cross terms Q_cz X_i T_i. With E_kj = dN/dtau_j at tau_k, row (k, j) of N_i is vech(G_ik E_kj G_ikᵀ).
-        For isotropic noise E_kj = 2 kappa tau_kj I, so the row is 2 kappa tau_kj v_ik with
-        v_ik = vech(G_ik G_ikᵀ): the sums contract v (H+1, nv, H) instead of N (H+1, nv, H·n), n times
-        fewer columns.
+        G (H+1, d, H·n) = d mu_x,i / d tau, zero for k ≥ i. With E_kj = dN/dtau_j at tau_k, column (k, j) of N_i
+        is vech(G_ik E_kj G_ikᵀ). For isotropic noise E_kj = 2 kappa tau_kj I, so the column is
+        2 kappa tau_kj v_ik with v_ik = vech(G_ik G_ikᵀ): n times fewer columns.
         """
         a, b = self._triangle.T
         H, n = tau.shape
+        G = G.reshape(H + 1, -1, H, n)
         if self.model.noise == "isotropic":
-            v = np.einsum("iakj,ibkj->iabk", G, G, optimize=True)[:, a, b]  # (H+1, nv, H)
-            scaled = 2 * self.model.kappa * tau
-            s = np.einsum("iak,iab,ibl->kl", v, Q_cc, v, optimize=True)
-            Y = v.reshape(-1, H).T @ R.reshape(-1, H * n)  # Σ_i v_ikᵀ R_i (H, H·n)
-            cross = (scaled[:, :, None] * Y[:, None, :]).reshape(H * n, H * n)
-            terms = (s[:, None, :, None] * scaled[:, :, None, None] * scaled[None, None]).reshape(H * n, H * n)
-            return terms + cross + cross.T
+            v = np.empty((H + 1, len(a), H))
+            for entry, (r, c) in enumerate(self._triangle):  # one einsum per entry: 3× faster than all at once
+                np.einsum("ikj,ikj->ik", G[:, r], G[:, c], out=v[:, entry])
+            return v, 2 * self.model.kappa * tau
         E = np.einsum("jlrs,kl->kjrs", self._noise_hessian, tau)
-        N = np.einsum("iakr,kjrs,ibks->iabkj", G, E, G, optimize=True)[:, a, b].reshape(-1, H * n)
-        gram = _causal_gram(N, (Q_cc @ N.reshape(H + 1, -1, H * n) + 2 * R).reshape(-1, H * n), len(a), n)
-        return 0.5 * (gram + gram.T)
+        N = np.einsum("iakr,kjrs,ibks->iabkj", G, E, G, optimize=True)[:, a, b]
+        return N.reshape(H + 1, len(a), H * n), None
+
+    @staticmethod
+    def _noise_row_terms(rows: np.ndarray, scale: np.ndarray | None, Q_cc: np.ndarray, cross: np.ndarray) -> np.ndarray:
+        """P (H·n, H·n) with P + Pᵀ = Σ_i N_iᵀ Q_cc,i N_i + N_iᵀ R_i + R_iᵀ N_i, the Hessian's terms in the noise
+        rows N_i (:meth:`_noise_rows`' factored form: rows (H+1, nv, c), scale (H, n) or None).
+
+        Q_cc (H+1, nv, nv) the reward's curvature in vech Sigma_x; cross (c, H·n) = Σ_i rows_iᵀ R_i, R_i =
+        Q_cz,i X_i T_i the mean rows' cross terms. With scale, P = diag(scale) (cross + ½ s diag(scale)),
+        s = Σ_i rows_iᵀ Q_cc,i rows_i (c, c).
+        """
+        c = rows.shape[2]
+        gram = rows.reshape(-1, c).T @ (Q_cc @ rows).reshape(-1, c)
+        if scale is None:
+            return cross + 0.5 * gram
+        H, n = scale.shape
+        half = cross + 0.5 * (gram[:, :, None] * scale).reshape(H, H * n)
+        return (scale[:, :, None] * half[:, None, :]).reshape(H * n, H * n)
 
     def trajectory(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray]:
         """Mean (H+1, 2n) and covariance (H+1, 2n, 2n) of the evaluated torques."""
@@ -282,6 +295,41 @@ class LinearisedCurvature:
 
 _TERM_FIELDS = ("mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "kinematic_hessian", "dvech")
 """The per-solve function's outputs after (f, grad), in order, named as the fields of :class:`ArmTerms`."""
+
+
+def _per_step(stacked: np.ndarray, steps: int) -> np.ndarray:
+    """A CasADi output stacked horizontally per step (rows, steps·cols) as blocks (steps, rows, cols) (a view)."""
+    return stacked.reshape(stacked.shape[0], steps, -1).transpose(1, 0, 2)
+
+
+def _costs_to_go(quadratic: np.ndarray, linear: np.ndarray, A: np.ndarray) -> None:
+    """Quadratic and linear costs on the states summed backwards along the linearised dynamics, in place:
+    S_i = M_i + A_iᵀ S_{i+1} A_i and P_i = L_i + A_iᵀ P_{i+1} for i = H-1, ..., 1 (S_H = M_H, P_H = L_H; S_0 and
+    P_0 are left as they are).
+
+    quadratic M (H+1, m, 2n, 2n) (m costs at once); linear L (H+1, 2n, c) (c costs); A (H, 2n, 2n).
+    """
+    for i in range(len(A) - 1, 0, -1):
+        quadratic[i] += A[i].T @ quadratic[i + 1] @ A[i]
+        linear[i] += A[i].T @ linear[i + 1]
+
+
+def _condensed_upper(T: np.ndarray, SB: np.ndarray) -> np.ndarray:
+    """U (H·n, H·n) with U + Uᵀ = Σ_i T_iᵀ M_i T_i, the Hessian of the state cost ½ Σ_i δmu_iᵀ M_i δmu_i along the
+    linearised dynamics.
+
+    T (H+1, 2n, H, n) the sensitivities; SB (H, 2n, n) = S_{l+1} B_l with S the cost-to-go of M
+    (:func:`_costs_to_go`). U's block (k, l) is T_{l+1,k}ᵀ SB_l above the diagonal, half of it on the diagonal
+    (B_kᵀ S_{k+1} B_k) and zero below (T_{l+1,k} = 0 for k > l).
+    """
+    H, n2, n = SB.shape
+    T = T.reshape(H + 1, n2, H * n)
+    upper = np.zeros((H * n, H * n))
+    for l in range(H):
+        np.matmul(T[l + 1, :, :(l + 1) * n].T, SB[l], out=upper[:(l + 1) * n, l * n:(l + 1) * n])
+    diagonal = np.arange(H)
+    upper.reshape(H, n, H, n)[diagonal, :, diagonal, :] *= 0.5
+    return upper
 
 
 def _stage_cost_function(model) -> ca.Function:

@@ -73,7 +73,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
 
     Args:
         evaluate: x (N,) -> (f, grad f (N,), data); ``data`` is handed to ``hessian`` and ``constraints``.
-        hessian: data -> ∇²f (N, N), symmetric.
+        hessian: data -> ∇²f (N, N), symmetric, a new array (with ``secant`` the solver adds its corrections to it
+            in place).
         x0: start (N,), projected onto the box; lb, ub: bounds (N,), ±inf allowed.
         tolerance: on max |gradient of the Lagrangian|.
         max_iterations: iterations allowed (each evaluates the Hessian, except a last one that only finds the
@@ -158,7 +159,7 @@ class _ActiveSetNewton:
                 correction = np.zeros_like(hessian) if correction is None else correction
                 if previous is not None:
                     _symmetric_rank_one_update(correction, hessian, point.x - previous[0], point.g - previous[1])
-                hessian = hessian + correction
+                hessian += correction  # in place: the array is this iteration's own (see ``hessian`` above)
                 previous = (point.x, point.g)
             # after a failed line search, a stronger shift turns the step towards steepest descent
             least = _RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
@@ -340,8 +341,9 @@ def _constrained_step(factor, g, c, A, margin: float, tolerance: float):
 
 def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> None:
     """correction += r rᵀ / (rᵀ s), r = y - (H + correction) s, in place; skipped when rᵀ s is tiny
-    (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|)."""
-    r = y - (H + correction) @ s
+    (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|). correction and H (N, N), s and y (N,)."""
+    r = y - H @ s - correction @ s
     denominator = r @ s
     if abs(denominator) > 1e-8 * np.linalg.norm(r) * np.linalg.norm(s):
-        correction += np.outer(r, r) / denominator
+        u = r / np.sqrt(abs(denominator))  # u_i u_j = u_j u_i: the correction stays exactly symmetric
+        correction += np.outer(u, np.sign(denominator) * u)
