@@ -9,7 +9,8 @@ import pytest
 import scipy.optimize
 
 import comanip
-from comanip.planning.compiled import BufferedFunction, compiled
+from comanip.planning import compiled as compiled_module
+from comanip.planning.compiled import BufferedFunction, compile_in_background, compiled
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.planner import Planner, SolverOptions
@@ -136,9 +137,61 @@ def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(t
     np.testing.assert_allclose(BufferedFunction(fallback)(np.ones(3))[0].ravel(), np.cos(np.ones(3)))
 
 
+def test_background_compile_skips_a_collected_owner_and_builds_for_a_live_one(tmp_path, monkeypatch):
+    monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
+    x = ca.SX.sym("x", 2)
+
+    class Owner:
+        function = ca.Function("background_test", [x], [ca.exp(x) * x[0]])
+
+    kept, dropped = Owner(), Owner()
+    with compiled_module._BACKGROUND:  # as if another build were running: both wait their turn
+        gone = compile_in_background(dropped, lambda owner: owner.function)
+        built = compile_in_background(kept, lambda owner: owner.function)
+        del dropped  # collected before its turn
+    assert gone.result(timeout=120) is None
+    point = np.array([0.5, -2.0])
+    np.testing.assert_array_equal(np.asarray(built.result(timeout=120)(point)), np.asarray(Owner.function(point)))
+    assert len(list(tmp_path.glob("background_test_*.so"))) == 1
+
+
+def test_a_compiler_running_at_exit_is_stopped_and_its_scratch_removed(tmp_path):
+    import subprocess
+
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    process = subprocess.Popen(["sleep", "60"])
+    compiled_module._RUNNING[process] = str(scratch)
+    try:
+        compiled_module._stop_running_builds()
+    finally:
+        compiled_module._RUNNING.pop(process, None)
+    assert process.poll() is not None and not scratch.exists()
+
+
+def test_a_point_mass_planner_compiles_in_the_background_after_its_solving_time(tmp_path, monkeypatch):
+    """Past ``compile_after`` seconds of solving the planner's terms switch to C, with the same plans."""
+    monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
+    model = comanip.presets.planar().replace(H=12)
+    planner = Planner(model, SolverOptions(compile_after=1e-6))
+    never = Planner(model, SolverOptions(compile=False))
+    start, goal = np.zeros(4), np.array([0.25, 0.05])
+    first = planner.solve(start, goal, 0.02)
+    curvature = planner.curvature
+    assert curvature._compiling is not None  # started by the first solve
+    curvature._compiling.result(timeout=120)
+    again = planner.solve(start, goal, 0.02)
+    assert curvature._compiling is None and curvature._terms.function.class_name() != "SXFunction"
+    reference = never.solve(start, goal, 0.02)
+    np.testing.assert_allclose(again.torque, reference.torque, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(first.torque, reference.torque, rtol=0, atol=1e-12)
+    assert never.curvature._compiling is None  # compile=False never compiles
+
+
 @pytest.mark.parametrize("kwargs, word", [(dict(method="lbfgs"), "method"), (dict(tolerance=0.0), "tolerance"),
                                           (dict(max_iterations=0), "max_iterations"), (dict(n_starts=1.5), "n_starts"),
-                                          (dict(cold_search="best"), "cold_search"), (dict(narrow_ratio=0.0), "narrow_ratio")])
+                                          (dict(cold_search="best"), "cold_search"), (dict(narrow_ratio=0.0), "narrow_ratio"),
+                                          (dict(compile_after=-1.0), "compile_after")])
 def test_bad_solver_options_name_the_field(kwargs, word):
     with pytest.raises(ValueError, match=word):
         SolverOptions(**kwargs)

@@ -11,17 +11,29 @@ library; stale files are simply never looked up again. The folder is ``$COMANIP_
 ``$XDG_CACHE_HOME/comanip`` or ``~/.cache/comanip``. Without a working C compiler (``$CC``, default
 ``gcc``) the uncompiled function is returned with a warning: same numbers, slower. Each compile shows a
 progress line with its elapsed time (:mod:`comanip.progress`).
+
+:func:`compile_in_background` builds one in a daemon thread while the caller goes on with the uncompiled
+function (CasADi evaluates it meanwhile, measured at the same speed on the Cartesian terms; compiled and
+uncompiled give identical numbers). Background builds run one at a time, a build whose owner has been
+garbage-collected before it started is skipped, and a compiler still running when Python exits is stopped
+and its scratch folder removed.
 """
 
 from __future__ import annotations
 
+import atexit
 import hashlib
 import os
 import shlex
+import shutil
 import subprocess
 import tempfile
+import threading
 import warnings
+import weakref
+from concurrent.futures import Future
 from pathlib import Path
+from typing import Callable
 
 import casadi as ca
 import numpy as np
@@ -66,6 +78,34 @@ def compiled(function: ca.Function) -> ca.Function:
     return ca.external(name, str(library))
 
 
+_BACKGROUND = threading.Lock()
+"""Held by the background build in progress: they run one at a time (each compiler takes a core)."""
+_RUNNING: dict[subprocess.Popen, str] = {}
+"""Compiler processes in progress and their scratch folders, stopped and removed at exit."""
+
+
+def compile_in_background(owner: object, function_of: Callable[[object], ca.Function]) -> Future:
+    """Start ``compiled(function_of(owner))`` in a daemon thread; the future's result is the compiled function.
+
+    Only a weak reference to ``owner`` is kept: if it is garbage-collected before its turn comes (builds run
+    one at a time), the build is skipped and the future holds None. A failed build (no compiler) gives the
+    uncompiled function with a warning, as :func:`compiled` does.
+    """
+    future: Future = Future()
+    reference = weakref.ref(owner)
+
+    def build():
+        with _BACKGROUND:
+            try:
+                owner = reference()
+                future.set_result(None if owner is None else compiled(function_of(owner)))
+            except BaseException as error:  # handed to the caller through the future
+                future.set_exception(error)
+
+    threading.Thread(target=build, name="comanip-compile", daemon=True).start()
+    return future
+
+
 def _build(source: str, compiler: list[str], library: Path) -> None:
     """Compile C source into ``library``, atomically (a concurrent build of the same key is harmless)."""
     library.parent.mkdir(parents=True, exist_ok=True)
@@ -73,9 +113,26 @@ def _build(source: str, compiler: list[str], library: Path) -> None:
         c_file = Path(scratch) / f"{library.stem}.c"
         c_file.write_text(source)
         built = Path(scratch) / library.name
-        subprocess.run([*compiler, *COMPILE_FLAGS, str(c_file), "-o", str(built), "-lm"],
-                       check=True, capture_output=True, text=True)
+        process = subprocess.Popen([*compiler, *COMPILE_FLAGS, str(c_file), "-o", str(built), "-lm"],
+                                   stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        _RUNNING[process] = scratch
+        try:
+            output, errors = process.communicate()
+        finally:
+            _RUNNING.pop(process, None)
+        if process.returncode != 0:
+            raise subprocess.CalledProcessError(process.returncode, process.args, output, errors)
         os.replace(built, library)
+
+
+@atexit.register
+def _stop_running_builds() -> None:
+    """Stop compilers still running at exit (a background build's daemon thread dies with Python and would
+    leave its compiler and scratch folder behind)."""
+    for process, scratch in list(_RUNNING.items()):
+        process.kill()
+        process.wait()
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 class BufferedFunction:

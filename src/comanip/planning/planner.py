@@ -102,9 +102,15 @@ class SolverOptions:
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
     """Compile the Newton method's per-solve function to C (cached on disk, see comanip.planning.compiled).
-    None: only for nonlinear bodies, where CasADi's virtual machine is ten times slower (a first build takes
-    about a minute for the Panda); a point mass's function runs fast enough uncompiled (benchmarks/README.md)
-    and compiling costs seconds for every new model."""
+    True: when the planner is built. False: never. None: when built for nonlinear bodies, where CasADi's
+    virtual machine is ten times slower (a first build takes about a minute for the Panda); for a point mass,
+    in a background thread once the planner has spent ``compile_after`` seconds solving, its solves going on
+    uncompiled meanwhile: compiling costs 3–17 s for every new model, which short-lived planners (a fit's,
+    one per parameter set) would not win back, while a long-lived one (a control loop, a sweep) solves
+    about a third faster afterwards (benchmarks/README.md)."""
+    compile_after: float = 2.0
+    """Seconds of solving (the sum of ``plan.solve_time``) after which a point-mass planner with ``compile=None``
+    compiles its per-solve function in the background."""
 
     def __post_init__(self):
         if self.method not in SOLVER_METHODS:
@@ -114,6 +120,7 @@ class SolverOptions:
             as_count(name, getattr(self, name))
         as_positive("far_warm_start", self.far_warm_start, "goal widths")
         as_positive("narrow_ratio", self.narrow_ratio, "reach distance over goal width")
+        as_positive("compile_after", self.compile_after, "s of solving")
         if self.cold_search not in COLD_SEARCHES:
             raise ValueError(f"cold_search must be one of {COLD_SEARCHES}, got {self.cold_search!r}")
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
@@ -154,6 +161,7 @@ class Planner:
         self._library = self._reach_library()
         ranked_arm = self.options.cold_search == "ranked" and not body.is_linear
         self._arm_library = self._arm_reach_library() if ranked_arm else None
+        self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
 
     def _arm_reach_library(self) -> ArmReachLibrary | None:
         """The arm's reach library: ``options.arm_library`` (it must be this model's) or the shipped one."""
@@ -243,8 +251,19 @@ class Planner:
         guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
                                         goal_q=goal_q if warm_start is None else None)
         from_library = warm_start is None and self._arm_library is not None and self._arm_library.starts_at(start)
-        return with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
+        plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
                                                  until_converged=from_library))
+        self._count_solving_time(plan.solve_time)
+        return plan
+
+    def _count_solving_time(self, seconds: float) -> None:
+        """Add a solve's time; past ``compile_after`` seconds, start the point mass's background compile."""
+        if self._solving_time is None:
+            return
+        self._solving_time += seconds
+        if self._solving_time >= self.options.compile_after:
+            self._curvature.compile_in_background()
+            self._solving_time = None
 
     def _goal_joints(self, start, goal, warm_start) -> np.ndarray:
         """An arm's joint position (n,) nearest the goal, by inverse kinematics from the warm start's final
