@@ -95,3 +95,27 @@ def test_a_budgeted_cold_solve_does_not_solve_a_new_library_reach():
     plan = planner.solve(start, goal, 0.02)
     assert plan.success and len(planner._library._entries) == 1
     np.testing.assert_allclose(budgeted.objective, plan.objective, rtol=RELATIVE)
+
+
+@pytest.mark.parametrize("preset", ["planar", "cartesian", "human"])
+def test_a_retargeted_plan_moves_its_mean_path_by_the_shift(preset):
+    """A point mass's mean is affine in the torques: a plan retargeted by a move of ≥ 12 steps ends moved by
+    the joint shift to within 4 % (the move's acceleration is sampled once per step), for a bare point mass;
+    retargeting for several durations at once equals retargeting for each alone."""
+    from comanip.planning.initial_guess import retargeted_torques
+
+    model = comanip.presets.load(preset)
+    planner = comanip.Planner(model)
+    start = model.full_state(np.zeros(2 * model.n))
+    goal = np.full(model.d, 0.2)
+    plan = planner.solve(start, goal, model.width)
+    shift = np.linspace(0.03, -0.02, model.n)
+    durations = np.array([12, 20, 0.75 * model.H]) * model.h
+    moved = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, durations)
+    for T, torque in zip(durations, moved):
+        alone = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, [T])[0]
+        np.testing.assert_allclose(torque, alone, rtol=1e-12, atol=1e-12)
+        if not model.activation:  # activation stages lag the move (an initial guess tolerates it)
+            trajectory = planner.problem.trajectory(tau=np.ravel(torque), s0=start, goal=goal, width=model.width)
+            end = np.asarray(trajectory["ee_mean"])[:, -1]
+            np.testing.assert_allclose(end - plan.ee_mean[-1], shift, atol=0.04 * np.abs(shift).max())

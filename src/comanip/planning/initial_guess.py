@@ -76,15 +76,13 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
     else:
         inertia = np.asarray(body.mass_matrix_function.map(H)(mean[:H, : body.n].T)).reshape(body.n, H, body.n).transpose(1, 0, 2)
     push = inertia @ shift_q  # (H, n)
-    t = h * np.arange(H)
-    results = []
-    for T in durations:
-        s = np.clip(t / T, 0.0, 1.0)
-        # x(t) = shift_q (10 s³ - 15 s⁴ + 6 s⁵): Flash–Hogan from rest to rest
-        speed = (30 * s**2 - 60 * s**3 + 30 * s**4) / T
-        acceleration = (60 * s - 180 * s**2 + 120 * s**3) / T**2
-        results.append(torque + body.command_for_force(acceleration[:, None] * push + np.outer(speed, body.damping @ shift_q), h))
-    return results
+    T = np.asarray(durations, dtype=float)[:, None]
+    s = np.clip(h * np.arange(H) / T, 0.0, 1.0)  # (durations, H)
+    # x(t) = shift_q (10 s³ - 15 s⁴ + 6 s⁵): Flash–Hogan from rest to rest, all durations at once
+    speed = 30 * s**2 * (1 - s) ** 2 / T
+    acceleration = 60 * s * (1 - s) * (1 - 2 * s) / T**2
+    forces = acceleration[:, :, None] * push + speed[:, :, None] * (body.damping @ shift_q)
+    return [torque + body.command_for_force(force, h) for force in forces]
 
 
 def guess_durations(horizon_s: float, count: int) -> np.ndarray:

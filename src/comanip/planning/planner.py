@@ -156,6 +156,9 @@ class Planner:
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
         self._linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
+        # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
+        self._task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
+            if body.is_linear else None
         self._blas = ThreadpoolController()
         self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
         self._library = self._reach_library()
@@ -313,8 +316,11 @@ class Planner:
         """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
         minimum-jerk corrections of four durations (:func:`retargeted_torques`, along its mean (H+1, nx))."""
         model, body = self.model, self.model.body
-        J = np.asarray(body.kinematics_function(mean[-1, : model.n])[1])
-        shift_q = np.linalg.lstsq(J, goal - planned_goal, rcond=None)[0]
+        if self._linear_dynamics is not None:  # x_ee linear in q: one constant pseudo-inverse
+            shift_q = self._task_to_joint_shift @ (goal - planned_goal)
+        else:
+            J = np.asarray(body.kinematics_function(mean[-1, : model.n])[1])
+            shift_q = np.linalg.lstsq(J, goal - planned_goal, rcond=None)[0]
         return [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q, guess_durations(model.duration, 4),
                                              mean, self._linear_dynamics)
 
