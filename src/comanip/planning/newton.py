@@ -28,6 +28,11 @@ of :mod:`comanip.optim`.
   the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (hessian + C) s, y the change of gradient, and
   hessian + C is used in its place. It learns the curvature the approximation misses along the directions
   the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md).
+- Chord steps (exact Hessians, ``secant=False``): while no constraint is in the working set and the last step
+  cut max |∇f| at least tenfold, the next step reuses that step's factorisation instead of evaluating and
+  factoring a new Hessian (Kelley 2003, sec. 5.4: the chord method); a step that cuts it less, or fails the
+  line search, brings a fresh Hessian back. On warm point-mass solves it saves one Hessian and factorisation
+  of about four, for one more cheap iteration (benchmarks/README.md); the optimum is the same (J to ~1e-11).
 - Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
   the violated constraints' linearisation is taken if it halves the violation.
 - Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
@@ -60,6 +65,8 @@ _RECOVERIES, _RECOVERY_SHIFT = 3, 1e-3
 """Attempts after a failed line search, and the least relative shift delta of the first (ten times more each after)."""
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
+_REUSE_RATIO = 0.1
+"""An exact Hessian's factor is reused while each step cuts the gradient by at least this factor."""
 
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
@@ -135,6 +142,7 @@ class _ActiveSetNewton:
         correction, previous = None, None  # secant correction; (x, g) before the last step
         recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
         history = [point.f]
+        kept = None  # an exact Hessian's factor and the optimality where the last step was taken (see _reusable)
 
         def result(status, message, optimality):
             return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c))
@@ -145,13 +153,25 @@ class _ActiveSetNewton:
             if expired():
                 return result(Status.MAX_WALL_TIME, "wall-time budget spent", np.inf)
             iterations += 1
-            if not np.any(point.c > -self.margin):
+            free = not np.any(point.c > -self.margin)
+            if free:
                 # no constraint in the working set: the Lagrangian's gradient is the gradient, and a converged
                 # point needs no Hessian (a warm point-mass solve's last of about five)
                 optimality = float(np.max(np.abs(point.g)))
                 converged = self._converged(optimality, point, history)
                 if converged is not None:
                     return result(*converged, optimality)
+                if not secant and recoveries == 0 and kept is not None and optimality <= _REUSE_RATIO * kept[1]:
+                    # the last step cut the gradient tenfold: the factor it used still models the curvature
+                    # well enough (a chord step, Kelley 2003, sec. 5.4), at a third of a point mass's iteration
+                    step = -scipy.linalg.cho_solve(kept[0], point.g, check_finite=False)
+                    kept = (kept[0], optimality)
+                    accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight)
+                    if accepted is not None:
+                        point = accepted
+                        history.append(point.f)
+                        continue
+            kept = None
             hessian = self.hessian(point.data)
             if not np.all(np.isfinite(hessian)):
                 return result(Status.FAILED, "Hessian not finite", np.inf)
@@ -173,6 +193,8 @@ class _ActiveSetNewton:
             converged = self._converged(optimality, point, history)
             if converged is not None:
                 return result(*converged, optimality)
+            if free and not secant and len(working) == 0:
+                kept = (factor, optimality)
             merit_weight = max(merit_weight, 2 * float(np.max(multipliers, initial=0.0)))
             accepted = self._line_search(point, step, working, correct, merit_weight)
             if accepted is None and self.problem.violation(point.c) > self.constraint_tolerance:
