@@ -164,7 +164,8 @@ class BufferedFunction:
 
     def __call__(self, *args) -> list[np.ndarray]:
         for array, value in zip(self._inputs, args):
-            array[:] = np.ravel(value, order="F")
+            # vectors and scalars as they are (np.ravel costs more than the copy); matrices column by column
+            array[:] = value.ravel(order="F") if getattr(value, "ndim", 0) > 1 else value
         self._evaluate()
         if self._buffer.ret() != 0:
             raise RuntimeError(f"evaluating {self.function.name()} failed")

@@ -295,7 +295,7 @@ def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int, chun
     size = Z.shape[1]
     steps = Z.shape[0] // rows_per_step
     out = np.zeros((size, size))
-    bounds = np.linspace(0, steps, chunks + 1).astype(int)
+    bounds = [steps * k // chunks for k in range(chunks + 1)]
     for lo, hi in zip(bounds[:-1], bounds[1:]):
         cols = min(size, n * (hi - 1))
         if cols > 0:

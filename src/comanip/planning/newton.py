@@ -189,7 +189,8 @@ class _ActiveSetNewton:
             shift_last = shift if shift > 0 else shift_last
             step, multipliers, working, correct = _constrained_step(factor, point.g, point.c, point.rows, self.margin,
                                                                     self.constraint_tolerance)
-            optimality = float(np.max(np.abs(point.g + point.rows(working).T @ multipliers)))
+            lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
+            optimality = float(np.max(np.abs(lagrangian_gradient)))
             converged = self._converged(optimality, point, history)
             if converged is not None:
                 return result(*converged, optimality)
