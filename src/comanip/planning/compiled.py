@@ -84,8 +84,9 @@ _RUNNING: dict[subprocess.Popen, str] = {}
 """Compiler processes in progress and their scratch folders, stopped and removed at exit."""
 
 
-def compile_in_background(owner: object, function_of: Callable[[object], ca.Function]) -> Future:
-    """Start ``compiled(function_of(owner))`` in a daemon thread; the future's result is the compiled function.
+def compile_in_background(owner: object, functions_of: Callable[[object], list[ca.Function]]) -> Future:
+    """Start compiling ``functions_of(owner)`` in a daemon thread; the future's result is the list of compiled
+    functions (:func:`compiled` of each, in order).
 
     Only a weak reference to ``owner`` is kept: if it is garbage-collected before its turn comes (builds run
     one at a time), the build is skipped and the future holds None. A failed build (no compiler) gives the
@@ -98,7 +99,7 @@ def compile_in_background(owner: object, function_of: Callable[[object], ca.Func
         with _BACKGROUND:
             try:
                 owner = reference()
-                future.set_result(None if owner is None else compiled(function_of(owner)))
+                future.set_result(None if owner is None else [compiled(f) for f in functions_of(owner)])
             except BaseException as error:  # handed to the caller through the future
                 future.set_exception(error)
 
