@@ -6,12 +6,13 @@ from __future__ import annotations
 from typing import Iterable, Iterator
 
 import numpy as np
-import scipy.linalg
+from scipy.linalg.lapack import dpotrf as _potrf, dpotrs as _potrs
 
 
 def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple | None, float]:
-    """(scipy Cholesky factor of matrix + delta·s·I, delta) for the first relative shift delta in ``shifts``
-    that gives a positive definite matrix, s = max |diag matrix| (so delta is relative); (None, nan) if none.
+    """(Cholesky factor of matrix + delta·s·I as scipy.linalg.cho_factor gives it, delta) for the first relative
+    shift delta in ``shifts`` that gives a positive definite matrix, s = max |diag matrix| (so delta is
+    relative); (None, nan) if none. Solve with the factor by :func:`cholesky_solve`.
 
     ``matrix`` (N, N) is read as symmetric (its upper triangle); delta = 0 factors it as it is.
     """
@@ -26,11 +27,22 @@ def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple
                 shifted = matrix.copy()
             np.fill_diagonal(shifted, diagonal + delta * scale)
             candidate = shifted
-        try:
-            return scipy.linalg.cho_factor(candidate, check_finite=False), delta
-        except scipy.linalg.LinAlgError:
-            continue
+        # LAPACK directly: scipy.linalg.cho_factor's checks and wrappers cost as much as factoring a point
+        # mass's 60 x 60 Hessian
+        factor, info = _potrf(candidate, lower=False, clean=False, overwrite_a=False)
+        if info == 0:
+            return (factor, False), delta
+        if info < 0:
+            raise ValueError(f"LAPACK potrf rejected argument {-info} (matrix {matrix.shape})")
     return None, np.nan
+
+
+def cholesky_solve(factor: tuple, b: np.ndarray) -> np.ndarray:
+    """x with (R^T R) x = b for a factor (R, lower) from :func:`shifted_cholesky`; b (N,) or (N, k)."""
+    x, info = _potrs(factor[0], b, lower=factor[1])
+    if info != 0:
+        raise ValueError(f"LAPACK potrs rejected argument {-info} (factor {factor[0].shape}, right-hand side {np.shape(b)})")
+    return x
 
 
 def growing_shifts(last: float, least: float = 0.0) -> Iterator[float]:

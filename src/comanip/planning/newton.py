@@ -55,9 +55,8 @@ from dataclasses import dataclass
 from typing import Any, Callable
 
 import numpy as np
-import scipy.linalg
 
-from comanip.optim import SolverResult, Status, backtrack, growing_shifts, shifted_cholesky
+from comanip.optim import SolverResult, Status, backtrack, cholesky_solve, growing_shifts, shifted_cholesky
 
 _BACKTRACKS = 30
 """Step lengths tried by one line search."""
@@ -164,7 +163,7 @@ class _ActiveSetNewton:
                 if not secant and recoveries == 0 and kept is not None and optimality <= _REUSE_RATIO * kept[1]:
                     # the last step cut the gradient tenfold: the factor it used still models the curvature
                     # well enough (a chord step, Kelley 2003, sec. 5.4), at a third of a point mass's iteration
-                    step = -scipy.linalg.cho_solve(kept[0], point.g, check_finite=False)
+                    step = -cholesky_solve(kept[0], point.g)
                     kept = (kept[0], optimality)
                     accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight)
                     if accepted is not None:
@@ -343,11 +342,11 @@ def _constrained_step(factor, g, c, A, margin: float, tolerance: float):
     the solve stalled with a large Lagrangian gradient.) Returns (step,
     multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
     """
-    Hg = scipy.linalg.cho_solve(factor, g, check_finite=False)
+    Hg = cholesky_solve(factor, g)
     working = np.flatnonzero(c > -margin)
     while len(working):
         rows = A(working)
-        HA = scipy.linalg.cho_solve(factor, rows.T, check_finite=False)
+        HA = cholesky_solve(factor, rows.T)
         schur = rows @ HA
         multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
         dropping = (multipliers < 0) & (c[working] <= tolerance)
