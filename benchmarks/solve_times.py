@@ -74,7 +74,8 @@ def reach_case(preset: str, paper_time: float, options: SolverOptions | None = N
     return make
 
 
-def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4), moving: bool = False) -> Callable[[], Case]:
+def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4), moving: bool = False,
+              options: SolverOptions | None = None, label: str = "") -> Callable[[], Case]:
     """Cold solves (no warm start) from the home position to goals ``distances`` (m; 0.1–0.4 m) away in
     uniformly drawn directions, a new goal each time (a user's first plan for a goal), at the model's width;
     from rest, or (``moving``) with start velocities uniform in ±0.3 m/s per axis. The planner is fresh: its
@@ -82,7 +83,7 @@ def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4)
 
     def make() -> Case:
         model = comanip.presets.load(preset)
-        planner, build = timed(lambda: comanip.Planner(model))
+        planner, build = timed(lambda: comanip.Planner(model, options))
         rng = np.random.default_rng(1)
         home = model.body.home_position
         start = np.concatenate([home, np.zeros(model.n)])
@@ -96,8 +97,8 @@ def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4)
             plan = planner.solve(np.r_[start[: model.n], velocity], goal, model.width)
             return plan.solve_time, plan.success
 
-        label = "cold, moving start" if moving else "cold"
-        return Case(f"{preset} {label} (H={model.H}, n={model.n})", build, solve, paper_time)
+        kind = "cold, moving start" if moving else "cold"
+        return Case(f"{preset} {kind} (H={model.H}, n={model.n}){label}", build, solve, paper_time)
 
     return make
 
@@ -222,6 +223,8 @@ CASES: dict[str, Callable[[], Case]] = {
     "cartesian": reach_case("cartesian", 0.20),
     "planar_compiled": reach_case("planar", 0.04, SolverOptions(compile=True), " compiled"),
     "cartesian_compiled": reach_case("cartesian", 0.20, SolverOptions(compile=True), " compiled"),
+    "planar_cold_compiled": cold_case("planar", 0.04, options=SolverOptions(compile=True), label=" compiled"),
+    "cartesian_cold_compiled": cold_case("cartesian", 0.20, options=SolverOptions(compile=True), label=" compiled"),
     "planar_ipopt": reach_case("planar", 0.04, SolverOptions(method="ipopt"), " IPOPT"),
     "cartesian_ipopt": reach_case("cartesian", 0.20, SolverOptions(method="ipopt"), " IPOPT"),
     "franka": reach_case("franka", 1.3, reach=(0.15, 0.1, -0.1)),

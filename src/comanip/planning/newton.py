@@ -152,11 +152,11 @@ class _ActiveSetNewton:
             if expired():
                 return result(Status.MAX_WALL_TIME, "wall-time budget spent", np.inf)
             iterations += 1
-            free = not np.any(point.c > -self.margin)
+            free = not (point.c > -self.margin).any()
             if free:
                 # no constraint in the working set: the Lagrangian's gradient is the gradient, and a converged
                 # point needs no Hessian (a warm point-mass solve's last of about five)
-                optimality = float(np.max(np.abs(point.g)))
+                optimality = float(np.abs(point.g).max())
                 converged = self._converged(optimality, point, history)
                 if converged is not None:
                     return result(*converged, optimality)
@@ -172,7 +172,7 @@ class _ActiveSetNewton:
                         continue
             kept = None
             hessian = self.hessian(point.data)
-            if not np.all(np.isfinite(hessian)):
+            if not np.isfinite(hessian).all():
                 return result(Status.FAILED, "Hessian not finite", np.inf)
             if secant:
                 correction = np.zeros_like(hessian) if correction is None else correction
@@ -189,7 +189,7 @@ class _ActiveSetNewton:
             step, multipliers, working, correct = _constrained_step(factor, point.g, point.c, point.rows, self.margin,
                                                                     self.constraint_tolerance)
             lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
-            optimality = float(np.max(np.abs(lagrangian_gradient)))
+            optimality = float(np.abs(lagrangian_gradient).max())
             converged = self._converged(optimality, point, history)
             if converged is not None:
                 return result(*converged, optimality)
@@ -236,7 +236,7 @@ class _ActiveSetNewton:
     def _penalty(self, c: np.ndarray) -> float:
         """The merit's l1 violation, counted from half the tolerance: violations the solution may keep cost
         nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
-        return float(np.sum(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0)))
+        return float(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct, merit_weight: float) -> _Iterate | None:
         """The accepted point along ``step`` (Armijo on the l1 merit, with second-order corrections), or None."""
@@ -290,7 +290,7 @@ class _ActiveSetNewton:
 
 
 def _finite(f: float, g: np.ndarray | None) -> bool:
-    return bool(np.isfinite(f)) and (g is None or bool(np.all(np.isfinite(g))))
+    return bool(np.isfinite(f)) and (g is None or bool(np.isfinite(g).all()))
 
 
 class _Constraints:
@@ -301,9 +301,13 @@ class _Constraints:
         self.upper = np.flatnonzero(np.isfinite(ub))
         self.lower = np.flatnonzero(np.isfinite(lb))
         self.lb, self.ub, self.size = lb, ub, len(lb)
+        self.all_finite = len(self.upper) == len(self.lower) == self.size
 
     def __call__(self, x, data):
-        bounds = np.concatenate([x[self.upper] - self.ub[self.upper], self.lb[self.lower] - x[self.lower]])
+        if self.all_finite:  # the usual case (torque bounds): no index arrays to gather through
+            bounds = np.concatenate([x - self.ub, self.lb - x])
+        else:
+            bounds = np.concatenate([x[self.upper] - self.ub[self.upper], self.lb[self.lower] - x[self.lower]])
         if self.constraints is None:
             return bounds, self._bound_rows
         c_user, user_rows = self.constraints(x, data)
@@ -329,7 +333,7 @@ class _Constraints:
 
     @staticmethod
     def violation(c) -> float:
-        return float(max(0.0, np.max(c, initial=0.0)))
+        return float(max(0.0, c.max(initial=0.0)))
 
 
 def _constrained_step(factor, g, c, A, margin: float, tolerance: float):
