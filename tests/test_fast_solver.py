@@ -232,6 +232,11 @@ def test_a_point_mass_planner_compiles_in_the_background_after_its_solving_time(
     np.testing.assert_allclose(again.torque, reference.torque, rtol=0, atol=1e-12)
     np.testing.assert_allclose(first.torque, reference.torque, rtol=0, atol=1e-12)
     assert never.curvature._compiling is None  # compile=False never compiles
+    # a later planner for the same model loads the build from the cache at once; another model does not
+    kinds = {options: [Planner(changed, SolverOptions(compile=options)).curvature._terms.function.class_name()
+                       for changed in (model, model.replace(nu=2 * model.nu))] for options in (None, False)}
+    assert kinds == {None: ["External", "SXFunction"], False: ["SXFunction", "SXFunction"]}
+    assert Planner(model).curvature._value.function.class_name() == "External"
 
 
 @pytest.mark.parametrize("kwargs, word", [(dict(method="lbfgs"), "method"), (dict(tolerance=0.0), "tolerance"),

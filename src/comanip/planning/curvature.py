@@ -32,7 +32,8 @@ import numpy as np
 from comanip.belief.noise import noise_covariance
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
-from comanip.planning.compiled import BufferedFunction, compile_in_background, compiled
+from comanip.model import model_key
+from comanip.planning.compiled import BufferedFunction, cached_compiled, compile_in_background, compiled
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ReachTerms
 
@@ -45,9 +46,10 @@ class ReachCurvature:
 
     Args:
         problem: the model's :class:`ReachProblem`.
-        compile: build the per-solve function as C (:mod:`comanip.planning.compiled`): about a third
-            faster per solve, at a few seconds' build per new model; otherwise CasADi's virtual machine
-            until :meth:`compile_in_background` has built it.
+        compile: True: build the per-solve functions as C (:mod:`comanip.planning.compiled`): about a third
+            faster per solve, at a few seconds' build per new model. None: load them if an earlier build for
+            this model is in the disk cache, else run CasADi's virtual machine until
+            :meth:`compile_in_background` has built them. False: the virtual machine.
     """
 
     exact = True
@@ -58,7 +60,7 @@ class ReachCurvature:
     carries_belief = False
     """The data holds no mean path: a point mass's belief comes from the problem's expanded rollout."""
 
-    def __init__(self, problem: ReachProblem, compile: bool = False):
+    def __init__(self, problem: ReachProblem, compile: bool | None = False):
         model = self.model = problem.model
         if not model.body.is_linear:
             raise ValueError(f"ReachCurvature needs a linear body (point mass), got {model.body.name!r}")
@@ -66,12 +68,17 @@ class ReachCurvature:
         n, d, H = model.n, model.d, model.H
         self.size = n * H
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
-        function = self._terms_function(problem)
-        self._terms = BufferedFunction(compiled(function) if compile else function)
+        self._tag = model_key(model)
+        functions = [self._terms_function(problem),
+                     ca.Function("reach_value", [ca.vec(problem.tau), problem.s0, problem.goal, problem.width],
+                                 [problem.objective / -problem.best_objective])]
+        if compile:
+            functions = [compiled(function, self._tag) for function in functions]
+        elif compile is None:
+            cached = [cached_compiled(function.name(), self._tag) for function in functions]
+            functions = cached if all(f is not None for f in cached) else functions
+        self._terms, self._value = (BufferedFunction(function) for function in functions)
         self._compiling = None  # the background build's future (compile_in_background)
-        value = ca.Function("reach_value", [ca.vec(problem.tau), problem.s0, problem.goal, problem.width],
-                            [problem.objective / -problem.best_objective])
-        self._value = BufferedFunction(compiled(value) if compile else value)
         self._effort = 2 * model.nu
         self._noise_hessian = _noise_second_derivatives(model)
         self._G = _constant_sensitivities(model)
@@ -132,7 +139,7 @@ class ReachCurvature:
         Nothing happens if they are compiled or being compiled."""
         if self._compiling is None and not _is_compiled(self._terms.function):
             self._compiling = compile_in_background(self, lambda curvature: [curvature._terms.function,
-                                                                             curvature._value.function])
+                                                                             curvature._value.function], self._tag)
 
     def _use_compiled_when_built(self) -> None:
         """Swap in the background build's function once it is ready (a failed build warns and keeps the

@@ -107,7 +107,8 @@ class SolverOptions:
     in a background thread once the planner has spent ``compile_after`` seconds solving, its solves going on
     uncompiled meanwhile: compiling costs 3–17 s for every new model, which short-lived planners (a fit's,
     one per parameter set) would not win back, while a long-lived one (a control loop, a sweep) solves
-    about a third faster afterwards (benchmarks/README.md)."""
+    about a third faster afterwards (benchmarks/README.md). A model compiled before (by any planner, in any
+    process, with this version of the package) is loaded compiled from the disk cache when built."""
     compile_after: float = 2.0
     """Seconds of solving (the sum of ``plan.solve_time``) after which a point-mass planner with ``compile=None``
     compiles its per-solve function in the background."""
@@ -208,7 +209,7 @@ class Planner:
         approximation with secant corrections for nonlinear ones."""
         compile = self.options.compile
         if self.model.body.is_linear:
-            return ReachCurvature(self.problem, compile=bool(compile))
+            return ReachCurvature(self.problem, compile=compile)
         return LinearisedCurvature(self.problem, compile=compile is not False)
 
     def _ipopt_solver(self) -> tuple[ca.Function, IpoptDeadline]:
