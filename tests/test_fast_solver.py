@@ -182,6 +182,26 @@ def test_chord_steps_reach_the_same_optimum_with_fewer_hessians(monkeypatch):
     assert counts[chord] < counts[fresh]
 
 
+def test_a_tagged_build_is_found_without_generating_source_and_only_for_the_same_libraries(tmp_path, monkeypatch):
+    monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
+    x = ca.SX.sym("x", 2)
+    f = ca.Function("tagged_test", [x], [ca.sin(x) * x[1]])
+    first = compiled_module.compiled_or_cached(f, "model A")
+    monkeypatch.setattr(ca, "CodeGenerator", None)  # generating source now fails
+    again = compiled_module.compiled_or_cached(f, "model A")
+    point = np.array([0.2, 3.0])
+    np.testing.assert_array_equal(np.asarray(again(point)), np.asarray(first(point)))
+    assert compiled_module.cached_compiled("tagged_test", "model B") is None
+    version = compiled_module.metadata.version
+    monkeypatch.setattr(compiled_module.metadata, "version", lambda name: "0.0" if name == "adam-robotics" else version(name))
+    compiled_module._source_fingerprint.cache_clear()
+    try:
+        assert compiled_module.cached_compiled("tagged_test", "model A") is None  # another adam: another dynamics
+    finally:
+        monkeypatch.undo()
+        compiled_module._source_fingerprint.cache_clear()
+
+
 def test_background_compile_skips_a_collected_owner_and_builds_for_a_live_one(tmp_path, monkeypatch):
     monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
     x = ca.SX.sym("x", 2)

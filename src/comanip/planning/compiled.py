@@ -33,6 +33,7 @@ import threading
 import warnings
 import weakref
 from concurrent.futures import Future
+from importlib import metadata
 from pathlib import Path
 from typing import Callable
 
@@ -104,20 +105,37 @@ def _file_under_tag(name: str, tag: str, library: Path) -> None:
     os.replace(scratch, index)
 
 
+def compiled_or_cached(function: ca.Function, tag: str) -> ca.Function:
+    """:func:`cached_compiled` if ``function`` was compiled under ``tag`` before, else :func:`compiled`."""
+    return cached_compiled(function.name(), tag) or compiled(function, tag)
+
+
 def _tag_key(tag: str) -> str:
-    """Key of a tag: with the package's source, CasADi's version and the compiler, the function is fixed."""
-    parts = [tag, _source_fingerprint(), ca.__version__, " ".join(_compiler() + list(COMPILE_FLAGS))]
+    """Key of a tag: with the package's source, the versions of the libraries that build the functions and
+    the compiler, the function is fixed."""
+    parts = [tag, _source_fingerprint(), " ".join(_compiler() + list(COMPILE_FLAGS))]
     return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:20]
+
+
+FUNCTION_SOURCES = ("casadi", "adam-robotics", "example-robot-data")
+"""Distributions whose versions, with comanip's own source, determine a compiled function (the Panda's
+dynamics come from adam and the URDF of example-robot-data)."""
 
 
 @functools.cache
 def _source_fingerprint() -> str:
-    """SHA-256 of every Python file of the comanip package (a changed formulation is a changed fingerprint)."""
+    """SHA-256 of every Python file of the comanip package and the versions of :data:`FUNCTION_SOURCES` (a
+    changed formulation or library is a changed fingerprint)."""
     package = Path(__file__).resolve().parents[1]
     digest = hashlib.sha256()
     for path in sorted(package.rglob("*.py")):
         digest.update(str(path.relative_to(package)).encode())
         digest.update(path.read_bytes())
+    for distribution in FUNCTION_SOURCES:
+        try:
+            digest.update(f"{distribution}=={metadata.version(distribution)}".encode())
+        except metadata.PackageNotFoundError:
+            digest.update(f"{distribution} absent".encode())
     return digest.hexdigest()
 
 

@@ -33,7 +33,7 @@ from comanip.belief.noise import noise_covariance
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.model import model_key
-from comanip.planning.compiled import BufferedFunction, cached_compiled, compile_in_background, compiled
+from comanip.planning.compiled import BufferedFunction, cached_compiled, compile_in_background, compiled_or_cached
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ReachTerms
 
@@ -73,7 +73,7 @@ class ReachCurvature:
                      ca.Function("reach_value", [ca.vec(problem.tau), problem.s0, problem.goal, problem.width],
                                  [problem.objective / -problem.best_objective])]
         if compile:
-            functions = [compiled(function, self._tag) for function in functions]
+            functions = [compiled_or_cached(function, self._tag) for function in functions]
         elif compile is None:
             cached = [cached_compiled(function.name(), self._tag) for function in functions]
             functions = cached if all(f is not None for f in cached) else functions

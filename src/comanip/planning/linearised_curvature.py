@@ -32,7 +32,8 @@ import numpy as np
 from comanip.belief.propagation import belief_step_function, linearised_step_function
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
-from comanip.planning.compiled import BufferedFunction, compiled
+from comanip.model import model_key
+from comanip.planning.compiled import BufferedFunction, compiled_or_cached
 from comanip.planning.curvature import _noise_second_derivatives, _reward_derivatives_function
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ArmTerms, Rollout
@@ -61,8 +62,9 @@ class LinearisedCurvature:
         d = model.d
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
         terms, value = self._functions(problem)
-        self._terms = BufferedFunction(compiled(terms) if compile else terms)
-        self._value = BufferedFunction(compiled(value) if compile else value)
+        tag = model_key(model)  # a model built before loads its C functions without generating their source (~1 s)
+        self._terms = BufferedFunction(compiled_or_cached(terms, tag) if compile else terms)
+        self._value = BufferedFunction(compiled_or_cached(value, tag) if compile else value)
         self._noise_hessian = _noise_second_derivatives(model)
         # D[j, l, r, s] as a matrix ((r, s), (j, l)): <S, ∂²N/∂tau_j ∂tau_l> for every (j, l) is S.ravel() @ it
         self._noise_hessian_matrix = self._noise_hessian.reshape(model.n ** 2, model.n ** 2).T.copy()
