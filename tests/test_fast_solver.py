@@ -137,6 +137,41 @@ def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(t
     np.testing.assert_allclose(BufferedFunction(fallback)(np.ones(3))[0].ravel(), np.cos(np.ones(3)))
 
 
+def test_goal_sensitivity_of_a_plan_matches_finite_differences_of_solved_plans():
+    """d tau*/d goal that a point-mass planner keeps after a solve (implicit function theorem with its last
+    factorisation) against central differences of plans solved to goals 0.1 mm away; a wrong sign or a
+    missing term is off by the whole column."""
+    model = comanip.presets.planar()
+    planner = Planner(model, SolverOptions(tolerance=1e-11))
+    start, goal, width = np.zeros(4), np.array([0.25, 0.04]), 0.02
+    plan = planner.solve(start, goal, width)
+    torque, sensitivity = planner._goal_sensitivity
+    assert torque is plan.torque and sensitivity.shape == (model.H * model.n, model.d)
+    step = 1e-4
+    for k in range(model.d):
+        shift = step * np.eye(model.d)[k]
+        ahead, behind = (Planner(model, SolverOptions(tolerance=1e-11)).solve(start, goal + sign * shift, width, warm_start=plan.torque)
+                         for sign in (1, -1))
+        difference = (ahead.torque - behind.torque).ravel() / (2 * step)
+        # to 2 %: the factorisation is the Hessian's of the last step, one or two iterates before the optimum
+        np.testing.assert_allclose(sensitivity[:, k], difference, rtol=0, atol=2e-2 * np.abs(difference).max())
+
+
+def test_the_goal_predictor_applies_only_to_the_planners_last_plan_at_its_start_and_width():
+    model = comanip.presets.planar()
+    planner, other = Planner(model), Planner(model)
+    start, goal, width = np.zeros(4), np.array([0.3, 0.0]), 0.02
+    plan = planner.solve(start, goal, width)
+    moved = goal + np.array([0.02, -0.01])
+    predicted = planner._predicted(plan, start, moved, width)
+    np.testing.assert_allclose(predicted, plan.torque + (planner._goal_sensitivity[1] @ (moved - goal)).reshape(plan.torque.shape))
+    assert planner._predicted(other.solve(start, goal, width), start, moved, width) is None  # another planner's plan
+    assert planner._predicted(plan, start, moved, 0.01) is None  # another width
+    assert planner._predicted(plan, np.array([0.0, 0.0, 0.1, 0.0]), moved, width) is None  # another start
+    planner.solve(start, moved, width)
+    assert planner._predicted(plan, start, moved, width) is None  # no longer the last plan
+
+
 def test_shifted_cholesky_solves_the_shifted_system(rng):
     """The factor of an indefinite matrix comes with the shift that made it definite, and solves that system."""
     from comanip.optim import cholesky_solve, growing_shifts, shifted_cholesky

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Generic, TypeVar
+from typing import Any, Generic, TypeVar
 
 from comanip.optim.status import CONVERGED, Status
 
@@ -27,6 +27,9 @@ class SolverResult(Generic[X]):
     """First-order optimality at x: max |gradient of the Lagrangian| (planner) or max |F| (goal estimate)."""
     violation: float = 0.0
     """Largest constraint violation at x (units of the constraints)."""
+    local_model: Any = None
+    """What the solver knows of the objective around x, for callers that extrapolate from it (the Newton
+    method: its last factorisation and the evaluation's data at x); None when it has nothing."""
 
     @property
     def success(self) -> bool:

@@ -97,7 +97,9 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
 
     Returns:
         A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
-        optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included.
+        optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included, local_model
+        (the Cholesky factor of the (regularised, corrected) Hessian of the last step taken, ``data`` at x),
+        None if no step was taken.
     """
     solver = _ActiveSetNewton(evaluate, hessian, _Constraints(lb, ub, constraints), value, tolerance=tolerance,
                               constraint_tolerance=constraint_tolerance, margin=margin)
@@ -141,10 +143,13 @@ class _ActiveSetNewton:
         correction, previous = None, None  # secant correction; (x, g) before the last step
         recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
         history = [point.f]
-        kept = None  # an exact Hessian's factor and the optimality where the last step was taken (see _reusable)
+        kept = None  # an exact Hessian's factor and the optimality where the last step was taken (Chord steps)
+        stepped_with = None  # the factorisation of the last step taken
 
         def result(status, message, optimality):
-            return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c))
+            local = None if stepped_with is None else (stepped_with, point.data)
+            return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c),
+                                local)
 
         while True:
             if iterations >= max_iterations:
@@ -167,7 +172,7 @@ class _ActiveSetNewton:
                     kept = (kept[0], optimality)
                     accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight)
                     if accepted is not None:
-                        point = accepted
+                        point, stepped_with = accepted, kept[0]
                         history.append(point.f)
                         continue
             kept = None
@@ -202,7 +207,7 @@ class _ActiveSetNewton:
             elif accepted is not None:
                 recoveries = 0
             if accepted is not None:
-                point = accepted
+                point, stepped_with = accepted, factor
                 history.append(point.f)
                 continue
             if recoveries < _RECOVERIES:
