@@ -119,3 +119,23 @@ def test_a_retargeted_plan_moves_its_mean_path_by_the_shift(preset):
             trajectory = planner.problem.trajectory(tau=np.ravel(torque), s0=start, goal=goal, width=model.width)
             end = np.asarray(trajectory["ee_mean"])[:, -1]
             np.testing.assert_allclose(end - plan.ee_mean[-1], shift, atol=0.04 * np.abs(shift).max())
+
+
+def test_minimum_jerk_profiles_meet_their_boundary_conditions_one_duration_or_several():
+    from comanip.planning.initial_guess import minimum_jerk
+
+    x0, v0, x1 = np.array([0.1, -0.2]), np.array([0.3, 0.05]), np.array([0.4, 0.2])
+    durations = np.array([0.2, 0.37, 0.5])
+    t = np.linspace(0.0, 0.6, 601)
+    together = minimum_jerk(x0, v0, x1, durations, t)
+    for k, T in enumerate(durations):
+        pos, vel, acc = minimum_jerk(x0, v0, x1, T, t)
+        for alone, batched in zip((pos, vel, acc), together):
+            np.testing.assert_array_equal(alone, batched[k])
+        np.testing.assert_allclose([pos[0], vel[0], acc[0]], [x0, v0, 0 * x0], atol=1e-12)
+        end = t >= T
+        np.testing.assert_allclose(pos[end], np.broadcast_to(x1, pos[end].shape), atol=1e-12)
+        np.testing.assert_allclose(vel[end], 0.0, atol=1e-9)
+        # the velocity is the derivative of the position (central differences inside the move)
+        inside = (t > 0.01) & (t < T - 0.01)
+        np.testing.assert_allclose(np.gradient(pos, t, axis=0)[inside], vel[inside], atol=2e-3)

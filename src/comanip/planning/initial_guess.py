@@ -12,40 +12,53 @@ import numpy as np
 from comanip.bodies.body import Body
 
 
-def minimum_jerk(x0, v0, x1, duration: float, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def minimum_jerk(x0, v0, x1, duration, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Quintic from x0 (k,) at velocity v0 (k,), zero acceleration, to rest at x1 (k,) after duration (s).
 
-    Returns position, velocity, acceleration, each (len(t), k); held at x1 after the duration.
+    Returns position, velocity, acceleration, each (len(t), k); held at x1 after the duration. ``duration``
+    may also be durations (m,), one profile each: the outputs are then (m, len(t), k).
     With v0 = 0 this is the Flash–Hogan minimum-jerk profile (peak speed at mid-movement).
     """
     x0, v0, x1 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (x0, v0, x1))
-    T = float(duration)
-    lhs = np.array([[T**3, T**4, T**5], [3 * T**2, 4 * T**3, 5 * T**4], [6 * T, 12 * T**2, 20 * T**3]])
-    rhs = np.stack([x1 - x0 - v0 * T, -v0, np.zeros_like(v0)])
-    a3, a4, a5 = np.linalg.solve(lhs, rhs)
-    tc = np.clip(np.asarray(t, dtype=float), 0.0, T)[:, None]
-    pos = x0 + v0 * tc + a3 * tc**3 + a4 * tc**4 + a5 * tc**5
-    vel = v0 + 3 * a3 * tc**2 + 4 * a4 * tc**3 + 5 * a5 * tc**4
-    acc = 6 * a3 * tc + 12 * a4 * tc**2 + 20 * a5 * tc**3
-    after = np.asarray(t, dtype=float) > T
+    durations = np.asarray(duration, dtype=float)
+    T = durations.reshape(-1, 1, 1)  # (m, 1, 1)
+    # the quintic's coefficients in closed form (x(0) = x0, x'(0) = v0, x''(0) = 0, x(T) = x1, x'(T) = x''(T) = 0)
+    delta = x1 - x0
+    a3 = (10 * delta - 6 * v0 * T) / T**3
+    a4 = (-15 * delta + 8 * v0 * T) / T**4
+    a5 = (6 * delta - 3 * v0 * T) / T**5
+    t = np.asarray(t, dtype=float)
+    tc = np.minimum(np.maximum(t, 0.0)[None, :, None], T)  # (m, len(t), 1)
+    pos = x0 + v0 * tc + tc**3 * (a3 + tc * (a4 + tc * a5))
+    vel = v0 + tc**2 * (3 * a3 + tc * (4 * a4 + tc * 5 * a5))
+    acc = tc * (6 * a3 + tc * (12 * a4 + tc * 20 * a5))
+    after = t[None, :] > T[:, :, 0]
     vel[after] = 0.0
     acc[after] = 0.0
-    return pos, vel, acc
+    return (pos, vel, acc) if durations.ndim else (pos[0], vel[0], acc[0])
 
 
-def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration: float,
+def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration,
                          linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Commands (H, n) that make the mean follow a joint-space minimum-jerk reach from start (nx,) to goal_q (n,)
-    (through the body's activation stages, if it has them).
+    (through the body's activation stages, if it has them); for durations (m,), one per duration (m, H, n).
 
     ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics_of`, evaluated
     once by a caller that makes many guesses; None evaluates them here."""
     t = h * np.arange(H)
     q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n:2 * body.n], goal_q, duration, t)
-    if body.is_linear:  # constant M and G: inverse dynamics of all steps at once
+    if body.is_linear:  # constant M and G: inverse dynamics of all steps (and durations) at once
         M, G = linear_dynamics or linear_dynamics_of(body)
-        return body.command_for_force(qddot @ M.T + qdot @ body.damping.T + G, h)
-    # M(q_i) and G(q_i) of all steps in one call each (a Python loop over the steps took ~50 ms on the Panda)
+        force = qddot @ M.T + qdot @ body.damping.T + G
+        return np.array([body.command_for_force(f, h) for f in force]) if force.ndim == 3 else body.command_for_force(force, h)
+    if q.ndim == 3:
+        return np.array([_arm_torques(body, h, H, *profile) for profile in zip(q, qdot, qddot)])
+    return _arm_torques(body, h, H, q, qdot, qddot)
+
+
+def _arm_torques(body: Body, h: float, H: int, q, qdot, qddot) -> np.ndarray:
+    """Commands (H, n) for a joint path q, qdot, qddot (H, n) of a nonlinear body: M(q_i) and G(q_i) of all steps
+    in one call each (a Python loop over the steps took ~50 ms on the Panda)."""
     M = np.asarray(body.mass_matrix_function.map(H)(q.T)).reshape(body.n, H, body.n).transpose(1, 0, 2)
     G = np.asarray(body.gravity_function.map(H)(q.T)).T
     return body.command_for_force(np.einsum("irs,is->ir", M, qddot) + qdot @ body.damping.T + G, h)

@@ -404,9 +404,9 @@ class Planner:
             return guesses if self._narrow(start, goal, width) else [best_guess]
         candidates = [turned]
         if moving:
-            candidates = [turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n), T,
-                                                        self._linear_dynamics)
-                          for T in guess_durations(model.duration, self.options.n_starts)]
+            candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
+                                                            guess_durations(model.duration, self.options.n_starts),
+                                                            self._linear_dynamics))
         best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
         return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
 
@@ -449,8 +449,8 @@ class Planner:
         when None), ``count`` durations."""
         model = self.model
         goal_q = model.body.inverse_kinematics(goal, start[: model.n]) if goal_q is None else goal_q
-        return [minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, T, self._linear_dynamics)
-                for T in guess_durations(model.duration, count)]
+        return list(minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, guess_durations(model.duration, count),
+                                         self._linear_dynamics))
 
     def _objective(self, torque: np.ndarray, params: np.ndarray) -> float:
         """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
