@@ -238,7 +238,11 @@ class Planner:
                 stages also takes the full state (nx,), else they start at zero force.
             goal: goal position (d,), m, in task space.
             width: goal width w (m) > 0; the model's default when None.
-            warm_start: a previous :class:`Plan` or torques (H, n) to start from; cold multi-start when None.
+            warm_start: a previous :class:`Plan` or torques (H, n) to start from; cold multi-start when None. A
+                plan for another goal starts the solve from the best of itself and itself moved onto the goal:
+                for a point mass's plan this planner solved last, from the same start at the same width, by
+                the optimum's first-order sensitivity to the goal (:meth:`_predicted`); otherwise by joint-space
+                minimum-jerk corrections.
             max_wall_time: wall-time budget (s) for the whole solve; the best plan so far is returned with
                 status 'max_wall_time' when it runs out. A budgeted cold solve starts only from reach-library
                 entries solved before (:meth:`_cold_start`): a new one would be a whole solve outside the budget.
