@@ -326,8 +326,8 @@ class Planner:
         """The first-order prediction of the optimal torques (H, n) for ``goal`` from a point-mass plan this
         planner solved last (same start and width, another goal): tau* + (d tau*/d goal) (goal - its goal), the
         tangential predictor of parametric optimisation; None for any other warm start. On warm planar solves
-        to goals moved by up to 5 cm it starts the Newton method a tenth of the way from the optimum
-        (benchmarks/README.md)."""
+        to goals moved by up to 5 cm its gradient is about a tenth of the retargeted plan's, and the solves
+        take 4.7 instead of 5.9 Newton iterations (benchmarks/README.md)."""
         remembered = self._goal_sensitivity
         if remembered is None or remembered[0] is not warm_start.torque or warm_start.width != width \
                 or not np.array_equal(warm_start.start, start):
