@@ -79,12 +79,13 @@ class SolverOptions:
     """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
     times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``. For nonlinear bodies
     ``arm_tolerance`` applies instead, unless it is None."""
-    arm_tolerance: float | None = 1e-5
+    arm_tolerance: float | None = 1e-6
     """The convergence tolerance for nonlinear bodies (None: ``tolerance``). Their approximate Hessian converges
-    linearly, and the iterations from 1e-5 to 1e-8 only polish the gradient: on 16 cold and 16 warm
-    ``franka_rest`` problems, stopping at 1e-5 changed J by at most 1.7e-7 relative and the mean hand paths by at
-    most 0.033 mm, and took a quarter fewer iterations (benchmarks/franka_solver_options.py; 40 random cold
-    problems of benchmarks/cold_quality.py: all equal to 1e-6)."""
+    linearly, and the iterations from 1e-6 to 1e-8 only polish the gradient: on 16 cold and 16 warm
+    ``franka_rest`` problems, stopping at 1e-6 changed J by at most 1.4e-9 relative and the mean hand paths by at
+    most 0.004 mm, and took a sixth fewer iterations (benchmarks/franka_solver_options.py). 1e-5 saves as many
+    again on ``franka_rest`` (J within 1.7e-7), but the paper's ``franka`` plans lie on a flat valley where it
+    stopped one warm plan 2e-3 above the previous solver's J (benchmarks/README.md, "Franka warm solves")."""
     hessian_refresh: int = 3
     """Nonlinear bodies: the approximate Hessian is assembled every this many Newton iterations and kept, with
     its secant corrections updated, in between (:func:`comanip.planning.newton.newton_minimize`); 1: every
