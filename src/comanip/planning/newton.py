@@ -34,8 +34,10 @@ of :mod:`comanip.optim`.
   line search, brings a fresh Hessian back. On warm point-mass solves it saves one Hessian and factorisation
   of about four, for one more cheap iteration (benchmarks/README.md); the optimum is the same (J to ~1e-11).
 - Lazy assembly (approximate Hessians, ``hessian_refresh`` k > 1): the hessian is assembled only every k-th
-  iteration (and after a failed line search); in between the last one is kept and the secant corrections,
-  updated against it, carry the change of curvature (an update costs about a twentieth of an assembly on the
+  iteration, and whenever the last step was shortened by the line search or taken with constraints in the
+  working set (there the model had been wrong, or the iterate follows a limit: on the Panda's reaches along a
+  joint limit keeping the hessian then ended 1e-4 to 6e-3 worse); in between the last one is kept and the
+  secant corrections, updated against it, carry the change of curvature (an update costs about a twentieth of an assembly on the
   Panda). The Cholesky factor of the last factored matrix then takes those rank-one updates by the Woodbury
   identity, when it needed no shift and stays positive definite (checked by the inertia of the small
   capacitance matrix), instead of a new factorisation. The gradient is evaluated at every iterate, so the
@@ -102,8 +104,9 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         value: x -> (f, data) without the gradient, for line-search trials when that is much cheaper than
             ``evaluate`` (``data`` then only needs what ``constraints`` reads); ``evaluate`` runs once a trial
             is accepted. None: trials use ``evaluate``.
-        hessian_refresh: with ``secant``, assemble ``hessian`` every this many iterations (and after a failed line
-            search), keeping the last one with updated secant corrections in between; 1: every iteration. Must be 1
+        hessian_refresh: with ``secant``, assemble ``hessian`` every this many iterations (and after any step that
+            was not a full, unconstrained one), keeping the last one with updated secant corrections in between; 1:
+            every iteration. Must be 1
             without ``secant`` (an exact Hessian is assembled at every iteration, chord steps apart).
 
     Returns:
@@ -158,6 +161,7 @@ class _ActiveSetNewton:
         shift_last, merit_weight, iterations = 0.0, 0.0, 0
         correction, previous = None, None  # secant correction; (x, g) before the last step
         assembled, age = None, 0  # with secant: the last assembled hessian, and the iterations it has served
+        model_held = False  # the last step was a full step with no constraint in the working set
         updated = None  # with secant: the last factored matrix's _UpdatedFactor
         recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
         history = [point.f]
@@ -188,7 +192,7 @@ class _ActiveSetNewton:
                     # well enough (a chord step, Kelley 2003, sec. 5.4), at a third of a point mass's iteration
                     step = -cholesky_solve(kept[0], point.g)
                     kept = (kept[0], optimality)
-                    accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight)
+                    accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight)[1]
                     if accepted is not None:
                         point, stepped_with = accepted, kept[0]
                         history.append(point.f)
@@ -199,7 +203,7 @@ class _ActiveSetNewton:
                 if not np.isfinite(hessian).all():
                     return result(Status.FAILED, "Hessian not finite", np.inf)
             else:
-                reused = assembled is not None and age < self.hessian_refresh
+                reused = assembled is not None and age < self.hessian_refresh and model_held
                 if not reused:
                     assembled, age = self.hessian(point.data), 0
                     if not np.isfinite(assembled).all():
@@ -237,7 +241,8 @@ class _ActiveSetNewton:
             if free and not secant and len(working) == 0:
                 kept = (factor, optimality)
             merit_weight = max(merit_weight, 2 * float(np.max(multipliers, initial=0.0)))
-            accepted = self._line_search(point, step, working, correct, merit_weight)
+            alpha, accepted = self._line_search(point, step, working, correct, merit_weight)
+            model_held = alpha == 1.0 and len(working) == 0
             if accepted is None and self.problem.violation(point.c) > self.constraint_tolerance:
                 accepted = self._restore(point)
             elif accepted is not None:
@@ -279,13 +284,15 @@ class _ActiveSetNewton:
         nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
         return float(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
-    def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct, merit_weight: float) -> _Iterate | None:
-        """The accepted point along ``step`` (Armijo on the l1 merit, with second-order corrections), or None."""
+    def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct,
+                     merit_weight: float) -> tuple[float, _Iterate | None]:
+        """(alpha, the accepted point alpha·``step`` away) by Armijo's rule on the l1 merit, with second-order
+        corrections; (0, None) when no step length is accepted."""
         penalty = self._penalty(point.c)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
         if not slope < -1e-16 * max(1.0, abs(merit)):
-            return None
+            return 0.0, None
 
         def attempt(alpha: float, bound: float) -> _Iterate | None:
             trial = self._trial(point.x + alpha * step)
@@ -304,7 +311,8 @@ class _ActiveSetNewton:
                 trial = self.at(trial.x, *self.evaluate(trial.x))
             return trial if _finite(trial.f, trial.g) else None
 
-        return backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)[1]
+        alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
+        return (alpha, accepted) if accepted is not None else (0.0, None)
 
     def _trial(self, x: np.ndarray) -> _Iterate | None:
         """The point x evaluated (value only when a cheaper ``value`` is given); None where not finite."""
