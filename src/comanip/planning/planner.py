@@ -82,18 +82,17 @@ class SolverOptions:
     arm_tolerance: float | None = 1e-6
     """The convergence tolerance for nonlinear bodies (None: ``tolerance``). Their approximate Hessian converges
     linearly, and the iterations from 1e-6 to 1e-8 only polish the gradient: on 16 cold and 16 warm
-    ``franka_rest`` problems, stopping at 1e-6 changed J by at most 1.4e-9 relative and the mean hand paths by at
-    most 0.004 mm, and took a sixth fewer iterations (benchmarks/franka_solver_options.py). 1e-5 saves as many
-    again on ``franka_rest`` (J within 1.7e-7), but the paper's ``franka`` plans lie on a flat valley where it
+    ``franka_rest`` problems, stopping at 1e-6 changed J by at most 1.1e-9 relative and the mean hand paths by at
+    most 0.004 mm, and took a sixth fewer iterations (benchmarks/franka_solver_options.py). 1e-5 saves about as
+    many again on ``franka_rest`` (J within 1e-7), but the paper's ``franka`` plans lie on a flat valley where it
     stopped one warm plan 2e-3 above the previous solver's J (benchmarks/README.md, "Franka warm solves")."""
     hessian_refresh: int = 3
-    """Nonlinear bodies: the approximate Hessian is assembled every this many Newton iterations and kept, with
-    its secant corrections updated, in between (:func:`comanip.planning.newton.newton_minimize`); 1: every
-    iteration. Point masses (exact Hessian) assemble theirs at every iteration whatever this says. On the
-    ``franka_rest`` problems above (tolerance 1e-8), 3 took as many iterations as 1 (464 against 454), a third
-    of the assemblies (162 against 434) and ended at the same plans (J within 1.4e-10); 2 was slower, 4 no faster
-    over 30 chained warm solves (453 iterations against 420) and moved one cold plan by 8.6e-7 in J
-    (benchmarks/franka_solver_options.py)."""
+    """Nonlinear bodies: the approximate Hessian is assembled every this many Newton iterations, and after any step
+    the line search shortened or taken with a limit in the working set; in between it is kept with its secant
+    corrections updated (:func:`comanip.planning.newton.newton_minimize`). 1: every iteration. Point masses (exact
+    Hessian) assemble theirs as before whatever this says. On the ``franka_rest`` problems above (tolerance 1e-8),
+    3 took as many iterations as 1 (447 against 454), 62 % of the assemblies and ended at the same plans (J within
+    1.6e-9); at tolerance 1e-6, 2 and 4 were slower than 3 (benchmarks/franka_solver_options.py)."""
     n_starts: int = 3
     """Minimum-jerk initial guesses of a cold solve (durations spread over the horizon). A warm-started
     solve uses the warm start only."""
