@@ -37,9 +37,9 @@ of :mod:`comanip.optim`.
   iteration, and whenever the last step was shortened by the line search or taken with constraints in the
   working set (there the model had been wrong, or the iterate follows a limit: on the Panda's reaches along a
   joint limit keeping the hessian then ended 1e-4 to 6e-3 worse); in between the last one is kept and the
-  secant corrections, updated against it, carry the change of curvature (an update costs about a twentieth of an assembly on the
-  Panda). The Cholesky factor of the last factored matrix then takes those rank-one updates by the Woodbury
-  identity, when it needed no shift and stays positive definite (checked by the inertia of the small
+  secant corrections, updated against it, carry the change of curvature (an update costs about a twentieth of
+  an assembly on the Panda). The Cholesky factor of the last factored matrix then takes those rank-one updates
+  by the Woodbury identity, when it needed no shift and stays positive definite (checked by the inertia of the small
   capacitance matrix), instead of a new factorisation. The gradient is evaluated at every iterate, so the
   convergence test and the optimum are those of k = 1.
 - Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
@@ -106,8 +106,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             is accepted. None: trials use ``evaluate``.
         hessian_refresh: with ``secant``, assemble ``hessian`` every this many iterations (and after any step that
             was not a full, unconstrained one), keeping the last one with updated secant corrections in between; 1:
-            every iteration. Must be 1
-            without ``secant`` (an exact Hessian is assembled at every iteration, chord steps apart).
+            every iteration. Must be 1 without ``secant`` (an exact Hessian is assembled at every iteration, chord
+            steps apart).
 
     Returns:
         A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
