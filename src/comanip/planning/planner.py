@@ -56,7 +56,8 @@ SOLVER_METHODS = ("newton", "ipopt")
 COLD_SEARCHES = ("ranked", "all")
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
-full inverse kinematics (:meth:`Planner._goal_joints`): from 5–10 cm away two reach the Panda's goals to mm."""
+full inverse kinematics (:meth:`Planner._goal_joints`): on 30 chained warm ``franka_rest`` goals 22–120 mm from
+the previous plan's final hand position, one step left up to 18 mm, two 0.3 mm, three 1e-4 mm."""
 
 
 @dataclass(frozen=True)
