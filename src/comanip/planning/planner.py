@@ -57,7 +57,8 @@ COLD_SEARCHES = ("ranked", "all")
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
 full inverse kinematics (:meth:`Planner._goal_joints`): on 30 chained warm ``franka_rest`` goals 22–120 mm from
-the previous plan's final hand position, one step left up to 18 mm, two 0.3 mm, three 1e-4 mm."""
+the previous plan's final hand position, one step left up to 18 mm, two 0.3 mm, three 1e-4 mm
+(benchmarks/franka_witness_steps.py)."""
 
 
 @dataclass(frozen=True)
