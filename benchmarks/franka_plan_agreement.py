@@ -9,8 +9,9 @@ axis (seed 1), warm-started from the cold plan. This checkout's code and REF's (
 worktree at main) each run in their own process. ``--perturb EPS`` multiplies REF's Panda Hessian by (1 + EPS):
 with REF this checkout and EPS one rounding unit it shows how far rounding alone moves the plans.
 
-Per plan: J of both, their relative difference, iterations and statuses of both, and the largest torque
-difference (N·m). Solve times are left to solve_times.py.
+Per plan: J of both, their relative difference, iterations and statuses of both, the largest torque
+difference (N·m) and the largest distance between the two mean hand paths (mm, over the H+1 steps). Solve times
+are left to solve_times.py.
 """
 
 from __future__ import annotations
@@ -52,7 +53,8 @@ def plans(presets: list[str], goals: int, perturb: float) -> dict:
             warm = planner.solve(start, origin + offset + shift, warm_start=cold)
             for kind, plan in (("cold", cold), ("warm", warm)):
                 out[f"{preset}/{k}/{kind}"] = {"J": plan.objective, "iterations": int(plan.iterations),
-                                               "status": str(plan.status), "torque": plan.torque.tolist()}
+                                               "status": str(plan.status), "torque": plan.torque.tolist(),
+                                               "hand": plan.ee_mean.tolist()}
     return out
 
 
@@ -80,20 +82,27 @@ def main(argv=None) -> None:
     new, ref = run(HERE.parent / "src", presets, args.goals, 0.0), run(args.compare.resolve() / "src", presets,
                                                                         args.goals, args.perturb)
     new, ref = (json.loads(p.communicate()[0].strip().splitlines()[-1]) for p in (new, ref))
-    print("| plan | J new | J ref | relative difference | iterations new / ref | status new / ref | max torque difference (N·m) |")
-    print("|---|---|---|---|---|---|---|")
+    print("| plan | J new | J ref | relative difference | iterations new / ref | status new / ref | max torque difference (N·m) "
+          "| max hand-path distance (mm) |")
+    print("|---|---|---|---|---|---|---|---|")
     for key, a in new.items():
         b = ref[key]
         torque = np.abs(np.array(a["torque"]) - np.array(b["torque"])).max()
         print(f"| {key} | {a['J']:.6f} | {b['J']:.6f} | {abs(a['J'] - b['J']) / abs(b['J']):.1e} | "
-              f"{a['iterations']} / {b['iterations']} | {a['status']} / {b['status']} | {torque:.1e} |")
+              f"{a['iterations']} / {b['iterations']} | {a['status']} / {b['status']} | {torque:.1e} | {hand_distance(a, b):.3f} |")
     for preset in presets:
         keys = [key for key in new if key.startswith(preset + "/")]
         same = sum(new[k]["iterations"] == ref[k]["iterations"] and new[k]["status"] == ref[k]["status"] for k in keys)
         worst = max(abs(new[k]["J"] - ref[k]["J"]) / abs(ref[k]["J"]) for k in keys)
+        farthest = max(hand_distance(new[k], ref[k]) for k in keys)
         print(f"\n{preset}: {same}/{len(keys)} plans with the same iterations and status; largest relative J "
-              f"difference {worst:.1e}; iterations new {sum(new[k]['iterations'] for k in keys)}, "
-              f"ref {sum(ref[k]['iterations'] for k in keys)}")
+              f"difference {worst:.1e}; largest hand-path distance {farthest:.3f} mm; iterations new "
+              f"{sum(new[k]['iterations'] for k in keys)}, ref {sum(ref[k]['iterations'] for k in keys)}")
+
+
+def hand_distance(a: dict, b: dict) -> float:
+    """The largest distance (mm) between two plans' mean hand positions at the same step."""
+    return 1e3 * float(np.max(np.linalg.norm(np.array(a["hand"]) - np.array(b["hand"]), axis=1)))
 
 
 if __name__ == "__main__":

@@ -84,6 +84,50 @@ def test_newton_matches_scipy_on_a_bounded_rosenbrock():
     assert result.fun <= reference.fun + 1e-12
 
 
+def test_hessian_refresh_reaches_the_same_minimiser_with_fewer_assemblies():
+    """An approximate Hessian (the Rosenbrock function's with its off-diagonal halved) assembled every third
+    iteration, secant corrections in between, reaches the minimiser of every-iteration assembly, and of L-BFGS-B
+    with a bound active; without bounds it assembles at most one Hessian per two iterations (a short step or a
+    constraint in the working set brings an assembly back sooner)."""
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    def approximate_hessian(x):
+        assemblies.append(x)
+        exact = scipy.optimize.rosen_hess(x)
+        return 0.5 * (exact + np.diag(np.diag(exact)))
+
+    free = (np.full(6, -np.inf), np.full(6, np.inf))
+    bounded = (np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5])
+    for lb, ub in (free, bounded):
+        results = {}
+        for refresh in (1, 3):
+            assemblies = []
+            result = newton_minimize(evaluate, approximate_hessian, np.full(6, -1.2), lb, ub, tolerance=1e-8,
+                                     max_iterations=500, secant=True, hessian_refresh=refresh)
+            assert result.success, result.message
+            results[refresh] = (result, len(assemblies))
+        lazy, eager = results[3][0], results[1][0]
+        np.testing.assert_allclose(lazy.x, eager.x, atol=1e-6)
+        assert lazy.fun == pytest.approx(eager.fun, rel=1e-9, abs=1e-15)
+        assert results[3][1] <= (lazy.nit / 2 if lb is free[0] else lazy.nit - 1)
+    reference = scipy.optimize.minimize(scipy.optimize.rosen, np.full(6, -1.2), jac=scipy.optimize.rosen_der,
+                                        method="L-BFGS-B", bounds=list(zip(*bounded)), options={"ftol": 1e-15, "gtol": 1e-12})
+    np.testing.assert_allclose(lazy.x, reference.x, atol=1e-6)
+
+
+@pytest.mark.parametrize("refresh, secant, word", [(0, True, "≥ 1"), (1.5, True, "≥ 1"), (True, True, "≥ 1"),
+                                                   (2, False, "without secant")])
+def test_hessian_refresh_is_checked(refresh, secant, word):
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    with pytest.raises(ValueError, match="hessian_refresh") as error:
+        newton_minimize(evaluate, scipy.optimize.rosen_hess, np.zeros(3), np.full(3, -1.0), np.full(3, 1.0),
+                        tolerance=1e-8, max_iterations=10, secant=secant, hessian_refresh=refresh)
+    assert word in str(error.value)
+
+
 def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
     """After the update in place, (H + C) s = y, C stays symmetric and C's change is rank one; a residual r
     orthogonal to s (no finite update meets the equation) leaves C alone."""
@@ -101,6 +145,30 @@ def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
     w = rng.normal(size=size)
     _symmetric_rank_one_update(C, H, s, (H + C) @ s + w - (w @ s) / (s @ s) * s)  # r ⟂ s: no finite update
     np.testing.assert_array_equal(C, unchanged)
+
+
+def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite_one(rng):
+    """The Woodbury solve after secant updates equals a direct solve with F + Σ sign_j u_j u_jᵀ, and an update
+    that makes the matrix indefinite (eigenvalues checked directly) gives None."""
+    from comanip.planning.newton import _UpdatedFactor
+
+    size = 30
+    root = rng.normal(size=(size, size))
+    F = root @ root.T + size * np.eye(size)
+    factor = _UpdatedFactor(scipy.linalg.cho_factor(F), 0.0)
+    matrix = F.copy()
+    for sign in (1.0, -1.0):
+        u = rng.normal(size=size)
+        factor = factor.updated((u, sign))
+        matrix += sign * np.outer(u, u)
+        assert np.linalg.eigvalsh(matrix)[0] > 0 and factor is not None
+        b = rng.normal(size=(size, 3))
+        np.testing.assert_allclose(factor.solve(b), np.linalg.solve(matrix, b), rtol=1e-9, atol=1e-12)
+    eigenvalues, vectors = np.linalg.eigh(matrix)
+    breaking = vectors[:, 0] * np.sqrt(2 * eigenvalues[0])  # subtracting it leaves eigenvalue -eigenvalues[0]
+    assert np.linalg.eigvalsh(matrix - np.outer(breaking, breaking))[0] < 0
+    assert factor.updated((breaking, -1.0)) is None
+    assert factor.updated(None) is factor
 
 
 def test_newton_stops_at_the_deadline():
@@ -297,7 +365,8 @@ def test_a_point_mass_planner_compiles_in_the_background_after_its_solving_time(
 @pytest.mark.parametrize("kwargs, word", [(dict(method="lbfgs"), "method"), (dict(tolerance=0.0), "tolerance"),
                                           (dict(max_iterations=0), "max_iterations"), (dict(n_starts=1.5), "n_starts"),
                                           (dict(cold_search="best"), "cold_search"), (dict(narrow_ratio=0.0), "narrow_ratio"),
-                                          (dict(compile_after=-1.0), "compile_after")])
+                                          (dict(compile_after=-1.0), "compile_after"),
+                                          (dict(arm_tolerance=-1e-6), "arm_tolerance"), (dict(hessian_refresh=0), "hessian_refresh")])
 def test_bad_solver_options_name_the_field(kwargs, word):
     with pytest.raises(ValueError, match=word):
         SolverOptions(**kwargs)

@@ -96,6 +96,12 @@ class Body(ABC):
 
     def inverse_kinematics(self, x: np.ndarray, q_init: np.ndarray, iterations: int = 100) -> np.ndarray:
         """Joint position (n,) whose end effector is nearest x (d,), m, by damped least squares from q_init."""
+        return self.least_squares_inverse_kinematics(x, q_init, iterations)
+
+    def least_squares_inverse_kinematics(self, x: np.ndarray, q_init: np.ndarray, iterations: int) -> np.ndarray:
+        """Joint position (n,) after at most ``iterations`` damped least-squares steps of the end effector from
+        q_init (n,) towards x (d,), m, each clipped to the joint limits (a body may find its nearest point
+        otherwise: :meth:`inverse_kinematics`)."""
         q = np.array(q_init, dtype=float)
         for _ in range(iterations):
             x_q, J = (np.asarray(v) for v in self.kinematics_function(q))

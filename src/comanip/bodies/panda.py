@@ -120,7 +120,7 @@ class Panda(Body):
         x = as_vector("x", x, self.d, "end-effector position, m")
         result = self._inverse_kinematics_solver(x0=q_init, p=np.concatenate([x, q_init]), lbx=self.q_min, ubx=self.q_max)
         q_nearest = self.clip_to_limits(np.asarray(result["x"]).ravel())  # IPOPT relaxes bounds by ~1e-8
-        q_polished = super().inverse_kinematics(x, q_nearest, iterations)
+        q_polished = self.least_squares_inverse_kinematics(x, q_nearest, iterations)
         # Out of reach the least-squares steps leap about near the stretched-out singularity: keep the better.
         return min((q_polished, q_nearest), key=lambda q: np.linalg.norm(np.asarray(self.kinematics_function(q)[0]).ravel() - x))
 

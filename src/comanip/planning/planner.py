@@ -54,6 +54,11 @@ from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
 COLD_SEARCHES = ("ranked", "all")
+WITNESS_STEPS = 3
+"""Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
+full inverse kinematics (:meth:`Planner._goal_joints`): on 30 chained warm ``franka_rest`` goals 22–120 mm from
+the previous plan's final hand position, one step left up to 18 mm, two 0.3 mm, three 1e-4 mm
+(benchmarks/franka_witness_steps.py)."""
 
 
 @dataclass(frozen=True)
@@ -74,7 +79,22 @@ class SolverOptions:
     convergence)."""
     tolerance: float = 1e-8
     """Convergence tolerance on the gradient of the normalised objective (J divided by the goal's peak reward
-    times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``."""
+    times the sum of discount weights, so it lies in about [-1, 0]); IPOPT's ``tol``. For nonlinear bodies
+    ``arm_tolerance`` applies instead, unless it is None."""
+    arm_tolerance: float | None = 1e-6
+    """The convergence tolerance for nonlinear bodies (None: ``tolerance``). Their approximate Hessian converges
+    linearly, and the iterations from 1e-6 to 1e-8 only polish the gradient: on 16 cold and 16 warm
+    ``franka_rest`` problems, stopping at 1e-6 changed J by at most 1.1e-9 relative and the mean hand paths by at
+    most 0.004 mm, and took a sixth fewer iterations (benchmarks/franka_solver_options.py). 1e-5 saves about as
+    many again on ``franka_rest`` (J within 1e-7), but the paper's ``franka`` plans lie on a flat valley where it
+    stopped one warm plan 2e-3 above the previous solver's J (benchmarks/README.md, "Franka warm solves")."""
+    hessian_refresh: int = 3
+    """Nonlinear bodies: the approximate Hessian is assembled every this many Newton iterations, and after any step
+    the line search shortened or taken with a limit in the working set; in between it is kept with its secant
+    corrections updated (:func:`comanip.planning.newton.newton_minimize`). 1: every iteration. Point masses (exact
+    Hessian) assemble theirs as before whatever this says. On the ``franka_rest`` problems above (tolerance 1e-8),
+    3 took as many iterations as 1 (447 against 454), 62 % of the assemblies and ended at the same plans (J within
+    1.6e-9); at tolerance 1e-6, 2 and 4 were slower than 3 (benchmarks/franka_solver_options.py)."""
     n_starts: int = 3
     """Minimum-jerk initial guesses of a cold solve (durations spread over the horizon). A warm-started
     solve uses the warm start only."""
@@ -117,7 +137,7 @@ class SolverOptions:
         if self.method not in SOLVER_METHODS:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
         as_count("max_iterations", self.max_iterations, optional=True)
-        for name in ("n_starts", "point_mass_iterations", "arm_iterations"):
+        for name in ("n_starts", "point_mass_iterations", "arm_iterations", "hessian_refresh"):
             as_count(name, getattr(self, name))
         as_positive("far_warm_start", self.far_warm_start, "goal widths")
         as_positive("narrow_ratio", self.narrow_ratio, "reach distance over goal width")
@@ -125,6 +145,8 @@ class SolverOptions:
         if self.cold_search not in COLD_SEARCHES:
             raise ValueError(f"cold_search must be one of {COLD_SEARCHES}, got {self.cold_search!r}")
         as_positive("tolerance", self.tolerance, "gradient of the normalised objective")
+        if self.arm_tolerance is not None:
+            as_positive("arm_tolerance", self.arm_tolerance, "gradient of the normalised objective")
         if self.compile not in (None, True, False):
             raise ValueError(f"compile must be None, True or False, got {self.compile!r}")
 
@@ -153,6 +175,8 @@ class Planner:
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
         self._curvature = self._newton_terms() if self.options.method == "newton" else None
+        carries_belief = self._curvature is not None and self._curvature.carries_belief
+        self._evaluate = _LastEvaluation(self._curvature) if carries_belief else None
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
@@ -205,6 +229,12 @@ class Planner:
             return self.options.max_iterations
         return self.options.point_mass_iterations if self.model.body.is_linear else self.options.arm_iterations
 
+    @property
+    def _tolerance(self) -> float:
+        """The Newton method's convergence tolerance: ``arm_tolerance`` for nonlinear bodies, if set."""
+        options = self.options
+        return options.tolerance if self.model.body.is_linear or options.arm_tolerance is None else options.arm_tolerance
+
     def _newton_terms(self):
         """Objective, gradient and Hessian for the Newton method: exact for linear bodies, structured
         approximation with secant corrections for nonlinear ones."""
@@ -253,7 +283,7 @@ class Planner:
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
-        goal_q = None if self.model.body.is_linear else self._goal_joints(start, goal, warm_start)
+        goal_q = None if self.model.body.is_linear else self._goal_joints(start, goal, width, warm_start)
         unreachable = self._unreachable_plan(start, goal, width, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
@@ -274,23 +304,30 @@ class Planner:
             self._curvature.compile_in_background()
             self._solving_time = None
 
-    def _goal_joints(self, start, goal, warm_start) -> np.ndarray:
-        """An arm's joint position (n,) nearest the goal, by inverse kinematics from the warm start's final
-        position or else the start's (about 17 ms for the Panda)."""
-        model = self.model
-        seed = warm_start.mean[-1, : model.n] if isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size) \
-            else start[: model.n]
-        return model.body.inverse_kinematics(goal, seed)
+    def _goal_joints(self, start, goal, width, warm_start) -> np.ndarray:
+        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w of the
+        goal if any does (the reachability witness of :meth:`_unreachable_plan`).
+
+        A cold solve: the inverse kinematics from the start (about 15 ms for the Panda; its guesses reach for
+        it). A warm start from a plan: ``WITNESS_STEPS`` damped least-squares steps (clipped to the limits) from
+        the plan's final mean position, about 0.1 ms, when they bring the hand within w of the goal (a warm
+        solve to a goal moved by a few cm: they do), else the inverse kinematics from that position."""
+        model, body = self.model, self.model.body
+        if not (isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size)):
+            return body.inverse_kinematics(goal, start[: model.n])
+        final = warm_start.mean[-1, : model.n]
+        near = body.clip_to_limits(body.least_squares_inverse_kinematics(goal, final, WITNESS_STEPS))
+        return near if _distance(body, near, goal) <= width else body.inverse_kinematics(goal, final)
 
     def _unreachable_plan(self, start, goal, width, goal_q: np.ndarray | None, t_begin: float) -> Plan | None:
         """A plan with status 'unreachable' when no joint position within the limits puts the end effector
-        within the goal width of the goal (the residual of ``goal_q`` (n,), the inverse kinematics, > w); None
+        within the goal width of the goal (the residual of ``goal_q`` (n,), :meth:`_goal_joints`, > w); None
         otherwise, and for point masses (``goal_q`` None: they reach everywhere). An arm is checked before any
         solver work."""
         model, body = self.model, self.model.body
         if goal_q is None:
             return None
-        residual = float(np.linalg.norm(np.asarray(body.kinematics_function(goal_q)[0]).ravel() - goal))
+        residual = _distance(body, goal_q, goal)
         if residual <= width:
             return None
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
@@ -513,7 +550,7 @@ class Planner:
         curvature = self._curvature
         if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
             return self.problem.make_plan(torque, start, goal, width, **fields)
-        f, _, data = curvature.evaluate(np.ravel(torque), params)
+        f, _, data = self._evaluate(np.ravel(torque), params)
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
@@ -524,9 +561,11 @@ class Planner:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
         value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
-        result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
-                                 *self._torque_bounds, tolerance=self.options.tolerance,
+        evaluate = self._evaluate or curvature.evaluate
+        result = newton_minimize(lambda x: evaluate(x, params), curvature.hessian, np.ravel(guess),
+                                 *self._torque_bounds, tolerance=self._tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
+                                 hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                                  constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
                                  value=value)
@@ -540,6 +579,29 @@ class Planner:
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
+
+
+class _LastEvaluation:
+    """A belief-carrying curvature's ``evaluate(x (N,), params)`` that keeps its last result: a plan is built at
+    the point its Newton solve evaluated last (the converged one, usually) without evaluating it again (about
+    4 ms of a Panda solve's plan)."""
+
+    def __init__(self, curvature: Curvature):
+        self._curvature = curvature
+        self._last: tuple[np.ndarray, np.ndarray, tuple] | None = None  # (x, params, (f, grad, data))
+
+    def __call__(self, x: np.ndarray, params: np.ndarray) -> tuple:
+        last = self._last
+        if last is not None and np.array_equal(last[0], x) and np.array_equal(last[1], params):
+            return last[2]
+        result = self._curvature.evaluate(x, params)
+        self._last = (np.array(x, dtype=float), np.array(params, dtype=float), result)
+        return result
+
+
+def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
+    """Distance (m) of the body's end effector at joint position q (n,) from a point (d,)."""
+    return float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - point))
 
 
 def _rank(candidate: SolverResult) -> tuple[bool, float]:
