@@ -265,14 +265,16 @@ def test_cli_errors_exit_2_with_one_line(argv, synthetic, capsys):
 
 
 @pytest.mark.slow
-@pytest.mark.slow
 def test_three_parameter_fit_finds_the_likelihood_maximum_and_says_nu_is_unconstrained(synthetic):
-    # measured (45 s): kappa 0.0219 ± 0.0029, gamma 0.967 ± 0.005, nu at its lower bound 1e-8 (true 1e-5),
-    # NLL 3.9 nats below the truth's: the planar preset's plans hardly depend on the effort weight
+    # measured (45 s): kappa 0.0219 ± 0.0029, gamma 0.967 ± 0.005, nu 3.4e-8 ± 5.0e-8 (true 1e-5; an earlier
+    # solver's rounding stopped it at the lower bound 1e-8), NLL 3.9 nats below the truth's: the planar preset's
+    # plans hardly depend on the effort weight, and Nelder-Mead stops anywhere along that flat direction
     fit = fit_model(comanip.presets.planar().replace(kappa=START_KAPPA), synthetic[0], max_evaluations=400, progress=False)
     assert fit.status == "converged"
     assert fit.objective <= recordings_nll(true_model(), synthetic[0])
     assert fit.values["kappa"] == pytest.approx(TRUE_KAPPA, rel=0.25)
     assert fit.values["gamma"] == pytest.approx(0.97, abs=0.01)
-    assert fit.values["nu"] < 1e-7  # three decades below the truth, at the default bound: flagged, no error
-    assert "['nu'] ended at a search bound" in fit.message and np.isnan(fit.std_errors["nu"])
+    assert fit.values["nu"] < 1e-7  # more than two decades below the truth
+    # unconstrained: at the bound (flagged, no error) or with a standard error at least its value
+    at_bound = "['nu'] ended at a search bound" in fit.message and np.isnan(fit.std_errors["nu"])
+    assert at_bound or fit.std_errors["nu"] >= fit.values["nu"]
