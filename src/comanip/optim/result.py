@@ -28,8 +28,8 @@ class SolverResult(Generic[X]):
     violation: float = 0.0
     """Largest constraint violation at x (units of the constraints)."""
     local_model: Any = None
-    """What the solver knows of the objective around x, for callers that extrapolate from it (the Newton
-    method: its last factorisation and the evaluation's data at x); None when it has nothing."""
+    """What the solver knows of the objective at and around x, for callers that build on it (the Newton method:
+    its last factorisation, or None, and the evaluation's data at x); None when it has nothing."""
 
     @property
     def success(self) -> bool:

@@ -112,8 +112,9 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     Returns:
         A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
         optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included, local_model
-        (the Cholesky factor of the (regularised, corrected) Hessian of the last step taken, ``data`` at x),
-        None if no step was taken or the last step's matrix had secant updates since its factorisation.
+        (factor, data): the Cholesky factor of the (regularised, corrected) Hessian of the last step taken (None if
+        no step was taken or its matrix had secant updates since it was factored) and the evaluation's ``data``
+        at x.
     """
     hessian_refresh = as_count("hessian_refresh", hessian_refresh, unit="iterations")
     if hessian_refresh > 1 and not secant:
@@ -169,9 +170,8 @@ class _ActiveSetNewton:
         stepped_with = None  # the factorisation of the last step taken
 
         def result(status, message, optimality):
-            local = None if stepped_with is None else (stepped_with, point.data)
             return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c),
-                                local)
+                                (stepped_with, point.data))
 
         while True:
             if iterations >= max_iterations:

@@ -175,8 +175,6 @@ class Planner:
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
         self._curvature = self._newton_terms() if self.options.method == "newton" else None
-        carries_belief = self._curvature is not None and self._curvature.carries_belief
-        self._evaluate = _LastEvaluation(self._curvature) if carries_belief else None
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
@@ -377,7 +375,8 @@ class Planner:
         theorem, with the Newton method's last factorisation), which :meth:`_solve_from` keeps with the plan's
         torques for :meth:`_predicted`; None otherwise. About 0.05 ms."""
         curvature = self._curvature
-        if curvature is None or not curvature.exact or not result.success or result.local_model is None:
+        if curvature is None or not curvature.exact or not result.success or result.local_model is None \
+                or result.local_model[0] is None:
             return None
         factor, data = result.local_model
         return -cholesky_solve(factor, curvature.goal_derivatives(data)[1])
@@ -530,7 +529,8 @@ class Planner:
                 if until_converged and best.success and self._ends_at_goal(best.x, params):
                     break
         sensitivity = self._goal_sensitivity_at(best)
-        plan = self._make_plan(best.x, params, status=best.status, success=best.success, message=best.message,
+        evaluation = None if best.local_model is None else (best.fun, best.local_model[1])
+        plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
         self._goal_sensitivity = None if sensitivity is None else (plan.torque, sensitivity)
         return plan
@@ -544,13 +544,15 @@ class Planner:
         end = np.asarray(model.body.kinematics_function(q_end)[0]).ravel()
         return bool(np.linalg.norm(end - params[n2:n2 + d]) <= params[-1])
 
-    def _make_plan(self, torque, params, **fields) -> Plan:
+    def _make_plan(self, torque, params, evaluation: tuple | None = None, **fields) -> Plan:
+        """The Plan of torques (H, n); ``evaluation`` = (f, data): the Newton method's own evaluation at them, from
+        which an arm's belief is taken without evaluating again (about 4 ms of a Panda solve)."""
         n2, d = self.model.state_size, self.model.d
         start, goal, width = params[:n2], params[n2:n2 + d], params[-1]
         curvature = self._curvature
         if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
             return self.problem.make_plan(torque, start, goal, width, **fields)
-        f, _, data = self._evaluate(np.ravel(torque), params)
+        f, data = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)[::2]
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
@@ -561,8 +563,7 @@ class Planner:
             return self._run_ipopt(guess, params, deadline)
         curvature = self._curvature
         value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
-        evaluate = self._evaluate or curvature.evaluate
-        result = newton_minimize(lambda x: evaluate(x, params), curvature.hessian, np.ravel(guess),
+        result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                                  *self._torque_bounds, tolerance=self._tolerance,
                                  max_iterations=self._max_iterations, secant=not curvature.exact,
                                  hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
@@ -579,24 +580,6 @@ class Planner:
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
-
-
-class _LastEvaluation:
-    """A belief-carrying curvature's ``evaluate(x (N,), params)`` that keeps its last result: a plan is built at
-    the point its Newton solve evaluated last (the converged one, usually) without evaluating it again (about
-    4 ms of a Panda solve's plan)."""
-
-    def __init__(self, curvature: Curvature):
-        self._curvature = curvature
-        self._last: tuple[np.ndarray, np.ndarray, tuple] | None = None  # (x, params, (f, grad, data))
-
-    def __call__(self, x: np.ndarray, params: np.ndarray) -> tuple:
-        last = self._last
-        if last is not None and np.array_equal(last[0], x) and np.array_equal(last[1], params):
-            return last[2]
-        result = self._curvature.evaluate(x, params)
-        self._last = (np.array(x, dtype=float), np.array(params, dtype=float), result)
-        return result
 
 
 def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
