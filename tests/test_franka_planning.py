@@ -84,7 +84,8 @@ def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
     tau, p = _point(model, rng)
     data = curvature.evaluate(tau, p)[2]
     n, d, H = 7, 3, model.H
-    J, Q, phi_grad, W, dvech = data.J, data.phi_hess, data.phi_grad, data.kinematic_hessian, data.dvech
+    pieces = curvature.pieces(data)
+    J, Q, phi_grad, W, dvech = pieces.J, pieces.phi_hess, pieces.phi_grad, pieces.kinematic_hessian, pieces.dvech
     T = curvature.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
     triangle = [(a, b) for b in range(d) for a in range(b + 1)]
     vech = lambda S: np.array([S[a, b] for a, b in triangle])  # noqa: E731

@@ -19,9 +19,12 @@ eigenvectors of the exact Hessian it agrees to a few per cent except in a handfu
 negative curvature (measured on the Panda, benchmarks/README.md); the Newton method's secant corrections
 learn those. The gradient is exact, so the optimum is that of the SPEC §4 objective.
 
-The objective, gradient and per-step pieces come from one CasADi function: an MX graph over per-step SX
-functions (belief step, reward, kinematics), compiled to C on first use (:mod:`comanip.planning.compiled`);
-generating C for the expanded problem instead gives hundreds of megabytes that do not compile in minutes.
+The objective and gradient come from one CasADi function, the per-step pieces of the Hessian from a second one
+evaluated on the first one's rollout only when a Hessian is assembled (with ``hessian_refresh`` about one
+iteration in three on the Panda; the gradient alone is 2.8 of the 4.3 ms both took as one function). Both are
+MX graphs over per-step SX functions (belief step, reward, kinematics), compiled to C on first use
+(:mod:`comanip.planning.compiled`); generating C for the expanded problem instead gives hundreds of megabytes
+that do not compile in minutes.
 """
 
 from __future__ import annotations
@@ -36,7 +39,7 @@ from comanip.model import model_key
 from comanip.planning.compiled import BufferedFunction, compiled_or_cached
 from comanip.planning.curvature import _noise_second_derivatives, _reward_derivatives_function
 from comanip.planning.reach_problem import ReachProblem
-from comanip.planning.terms import ArmTerms, Rollout
+from comanip.planning.terms import ArmPieces, ArmTerms, Rollout
 
 
 class LinearisedCurvature:
@@ -61,10 +64,9 @@ class LinearisedCurvature:
         self.problem = problem
         d = model.d
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
-        terms, value = self._functions(problem)
         tag = model_key(model)  # a model built before loads its C functions without generating their source (~1 s)
-        self._terms = BufferedFunction(compiled_or_cached(terms, tag) if compile else terms)
-        self._value = BufferedFunction(compiled_or_cached(value, tag) if compile else value)
+        self._gradient, self._pieces, self._value = (BufferedFunction(compiled_or_cached(function, tag) if compile else function)
+                                                     for function in self._functions(problem))
         self._noise_hessian = _noise_second_derivatives(model)
         # D[j, l, r, s] as a matrix ((r, s), (j, l)): <S, ∂²N/∂tau_j ∂tau_l> for every (j, l) is S.ravel() @ it
         self._noise_hessian_matrix = self._noise_hessian.reshape(model.n ** 2, model.n ** 2).T.copy()
@@ -74,15 +76,17 @@ class LinearisedCurvature:
         self._speed_weights = ((np.array([model.stop_weight, model.joint_velocity_weight]),)
                                if model.has_velocity_cost else ())
 
-    def _functions(self, problem: ReachProblem) -> tuple[ca.Function, ca.Function]:
-        """The per-solve functions, both ``(x, s0, goal, width) -> ...`` with per-step outputs stacked horizontally:
+    def _functions(self, problem: ReachProblem) -> tuple[ca.Function, ca.Function, ca.Function]:
+        """The per-solve functions, with per-step outputs stacked horizontally:
 
-        - terms: ``(f, grad, mean, cov, A, B, J, phi_hess, phi_grad, W, dvech/dq)``, the last nine the fields of
-          :class:`~comanip.planning.terms.ArmTerms` (W its ``kinematic_hessian``);
-        - value: ``(f, mean)``, the forward rollout alone (0.4 ms against the terms' 2.4 ms on the Panda), for line-search
-          trials and comparisons of initial guesses.
+        - gradient: ``(x, s0, goal, width) -> (f, grad, mean, cov)``;
+        - pieces: ``(x, goal, width, mean, cov) -> (A, B, J, phi_hess, phi_grad, W, dvech/dq)``, the fields of
+          :class:`~comanip.planning.terms.ArmPieces` (W its ``kinematic_hessian``), from the gradient's rollout;
+        - value: ``(x, s0, goal, width) -> (f, mean)``, the forward rollout alone (0.6 ms against the gradient's
+          2.8 ms on the Panda), for line-search trials and comparisons of initial guesses.
 
-        A model with a speed cost adds a fifth input, its weights [stop_weight, joint_velocity_weight] (2,).
+        A model with a speed cost adds a fifth input to gradient and value, its weights [stop_weight,
+        joint_velocity_weight] (2,).
         """
         model, body = problem.model, problem.model.body
         n, d, H = model.n, model.d, model.H
@@ -105,14 +109,16 @@ class LinearisedCurvature:
             speed_weights = ca.MX.sym("speed_weights", 2)
             f += velocity_cost([m[n:] for m in mean[1:]], [S[n:, n:] for S in cov[1:]], speed_weights[0], speed_weights[1])
             inputs, input_names = inputs + [speed_weights], input_names + ["speed_weights"]
+        gradient = ca.Function("arm_reach_gradient", inputs, [f, ca.gradient(f, x), means, covs], input_names,
+                               ["f", "grad", "mean", "cov"])
+        value = ca.Function("arm_reach_value", inputs, [f, means], input_names, ["f", "mean"])
+        means, covs = ca.MX.sym("mean", 2 * n, H + 1), ca.MX.sym("cov", 2 * n, 2 * n * (H + 1))
         _, A, B = linearised_step_function(body, model.h).map(H)(means[:, :H], tau)
         J, phi_hess, phi_grad, W, dvech = _stage_curvature_function(model, self._triangle).map(H + 1)(
             means, covs, goal, width, weights)
-        terms = ca.Function("arm_reach_terms", inputs,
-                            [f, ca.gradient(f, x), means, covs, A, B, J, phi_hess, phi_grad, W, dvech], input_names,
-                            ["f", "grad", "mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "W", "dvech"])
-        value = ca.Function("arm_reach_value", inputs, [f, means], input_names, ["f", "mean"])
-        return terms, value
+        pieces = ca.Function("arm_reach_pieces", [x, goal, width, means, covs], [A, B, J, phi_hess, phi_grad, W, dvech],
+                             ["x", "goal", "width", "mean", "cov"], _PIECE_FIELDS)
+        return gradient, pieces, value
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: the objective is divided by it."""
@@ -121,9 +127,16 @@ class LinearisedCurvature:
     def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ArmTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""
         n2, d = 2 * self.model.n, self.model.d
-        f, grad, *terms = self._terms(x, params[:n2], params[n2:n2 + d], params[-1], *self._speed_weights)
-        return float(f.item()), grad.ravel(), ArmTerms(x=np.array(x, dtype=float), width=params[-1],
-                                                       **dict(zip(_TERM_FIELDS, terms)))
+        goal = params[n2:n2 + d]
+        f, grad, mean, cov = self._gradient(x, params[:n2], goal, params[-1], *self._speed_weights)
+        return float(f.item()), grad.ravel(), ArmTerms(np.array(x, dtype=float), goal.copy(), params[-1], mean, cov)
+
+    def pieces(self, data: ArmTerms) -> ArmPieces:
+        """The Hessian's per-step pieces at the evaluation ``data``, computed on first request and kept in
+        ``data.pieces`` (1.2 ms on the Panda)."""
+        if data.pieces is None:
+            data.pieces = ArmPieces(*self._pieces(data.x, data.goal, data.width, data.mean, data.cov))
+        return data.pieces
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         return self.value_and_data(x, params)[0]
@@ -147,7 +160,8 @@ class LinearisedCurvature:
         if data.sensitivities is not None:
             return data.sensitivities
         n, H = self.model.n, self.model.H
-        A, B = _per_step(data.A, H), _per_step(data.B, H)
+        pieces = self.pieces(data)
+        A, B = _per_step(pieces.A, H), _per_step(pieces.B, H)
         T = np.zeros((H + 1, 2 * n, H * n))
         steps = np.arange(H)
         T.reshape(H + 1, 2 * n, H, n)[steps + 1, :, steps] = B  # T_{k+1,k} = B_k
@@ -179,15 +193,16 @@ class LinearisedCurvature:
         n, d, H = model.n, model.d, model.H
         size = H * n
         tau = data.x.reshape(H, n)
-        J, Q, W, dvech = (_per_step(v, H + 1) for v in (data.J, data.phi_hess, data.kinematic_hessian, data.dvech))
-        A, B = _per_step(data.A, H), _per_step(data.B, H)
+        pieces = self.pieces(data)
+        J, Q, W, dvech = (_per_step(v, H + 1) for v in (pieces.J, pieces.phi_hess, pieces.kinematic_hessian, pieces.dvech))
+        A, B = _per_step(pieces.A, H), _per_step(pieces.B, H)
         T = self.mean_sensitivities(data)
         X = np.concatenate([J, dvech], axis=1)  # (H+1, nz, n): z_i's rows per joint position
         QX = Q @ X
         rows, scale = self._noise_rows(J @ T[:, :n].reshape(H + 1, n, size), tau)
         a, b = self._triangle.T
         Lambda = np.zeros((H + 1, d, d))
-        Lambda[:, a, b] = Lambda[:, b, a] = (data.phi_grad[d:] * self._vech_weights[:, None]).T
+        Lambda[:, a, b] = Lambda[:, b, a] = (pieces.phi_grad[d:] * self._vech_weights[:, None]).T
         quadratic = np.zeros((H + 1, 2, 2 * n, 2 * n))  # per step: the state cost M_i and the noise's M'_i
         quadratic[:, 0, :n, :n] = np.swapaxes(X, 1, 2) @ QX + W
         quadratic[:, 1, :n, :n] = np.swapaxes(J, 1, 2) @ Lambda @ J
@@ -229,11 +244,12 @@ class LinearisedCurvature:
         forming them. ∂f/∂g, ∂²f/∂g² and the mean rows' part of ∂²f/∂x∂g are exact; the covariance rows'
         part carries the Hessian's approximation (A_i, B_i held along the path).
         """
-        x, phi_grad = data.x, data.phi_grad
+        pieces = self.pieces(data)
+        x, phi_grad = data.x, pieces.phi_grad
         model = self.model
         n, d, H = model.n, model.d, model.H
         a, b = self._triangle.T
-        J, Q, dvech = (_per_step(v, H + 1) for v in (data.J, data.phi_hess, data.dvech))
+        J, Q, dvech = (_per_step(v, H + 1) for v in (pieces.J, pieces.phi_hess, pieces.dvech))
         c_mean, c_vech = -Q[:, :d, :d], -Q[:, d:, :d]  # ∂²phi_i/∂mu_x∂g (H+1, d, d), ∂²phi_i/∂vech∂g (H+1, nv, d)
         Tq = self.mean_sensitivities(data)[:, :n].reshape(H + 1, n, H * n)
         # mean rows J_i T_i and the rows of J(q_i)'s effect on Sigma_x, d vech/dq_i T_i, share T_i
@@ -295,8 +311,8 @@ class LinearisedCurvature:
         return data.mean.T.copy(), data.cov.reshape(n2, H + 1, n2).transpose(1, 0, 2).copy()
 
 
-_TERM_FIELDS = ("mean", "cov", "A", "B", "J", "phi_hess", "phi_grad", "kinematic_hessian", "dvech")
-"""The per-solve function's outputs after (f, grad), in order, named as the fields of :class:`ArmTerms`."""
+_PIECE_FIELDS = ["A", "B", "J", "phi_hess", "phi_grad", "kinematic_hessian", "dvech"]
+"""The pieces function's outputs, in order, named as the fields of :class:`~comanip.planning.terms.ArmPieces`."""
 
 
 def _per_step(stacked: np.ndarray, steps: int) -> np.ndarray:

@@ -46,24 +46,46 @@ class Rollout:
 
 
 @dataclass(eq=False)
-class ArmTerms(ReachTerms):
-    """One evaluation at torques x for a nonlinear body: the point-mass terms plus the rollout and the
-    per-step pieces of the approximate Hessian (:mod:`comanip.planning.linearised_curvature`)."""
+class ArmPieces:
+    """The per-step pieces of an arm's approximate Hessian at one evaluation
+    (:mod:`comanip.planning.linearised_curvature`)."""
 
-    mean: np.ndarray
-    """Mean states mu_i stacked (2n, H+1)."""
-    cov: np.ndarray
-    """State covariances Sigma_i stacked (2n, 2n·(H+1))."""
     A: np.ndarray
     """Step Jacobians d mu_{i+1}/d mu_i stacked (2n, 2n·H)."""
     B: np.ndarray
     """Step Jacobians d mu_{i+1}/d tau_i stacked (2n, n·H)."""
     J: np.ndarray
     """Kinematic Jacobians J(q_i) stacked (d, n·(H+1))."""
+    phi_hess: np.ndarray
+    """∇²_z phi_i stacked (nz, nz·(H+1))."""
+    phi_grad: np.ndarray
+    """∇_z phi_i stacked (nz, H+1)."""
     kinematic_hessian: np.ndarray
     """∇²_q [λ·x_ee(q) + <Λ, J Sigma_qq Jᵀ>] at q_i stacked (n, n·(H+1)) (the kinematics' curvature)."""
     dvech: np.ndarray
     """d vech Sigma_x,i / d q_i stacked (nv, n·(H+1))."""
+
+
+@dataclass(eq=False)
+class ArmTerms:
+    """One evaluation at torques x for a nonlinear body: the belief rollout (f and its gradient come with it).
+    The Hessian's pieces and the mean sensitivities are computed from the rollout on first request and kept
+    here (:meth:`~comanip.planning.linearised_curvature.LinearisedCurvature.pieces`,
+    :meth:`~comanip.planning.linearised_curvature.LinearisedCurvature.mean_sensitivities`): a Newton
+    iteration that keeps its last Hessian and has no limit in its working set does not need them."""
+
+    x: np.ndarray
+    """Torques evaluated (H·n,), N·m."""
+    goal: np.ndarray
+    """Goal g (d,), m."""
+    width: float
+    """Goal width w (m)."""
+    mean: np.ndarray
+    """Mean states mu_i stacked (2n, H+1)."""
+    cov: np.ndarray
+    """State covariances Sigma_i stacked (2n, 2n·(H+1))."""
+    pieces: ArmPieces | None = field(default=None, repr=False)
+    """The Hessian's per-step pieces, computed on first request."""
     sensitivities: np.ndarray | None = field(default=None, repr=False)
     """d mu_i / d tau_k (H+1, 2n, H, n), computed on first request and kept with the evaluation it belongs to."""
 
