@@ -163,6 +163,7 @@ class _ActiveSetNewton:
         correction, previous = None, None  # secant correction; (x, g) before the last step
         assembled, age = None, 0  # with secant: the last assembled hessian, and the iterations it has served
         model_held = False  # the last step was a full step with no constraint in the working set
+        full_steps = True  # the last line search took the full step: evaluate the next full step with its gradient
         updated = None  # with secant: the last factored matrix's _UpdatedFactor
         recoveries = 0  # consecutive iterations whose step was recomputed after a failed line search
         history = [point.f]
@@ -192,7 +193,8 @@ class _ActiveSetNewton:
                     # well enough (a chord step, Kelley 2003, sec. 5.4), at a third of a point mass's iteration
                     step = -cholesky_solve(kept[0], point.g)
                     kept = (kept[0], optimality)
-                    accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight)[1]
+                    alpha, accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight, full_steps)
+                    full_steps = alpha == 1.0
                     if accepted is not None:
                         point, stepped_with = accepted, kept[0]
                         history.append(point.f)
@@ -241,8 +243,9 @@ class _ActiveSetNewton:
             if free and not secant and len(working) == 0:
                 kept = (factor, optimality)
             merit_weight = max(merit_weight, 2 * float(np.max(multipliers, initial=0.0)))
-            alpha, accepted = self._line_search(point, step, working, correct, merit_weight)
+            alpha, accepted = self._line_search(point, step, working, correct, merit_weight, full_steps)
             model_held = alpha == 1.0 and len(working) == 0
+            full_steps = alpha == 1.0
             if accepted is None and self.problem.violation(point.c) > self.constraint_tolerance:
                 accepted = self._restore(point)
             elif accepted is not None:
@@ -285,9 +288,14 @@ class _ActiveSetNewton:
         return float(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct,
-                     merit_weight: float) -> tuple[float, _Iterate | None]:
+                     merit_weight: float, full_step_likely: bool) -> tuple[float, _Iterate | None]:
         """(alpha, the accepted point alpha·``step`` away) by Armijo's rule on the l1 merit, with second-order
-        corrections; (0, None) when no step length is accepted."""
+        corrections; (0, None) when no step length is accepted.
+
+        Trials are evaluated value-only (``value``) and the accepted one then with its gradient, except the full
+        step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
+        working set: that trial is evaluated with its gradient at once, saving the value-only call (a fifth of
+        an evaluation on the Panda) on most iterations for a wasted gradient on the few whose full step fails."""
         penalty = self._penalty(point.c)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
@@ -295,7 +303,7 @@ class _ActiveSetNewton:
             return 0.0, None
 
         def attempt(alpha: float, bound: float) -> _Iterate | None:
-            trial = self._trial(point.x + alpha * step)
+            trial = self._trial(point.x + alpha * step, with_gradient=full_step_likely and alpha == 1.0 and not len(working))
             if trial is None:
                 return None
             if len(working) and self._penalty(trial.c) > penalty:
@@ -314,9 +322,10 @@ class _ActiveSetNewton:
         alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
         return (alpha, accepted) if accepted is not None else (0.0, None)
 
-    def _trial(self, x: np.ndarray) -> _Iterate | None:
-        """The point x evaluated (value only when a cheaper ``value`` is given); None where not finite."""
-        if self.value is None:
+    def _trial(self, x: np.ndarray, with_gradient: bool = False) -> _Iterate | None:
+        """The point x evaluated (value only when a cheaper ``value`` is given, unless ``with_gradient``); None where
+        not finite."""
+        if self.value is None or with_gradient:
             f, g, data = self.evaluate(x)
         else:
             (f, data), g = self.value(x), None
