@@ -7,9 +7,13 @@ the solver where the reward is felt; the duration selects among the local optima
 
 from __future__ import annotations
 
+import functools
+
+import casadi as ca
 import numpy as np
 
 from comanip.bodies.body import Body
+from comanip.planning.compiled import BufferedFunction
 
 
 def minimum_jerk(x0, v0, x1, duration, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -59,8 +63,8 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
 def _arm_torques(body: Body, h: float, H: int, q, qdot, qddot) -> np.ndarray:
     """Commands (H, n) for a joint path q, qdot, qddot (H, n) of a nonlinear body: M(q_i) and G(q_i) of all steps
     in one call each (a Python loop over the steps took ~50 ms on the Panda)."""
-    M = np.asarray(body.mass_matrix_function.map(H)(q.T)).reshape(body.n, H, body.n).transpose(1, 0, 2)
-    G = np.asarray(body.gravity_function.map(H)(q.T)).T
+    M = _mass_matrices(body, q)
+    G = _along(body.gravity_function, H)(q.T)[0].T
     return body.command_for_force(np.einsum("irs,is->ir", M, qddot) + qdot @ body.damping.T + G, h)
 
 
@@ -87,7 +91,7 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
     elif mean is None:
         raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
     else:
-        inertia = np.asarray(body.mass_matrix_function.map(H)(mean[:H, : body.n].T)).reshape(body.n, H, body.n).transpose(1, 0, 2)
+        inertia = _mass_matrices(body, mean[:H, : body.n])
     push = inertia @ shift_q  # (H, n)
     T = np.asarray(durations, dtype=float)[:, None]
     s = np.clip(h * np.arange(H) / T, 0.0, 1.0)  # (durations, H)
@@ -103,3 +107,16 @@ def guess_durations(horizon_s: float, count: int) -> np.ndarray:
     if count == 1:
         return np.array([0.5 * horizon_s])
     return np.linspace(0.25, 0.75, count) * horizon_s
+
+
+def _mass_matrices(body: Body, q: np.ndarray) -> np.ndarray:
+    """M(q_k) (K, n, n) at joint positions q (K, n), in one call."""
+    K, n = q.shape
+    return _along(body.mass_matrix_function, K)(q.T)[0].reshape(n, K, n).transpose(1, 0, 2)
+
+
+@functools.lru_cache(maxsize=32)
+def _along(function: ca.Function, steps: int) -> BufferedFunction:
+    """``function`` mapped over ``steps`` columns, built once per (function, steps) and called without DM
+    conversions (building the map and converting cost ~1 ms a call on the Panda, more than the evaluation)."""
+    return BufferedFunction(function.map(steps))

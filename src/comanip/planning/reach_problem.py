@@ -66,7 +66,7 @@ class ReachProblem:
         self._ee_velocity = BufferedFunction(ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1))
         # NumPy in and out without CasADi's DM conversions (they cost more than a point mass's rollout itself)
         self._trajectory = BufferedFunction(self.trajectory)
-        self._ee_belief = ee.map(H + 1)
+        self._ee_belief = BufferedFunction(ee.map(H + 1))
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)| (> 0) for a goal width w (m): the solvers divide J by it, so their tolerances mean the same
