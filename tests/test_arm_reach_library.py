@@ -109,3 +109,21 @@ def test_a_library_start_that_converges_beside_the_goal_falls_back_to_the_guesse
     reference = comanip.Planner(model, SolverOptions(cold_search="all")).solve(start, goal, width)
     assert plan.success and reference.success
     assert abs(plan.objective - reference.objective) <= RELATIVE * abs(reference.objective)
+
+
+@pytest.mark.slow
+def test_a_warm_solve_from_the_ready_pose_also_starts_from_the_library():
+    """With a warm start to a goal 7 cm away, the library's nearest plan competes with the warm plan as the start:
+    the plan equals the one solved from the warm start alone (a planner without the library), in no more
+    Newton iterations."""
+    model = comanip.presets.load("franka_rest")
+    start = np.r_[model.body.home_position, np.zeros(model.n)]
+    hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
+    with_library, without = comanip.Planner(model), comanip.Planner(model, SolverOptions(cold_search="all"))
+    assert with_library._arm_library is not None and without._arm_library is None
+    previous = without.solve(start, hand + [0.15, 0.1, -0.1])
+    goal = previous.goal + [0.04, -0.03, 0.045]
+    plan, reference = with_library.solve(start, goal, warm_start=previous), without.solve(start, goal, warm_start=previous)
+    assert plan.success and reference.success
+    assert abs(plan.objective - reference.objective) <= RELATIVE * abs(reference.objective)
+    assert plan.iterations <= reference.iterations
