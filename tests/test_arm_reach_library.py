@@ -30,12 +30,12 @@ def test_every_goal_in_the_shell_has_an_entry_within_half_a_grid_diagonal():
 def test_franka_rest_ships_a_library_of_its_own():
     model = comanip.presets.load("franka_rest")
     library = bundled_library(model)
-    assert library is not None and library.is_for(model) and library.starts_at(np.r_[model.body.home_position, np.zeros(7)])
+    assert library is not None and library.is_for(model) and library.serves(np.r_[model.body.home_position, np.zeros(7)])
     hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     assert len(library.goals) >= 0.9 * len(grid_goals(hand))  # a few goals may be out of the arm's reach
     assert library.torques.shape[1:] == (model.H, model.n) and np.all(np.isfinite(library.torques))
     assert bundled_library(model.replace(kappa=2 * model.kappa)) is None  # another model: not its library
-    assert not library.starts_at(np.r_[model.body.home_position + 0.01, np.zeros(7)])
+    assert not library.serves(np.r_[model.body.home_position + 0.01, np.zeros(7)])
 
 
 def test_models_without_a_library_file_get_none():
@@ -68,6 +68,27 @@ def test_minimum_jerk_torques_of_an_arm_are_its_inverse_dynamics_step_by_step():
     q, qdot, qddot = minimum_jerk(start[:7], start[7:], goal_q, 0.8, model.h * np.arange(model.H))
     one_by_one = np.array([body.inverse_dynamics(q[i], qdot[i], qddot[i]) for i in range(model.H)])
     np.testing.assert_allclose(torques, body.command_for_force(one_by_one, model.h), rtol=0, atol=1e-10)
+
+
+@pytest.mark.parametrize("preset", ["planar", "franka_rest"])
+def test_a_braked_plan_from_a_moving_start_follows_the_plan_from_rest(preset):
+    """braked_torques: from a start moving at v the braked torques give nearly the mean path of the plan from
+    rest once the braking has ended (the move is continuous-time, the step forward Euler; for the Panda also
+    first order in the nonlinearity): the end state is ten times closer to the plan's than without braking."""
+    from comanip.belief.propagation import propagate_belief
+    from comanip.planning.initial_guess import braked_torques
+
+    model = comanip.presets.load(preset)
+    body, n = model.body, model.n
+    rest = np.r_[body.home_position, np.zeros(n)]
+    torque = minimum_jerk_torques(body, model.h, model.H, rest, body.home_position + 0.1, 0.5 * model.duration)
+    plan = propagate_belief(body, model.h, model.kappa, rest, torque, model.noise)[0]
+    moving = rest + np.r_[np.zeros(n), np.linspace(-0.3, 0.3, n)]
+    braked = [propagate_belief(body, model.h, model.kappa, moving, t, model.noise)[0]
+              for t in braked_torques(body, model.h, model.H, torque, moving[n:], [0.3, 0.6], plan)]
+    unbraked = propagate_belief(body, model.h, model.kappa, moving, torque, model.noise)[0]
+    for path in braked:
+        assert np.linalg.norm(path[-1] - plan[-1]) < 0.1 * np.linalg.norm(unbraked[-1] - plan[-1])
 
 
 def test_library_cli_refuses_a_point_mass(capsys):
@@ -127,3 +148,18 @@ def test_a_warm_solve_from_the_ready_pose_also_starts_from_the_library():
     assert plan.success and reference.success
     assert abs(plan.objective - reference.objective) <= RELATIVE * abs(reference.objective)
     assert plan.iterations <= reference.iterations
+
+
+@pytest.mark.slow
+def test_a_cold_solve_from_a_moving_start_at_the_ready_pose_starts_from_the_library():
+    """A start at the ready pose moving at up to 0.3 rad/s per joint: the library's plans with braking moves
+    superposed start the solve, which ends on the full search's plan in fewer iterations."""
+    model = comanip.presets.load("franka_rest")
+    start = np.r_[model.body.home_position, np.linspace(0.3, -0.3, model.n)]
+    hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
+    goal = hand + [0.12, -0.15, 0.08]
+    plan = comanip.Planner(model).solve(start, goal)
+    reference = comanip.Planner(model, SolverOptions(cold_search="all")).solve(start, goal)
+    assert plan.success and reference.success
+    assert (plan.objective - reference.objective) / abs(reference.objective) <= RELATIVE
+    assert plan.iterations < reference.iterations / 2

@@ -70,9 +70,11 @@ class ArmReachLibrary:
         """True when the library was solved for ``model`` (equal parameters)."""
         return self.model_key == model_key(model)
 
-    def starts_at(self, start: np.ndarray) -> bool:
-        """True when ``start`` (2n,) is the entries' start (to START_TOLERANCE)."""
-        return start.shape == self.start.shape and bool(np.all(np.abs(start - self.start) <= START_TOLERANCE))
+    def serves(self, start: np.ndarray) -> bool:
+        """True when ``start`` (2n,) has the entries' joint positions (to START_TOLERANCE), at rest or moving (the
+        planner superposes a braking move on the entries' plans for a moving start)."""
+        n = len(self.start) // 2
+        return start.shape == self.start.shape and bool(np.all(np.abs(start[:n] - self.start[:n]) <= START_TOLERANCE))
 
     def nearest(self, goal: np.ndarray, count: int = CANDIDATE_ENTRIES) -> list[tuple[np.ndarray, np.ndarray]]:
         """(entry goal (d,) m, torques (H, n) N·m) of the ``count`` entries nearest to goal (d,), nearest first."""

@@ -41,7 +41,8 @@ from comanip.arguments import as_count, as_goal_width, as_matrix, as_optional_po
 from comanip.model import ReachingModel
 from comanip.planning.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
 from comanip.planning.curvature import ReachCurvature
-from comanip.planning.initial_guess import guess_durations, linear_dynamics_of, minimum_jerk_torques, retargeted_torques
+from comanip.planning.initial_guess import (brake_durations, braked_torques, guess_durations, linear_dynamics_of,
+                                          minimum_jerk_torques, retargeted_torques)
 from comanip.optim import SolverResult, Status, cholesky_solve
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.linearised_curvature import LinearisedCurvature
@@ -287,7 +288,7 @@ class Planner:
             return unreachable
         guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
                                         goal_q=goal_q if warm_start is None else None)
-        from_library = warm_start is None and self._arm_library is not None and self._arm_library.starts_at(start)
+        from_library = warm_start is None and self._arm_library is not None and self._arm_library.serves(start)
         plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
                                                  until_converged=from_library))
         self._count_solving_time(plan.solve_time)
@@ -352,7 +353,7 @@ class Planner:
         predicted = self._predicted(warm_start, start, goal, width)
         candidates = [torque, predicted] if predicted is not None else \
             self._retargeted(torque, warm_start.mean, warm_start.goal, goal)
-        if self._arm_library is not None and self._arm_library.starts_at(start):
+        if self._arm_library is not None and self._arm_library.serves(start):
             # the solved reach nearest to the goal competes too: on 50 chained warm franka_rest solves to goals
             # moved by up to 5 cm per axis it was the best start 48 times (15 → 10 Newton iterations, J within 3e-9)
             candidates += self._library_candidates(start, goal, WARM_CANDIDATE_ENTRIES)
@@ -431,7 +432,7 @@ class Planner:
         benchmarks/cold_quality.py). A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
         before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
         """
-        if self._arm_library is not None and self._arm_library.starts_at(start):
+        if self._arm_library is not None and self._arm_library.serves(start):
             return self._arm_library_starts(start, goal, width, goal_q)
         if self._library is None:
             return self._searched_guesses(start, goal, width, goal_q)
@@ -466,12 +467,18 @@ class Planner:
 
     def _library_candidates(self, start, goal, entries: int) -> list[np.ndarray]:
         """The plans (H, n) of the arm reach library's ``entries`` entries nearest to ``goal`` (d,), each as solved
-        and moved onto the goal (:meth:`_retargeted`); ``start`` (2n,) is the library's."""
-        library, candidates = self._arm_library, []
+        and moved onto the goal (:meth:`_retargeted`); ``start`` (2n,) has the library's joint positions, and if it
+        moves, each candidate gets the braking moves of :func:`braked_torques` instead."""
+        library, model, candidates = self._arm_library, self.model, []
+        velocity = start[model.n:2 * model.n]
         for entry_goal, torque in library.nearest(goal, entries):
-            entry_params = np.concatenate([start, entry_goal, [library.width]])
+            entry_params = np.concatenate([library.start, entry_goal, [library.width]])
             mean = self._curvature.mean_path(self._curvature.value_and_data(np.ravel(torque), entry_params)[1])
-            candidates += self._retargeted(torque, mean, entry_goal, goal)
+            moved = self._retargeted(torque, mean, entry_goal, goal)
+            if np.any(velocity):
+                moved = [braked for candidate in moved for braked in
+                         braked_torques(model.body, model.h, model.H, candidate, velocity, brake_durations(model.duration), mean)]
+            candidates += moved
         return candidates
 
     def _drift(self, start, goal, width) -> float:
