@@ -7,8 +7,8 @@
 Problems (the same for both sides, seeded): point masses: goals 0.1–0.4 m from the start in uniformly drawn
 directions, widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per
 axis); arms: from the ready pose, goals 0.15–0.3 m from its hand, widths log-uniform over 2.5–10 cm, every
-tenth start in motion (±0.3 rad/s per joint; the reach library applies only at rest, so these run the search
-of the reference).
+tenth start in motion (±0.3 rad/s per joint; the reach library's plans then start with braking moves
+superposed).
 The reference is the code of another checkout (``--compare``: its src/ is imported in a separate process)
 or, without it, this code with ``SolverOptions(cold_search="all")`` (every minimum-jerk guess solved to
 convergence, the best kept). Each side runs in its own process, the presets alternating between them.

@@ -78,7 +78,7 @@ def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4)
               options: SolverOptions | None = None, label: str = "") -> Callable[[], Case]:
     """Cold solves (no warm start) from the home position to goals ``distances`` (m; 0.1–0.4 m) away in
     uniformly drawn directions, a new goal each time (a user's first plan for a goal), at the model's width;
-    from rest, or (``moving``) with start velocities uniform in ±0.3 m/s per axis. The planner is fresh: its
+    from rest, or (``moving``) with start velocities uniform in ±0.3 m/s per axis (rad/s per joint for an arm). The planner is fresh: its
     first solves also fill its reach library (comanip.planning.reach_library)."""
 
     def make() -> Case:
@@ -234,6 +234,7 @@ CASES: dict[str, Callable[[], Case]] = {
     "franka_cold": cold_case("franka", 1.3, distances=(0.15, 0.3)),
     "franka_rest": reach_case("franka_rest", 1.3, reach=(0.15, 0.1, -0.1)),
     "franka_rest_cold": cold_case("franka_rest", 1.3, distances=(0.15, 0.3)),
+    "franka_rest_cold_moving": cold_case("franka_rest", 1.3, distances=(0.15, 0.3), moving=True),
     "planar_cold": cold_case("planar", 0.04, options=COMPILED, label=" compiled"),
     "cartesian_cold": cold_case("cartesian", 0.20, options=COMPILED, label=" compiled"),
     "planar_cold_uncompiled": cold_case("planar", 0.04, options=UNCOMPILED, label=" uncompiled"),

@@ -43,7 +43,7 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
                "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,"
-               "franka,franka_cold,franka_rest,franka_rest_cold,franka_replan"]),
+               "franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
     "transition-trends": ("Peternel & Babič's trends in the shipped transition data and the fitted model (seconds)",
                           ["docs/print_transition_trends.py"]),
 }
