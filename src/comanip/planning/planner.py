@@ -271,7 +271,8 @@ class Planner:
                 plan for another goal starts the solve from the best of itself and itself moved onto the goal:
                 for a point mass's plan this planner solved last, from the same start at the same width, by
                 the optimum's first-order sensitivity to the goal (:meth:`_predicted`); otherwise by joint-space
-                minimum-jerk corrections.
+                minimum-jerk corrections. From an arm reach library's ready pose the library's nearest plan, moved
+                onto the goal (and braked, from a moving start), competes too.
             max_wall_time: wall-time budget (s) for the whole solve; the best plan so far is returned with
                 status 'max_wall_time' when it runs out. A budgeted cold solve starts only from reach-library
                 entries solved before (:meth:`_cold_start`): a new one would be a whole solve outside the budget.
