@@ -21,7 +21,7 @@ learn those. The gradient is exact, so the optimum is that of the SPEC §4 objec
 
 The objective and gradient come from one CasADi function, the per-step pieces of the Hessian from a second one
 evaluated on the first one's rollout only when a Hessian is assembled (with ``hessian_refresh`` about one
-iteration in three on the Panda; the gradient alone is 2.8 of the 4.3 ms both took as one function). Both are
+iteration in three on the Panda, where the gradient takes 1.9 ms and the pieces 1.2 ms). Both are
 MX graphs over per-step SX functions (belief step, reward, kinematics), compiled to C on first use
 (:mod:`comanip.planning.compiled`); generating C for the expanded problem instead gives hundreds of megabytes
 that do not compile in minutes.
@@ -83,7 +83,7 @@ class LinearisedCurvature:
         - pieces: ``(x, goal, width, mean, cov) -> (A, B, J, phi_hess, phi_grad, W, dvech/dq)``, the fields of
           :class:`~comanip.planning.terms.ArmPieces` (W its ``kinematic_hessian``), from the gradient's rollout;
         - value: ``(x, s0, goal, width) -> (f, mean)``, the forward rollout alone (0.6 ms against the gradient's
-          2.8 ms on the Panda), for line-search trials and comparisons of initial guesses.
+          1.9 ms on the Panda), for line-search trials and comparisons of initial guesses.
 
         A model with a speed cost adds a fifth input to gradient and value, its weights [stop_weight,
         joint_velocity_weight] (2,).

@@ -116,9 +116,9 @@ class SolverOptions:
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it."""
     arm_library: str | None = None
-    """An arm's reach library for 'ranked' cold solves from its ready pose (its nearest plan also competes with a
-    warm start there): a file written by ``comanip library`` (.npz) for this model. None: the library shipped for the model (``franka_rest``), if any
-    (:mod:`comanip.planning.arm_reach_library`)."""
+    """An arm's reach library for 'ranked' cold solves from its ready pose, at rest or moving (its nearest plan
+    also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:
+    the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.arm_reach_library`)."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
