@@ -147,6 +147,24 @@ def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
     np.testing.assert_array_equal(C, unchanged)
 
 
+def test_a_step_never_drives_a_row_past_its_limit_further_out():
+    """Two rows past their limits within the tolerance, both with negative multipliers: dropping both at once
+    gives the step -g, which moves row 0 further out (a first-order rise of the merit's penalty: no step length
+    is accepted, the Panda's 'failed' stalls along a joint limit). Row 0 must stay in the working set and the step
+    still descend."""
+    from comanip.planning.newton import _constrained_step
+
+    rows = np.array([[1.0, 0.0], [-1.0, 1.0]])
+    g = np.array([-0.9, 1.0])  # multipliers with both rows working: (-0.1, -1.0)
+    c = np.array([5e-7, 5e-7])
+    step, multipliers, working, _ = _constrained_step(lambda b: b, g, c, lambda indices: rows[indices],
+                                                      margin=1e-3, tolerance=1e-6)
+    assert np.all(rows @ step <= 1e-12), rows @ step
+    assert g @ step < 0
+    assert working.tolist() == [0] and multipliers[0] > 0
+    np.testing.assert_allclose(step, [-c[0], -1.0], atol=1e-12)  # row 0 brought back onto its limit
+
+
 def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite_one(rng):
     """The Woodbury solve after secant updates equals a direct solve with F + Σ sign_j u_j u_jᵀ, and an update
     that makes the matrix indefinite (eigenvalues checked directly) gives None."""

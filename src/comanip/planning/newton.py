@@ -400,28 +400,47 @@ def _constrained_step(solve, g, c, A, margin: float, tolerance: float):
 
     A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row with a negative
     multiplier is dropped and the step recomputed unless it is violated by more than ``tolerance`` (then
-    the step must restore it). (Keeping a row met to within the tolerance, say at 3e-8 past a joint limit,
+    the step must restore it), or it is past its limit already and the step without it would move it further
+    (then it is kept). (Keeping a row met to within the tolerance, say at 3e-8 past a joint limit,
     held the Panda's plans on the limit while the objective pulled them off it: the step vanished and
     the solve stalled with a large Lagrangian gradient.) Returns (step,
     multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
     """
     Hg = solve(g)
-    working = np.flatnonzero(c > -margin)
-    while len(working):
-        rows = A(working)
-        HA = solve(rows.T)
-        schur = rows @ HA
-        multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
-        dropping = (multipliers < 0) & (c[working] <= tolerance)
-        if not dropping.any():
+    near = np.flatnonzero(c > -margin)
+    working, pinned = near, np.zeros(0, dtype=int)
+    while True:
+        if len(working):
+            rows = A(working)
+            HA = solve(rows.T)
+            schur = rows @ HA
+            multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
+            dropping = (multipliers < 0) & (c[working] <= tolerance) & ~np.isin(working, pinned)
+            if dropping.any():
+                working = working[~dropping]
+                continue
             multipliers = np.maximum(multipliers, 0.0)
+            step = -(Hg + HA @ multipliers)
+        else:
+            multipliers, step = np.zeros(0), -Hg
+        # rows dropped together can push one another out: a dropped row already past its limit (within the
+        # tolerance) that the step would drive further out returns to the working set for good (on the Panda's
+        # reaches along a joint limit such rows made the merit rise at first order along every step, and the
+        # solve ended 'failed' at a gradient of 2e-4)
+        dropped = np.setdiff1d(near, working, assume_unique=True)
+        dropped = dropped[c[dropped] > 0]
+        blocking = dropped[A(dropped) @ step > 0] if len(dropped) else dropped
+        if not len(blocking):
+            break
+        pinned = np.union1d(pinned, blocking)
+        working = np.union1d(working, blocking)
+    if not len(working):
+        return step, multipliers, working, None
 
-            def correct(c_working, HA=HA, schur=schur):
-                return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
+    def correct(c_working, HA=HA, schur=schur):
+        return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
 
-            return -(Hg + HA @ multipliers), multipliers, working, correct
-        working = working[~dropping]
-    return -Hg, np.zeros(0), working, None
+    return step, multipliers, working, correct
 
 
 def _symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float] | None:
