@@ -427,6 +427,8 @@ def _constrained_step(solve, g, c, A, margin: float, tolerance: float):
         # tolerance) that the step would drive further out returns to the working set for good (on the Panda's
         # reaches along a joint limit such rows made the merit rise at first order along every step, and the
         # solve ended 'failed' at a gradient of 2e-4)
+        if len(working) == len(near):
+            break
         dropped = np.setdiff1d(near, working, assume_unique=True)
         dropped = dropped[c[dropped] > 0]
         blocking = dropped[A(dropped) @ step > 0] if len(dropped) else dropped
