@@ -23,14 +23,10 @@ import numpy as np
 import comanip
 from comanip.optim import Status
 from comanip.planning.arm_reach_library import CANDIDATE_ENTRIES
-from comanip.planning.planner import SolverOptions
+from comanip.planning.planner import SolverOptions, _rank
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cold_quality import RELATIVE, problems  # noqa: E402
-
-
-def _rank(result) -> tuple[bool, float]:
-    return result.status == Status.CONSTRAINTS_VIOLATED, float(result.fun)
 
 
 def main(argv=None) -> None:

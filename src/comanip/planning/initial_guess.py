@@ -92,14 +92,12 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
         raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
     else:
         inertia = _mass_matrices(body, mean[:H, : body.n])
-    push = inertia @ shift_q  # (H, n)
     T = np.asarray(durations, dtype=float)[:, None]
     s = np.clip(h * np.arange(H) / T, 0.0, 1.0)  # (durations, H)
     # x(t) = shift_q (10 s³ - 15 s⁴ + 6 s⁵): Flash–Hogan from rest to rest, all durations at once
     speed = 30 * s**2 * (1 - s) ** 2 / T
     acceleration = 60 * s * (1 - s) * (1 - 2 * s) / T**2
-    forces = acceleration[:, :, None] * push + speed[:, :, None] * (body.damping @ shift_q)
-    return [torque + body.command_for_force(force, h) for force in forces]
+    return _superposed(body, h, torque, inertia, shift_q, speed, acceleration)
 
 
 def braked_torques(body: Body, h: float, H: int, torque: np.ndarray, velocity: np.ndarray, durations,
@@ -110,12 +108,10 @@ def braked_torques(body: Body, h: float, H: int, torque: np.ndarray, velocity: n
     (the move is continuous-time, the step forward Euler; for a nonlinear body also to first order): a plan from
     rest becomes a start for the same reach from a moving start (on 20 moving franka_rest starts, 15 instead of
     86 Newton iterations, :func:`brake_durations`)."""
-    t = h * np.arange(H)
-    zero = np.zeros(body.n)
-    _, speed, acceleration = minimum_jerk(zero, velocity, zero, np.asarray(durations, dtype=float), t)  # (m, H, n)
-    inertia = _mass_matrices(body, mean[:H, : body.n])
-    return [torque + body.command_for_force(np.einsum("irs,is->ir", inertia, a) + v @ body.damping.T, h)
-            for a, v in zip(acceleration, speed)]
+    # the move is velocity·sigma(t): sigma the unit quintic from speed 1 to rest, all durations at once
+    _, speed, acceleration = minimum_jerk(0.0, 1.0, 0.0, np.asarray(durations, dtype=float), h * np.arange(H))
+    return _superposed(body, h, torque, _mass_matrices(body, mean[:H, : body.n]), velocity, speed[..., 0],
+                       acceleration[..., 0])
 
 
 def brake_durations(horizon_s: float) -> np.ndarray:
@@ -129,6 +125,15 @@ def guess_durations(horizon_s: float, count: int) -> np.ndarray:
     if count == 1:
         return np.array([0.5 * horizon_s])
     return np.linspace(0.25, 0.75, count) * horizon_s
+
+
+def _superposed(body: Body, h: float, torque: np.ndarray, inertia: np.ndarray, direction: np.ndarray,
+                speed: np.ndarray, acceleration: np.ndarray) -> list[np.ndarray]:
+    """torque (H, n) plus the commands of the joint motion direction (n,)·sigma(t), one result per row of the
+    profiles speed = sigma' and acceleration = sigma'' (m, H): delta tau_i = M_i direction sigma''_i +
+    D direction sigma'_i, with M_i = inertia (H, n, n) along the plan."""
+    forces = acceleration[:, :, None] * (inertia @ direction) + speed[:, :, None] * (body.damping @ direction)
+    return [torque + body.command_for_force(force, h) for force in forces]
 
 
 def _mass_matrices(body: Body, q: np.ndarray) -> np.ndarray:
