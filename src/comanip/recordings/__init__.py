@@ -1,0 +1,8 @@
+"""Recorded human movements: a typed :class:`Recording`, its preprocessing and loaders (CSV, ``cursory``)."""
+
+from comanip.recordings.csv_recordings import load_csv_recordings
+from comanip.recordings.cursory_data import load_cursory
+from comanip.recordings.preprocessing import recording_from_samples
+from comanip.recordings.recording import Recording
+
+__all__ = ["Recording", "load_csv_recordings", "load_cursory", "recording_from_samples"]
