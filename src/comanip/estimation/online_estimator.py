@@ -57,6 +57,7 @@ from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
+from comanip.estimation.people_model import shipped_people_model
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
@@ -64,6 +65,10 @@ from comanip.optim import CONVERGED, Status
 from comanip.planning.cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
+
+
+TIMINGS = ("estimated", "model")
+"""The values of :attr:`OnlineOptions.timing`."""
 
 
 @dataclass(frozen=True)
@@ -114,8 +119,21 @@ class OnlineOptions:
     pooled coverage of the 95 % ellipsoid at 0.2–0.8 s); the sync robot's belief uses 3
     (comanip.simulation.policies.continuous.ROBOT_BELIEF; docs/measure_goal_estimation.py --belief robot)."""
 
+    timing: str = "estimated"
+    """"model": the reach starts at t = 0 and moves at the model's pace (the estimate above, exact for the
+    model's own reaches). "estimated": that estimate while the model at its own pace explains the observations
+    (whitened misfit at most ``mismatch_threshold``), and from the first update on which it does not, the
+    estimate of the model fitted to recorded people (:mod:`comanip.estimation.people_model`), whose pace, onset
+    and shape are the person's own; its status is then ``people_model``."""
+    mismatch_threshold: float = 9.0
+    """With ``timing="estimated"``: the largest mean squared whitened residual (per observed number) at which
+    the model at its own pace still explains the observations (about 1 for the model's own reaches)."""
+
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
+        if self.timing not in TIMINGS:
+            raise ValueError(f"timing must be one of {TIMINGS}, got {self.timing!r}")
+        as_positive("mismatch_threshold", self.mismatch_threshold, "mean squared whitened residual")
         if not (math.isfinite(self.led_from) and self.led_from >= 0):
             raise ValueError(f"led_from must be a finite time ≥ 0 s, got {self.led_from!r}")
         if not (math.isfinite(self.led_deviation_time) and self.led_deviation_time >= 0):
@@ -254,6 +272,8 @@ class OnlineGoalEstimator:
         self._weights = np.zeros((H + 1, H + 1))
         self._last_time = -math.inf
         self._last_observation = np.zeros(2 * n)
+        self._history: list[np.ndarray] = []       # [t, position, velocity] of every observation, for the people model
+        self._off_model: float | None = None        # the misfit that showed the model's pace does not explain the hand
         self._whitening: ObservationWhitening | None = None
         self._blas = ThreadpoolController()
         self._whitening_goal = np.zeros(d)
@@ -300,11 +320,38 @@ class OnlineGoalEstimator:
         if fraction > 0:
             self._weights[before, before + 1] += fraction
         self._last_time, self._last_observation = time_s, observation
+        self._history.append(np.r_[time_s, observation])
         with self._blas.limit(limits=1, user_api="blas"):   # threads only slow products of this size down
             self.latest = self._estimate(t_begin)
         return self.latest
 
     def _estimate(self, t_begin: float) -> GoalEstimate:
+        if self._off_model is not None:
+            return self._people_estimate(t_begin)
+        estimate, misfit = self._model_estimate(t_begin)
+        if (self.options.timing == "estimated" and misfit is not None and misfit > self.options.mismatch_threshold):
+            self._off_model = misfit
+            return self._people_estimate(t_begin)
+        return estimate
+
+    def _people_estimate(self, t_begin: float) -> GoalEstimate:
+        """The estimate of the model fitted to recorded people (:mod:`comanip.estimation.people_model`) from
+        every observation so far; before the hand moves, the prior."""
+        n = self.model.n
+        history = np.asarray(self._history)
+        prediction = shipped_people_model().predict(history[:, 0], history[:, 1:1 + n], history[:, 1 + n:1 + 2 * n],
+                                                    self.start_position)
+        if prediction is None:
+            return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE,
+                                "no observation shows movement: the estimate is the prior", 0, t_begin)
+        return self._result(prediction.goal, prediction.covariance, Status.PEOPLE_MODEL,
+                            f"the model at its own pace does not explain the hand (misfit {self._off_model:.3g} per "
+                            f"observed number, above {self.options.mismatch_threshold:g}): the goal is the people model's",
+                            0, t_begin)
+
+    def _model_estimate(self, t_begin: float) -> tuple[GoalEstimate, float | None]:
+        """The estimate of the model at its own pace (module docstring) and its misfit (mean squared whitened
+        residual per observed number; None when nothing was fitted)."""
         steps = np.flatnonzero(self._counts)
         counts = self._counts[steps]
         observed = self._sums[steps] / counts[:, None]
@@ -316,7 +363,7 @@ class OnlineGoalEstimator:
                 goal = problem.cold_goal()
                 if goal is None:
                     return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE,
-                                        "no observation shows movement: the estimate is the prior", 0, t_begin)
+                                        "no observation shows movement: the estimate is the prior", 0, t_begin), None
             else:
                 goal = previous.goal
             iterations = 0
@@ -329,12 +376,13 @@ class OnlineGoalEstimator:
             covariance = self.options.covariance_scale * problem.distance_spread(goal, covariance, whitening)
             if not (np.all(np.isfinite(goal)) and np.all(np.isfinite(covariance))):
                 raise np.linalg.LinAlgError("non-finite estimate")
+            misfit = problem.misfit(whitening, goal) if self.options.timing == "estimated" else None
         except np.linalg.LinAlgError as error:
             self._whitening = None
             goal, covariance = (self.prior_mean, self.prior_cov) if previous is None else (previous.goal, previous.goal_covariance)
             return self._result(goal, covariance, Status.FAILED, f"the Newton iteration failed ({error}); "
-                                "the previous estimate is kept", 0, t_begin)
-        return self._result(goal, 0.5 * (covariance + covariance.T), status, message, iterations, t_begin)
+                                "the previous estimate is kept", 0, t_begin), math.inf
+        return self._result(goal, 0.5 * (covariance + covariance.T), status, message, iterations, t_begin), misfit
 
     def _stale(self, goal: np.ndarray) -> bool:
         """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance."""
@@ -441,6 +489,13 @@ class _Problem:
         z[:, :m] = self.weights.T @ whitening.transpose_apply(residual)
         newton = gauss_newton - prediction.hessian_contraction(z)
         return objective, 0.5 * (newton + newton.T), gauss_newton, G.T @ residual - e._prior_precision @ offset
+
+    def misfit(self, whitening: ObservationWhitening, goal: np.ndarray) -> float:
+        """Mean squared whitened residual of the observations at ``goal``, per observed number: about 1 where
+        the model at its own pace explains them."""
+        predicted = self.weights @ self._prediction(goal).mean[:, :self.m]
+        residual = whitening.apply((self.observed - predicted)[:, :, None]).ravel()
+        return float(residual @ residual) / residual.size
 
     def _projected(self, goal: np.ndarray) -> np.ndarray:
         """The goal moved into the family's range of distances from the start."""

@@ -30,9 +30,12 @@ class Status(StrEnum):
     """The observation says nothing about the goal (it is the start itself)."""
     PLANS_NOT_CONVERGED = "plans_not_converged"
     """A goal posterior some of whose candidates' plans did not converge."""
+    PEOPLE_MODEL = "people_model"
+    """A goal estimate from the model fitted to recorded people (:mod:`comanip.estimation.people_model`): the
+    reaching model at its own pace does not explain the observed hand."""
     FAILED = "failed"
     """No usable point (non-finite values, a singular system, no descent)."""
 
 
-CONVERGED = frozenset({Status.SOLVED, Status.SOLVED_ACCEPTABLE})
+CONVERGED = frozenset({Status.SOLVED, Status.SOLVED_ACCEPTABLE, Status.PEOPLE_MODEL})
 """The statuses that count as success."""

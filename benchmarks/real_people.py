@@ -1,0 +1,244 @@
+"""Goal prediction on recorded people: where does a moving hand stop, predicted from its first part?
+
+Every movement of a split of the ``cursory`` mouse recordings (``pip install -e ".[data]"``; the held-out
+split only to report) is observed sample by sample (every 10 ms) from its first sample; at 10, 25, 50, 75 and
+90 % of its movement time (MT, from the onset) each predictor's latest endpoint is scored by
+error / D = |g_hat - end| / |end - start|. Printed: the median and interquartile range per fraction, how
+often the predictor's 95 % region holds the endpoint (predictors with a covariance), how often it is worse
+than the current position by more than 0.05 D, and the update time. ``--source simulated`` runs the same
+table on reaches sampled from a reaching model's own noise (open loop, as the model's belief assumes).
+
+    python benchmarks/real_people.py                      # development split, every predictor
+    python benchmarks/real_people.py --limit 200          # the first 200 movements of the split
+    python benchmarks/real_people.py --split held_out     # the report split: run once per claimed improvement
+    python benchmarks/real_people.py --source simulated   # the model's own reaches
+
+Outputs in ``--out`` (default benchmarks/results/real_people_<source>_<split>/): ``errors.csv`` (one row per
+movement, fraction and predictor), ``summary.json``, ``summary.md`` and ``error_by_fraction.png``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import chi2
+
+FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
+WORSE_MARGIN = 0.05
+
+
+def predictors(model_names, library, exclude_self: bool):
+    """{name: factory(recording) -> online predictor with update(t, position, velocity)}."""
+    import comanip
+    from comanip.estimation.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
+    from comanip.estimation.template_matching import TemplateMatching
+
+    made = {
+        "current position": lambda r: CurrentPosition(r.position[0]),
+        "constant velocity": lambda r: ConstantVelocity(r.position[0]),
+        "minimum jerk": lambda r: MinimumJerkFit(r.position[0]),
+        "template matching": lambda r: TemplateMatching(r.position[0], library, exclude=r.name if exclude_self else None),
+    }
+    for name in model_names:
+        model = comanip.presets.load(name)
+        made[f"OnlineGoalEstimator ({name})"] = (lambda m: lambda r: _Online(comanip.OnlineGoalEstimator(
+            m, np.r_[r.position[0], np.zeros(m.state_size - m.n)])))(model)
+    return made
+
+
+class _Online:
+    """OnlineGoalEstimator behind the predictors' interface (goal and covariance of its estimate)."""
+
+    def __init__(self, estimator):
+        self.estimator = estimator
+
+    def update(self, t, position, velocity):
+        estimate = self.estimator.update(t, position, velocity)
+        return estimate.goal, estimate.goal_covariance
+
+
+def run_predictor(factory, recording):
+    """[(goal, covariance or None)] at FRACTIONS, and the update times (s)."""
+    predictor = factory(recording)
+    until = [recording.seen_until(f) for f in FRACTIONS]
+    results, times, latest = [], [], None
+    for k in range(max(until)):
+        begin = time.perf_counter()
+        answer = predictor.update(float(recording.t[k]), recording.position[k], recording.velocity[k])
+        times.append(time.perf_counter() - begin)
+        latest = (answer.goal, answer.covariance) if hasattr(answer, "goal") else answer
+        while len(results) < len(until) and until[len(results)] == k + 1:
+            results.append(latest)
+    while len(results) < len(until):
+        results.append(latest)
+    return results, times
+
+
+def simulated_recordings(model_name: str, count: int, seed: int):
+    """Reaches sampled from a preset's own noise (open loop) to random goals, as recordings."""
+    import comanip
+    from comanip.belief import sample_trajectories
+    from comanip.recordings import recording_from_samples
+
+    model = comanip.presets.load(model_name)
+    planner = comanip.Planner(model)
+    rng = np.random.default_rng(seed)
+    recordings = []
+    for k in range(count):
+        D, angle = rng.uniform(0.1, 0.6), rng.uniform(0, 2 * np.pi)
+        goal = D * np.array([np.cos(angle), np.sin(angle)])
+        start = np.zeros(model.state_size)
+        plan = planner.solve(start, goal, model.width)
+        states = sample_trajectories(model.body, model.h, model.kappa, plan.start, plan.torque, 1, rng, model.noise)[0]
+        rest = np.repeat(states[:1, :model.n], 10, axis=0)            # 0.1 s at rest before the reach
+        t = np.r_[np.arange(-10, 0) * model.h, plan.t] + 10 * model.h
+        recordings.append(recording_from_samples(f"{model_name}/{k}", t, np.r_[rest, states[:, :model.n]], step=0.01,
+                                                 target=goal))
+    return recordings
+
+
+def summarise(rows, names):
+    """{predictor: {fraction: {median, q25, q75, coverage, worse}}} from the per-movement rows."""
+    summary = {}
+    by = {(r["predictor"], r["fraction"]): [] for r in rows}
+    for r in rows:
+        by[(r["predictor"], r["fraction"])].append(r)
+    for name in names:
+        summary[name] = {}
+        for f in FRACTIONS:
+            chosen = by.get((name, f), [])
+            errors = np.array([r["error"] for r in chosen])
+            covered = [r["covered"] for r in chosen if r["covered"] is not None]
+            worse = np.mean([r["error"] > r["current_error"] + WORSE_MARGIN for r in chosen])
+            summary[name][f] = {"median": float(np.median(errors)), "q25": float(np.percentile(errors, 25)),
+                                "q75": float(np.percentile(errors, 75)), "worse_than_current": float(worse),
+                                "coverage": float(np.mean(covered)) if covered else None}
+    return summary
+
+
+def markdown(summary, latency, count, title):
+    lines = [f"{title} ({count} movements): error / D, median [IQR]; 95 % coverage; share worse than the current "
+             f"position by > {WORSE_MARGIN} D; update time", "",
+             "| predictor | " + " | ".join(f"{int(f * 100)} % of MT" for f in FRACTIONS) + " | update median / p95 (ms) |",
+             "|---|" + "---|" * (len(FRACTIONS) + 1)]
+    for name, by_fraction in summary.items():
+        cells = []
+        for f in FRACTIONS:
+            s = by_fraction[f]
+            cell = f"{s['median']:.3f} [{s['q25']:.2f}–{s['q75']:.2f}]"
+            if s["coverage"] is not None:
+                cell += f"; cov {100 * s['coverage']:.0f} %"
+            cell += f"; worse {100 * s['worse_than_current']:.0f} %"
+            cells.append(cell)
+        lat = latency[name]
+        lines.append(f"| {name} | " + " | ".join(cells) + f" | {1e3 * lat['median']:.2f} / {1e3 * lat['p95']:.2f} |")
+    return "\n".join(lines)
+
+
+def figure(summary, path: Path, title: str):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4))
+    x = np.array(FRACTIONS)
+    for name, by_fraction in summary.items():
+        med = np.array([by_fraction[f]["median"] for f in FRACTIONS])
+        lo = np.array([by_fraction[f]["q25"] for f in FRACTIONS])
+        hi = np.array([by_fraction[f]["q75"] for f in FRACTIONS])
+        line, = ax.plot(x, med, marker="o", label=name)
+        ax.fill_between(x, lo, hi, color=line.get_color(), alpha=0.12)
+    ax.set_yscale("log")
+    ax.set_xlabel("fraction of the movement time seen")
+    ax.set_ylabel("endpoint error / D (median, IQR)")
+    ax.set_title(title, fontsize=10)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--source", choices=("cursory", "simulated"), default="cursory")
+    parser.add_argument("--split", choices=("development", "held_out"), default="development",
+                        help="cursory split; held_out only to report a claimed improvement")
+    parser.add_argument("--limit", type=int, default=None, help="at most this many movements")
+    parser.add_argument("--models", default="planar,human,people", help="presets whose OnlineGoalEstimator is scored")
+    parser.add_argument("--only", default=None, help="comma-separated predictor names to run (default: all)")
+    parser.add_argument("--scale", type=float, default=None, help="cursory pixels to metres (m/px)")
+    parser.add_argument("--count", type=int, default=100, help="simulated reaches")
+    parser.add_argument("--out", type=Path, default=None)
+    args = parser.parse_args(argv)
+    from comanip.estimation.template_matching import TemplateLibrary
+    from comanip.recordings import load_cursory
+    from comanip.recordings.cursory_data import SCALE
+
+    scale = args.scale or SCALE
+    development = load_cursory("development", scale=scale)
+    if args.source == "cursory":
+        recordings = development if args.split == "development" else load_cursory("held_out", scale=scale)
+        title = f"cursory mouse movements, {args.split} split"
+    else:
+        recordings = simulated_recordings("planar", args.count, seed=1)
+        title = "reaches sampled from the planar preset's own noise"
+    if args.limit:
+        recordings = recordings[:args.limit]
+    library = TemplateLibrary(development)
+    made = predictors([m for m in args.models.split(",") if m], library, exclude_self=args.split == "development")
+    if args.only:
+        made = {k: v for k, v in made.items() if any(o.strip() in k for o in args.only.split(","))}
+    names = list(made)
+    out = args.out or Path(__file__).parent / "results" / f"real_people_{args.source}_{args.split if args.source == 'cursory' else 'planar'}"
+    out.mkdir(parents=True, exist_ok=True)
+    rows, latency = [], {name: [] for name in names}
+    first = {name: [] for name in names}
+    begin = time.perf_counter()
+    for i, recording in enumerate(recordings):
+        D = recording.distance
+        current = None
+        for name in names:
+            answers, times = run_predictor(made[name], recording)
+            latency[name] += times[1:]
+            first[name].append(times[0])
+            errors = [float(np.linalg.norm(goal - recording.end)) / D for goal, _ in answers]
+            if name == "current position":
+                current = errors
+            for f, (goal, cov), error in zip(FRACTIONS, answers, errors):
+                covered = None
+                if cov is not None:
+                    e = goal - recording.end
+                    try:
+                        covered = bool(e @ np.linalg.solve(cov, e) <= chi2.ppf(0.95, len(e)))
+                    except np.linalg.LinAlgError:
+                        covered = False
+                rows.append({"movement": recording.name, "predictor": name, "fraction": f, "distance_m": D,
+                             "movement_time_s": recording.movement_time, "error": error, "covered": covered})
+        for row in rows[-len(names) * len(FRACTIONS):]:
+            row["current_error"] = current[FRACTIONS.index(row["fraction"])] if current else math.nan
+        if (i + 1) % 50 == 0 or i + 1 == len(recordings):
+            print(f"  {i + 1}/{len(recordings)} movements, {time.perf_counter() - begin:.0f} s", flush=True)
+    summary = summarise(rows, names)
+    lat = {name: {"median": float(np.median(v)) if v else math.nan, "p95": float(np.percentile(v, 95)) if v else math.nan,
+                  "first_median": float(np.median(first[name]))} for name, v in latency.items()}
+    table = markdown(summary, lat, len(recordings), title)
+    print(table)
+    import csv
+    with open(out / "errors.csv", "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    (out / "summary.json").write_text(json.dumps({"source": args.source, "split": args.split, "scale_m_per_px": scale,
+                                                  "movements": len(recordings), "summary": summary, "latency_s": lat},
+                                                 indent=1))
+    (out / "summary.md").write_text(table + "\n")
+    figure(summary, out / "error_by_fraction.png", title)
+    print(f"wrote {out}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,191 @@
+"""Where a person's moving hand will stop: a model fitted to recorded people's movements.
+
+From the movement so far (times t_k s, positions x_k m, velocities v_k m/s, k ≤ K, from a hand at rest at
+x_0) :func:`movement_features` computes numbers that say how far along its movement the hand is, most of
+them without units: time since the onset tau, path length since the onset L, the speed now over the peak
+speed so far, the acceleration, time since the peak speed over tau, the path length at the peak over L, the
+straightness |x_K - x_0| / L, the angle between the velocity and the displacement, and v_peak tau / L.
+Two gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
+them how far beyond the hand the endpoint lies along the direction of motion u (the hand's displacement over
+the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
+endpoint is never behind the hand along u. Its covariance is isotropic: the predicted squared error times a
+factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors).
+
+The fitted model ships with comanip (``comanip/data/people_endpoint_model.pkl``), fitted on the development
+split of the ``cursory`` mouse recordings mapped to arm scale (:mod:`comanip.recordings.cursory_data`):
+``python -m comanip.estimation.people_model`` fits it again.
+"""
+
+from __future__ import annotations
+
+import math
+import pickle
+from dataclasses import dataclass
+from importlib import resources
+from pathlib import Path
+
+import numpy as np
+from scipy.stats import chi2
+
+from sklearn.ensemble import HistGradientBoostingRegressor
+from threadpoolctl import ThreadpoolController
+
+from comanip.estimation.endpoint_baselines import MOVING_SPEED, EndpointPrediction
+
+FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak", "acceleration_scaled",
+            "since_peak_over_tau", "path_at_peak_over_path", "straightness", "direction_cosine", "peak_speed_tau_over_path")
+"""Names of :func:`movement_features`' numbers, in order."""
+SHIPPED = "people_endpoint_model.pkl"
+"""File name of the fitted model in ``comanip/data``."""
+DIRECTION_WINDOW = 0.05
+"""The direction of motion u is that of the hand's displacement over the last this many seconds (s)."""
+QUANTILE = 0.3
+"""The along regressor predicts this quantile of the distance still to go: below the median, since a goal
+predicted beyond where the hand stops costs a robot more than one predicted short of it."""
+_MIN_PATH = 1e-4
+_MIN_RECENT = 2e-3
+_ONE_THREAD = ThreadpoolController()
+
+
+def movement_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray, start: np.ndarray):
+    """(features (len(FEATURES),), direction u (d,), path length L m) of the movement so far, or None before its onset.
+
+    Args:
+        t: times (K,), s; position: (K, d) m; velocity: (K, d) m/s; start: rest position x_0 (d,), m.
+    """
+    speed = np.sqrt((velocity * velocity).sum(axis=1))
+    moving = np.flatnonzero(speed > MOVING_SPEED)
+    if moving.size == 0:
+        return None
+    first = int(moving[0])
+    covered = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))]
+    path = covered[-1] - covered[first] + _MIN_PATH
+    tau = t[-1] - t[first] + 1e-3
+    peak = int(np.argmax(speed))
+    offset = position[-1] - start
+    displacement = math.sqrt(float(offset @ offset))
+    recent = position[-1] - position[int(np.searchsorted(t, t[-1] - DIRECTION_WINDOW))]
+    recent_length = math.sqrt(float(recent @ recent))
+    if recent_length > _MIN_RECENT:
+        u = recent / recent_length
+    elif speed[-1] > 1e-3:
+        u = velocity[-1] / speed[-1]
+    elif displacement > 0:
+        u = offset / displacement
+    else:
+        u = np.eye(len(start))[0]
+    acceleration = (speed[-1] - speed[-2]) / (t[-1] - t[-2]) if len(t) > 1 and t[-1] > t[-2] else 0.0
+    features = np.array([tau, path, speed[-1], speed[peak], speed[-1] / speed[peak], acceleration * tau / speed[peak],
+                         (t[-1] - t[peak]) / tau, (covered[peak] - covered[first]) / path, displacement / path,
+                         float(u @ offset) / displacement if displacement > 0 else 1.0, speed[peak] * tau / path])
+    return features, u, path
+
+
+@dataclass
+class PeopleModel:
+    """The fitted endpoint model (module docstring)."""
+
+    along: object
+    """Regressor of the endpoint's distance beyond the hand along u, over L (its ``QUANTILE`` quantile)."""
+    spread: object
+    """Regressor of log(|error|² / L²) from the features."""
+    coverage_factor: float
+    """Multiplies the predicted squared error so the 95 % region holds 95 % of the fitting samples' endpoints."""
+    trained_on: str = ""
+    """What the model was fitted on."""
+
+    @classmethod
+    def fit(cls, recordings, trained_on: str = "", seed: int = 0, progress=None) -> "PeopleModel":
+        """Fit on recordings (:class:`comanip.recordings.Recording`), every sample from each one's onset to its
+        end: the spread and the coverage factor on two-fold out-of-sample errors of the along regressor, then
+        the along regressor on all samples. ``progress``: called with a line of text per stage."""
+        say = progress or (lambda line: None)
+        X, along, across, owner = _samples(recordings)
+        fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
+        predicted = np.zeros(len(X))
+        for k in (0, 1):
+            say(f"along regressor, fold {k + 1} of 2 ({int((fold != k).sum())} samples)")
+            predicted[fold == k] = _along_regressor(X[fold != k], along[fold != k], seed).predict(X[fold == k])
+        squared = (np.maximum(predicted, 0.0) - along) ** 2 + across**2
+        say("spread regressor")
+        spread = HistGradientBoostingRegressor(max_iter=120, learning_rate=0.06, random_state=seed).fit(X, np.log(squared + 1e-6))
+        d = recordings[0].position.shape[1]
+        factor = float(np.quantile(squared / np.exp(spread.predict(X)), 0.95) / chi2.ppf(0.95, d) * d)
+        say("along regressor, all samples")
+        return cls(_along_regressor(X, along, seed), spread, factor, trained_on)
+
+    def predict(self, t, position, velocity, start) -> EndpointPrediction | None:
+        """The endpoint (d,) m and its covariance (d, d) m² from the movement so far (:func:`movement_features`'
+        arguments), or None before the onset."""
+        described = movement_features(t, position, velocity, start)
+        if described is None:
+            return None
+        features, u, path = described
+        with _ONE_THREAD.limit(limits=1, user_api="openmp"):      # threads cost more than one row takes
+            along = float(self.along.predict(features[None])[0])
+            log_squared = float(self.spread.predict(features[None])[0])
+        goal = position[-1] + path * max(along, 0.0) * u
+        variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
+        return EndpointPrediction(goal, variance * np.eye(len(u)))
+
+    def save(self, path: str | Path) -> Path:
+        """Write the model (pickle) to ``path``."""
+        path = Path(path)
+        path.write_bytes(pickle.dumps(self))
+        return path
+
+
+def _along_regressor(X, along, seed: int):
+    return HistGradientBoostingRegressor(max_iter=250, learning_rate=0.06, loss="quantile", quantile=QUANTILE,
+                                         random_state=seed).fit(X, along)
+
+
+def _samples(recordings):
+    """Features (N, F), the endpoint's offset from the hand over L along u (N,) and across it (N,), and the
+    index of the recording of each sample (N,), for every sample from onset to end of the recordings."""
+    X, along, across, owner = [], [], [], []
+    for index, recording in enumerate(recordings):
+        for k in range(2, len(recording.t) + 1):
+            described = movement_features(recording.t[:k], recording.position[:k], recording.velocity[:k], recording.position[0])
+            if described is None:
+                continue
+            features, u, path = described
+            e = recording.end - recording.position[k - 1]
+            on = float(e @ u)
+            X.append(features)
+            along.append(on / path)
+            across.append(math.sqrt(max(float(e @ e) - on * on, 0.0)) / path)
+            owner.append(index)
+    return np.array(X), np.array(along), np.array(across), np.array(owner)
+
+
+_LOADED: dict[str, PeopleModel] = {}
+
+
+def shipped_people_model() -> PeopleModel:
+    """The model fitted to recorded people that ships with comanip (loaded once)."""
+    if SHIPPED not in _LOADED:
+        _LOADED[SHIPPED] = pickle.loads((resources.files("comanip") / "data" / SHIPPED).read_bytes())
+    return _LOADED[SHIPPED]
+
+
+def main(argv=None):
+    """Fit the shipped model on the development split of the cursory recordings and write it into the package."""
+    import argparse
+
+    from comanip.recordings import load_cursory
+
+    parser = argparse.ArgumentParser(description="Fit the people endpoint model on the cursory development split.")
+    parser.add_argument("--out", type=Path, default=Path(str(resources.files("comanip") / "data" / SHIPPED)))
+    args = parser.parse_args(argv)
+    recordings = load_cursory("development")
+    print(f"fitting on {len(recordings)} development movements ...", flush=True)
+    from comanip.estimation import people_model     # the class under its importable name, not __main__'s, for the pickle
+
+    model = people_model.PeopleModel.fit(recordings, trained_on=f"cursory 2.1.0 development split ({len(recordings)} movements)",
+                            progress=lambda line: print(f"  {line}", flush=True))
+    print(f"coverage factor {model.coverage_factor:.3f}; wrote {model.save(args.out)}")
+
+
+if __name__ == "__main__":
+    main()
