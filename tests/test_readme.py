@@ -143,7 +143,7 @@ def test_readme_needs_nothing_outside_the_repository():
 
 
 def _numbers_script():
-    """docs/make_readme_numbers.py as a module (a script, not part of the package)."""
+    """studies/regenerate_results.py as a module (a script, not part of the package)."""
     import importlib.util
 
     spec = importlib.util.spec_from_file_location("make_readme_numbers", README.parent / "docs" / "make_readme_numbers.py")
@@ -174,12 +174,12 @@ def markdown_tables(text: str) -> list[tuple[int, list[str]]]:
 
 def test_every_table_of_measured_numbers_is_a_marked_block_with_its_script():
     """A table with a digit in its body is measured: it sits between <!-- NAME:begin/end --> markers that
-    docs/make_readme_numbers.py knows (and rewrites by running the script it names), unless it is one of the
+    studies/regenerate_results.py knows (and rewrites by running the script it names), unless it is one of the
     tables of settings above. Every block has a script that exists, and every script's block is in the README."""
     script = _numbers_script()
     text = README.read_text(encoding="utf-8")
     names = script.block_names(text)
-    assert sorted(names) == sorted(script.BLOCKS), "README blocks and docs/make_readme_numbers.py's BLOCKS differ"
+    assert sorted(names) == sorted(script.BLOCKS), "README blocks and studies/regenerate_results.py's BLOCKS differ"
     for name, (_, command) in script.BLOCKS.items():
         for word in command:
             if word.endswith((".py", ".yaml")):

@@ -1,6 +1,6 @@
 """``report.md``: the validation report dictionary of :func:`comanip.validation.run.run_validation` as tables.
 
-The human-likeness section's verdict table (:func:`verdict_table`) is also what ``docs/make_calibration_table.py``
+The human-likeness section's verdict table (:func:`verdict_table`) is also what ``studies/which_model_options_make_reaching_human_like/make_calibration_table.py``
 writes into the README."""
 
 from __future__ import annotations

@@ -39,7 +39,7 @@ ROBOT_COVARIANCE_SCALE = 3.0
 """OnlineOptions.covariance_scale of the policy's belief: the factor that brings the 95 % ellipsoid's coverage,
 on reaches sampled from the corrected process, to 90–98 %: chosen on sampling seed 1, 150 reaches (pooled over
 0.2–0.8 s 87.0 % unscaled, 93.0 / 94.3 / 95.8 % with 2 / 3 / 5 for z led from the start; with this belief,
-z led from 0.2 s, 94.2 %); ``docs/measure_goal_estimation.py --belief robot`` reports seed 0."""
+z led from 0.2 s, 94.2 %); ``studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot`` reports seed 0."""
 
 ROBOT_BELIEF = dataclasses.replace(CORRECTING_PERSON, led_axes=ROBOT_LED_AXES, led_deviation_time=ROBOT_LED_DEVIATION_TIME,
                                    led_from=0.2, covariance_scale=ROBOT_COVARIANCE_SCALE)

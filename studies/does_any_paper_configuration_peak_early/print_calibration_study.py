@@ -1,7 +1,7 @@
 """Print the README's calibration-study block: every configuration of the planar preset's family over the
 Fitts grid, with its t_peak/MT range, movement times, Fitts and Shannon R², and the two verdicts.
 
-    PYTHONPATH=src python docs/print_calibration_study.py [--workers N] [--seed 0]
+    PYTHONPATH=src python studies/does_any_paper_configuration_peak_early/print_calibration_study.py [--workers N] [--seed 0]
 
 The same study, settings and rows as ``comanip validate`` (full run; ``report.md``, "Calibration study"),
 as a shorter table; the verdicts' definitions are in :mod:`comanip.analysis.calibration`.
@@ -30,7 +30,7 @@ def study_block(rows: list[dict], settings: ValidationSettings, seconds: float) 
                      f"{r['asymmetry_max']:.2f} | {r['mt_min_s']:.2f}–{r['mt_max_s']:.2f} | {r['fitts_r2']:.3f} / "
                      f"{r['shannon_r2']:.3f} | {'yes' if r['fitts_law'] else 'no'} | {'yes' if r['early_peak'] else 'no'} |")
     both = [r["configuration"] for r in rows if r["both"]]
-    return (f"Measured by `docs/print_calibration_study.py` ({len(rows)} configurations; D ∈ {list(settings.distances)} m × "
+    return (f"Measured by `studies/does_any_paper_configuration_peak_early/print_calibration_study.py` ({len(rows)} configurations; D ∈ {list(settings.distances)} m × "
             f"w ∈ {list(settings.widths)} m; closed loop: {settings.calibration_trials} executions per condition; seed "
             f"{settings.seed}; {seconds:.0f} s). Configurations with Fitts' law and an early peak at once: "
             f"{', '.join(both) if both else '**none**'}. {LABELS}\n\n" + "\n".join(lines))

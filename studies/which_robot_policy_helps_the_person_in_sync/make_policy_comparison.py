@@ -1,19 +1,19 @@
-"""Print the README's robot-policy comparison block (sync scenario, issue 12) from a fresh simulation
-(``docs/make_readme_numbers.py policy-comparison`` puts it in the README).
+"""Print the robot-policy comparison block of docs/results/policy_comparison.md (sync scenario) from a fresh simulation
+(``studies/regenerate_results.py policy-comparison`` puts it in the README).
 
-    PYTHONPATH=src python docs/make_policy_comparison.py [--trials 20] [--seed 0]
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py [--trials 20] [--seed 0]
 
 On a busy machine the goals can run in separate processes and be merged afterwards:
 
-    PYTHONPATH=src python docs/make_policy_comparison.py --goals near,far --save /tmp/a.pkl
-    PYTHONPATH=src python docs/make_policy_comparison.py --goals right,high --save /tmp/b.pkl
-    PYTHONPATH=src python docs/make_policy_comparison.py --load /tmp/a.pkl /tmp/b.pkl
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --goals near,far --save /tmp/a.pkl
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --goals right,high --save /tmp/b.pkl
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --load /tmp/a.pkl /tmp/b.pkl
 
 (--policies re-runs some policies only; a later pickle's runs replace an earlier one's for the same goal and policy.)
 
 Runs every robot policy (:data:`comanip.simulation.policies.POLICIES`) on the synchronisation scenario for
 the near and far goals and two more (GOALS), ``--trials`` trials each with the same person seeds for every
-policy, and writes docs/policy_comparison_sync.csv and .md (median [q25, q75] over the trials),
+policy, and writes studies/which_robot_policy_helps_the_person_in_sync/policy_comparison_sync.csv and .md (median [q25, q75] over the trials),
 docs/figures/policy_comparison_sync.png, and prints the table with its verdicts (stdout; progress on stderr).
 """
 
@@ -98,16 +98,16 @@ def main(argv: list[str] | None = None) -> int:
             return 0
     rows = comparison_rows(results)
     files = write_comparison(rows, DOCS / "policy_comparison_sync")
-    figure = plot_policy_comparison(results, DOCS / "figures" / "policy_comparison_sync.png")
+    figure = plot_policy_comparison(results, DOCS.parents[1] / "docs" / "figures" / "policy_comparison_sync.png")
     goals = "; ".join(f"{label} {np.round(s.goal, 2).tolist()}" for label, s in settings.items())
-    block = (f"Measured by `PYTHONPATH=src python docs/make_policy_comparison.py --trials {trials} --seed {seed}` "
+    block = (f"Measured by `PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --trials {trials} --seed {seed}` "
              f"({trials} trials per goal and policy, person seeds {seed}–{seed + trials - 1} for every "
              f"policy; goals (m): {goals}; prior goal {list(next(iter(settings.values())).prior_goal)} m; "
              f"{wall / 60:.0f} min of simulation on the shared, loaded 2-core machine). Each cell: median [q25, q75] over "
              f"the trials; force and work from t_o = 0.2 s on.\n\n"
              f"{markdown_table(rows)}\n"
-             f"Verdicts (issue 12's \"done when\"):\n\n" + "\n".join(verdicts(rows)) + "\n\n"
-             f"![policy comparison]({figure.relative_to(DOCS.parent)})")
+             f"Verdicts (does the continuous policy beat every baseline?):\n\n" + "\n".join(verdicts(rows)) + "\n\n"
+             f"![policy comparison](../figures/{figure.name})")
     print(block)
     print("wrote", *[str(p) for p in files + [figure]], file=sys.stderr)
     return 0

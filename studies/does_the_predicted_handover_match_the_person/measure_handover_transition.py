@@ -1,21 +1,21 @@
 """Where the simulated person's reach turns from the fast sub-movement to the corrective one, against the
-handover's predicted transition T (issue 12, item 6).
+handover's predicted transition T.
 
-    PYTHONPATH=src python docs/measure_handover_transition.py [--trials 20] [--transition-data CSV]
+    PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py [--trials 20] [--transition-data CSV]
         [--passive PKL ...]
-    PYTHONPATH=src python docs/measure_handover_transition.py --release [--trials 10]
+    PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py --release [--trials 10]
 
 For the near and far goals: the transition distance T the handover predicts (:class:`TransitionModel` on the
 shipped planar data, or on --transition-data, e.g. made by ``comanip transition generate --preset
 cartesian``), the distance at which the robot released, the peak of the perpendicular spread of the handle
 paths in the handover run, and the same peak for the person alone (a passive robot in the sync scenario,
 same seeds: the person's own transition; --passive reuses pickles written by
-``docs/make_policy_comparison.py --save``). Writes docs/handover_transition.md.
+``studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --save``). Writes studies/does_the_predicted_handover_match_the_person/handover_transition.md.
 
 With --release: the two release triggers (``HandoverSettings.release_trigger``) over the same trials and
 seeds, per goal: when and where the robot let go against the predicted transition and, paired by seed,
 against the goal-distance trigger; the estimate at the release; the final placement error and the person's
-RMS interaction force. Replaces the block between the release markers of docs/handover_transition.md.
+RMS interaction force. Replaces the block between the release markers of studies/does_the_predicted_handover_match_the_person/handover_transition.md.
 """
 
 from __future__ import annotations
@@ -41,7 +41,7 @@ def spread_peak(paths: np.ndarray, goal: np.ndarray) -> tuple[float, float]:
 
 
 RELEASE_BEGIN, RELEASE_END = "<!-- release:begin -->", "<!-- release:end -->"
-#: The heading of docs/handover_transition.md's section on the release triggers, kept by the default mode.
+#: The heading of studies/does_the_predicted_handover_match_the_person/handover_transition.md's section on the release triggers, kept by the default mode.
 RELEASE_SECTION = "## What releases the robot"
 
 
@@ -80,13 +80,13 @@ def release_table(trials: int, seed: int) -> str:
                          f"{_median_iqr(m['rms_force_N'], 1, 1)}; {_median_iqr(m['rms_force_change_N'], 1, 1)}"])
     table = "\n".join(["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)] +
                       ["| " + " | ".join(row) + " |" for row in rows])
-    command = f"PYTHONPATH=src python docs/measure_handover_transition.py --release --trials {trials}"
+    command = f"PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py --release --trials {trials}"
     return (f"{RELEASE_BEGIN}\nMedian [quartiles] over {trials} trials per goal (seeds {seed}–{seed + trials - 1}, the same "
             f"for both triggers); measured by `{command}`.\n\n{table}\n{RELEASE_END}")
 
 
 def write_release_block(block: str) -> None:
-    """Put block in place of the release markers' block of docs/handover_transition.md (or at its end)."""
+    """Put block in place of the release markers' block of studies/does_the_predicted_handover_match_the_person/handover_transition.md (or at its end)."""
     path = DOCS / "handover_transition.md"
     text = path.read_text()
     if RELEASE_BEGIN in text:
@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
                 "person alone: handle spread peak (m, peak spread)", "person alone: intention spread peak (m)"]
     table = "\n".join(["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)] +
                       ["| " + " | ".join(row) + " |" for row in rows]) + "\n"
-    command = f"PYTHONPATH=src python docs/measure_handover_transition.py --trials {args.trials}" + \
+    command = f"PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py --trials {args.trials}" + \
               (f" --transition-data {args.transition_data}" if args.transition_data else "")
     text = f"Distances from the goal; measured by `{command}` (seeds {args.seed}–{args.seed + args.trials - 1}).\n\n{table}"
     suffix = "" if args.transition_data is None else "_" + args.transition_data.stem

@@ -1,5 +1,5 @@
-"""Marked blocks of README.md: the text between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` lines, which
-``docs/make_readme_numbers.py`` rewrites from the output of the script that measures them."""
+"""Marked blocks of the results pages (docs/results/*.md): the text between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` lines, which
+``studies/regenerate_results.py`` rewrites from the output of the script that measures them."""
 
 from __future__ import annotations
 
@@ -40,9 +40,9 @@ def block_spans(text: str) -> dict[str, tuple[int, int]]:
 
 
 def replace_block(text: str, name: str, block: str) -> str:
-    """text with the content of block ``name`` replaced by ``block``; ValueError if the README lacks it."""
+    """text with the content of block ``name`` replaced by ``block``; ValueError if the text lacks it."""
     if name not in block_names(text):
-        raise ValueError(f"README.md has no block <!-- {name}:begin --> … <!-- {name}:end -->")
+        raise ValueError(f"no block <!-- {name}:begin --> … <!-- {name}:end -->")
     begin, end = f"<!-- {name}:begin -->", f"<!-- {name}:end -->"
     head, rest = text.split(begin)
     _, tail = rest.split(end)

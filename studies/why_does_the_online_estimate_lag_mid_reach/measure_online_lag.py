@@ -1,6 +1,6 @@
-"""Why the continuous goal estimate lags in the middle of a sync reach (issue 12): writes docs/online_lag.md.
+"""Why the continuous goal estimate lags in the middle of a sync reach: writes studies/why_does_the_online_estimate_lag_mid_reach/online_lag.md.
 
-    PYTHONPATH=src python docs/measure_online_lag.py [--trials 5] [--seed 20]
+    PYTHONPATH=src python studies/why_does_the_online_estimate_lag_mid_reach/measure_online_lag.py [--trials 5] [--seed 20]
 
 Runs the constant-velocity and continuous robots on the sync scenario's four goals (``--trials`` person seeds
 from ``--seed``; by default seeds the README's table does not use), then prints, as medians over the trials:
@@ -98,8 +98,8 @@ def main() -> None:
     results = compare_sync_policies(settings, ["constant-velocity", "continuous"], setup)
     model = setup.model
     planner = OnlineGoalEstimator(model, np.zeros(model.state_size)).planner
-    out = [f"# Why the continuous goal estimate lags mid-reach (issue 12)\n",
-           f"Measured by `PYTHONPATH=src python docs/measure_online_lag.py --trials {args.trials} --seed {args.seed}` "
+    out = [f"# Why the continuous goal estimate lags mid-reach\n",
+           f"Measured by `PYTHONPATH=src python studies/why_does_the_online_estimate_lag_mid_reach/measure_online_lag.py --trials {args.trials} --seed {args.seed}` "
            f"(sync scenario, person seeds {args.seed}–{args.seed + args.trials - 1}, medians over the trials; "
            "{wall} s).\n"]
     for label, by_policy in results.items():

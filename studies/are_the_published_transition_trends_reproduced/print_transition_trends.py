@@ -1,6 +1,6 @@
 """Print the README's block on Peternel & Babič's trends: the shipped transition data and the GP fitted to it.
 
-    PYTHONPATH=src python docs/print_transition_trends.py [--data transition.csv]
+    PYTHONPATH=src python studies/are_the_published_transition_trends_reproduced/print_transition_trends.py [--data transition.csv]
 
 The same numbers as ``comanip transition fit`` writes to ``trends.json`` (:func:`comanip.multicomponent.trends.trend_report`),
 as a markdown table.
@@ -49,7 +49,7 @@ def trends_block(report: dict, data_name: str) -> str:
         verdicts = [trend["data"]["verdict"] if trend["data"] else "–", trend["model"]["verdict"] if trend["model"] else "–"]
         verdict = " / ".join(v if v == "reproduced" or v == "–" else f"**{v}**" for v in verdicts)
         rows.append(f"| {trend['claim']} | {data_cell(trend)} | {model_cell(trend)} | {verdict} |")
-    return (f"Measured by `docs/print_transition_trends.py` on `{data_name}` ({report['rows']} rows): "
+    return (f"Measured by `studies/are_the_published_transition_trends_reproduced/print_transition_trends.py` on `{data_name}` ({report['rows']} rows): "
             f"{report['method']}\n\n" + "\n".join(rows))
 
 

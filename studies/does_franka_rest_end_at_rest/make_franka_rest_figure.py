@@ -1,10 +1,10 @@
 """Joint velocities of one Franka reach before and after the speed cost: the paper's ``franka`` preset
 (left) and ``franka_rest`` (right), each solved cold from rest at the ready pose to the same goal.
 
-    PYTHONPATH=src python docs/make_franka_rest_figure.py [--offset 0.15 0.1 -0.1]
+    PYTHONPATH=src python studies/does_franka_rest_end_at_rest/make_franka_rest_figure.py [--offset 0.15 0.1 -0.1]
 
 Writes docs/figures/franka_joint_velocities.png: every joint's mean speed as a fraction of its limit
-(qdot / qdot_max, ±1 dashed), MT (SPEC §6, the hand has stopped) dotted; prints each plan's largest final joint
+(qdot / qdot_max, ±1 dashed), MT (docs/formulation.md §6, the hand has stopped) dotted; prints each plan's largest final joint
 speed and the time after MT with a joint at ≥ 95 % of its speed limit.
 """
 
@@ -23,7 +23,7 @@ import comanip  # noqa: E402
 from comanip.analysis import settling_motion, speed_metrics  # noqa: E402
 from comanip.plots.figure_file import save_figure  # noqa: E402
 
-OUT = Path(__file__).resolve().parent / "figures" / "franka_joint_velocities.png"
+OUT = Path(__file__).resolve().parents[2] / "docs" / "figures" / "franka_joint_velocities.png"   # shown in the user guide
 
 
 def main(argv=None) -> None:

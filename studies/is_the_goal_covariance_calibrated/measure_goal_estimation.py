@@ -1,4 +1,4 @@
-"""The numbers of the README section "Goal estimation" on the goal's uncertainty and the prior (issue 12).
+"""The numbers of docs/results/calibration.md on the goal's uncertainty and the prior.
 
 1. Calibration of the online estimator's goal covariance: reaches from rest to goals 0.15–0.45 m away in
    random directions, sampled from the model's own noisy dynamics (open loop, as the belief assumes; between
@@ -15,10 +15,10 @@
    the one-shot estimate and the online estimator with the default prior, and of the one-shot estimate with
    the paper's weighting (prior_std="width").
 
-    PYTHONPATH=src python docs/measure_goal_estimation.py [--reaches 200] [--presets cartesian,planar] [--markdown]
-    PYTHONPATH=src python docs/measure_goal_estimation.py --belief robot [--reaches 200] [--seed 0]   # only 2.
+    PYTHONPATH=src python studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py [--reaches 200] [--presets cartesian,planar] [--markdown]
+    PYTHONPATH=src python studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot [--reaches 200] [--seed 0]   # only 2.
 
-``--markdown`` prints the README's block ``goal-calibration`` (docs/make_readme_numbers.py) instead.
+``--markdown`` prints the README's block ``goal-calibration`` (studies/regenerate_results.py) instead.
 """
 
 from __future__ import annotations
@@ -125,7 +125,7 @@ def robot_table(results: dict[str, dict], reaches: int, seed: int) -> str:
         lines.append(f"| {label} | " + " | ".join(cells) + f" | {pooled:.1f} % |")
     return "\n".join(lines) + (f"\n\n(The sync robot's belief on {reaches} Cartesian reaches sampled from the corrected process "
                                f"(seed {seed}), 95 % ellipsoid coverage and median goal error; "
-                               "`docs/measure_goal_estimation.py --belief robot`.)\n")
+                               "`studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot`.)\n")
 
 
 def markdown_block(results: dict[str, dict], exact: dict, reaches: int) -> str:
@@ -138,7 +138,7 @@ def markdown_block(results: dict[str, dict], exact: dict, reaches: int) -> str:
     one_low, one_high = exact["one-shot, default prior"]
     paper_low, paper_high = exact["one-shot, prior_std='width' (paper)"]
     lines += ["", f"(Coverage of the 95 % ellipsoid and median goal error over {reaches} reaches per preset, each estimate "
-              "from all observations up to that time; `docs/measure_goal_estimation.py --markdown`.) An exact "
+              "from all observations up to that time; `studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --markdown`.) An exact "
               f"observation at 0.165 s on the Cartesian preset with a prior 0.2–0.45 m off: online {low:.2f}–{high:.2f} %, "
               f"one-shot {one_low:.3f}–{one_high:.3f} % of the distance with the default prior; "
               f"{paper_low:.0f}–{paper_high:.0f} % with `prior_std=\"width\"` (the paper's)."]

@@ -1,7 +1,7 @@
-"""Print the README's human-likeness block from a fresh measurement (``docs/make_readme_numbers.py
+"""Print the README's human-likeness block from a fresh measurement (``studies/regenerate_results.py
 human-targets`` puts it in the README).
 
-    PYTHONPATH=src python docs/make_calibration_table.py [PRESET ...] [--samples 2000] [--seed 0] [--trials 20]
+    PYTHONPATH=src python studies/which_model_options_make_reaching_human_like/make_calibration_table.py [PRESET ...] [--samples 2000] [--seed 0] [--trials 20]
 
 Scores each preset (a built-in name or a model YAML; default: ``human`` when that preset exists, then
 ``planar``) on the human-likeness targets (:func:`comanip.analysis.measure_human_targets`, the grid
@@ -30,7 +30,7 @@ def measured_block(names: list[str], samples: int, seed: int, trials: int) -> st
         if model.observation:  # a model with feedback is scored on its closed loop too
             results.append(measure_closed_loop_targets(model, trials, seed=seed))
     section = human_section(results)
-    command = " ".join(["docs/make_calibration_table.py", *names, f"--trials {trials}"])
+    command = " ".join(["studies/which_model_options_make_reaching_human_like/make_calibration_table.py", *names, f"--trials {trials}"])
     return (f"Measured by `{command}` ({samples} open-loop Monte Carlo executions per condition; {trials} closed-loop "
             f"executions per condition for a model with feedback (`observation`), scored on their mean velocity and "
             f"their hands at MT; seed {seed}; {time.perf_counter() - began:.0f} s for planning, executing and scoring): "
