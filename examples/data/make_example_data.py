@@ -53,11 +53,12 @@ def write_recordings() -> None:
 
 
 def write_hand() -> None:
-    """hand.csv: a Cartesian hand reaching for [0.35, 0.1, 0.05] m, at 100 Hz for 1 s (the node replay's input)."""
+    """hand.csv: a Cartesian hand reaching for [0.35, 0.1, 0.05] m, at 100 Hz for 1 s (the node replay's input):
+    the model's mean reach, as a tracker would sample it between the model's steps of 55 ms."""
     model = comanip.presets.cartesian()
-    times, states = noisy_reach(model, [0.35, 0.1, 0.05], seed=3)
+    plan = comanip.Planner(model).solve(np.zeros(6), [0.35, 0.1, 0.05], model.width)
     grid = np.arange(0.0, 1.0 + 1e-9, 0.01)
-    sampled = np.column_stack([np.interp(grid, times, states[:, j]) for j in range(states.shape[1])])
+    sampled = np.column_stack([np.interp(grid, plan.t, plan.mean[:, j]) for j in range(6)])
     header = "t_s,q0,q1,q2,qdot0,qdot1,qdot2"
     rows = [header] + [",".join(f"{v:.6g}" for v in (t, *s)) for t, s in zip(grid, sampled)]
     (HERE / "hand.csv").write_text("\n".join(rows) + "\n")
