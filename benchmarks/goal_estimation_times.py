@@ -1,9 +1,9 @@
 """Goal-estimation times: the one-shot estimate (`GoalEstimator.estimate`) against the online estimator
-(`OnlineGoalEstimator.update`), cold and warm, on the same noisy reaches, in the same run (issue 12).
+(`OnlineGoalEstimator.update`), cold and warm, on the same noisy reaches, in the same run.
 
     .venv/bin/python benchmarks/goal_estimation_times.py [--reaches 20] [--only cartesian,planar] [--markdown]
 
-``--markdown`` prints the README's block ``online-estimation-speed`` (studies/regenerate_results.py) instead.
+``--markdown`` prints the block ``online-estimation-speed`` of docs/results/speed.md (studies/regenerate_results.py) instead.
 
 Each reach goes from rest to a goal 0.15–0.45 m away in a random direction, sampled from the model's own
 noisy dynamics (open loop) and observed every 10 ms from 10 ms to 0.5 s with the default observation noise

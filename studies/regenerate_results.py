@@ -49,15 +49,15 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
 }
 
 RESULTS = ROOT / "docs" / "results"
-#: block name: the results page that shows it
-PAGES: dict[str, Path] = {
-    "calibration-study": RESULTS / "calibration.md",
-    "human-targets": RESULTS / "calibration.md",
-    "goal-calibration": RESULTS / "calibration.md",
-    "transition-trends": RESULTS / "calibration.md",
-    "policy-comparison": RESULTS / "policy_comparison.md",
-    "speed": RESULTS / "speed.md",
-    "online-estimation-speed": RESULTS / "speed.md",
+#: block name: the pages that show it (a results page, and for the solve times benchmarks/README.md too)
+PAGES: dict[str, tuple[Path, ...]] = {
+    "calibration-study": (RESULTS / "calibration.md",),
+    "human-targets": (RESULTS / "calibration.md",),
+    "goal-calibration": (RESULTS / "calibration.md",),
+    "transition-trends": (RESULTS / "calibration.md",),
+    "policy-comparison": (RESULTS / "policy_comparison.md",),
+    "speed": (RESULTS / "speed.md", ROOT / "benchmarks" / "README.md"),
+    "online-estimation-speed": (RESULTS / "speed.md",),
 }
 
 
@@ -73,20 +73,19 @@ def main(argv: list[str] | None = None) -> int:
     unknown = sorted(set(args.names) - set(BLOCKS))
     if unknown:
         parser.error(f"unknown blocks {unknown}; known: {', '.join(BLOCKS)}")
-    for name, page in PAGES.items():
-        if name not in block_names(page.read_text(encoding="utf-8")):
-            parser.error(f"{page} lacks the block {name}")
+    for name, pages in PAGES.items():
+        for page in pages:
+            if name not in block_names(page.read_text(encoding="utf-8")):
+                parser.error(f"{page} lacks the block {name}")
     for name in args.names or list(BLOCKS):
-        page = PAGES[name]
-        text = page.read_text(encoding="utf-8")
         command = [sys.executable, *BLOCKS[name][1]]
         began = time.perf_counter()
         print(f"{name}: {' '.join(BLOCKS[name][1])} …", file=sys.stderr, flush=True)
         # the script's progress goes to stderr, shown as it runs; its stdout is the block
         block = subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.PIPE, text=True,
                                env={**os.environ, "PYTHONPATH": str(ROOT / "src")}).stdout
-        text = replace_block(text, name, block)
-        page.write_text(text, encoding="utf-8")   # after each block: a later failure keeps the earlier ones
+        for page in PAGES[name]:   # written after each block: a later failure keeps the earlier ones
+            page.write_text(replace_block(page.read_text(encoding="utf-8"), name, block), encoding="utf-8")
         print(f"{name}: rewritten ({time.perf_counter() - began:.0f} s)", file=sys.stderr, flush=True)
     return 0
 

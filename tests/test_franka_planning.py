@@ -239,7 +239,7 @@ ROUNDING_SENSITIVE = pytest.mark.xfail(strict=False, reason=(
     "known: at 0.25 m two of the three starts stall along the joint limit with gradients of about 1.1e-4, just "
     "above the 1e-4 that makes a stalled point 'solved_acceptable'; since rows past their limits are no longer "
     "dropped when the step would drive them further out (newton._constrained_step) the third converges "
-    "('solved'), before that all three could stall, depending on rounding (benchmarks/HISTORY.md)"))
+    "('solved'), before that all three could stall, depending on rounding (git log -- benchmarks/HISTORY.md)"))
 
 
 @pytest.mark.parametrize("drop", [0.2, pytest.param(0.25, marks=ROUNDING_SENSITIVE)])
