@@ -1,4 +1,4 @@
-"""Print the README's block on Peternel & Babič's trends: the shipped transition data and the GP fitted to it.
+"""Print the results page's block on Peternel & Babič's trends: the shipped transition data and the GP fitted to it.
 
     PYTHONPATH=src python studies/are_the_published_transition_trends_reproduced/print_transition_trends.py [--data transition.csv]
 

@@ -1,4 +1,4 @@
-"""Print the README's calibration-study block: every configuration of the planar preset's family over the
+"""Print the calibration-study block of docs/results/calibration.md: every configuration of the planar preset's family over the
 Fitts grid, with its t_peak/MT range, movement times, Fitts and Shannon R², and the two verdicts.
 
     PYTHONPATH=src python studies/does_any_paper_configuration_peak_early/print_calibration_study.py [--workers N] [--seed 0]

@@ -18,7 +18,7 @@
     PYTHONPATH=src python studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py [--reaches 200] [--presets cartesian,planar] [--markdown]
     PYTHONPATH=src python studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot [--reaches 200] [--seed 0]   # only 2.
 
-``--markdown`` prints the README's block ``goal-calibration`` (studies/regenerate_results.py) instead.
+``--markdown`` prints the results page's block ``goal-calibration`` (studies/regenerate_results.py) instead.
 """
 
 from __future__ import annotations
@@ -129,7 +129,7 @@ def robot_table(results: dict[str, dict], reaches: int, seed: int) -> str:
 
 
 def markdown_block(results: dict[str, dict], exact: dict, reaches: int) -> str:
-    """The README's calibration table and the exact-observation line."""
+    """The results page's calibration table and the exact-observation line."""
     lines = ["| preset | " + " | ".join(f"{t:g} s" for t in CHECK_TIMES) + " |", "|---|" + "---|" * len(CHECK_TIMES)]
     for preset, result in results.items():
         cells = [f"{100 * c:.1f} % ({1e3 * e:.0f} mm)" for c, e in result.values()]
@@ -149,7 +149,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--reaches", type=int, default=200, help="noisy reaches per preset (default: %(default)s)")
     parser.add_argument("--presets", default="cartesian,planar", help="comma-separated presets (default: %(default)s)")
-    parser.add_argument("--markdown", action="store_true", help="print the README's block instead")
+    parser.add_argument("--markdown", action="store_true", help="print the results page's block instead")
     parser.add_argument("--belief", choices=["robot"], help="only item 2: the sync robot's belief")
     parser.add_argument("--seed", type=int, default=0, help="sampling seed of item 2 (default: %(default)s)")
     args = parser.parse_args()

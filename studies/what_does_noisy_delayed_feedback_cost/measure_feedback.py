@@ -1,4 +1,4 @@
-"""The numbers of the README section "Feedback from noisy, delayed observation".
+"""What noisy, delayed feedback costs a closed-loop reach (docs/guide/human_like.md, "Feedback from noisy, delayed observation").
 
 Closed-loop reaches of the planar preset (D = 0.3 m along x, w = 0.02 m, 60 steps, replanning every step),
 once from the exact state and once from the Kalman estimate made with noisy, delayed observation

@@ -1,5 +1,5 @@
-"""Print the README's human-likeness block from a fresh measurement (``studies/regenerate_results.py
-human-targets`` puts it in the README).
+"""Print the human-likeness block of docs/results/calibration.md from a fresh measurement (``studies/regenerate_results.py
+human-targets`` puts it on its results page).
 
     PYTHONPATH=src python studies/which_model_options_make_reaching_human_like/make_calibration_table.py [PRESET ...] [--samples 2000] [--seed 0] [--trials 20]
 

@@ -1,4 +1,4 @@
-"""Write the one-option variants of the ``human`` preset that the README's trade-off table scores
+"""Write the one-option variants of the ``human`` preset that the trade-off table of docs/results/calibration.md scores
 (studies/which_model_options_make_reaching_human_like/variants/*.yaml), so that every configuration in it can be rebuilt and rerun.
 
     PYTHONPATH=src python studies/which_model_options_make_reaching_human_like/make_variants.py

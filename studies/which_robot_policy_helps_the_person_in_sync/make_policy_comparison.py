@@ -1,5 +1,5 @@
 """Print the robot-policy comparison block of docs/results/policy_comparison.md (sync scenario) from a fresh simulation
-(``studies/regenerate_results.py policy-comparison`` puts it in the README).
+(``studies/regenerate_results.py policy-comparison`` puts it on its results page).
 
     PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py [--trials 20] [--seed 0]
 

@@ -1,7 +1,8 @@
 """``report.md``: the validation report dictionary of :func:`comanip.validation.run.run_validation` as tables.
 
-The human-likeness section's verdict table (:func:`verdict_table`) is also what ``studies/which_model_options_make_reaching_human_like/make_calibration_table.py``
-writes into the README."""
+The human-likeness section's verdict table (:func:`verdict_table`) is also what
+``studies/which_model_options_make_reaching_human_like/make_calibration_table.py`` writes into
+docs/results/calibration.md."""
 
 from __future__ import annotations
 

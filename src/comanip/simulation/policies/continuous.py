@@ -19,7 +19,7 @@ PRIOR_STD = 0.25
 """The robot's prior goal's standard deviation per axis (m): things are placed within about ±0.5 m of the table
 centre (the scenario's goals lie 0.07–0.38 m from it). With the estimator's weak default (10 m) the first
 estimates, from 0.2 s of the reach, were farther off than the prior alone (medians 0.18–0.40 m over 20 trials
-per goal); with this prior 0.06–0.19 m, and the final error within 0.2 mm of before (README, policy comparison)."""
+per goal); with this prior 0.06–0.19 m, and the final error within 0.2 mm of before (docs/results/policy_comparison.md)."""
 
 
 ROBOT_LED_AXES = (2,)
@@ -28,7 +28,7 @@ not the person's reach, so the estimator lets it stray by ROBOT_LED_DEVIATION_TI
 (OnlineOptions.led_axes): it counts for less while the hand moves and still pins the goal at rest."""
 
 ROBOT_LED_DEVIATION_TIME = 0.5
-"""sigma_t (s) along ROBOT_LED_AXES. Chosen on person seeds 20–24 (not the README table's) by replaying the
+"""sigma_t (s) along ROBOT_LED_AXES. Chosen on person seeds 20–24 (not the results table's) by replaying the
 continuous robot's recorded observations into the estimator: mean goal error t_o–MT 40.6/142/54.1/71.2 mm
 (near/far/right/high) with z read as the person's; 39.1/137/53.6/72.0 with 0.3 s, 39.3/131/51.7/71.4 with
 0.5 s, 40.8/129/49.5/87.5 with 1 s; final errors within 0.1 mm of the person's-z ones with 0.5 s. White
