@@ -35,6 +35,8 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                        *(f"studies/which_model_options_make_reaching_human_like/variants/human_{name}.yaml"
                          for name in ("paper_damping", "hit_reward", "effective_width", "stopping", "hyperbolic")),
                        "--trials", "20"]),
+    "feedback-cost": ("closed-loop reaches from the exact state against noisy, delayed observation (seconds)",
+                      ["studies/what_does_noisy_delayed_feedback_cost/measure_feedback.py", "--markdown"]),
     "online-estimation-speed": ("one-shot against online goal estimates, cold and warm (about 2 min)",
                                 ["benchmarks/goal_estimation_times.py", "--markdown", "--reaches", "20"]),
     "policy-comparison": ("robot policies compared on the sync scenario, 20 trials × 4 goals (about 10 min idle, an hour loaded)",
@@ -55,6 +57,7 @@ PAGES: dict[str, tuple[Path, ...]] = {
     "human-targets": (RESULTS / "calibration.md",),
     "goal-calibration": (RESULTS / "calibration.md",),
     "transition-trends": (RESULTS / "calibration.md",),
+    "feedback-cost": (RESULTS / "calibration.md",),
     "policy-comparison": (RESULTS / "policy_comparison.md",),
     "speed": (RESULTS / "speed.md", ROOT / "benchmarks" / "README.md"),
     "online-estimation-speed": (RESULTS / "speed.md",),

@@ -6,7 +6,9 @@ once from the exact state and once from the Kalman estimate made with noisy, del
 the RMS error of the estimated hand position (per run over its steps, then averaged over runs) and the
 wall time of a reach (median; depends on the machine's load).
 
-    PYTHONPATH=src python studies/what_does_noisy_delayed_feedback_cost/measure_feedback.py [--seeds 10]
+    PYTHONPATH=src python studies/what_does_noisy_delayed_feedback_cost/measure_feedback.py [--seeds 10] [--markdown]
+
+``--markdown`` prints the block ``feedback-cost`` of docs/results/calibration.md instead.
 """
 
 from __future__ import annotations
@@ -45,10 +47,24 @@ def measure(planner: comanip.Planner, observation: Observation | None, seeds: in
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--seeds", type=int, default=10, help="runs per loop, seeds 0..N-1 (default: %(default)s)")
+    parser.add_argument("--markdown", action="store_true", help="print the results page's block instead")
     args = parser.parse_args()
     planner = comanip.Planner(comanip.presets.planar())
-    for label, observation in (("exact state", None), ("vision", VISION)):
-        result = measure(planner, observation, args.seeds)
+    results = {label: measure(planner, observation, args.seeds) for label, observation in
+               (("exact state", None), ("vision", VISION))}
+    if args.markdown:
+        print(f"Measured by `studies/what_does_noisy_delayed_feedback_cost/measure_feedback.py --seeds {args.seeds}` "
+              f"(planar preset, D = {GOAL[0]} m, w = {WIDTH} m, {STEPS} steps replanned every step, seeds "
+              f"0–{args.seeds - 1}; vision: {VISION.position_std * 1000:g} mm / {VISION.velocity_std:g} m/s noise, "
+              f"{VISION.delay:g} s late).\n")
+        print("| loop | final error, median (mm) | final error, max (mm) | estimated hand, RMS error (mm) | wall time of a reach, median (s) |")
+        print("|---|---|---|---|---|")
+        for label, result in results.items():
+            rms = "–" if result["estimate_rms_mm"] is None else f"{result['estimate_rms_mm']:.1f}"
+            print(f"| {label} | {result['final_error_median_mm']:.2g} | {result['final_error_max_mm']:.2g} | {rms} | "
+                  f"{result['reach_wall_time_median_s']:.2f} |")
+        return
+    for label, result in results.items():
         rms = "" if result["estimate_rms_mm"] is None else f", estimated hand off by {result['estimate_rms_mm']:.1f} mm RMS"
         print(f"{label}: final error {result['final_error_median_mm']:.2g} mm median, {result['final_error_max_mm']:.2g} mm max"
               f"{rms}; a reach takes {result['reach_wall_time_median_s']:.2f} s (median)")
