@@ -112,7 +112,7 @@ def markdown_block(tables: dict[str, list[tuple]], reaches: int) -> str:
                      f"{update_p90:.1f}) | {build / 1e3:.1f} s |")
     lines += ["", f"({reaches} noisy reaches per preset observed at 100 Hz, medians of one run of "
               "`benchmarks/goal_estimation_times.py --markdown`; the one-shot rows from the state at 0.2 s, warm from "
-              "the estimate 10 ms earlier; both with a prior 0.1 m off and `prior_std=0.1`; benchmarks/README.md.)"]
+              "the estimate 10 ms earlier; both with a prior 0.1 m off and `prior_std=0.1`.)"]
     return "\n".join(lines) + "\n"
 
 
