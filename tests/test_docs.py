@@ -137,13 +137,19 @@ def test_readme_online_snippet_recovers_the_observed_goal(workdir, monkeypatch):
     assert abs(namespace["estimate"].goal - [0.3, 0.1]).max() < 5e-3
 
 
-def test_goal_estimate_snippet_recovers_the_observed_plan_goal(workdir, monkeypatch):
-    """The goal-estimation guide observes a plan to [0.3, 0.1]: the regret estimate gives it back."""
-    namespace = run_page_blocks(DOCS / "guide" / "goal_estimation.md", workdir, monkeypatch)
+def test_goal_estimate_snippets_recover_the_observed_goals(workdir, monkeypatch):
+    """The goal-estimation guide observes a plan to [0.3, 0.1] (one-shot: the regret estimate gives it back) and
+    a Cartesian reach to [0.3, 0.1, 0.05] (online, from 0.25 s of it)."""
+    page = DOCS / "guide" / "goal_estimation.md"
+    first, second = [source for _, source in fenced_blocks(page.read_text(encoding="utf-8"), "python")][:2]
+    monkeypatch.chdir(workdir)
+    namespace: dict = {}
+    exec(compile(first, "goal_estimation.md:one-shot", "exec"), namespace)
     estimate, posterior = namespace["estimate"], namespace["posterior"]
-    assert abs(estimate.goal - [0.3, 0.1, 0.05]).max() < 0.05   # the online estimate of the second block
-    assert posterior.probabilities.shape == (3, 3)
-    assert posterior.probabilities[-1].argmax() == 0
+    assert estimate.success and abs(estimate.goal - [0.3, 0.1]).max() < 5e-3
+    assert posterior.probabilities.shape == (3, 3) and posterior.probabilities[-1].argmax() == 0
+    exec(compile(second, "goal_estimation.md:online", "exec"), namespace)
+    assert abs(namespace["estimate"].goal - [0.3, 0.1, 0.05]).max() < 0.05
 
 
 def subcommand_tree() -> dict[str, set[str]]:
