@@ -1,9 +1,9 @@
 """Goal-estimation times: the one-shot estimate (`GoalEstimator.estimate`) against the online estimator
-(`OnlineGoalEstimator.update`), cold and warm, on the same noisy reaches, in the same run (issue 12).
+(`OnlineGoalEstimator.update`), cold and warm, on the same noisy reaches, in the same run.
 
     .venv/bin/python benchmarks/goal_estimation_times.py [--reaches 20] [--only cartesian,planar] [--markdown]
 
-``--markdown`` prints the README's block ``online-estimation-speed`` (docs/make_readme_numbers.py) instead.
+``--markdown`` prints the block ``online-estimation-speed`` of docs/results/speed.md (studies/regenerate_results.py) instead.
 
 Each reach goes from rest to a goal 0.15–0.45 m away in a random direction, sampled from the model's own
 noisy dynamics (open loop) and observed every 10 ms from 10 ms to 0.5 s with the default observation noise
@@ -112,7 +112,7 @@ def markdown_block(tables: dict[str, list[tuple]], reaches: int) -> str:
                      f"{update_p90:.1f}) | {build / 1e3:.1f} s |")
     lines += ["", f"({reaches} noisy reaches per preset observed at 100 Hz, medians of one run of "
               "`benchmarks/goal_estimation_times.py --markdown`; the one-shot rows from the state at 0.2 s, warm from "
-              "the estimate 10 ms earlier; both with a prior 0.1 m off and `prior_std=0.1`; benchmarks/README.md.)"]
+              "the estimate 10 ms earlier; both with a prior 0.1 m off and `prior_std=0.1`.)"]
     return "\n".join(lines) + "\n"
 
 

@@ -1,8 +1,8 @@
-"""CasADi's structure-exploiting solvers on the Franka reach, multiple shooting over the belief state (issue 3).
+"""CasADi's structure-exploiting solvers on the Franka reach, multiple shooting over the belief state .
 
     nice .venv/bin/python benchmarks/structured_solvers.py [--repeats 10] [--only fatrop,sqp_hpipm,ipopt]
 
-Notation (SPEC §2–4): stage state y_k = (mu_k (2n,), vech Sigma_k (n2(n2+1)/2,)), n2 = 2n, control tau_k (n,),
+Notation (docs/formulation.md §2–4): stage state y_k = (mu_k (2n,), vech Sigma_k (n2(n2+1)/2,)), n2 = 2n, control tau_k (n,),
 k = 0..H. The OCP, in the planner's normalised units (J / |J_best(w)|, same minimiser):
 
     min  Σ_{k=0..H} -(w_k / |J_best|) R(mu_k, Sigma_k) + (nu / |J_best|) Σ_{k<H} ||tau_k||²

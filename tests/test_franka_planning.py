@@ -239,7 +239,7 @@ ROUNDING_SENSITIVE = pytest.mark.xfail(strict=False, reason=(
     "known: at 0.25 m two of the three starts stall along the joint limit with gradients of about 1.1e-4, just "
     "above the 1e-4 that makes a stalled point 'solved_acceptable'; since rows past their limits are no longer "
     "dropped when the step would drive them further out (newton._constrained_step) the third converges "
-    "('solved'), before that all three could stall, depending on rounding (benchmarks/HISTORY.md)"))
+    "('solved'), before that all three could stall, depending on rounding (git log -- benchmarks/HISTORY.md)"))
 
 
 @pytest.mark.parametrize("drop", [0.2, pytest.param(0.25, marks=ROUNDING_SENSITIVE)])
@@ -309,7 +309,7 @@ def test_warm_solve_to_a_nearby_goal_needs_no_inverse_kinematics(franka_rest_pla
 def test_lazy_hessian_reaches_the_optimum_of_eager_assembly(franka_rest_planner, offset):
     """The default solver (Hessian assembled every third iteration, arm tolerance 1e-6) and the Hessian assembled
     at every iteration with tolerance 1e-8 end at the same cold and warm plans: J within 1e-6 relative (measured:
-    about 1e-9, benchmarks/README.md) and mean hand paths within 1 mm."""
+    about 1e-9, benchmarks/franka_solver_options.py) and mean hand paths within 1 mm."""
     from comanip.planning.planner import SolverOptions
 
     eager = comanip.Planner(franka_rest_planner.model, SolverOptions(hessian_refresh=1, arm_tolerance=None))

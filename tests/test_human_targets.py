@@ -115,7 +115,7 @@ def _verdict(result, start):
 
 @pytest.mark.slow
 def test_planar_preset_reproduces_the_known_failures(planar_result):
-    # the shipped preset misses the hit-rate band somewhere and peaks late in most conditions (README)
+    # the shipped preset misses the hit-rate band somewhere and peaks late in most conditions (docs/results/calibration.md)
     for name in ("hit rate at MT, closed form", "hit rate at MT, Monte Carlo"):
         verdict = _verdict(planar_result, name)
         assert not verdict.passed and verdict.low < 0.9 and verdict.failing

@@ -155,7 +155,7 @@ def test_prior_std_decides_how_far_the_prior_pulls(online, cartesian_planner):
 def test_goal_covariance_is_calibrated(online):
     """Reaches sampled from the model's own noisy dynamics (open loop, as the belief assumes), observed every
     23 ms with the default noise: the true goal lies inside the 95 % ellipsoid 90–98 % of the time, early in
-    the reach (where the distance is poorly known) and late (docs/measure_goal_estimation.py: more reaches)."""
+    the reach (where the distance is poorly known) and late (studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py: more reaches)."""
     model, planner = online.model, online.planner
     rng = np.random.default_rng(0)
     times = np.arange(0.011, 0.45, 0.023)

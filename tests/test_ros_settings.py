@@ -43,10 +43,15 @@ def test_the_command_reports_a_bad_parameter_file_in_one_line(tmp_path, capsys):
     assert capsys.readouterr().err.strip() == "comanip ros: error: status_rate must be a finite number > 0 (Hz), got 0"
 
 
-def test_the_readmes_franka_parameters_are_valid(tmp_path):
-    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+def test_the_ros_guides_franka_parameters_are_valid(tmp_path):
+    readme = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "ros.md").read_text()
     block = readme.split("```yaml\ncomanip_goal:", 1)[1].split("```", 1)[0]
     params = tmp_path / "franka.yaml"
     params.write_text("comanip_goal:" + block)
     settings = NodeSettings.from_yaml(params)
     assert settings.frame_id == "fr3_link0" and settings.equilibrium_topic.endswith("/equilibrium_pose")
+
+
+def test_the_example_node_config_is_valid():
+    settings = NodeSettings.from_yaml(Path(__file__).resolve().parents[1] / "examples" / "data" / "node.yaml")
+    assert settings.preset == "cartesian" and settings.prior_goal == (0.4, 0.1, 0.1)

@@ -180,7 +180,7 @@ def shipped_model():
 
 
 def test_shipped_data_and_model_against_the_published_trends(shipped_model):
-    # README "Multi-component reaching" states these verdicts; a regenerated dataset must keep them in step
+    # docs/results/calibration.md states these verdicts; a regenerated dataset must keep them in step
     report = {(t["input"], t["output"]): t for t in trend_report(shipped_model)["trends"]}
     farther = report[("distance_over_arm_length", "transition_distance_m")]
     assert farther["data"]["verdict"] == "reproduced" and farther["model"]["verdict"] == "reproduced"

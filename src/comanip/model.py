@@ -1,4 +1,4 @@
-"""A reaching model: a body plus the motor-control parameters of the paper (Table II, SPEC §5).
+"""A reaching model: a body plus the motor-control parameters of the paper (Table II, docs/formulation.md §5).
 
 Every field of :class:`ReachingModel` is checked at construction, so a bad value fails before any
 CasADi work. Symbols follow the paper: h, H, gamma, nu, kappa, W (``docs/notation.md``).
@@ -42,9 +42,9 @@ class ReachingModel:
     width: float
     """Default goal width w (m), > 0, used when a solve is given no width."""
     noise: str = "isotropic"
-    """Noise covariance form: 'isotropic' (default), 'per_channel' or 'rank_one' (SPEC §2)."""
+    """Noise covariance form: 'isotropic' (default), 'per_channel' or 'rank_one' (docs/formulation.md §2)."""
     goal_covariance: str = "std"
-    """How W is built from w: 'std' W = w² I (default), 'cov' W = w I (SPEC §3), or 'effective'
+    """How W is built from w: 'std' W = w² I (default), 'cov' W = w I (docs/formulation.md §3), or 'effective'
     W = (2w / effective_k)² I (the goal's full width 2w read as effective_k standard deviations)."""
     effective_k: float = 4.133
     """Standard deviations spanned by the full width 2w under goal_covariance 'effective', > 0; 4.133 is the

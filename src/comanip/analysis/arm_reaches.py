@@ -4,7 +4,7 @@ its speed rise and fall, and how much of each joint limit does the plan use.
 
 Every reach starts at rest at the body's home position (the Panda's ready pose) and aims at the home
 end-effector position plus an offset (m). The first goal is solved cold (multi-start); each later one is
-warm-started from the plan before it, as a robot following a person's goals would. Timing is SPEC §6's
+warm-started from the plan before it, as a robot following a person's goals would. Timing is docs/formulation.md §6's
 (:func:`comanip.analysis.speed_metrics` on the hand speed ||J(mu_q) mu_qdot||).
 
 Limit usage, per joint, as a fraction of the limit (1 = at the limit), over the mean of steps 1..H:
@@ -79,7 +79,7 @@ AT_VELOCITY_LIMIT = 0.95
 
 @dataclass(frozen=True)
 class SettlingMotion:
-    """How an arm moves once its hand has stopped (after MT, SPEC §6), and how it ends."""
+    """How an arm moves once its hand has stopped (after MT, docs/formulation.md §6), and how it ends."""
 
     final_joint_speed: float
     """Largest |qdot_H| over the joints at the end of the plan, rad/s."""
@@ -108,7 +108,7 @@ class ArmReach:
     warm_started: bool
     """Solved from the previous goal's plan (False: a cold multi-start solve)."""
     metrics: SpeedMetrics
-    """SPEC §6 timing of the hand speed."""
+    """docs/formulation.md §6 timing of the hand speed."""
     limits: LimitUsage
     velocity_usage_after_mt: float
     """Largest |qdot| / qdot_max of any joint after MT: how fast the arm still moves (in its null space) once

@@ -1,10 +1,10 @@
 """The calibration study: which configuration of the model gets Fitts' law and an early velocity peak?
 
-SPEC §3 records that a faithful re-implementation got Fitts' law (W = w² I) or an early peak (W = w I),
+docs/formulation.md §3 records that a faithful re-implementation got Fitts' law (W = w² I) or an early peak (W = w I),
 never both. This study measures, for each configuration of the model's own family (ReachingModel fields
 and the execution mode; nothing is tuned by hand), over a grid of distances D × widths w:
 
-- t_peak/MT per condition (SPEC §6), and how many conditions have it below 0.5 (the paper's claim);
+- t_peak/MT per condition (docs/formulation.md §6), and how many conditions have it below 0.5 (the paper's claim);
 - the Fitts and Shannon fits MT = a + b·ID (R², slope);
 - the trends: wider goal → no slower at fixed D, farther goal → no faster at fixed w;
 - whether every movement time lies in a human range and every reach finished (speed fell below 5 %).

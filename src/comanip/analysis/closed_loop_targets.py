@@ -4,7 +4,7 @@ A plan is what the robot predicts; a person executes it with feedback: :func:`co
 execute_receding_horizon` replans every step from the state, or, with the model's ``observation`` (or one
 given here), from a Kalman estimate of it made from noisy, delayed observations. Each condition of the grid
 runs ``n_trials`` executions from rest at the home position; the scored profile is their mean end-effector
-velocity (SPEC §6 timing, the same shape measures as open loop), the hand is scored at the first step at or
+velocity (docs/formulation.md §6 timing, the same shape measures as open loop), the hand is scored at the first step at or
 after MT:
 
 - hit rate, Monte Carlo: the share of executions with ||x − g|| ≤ w there;

@@ -1,4 +1,4 @@
-"""Endpoint dispersion by open-loop Monte Carlo of a plan's torques (paper Fig. 4, SPEC §6).
+"""Endpoint dispersion by open-loop Monte Carlo of a plan's torques (paper Fig. 4, docs/formulation.md §6).
 
 The planned torques tau_{0:H-1} are executed as (I + E_i) tau_i with E_i drawn as the model's noise form
 says (:func:`comanip.belief.sample_trajectories`), without feedback. At the plan's movement time the hand

@@ -1,10 +1,10 @@
-"""Score a model against the human-likeness targets (issue 11, item 2; thresholds and verdicts in
+"""Score a model against the human-likeness targets (thresholds and verdicts in
 :mod:`comanip.analysis.target_verdicts`).
 
 Each condition of the grid D × w is an open-loop plan from rest at the body's home position to a goal D
 along the first task axis (:func:`comanip.analysis.open_loop_grid`), measured on its mean:
 
-- timing (SPEC §6, :func:`comanip.analysis.speed_metrics`): t_peak, MT, t_peak/MT, peak speed / (D/MT);
+- timing (docs/formulation.md §6, :func:`comanip.analysis.speed_metrics`): t_peak, MT, t_peak/MT, peak speed / (D/MT);
 - shape (:func:`comanip.analysis.profile_shape`): onset, peaks, reversal, end speed;
 - the hand at the first step at or after MT (the last step when the reach never settles): the hit rate
   P(||x − g|| ≤ w) in closed form from the plan's predicted mean and covariance there
@@ -48,7 +48,7 @@ class ConditionTargets:
     index_of_difficulty: float
     """log2(2D/w), bits."""
     movement_time: float
-    """SPEC §6 MT (NaN when the reach never settles)."""
+    """docs/formulation.md §6 MT (NaN when the reach never settles)."""
     t_peak: float
     asymmetry: float
     """t_peak/MT."""

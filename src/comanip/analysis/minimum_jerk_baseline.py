@@ -2,9 +2,9 @@
 
 A minimum-jerk reach from rest to rest over duration T has speed (D/T) · 30 s²(1 - s)², s = t/T: a
 symmetric bell with its peak at mid-movement. Its speed falls below a fraction f of the peak when
-16 s²(1 - s)² = f, i.e. at s_f = (1 + sqrt(1 - sqrt(f)))/2 (0.9406 for f = 5 %), so its SPEC §6 movement
+16 s²(1 - s)² = f, i.e. at s_f = (1 + sqrt(1 - sqrt(f)))/2 (0.9406 for f = 5 %), so its docs/formulation.md §6 movement
 time is s_f · T and its asymmetry t_peak/MT is 0.5/s_f (0.532 for f = 5 %). The baseline for a reach is
-the minimum-jerk reach with the same start, goal and SPEC §6 movement time: only the shape differs.
+the minimum-jerk reach with the same start, goal and docs/formulation.md §6 movement time: only the shape differs.
 """
 
 from __future__ import annotations
@@ -24,7 +24,7 @@ def minimum_jerk_settling_fraction(settling_fraction: float = SETTLING_FRACTION)
 
 
 def minimum_jerk_asymmetry(settling_fraction: float = SETTLING_FRACTION) -> float:
-    """t_peak/MT of a rest-to-rest minimum-jerk reach under the SPEC §6 movement time."""
+    """t_peak/MT of a rest-to-rest minimum-jerk reach under the docs/formulation.md §6 movement time."""
     return 0.5 / minimum_jerk_settling_fraction(settling_fraction)
 
 
@@ -32,7 +32,7 @@ def minimum_jerk_velocity(start, goal, movement_time: float, t, start_velocity=N
                           settling_fraction: float = SETTLING_FRACTION) -> np.ndarray:
     """Velocity (len(t), d) in m/s of the minimum-jerk reach from start (d,) m to rest at goal (d,) m.
 
-    Its duration is movement_time / s_f, so that from rest its SPEC §6 movement time equals movement_time
+    Its duration is movement_time / s_f, so that from rest its docs/formulation.md §6 movement time equals movement_time
     (s). start_velocity (d,) m/s (default 0) starts the quintic moving; the duration rule is kept.
     """
     start = np.atleast_1d(np.asarray(start, dtype=float))
@@ -46,7 +46,7 @@ def minimum_jerk_velocity(start, goal, movement_time: float, t, start_velocity=N
 
 def minimum_jerk_speed_fraction(t, movement_time: float, settling_fraction: float = SETTLING_FRACTION) -> np.ndarray:
     """Speed over peak speed, 16 s²(1 − s)² with s = t/T clipped to [0, 1], at times t (s, any shape) of the
-    rest-to-rest minimum-jerk reach whose SPEC §6 movement time is movement_time (s), T = movement_time/s_f."""
+    rest-to-rest minimum-jerk reach whose docs/formulation.md §6 movement time is movement_time (s), T = movement_time/s_f."""
     if not (np.isfinite(movement_time) and movement_time > 0):
         raise ValueError(f"movement_time must be a finite number > 0 (s), got {movement_time!r}")
     s = np.clip(np.asarray(t, dtype=float) * minimum_jerk_settling_fraction(settling_fraction) / movement_time, 0.0, 1.0)

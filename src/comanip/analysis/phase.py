@@ -33,7 +33,7 @@ class PhaseCurve:
     velocity: np.ndarray
     """Mean hand velocity along the direction (T,), m/s."""
     metrics: SpeedMetrics
-    """SPEC §6 timing of the plan's speed."""
+    """docs/formulation.md §6 timing of the plan's speed."""
     success: bool
     final_error: float
     """Distance of the final mean hand from the goal (m)."""

@@ -35,7 +35,7 @@ class ReachOutcome:
     velocity: np.ndarray
     """Mean end-effector velocity (T, d), m/s: the plan's, or the mean over executed trials."""
     metrics: SpeedMetrics
-    """SPEC §6 timing of ||velocity||."""
+    """docs/formulation.md §6 timing of ||velocity||."""
     success: bool
     """Every solve (and, in closed loop, every replan) converged."""
     final_error: float

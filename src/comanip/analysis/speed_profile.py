@@ -1,4 +1,4 @@
-"""Speed-profile metrics of one reach (SPEC §6): time of peak speed, movement time, asymmetry.
+"""Speed-profile metrics of one reach (docs/formulation.md §6): time of peak speed, movement time, asymmetry.
 
 For a speed profile v(t_i) = ||d mu_x/dt|| sampled at uniform times t_i (s):
 
@@ -19,7 +19,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-#: Fraction of the peak speed below which a reach counts as finished (SPEC §6).
+#: Fraction of the peak speed below which a reach counts as finished (docs/formulation.md §6).
 SETTLING_FRACTION = 0.05
 
 

@@ -1,4 +1,4 @@
-"""Human-likeness targets (issue 11, item 2) and the verdict of a model's measurements against them.
+"""Human-likeness targets and the verdict of a model's measurements against them.
 
 w is the goal radius everywhere: a reach hits when ||x − g|| ≤ w at the movement time, so 2w is the goal's
 full width and the index of difficulty is ID = log2(2D/w) (bits). The targets, on the grid D × w of reaches

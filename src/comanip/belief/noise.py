@@ -1,4 +1,4 @@
-"""Signal-dependent motor noise (SPEC §2): the command tau is executed as (I + E) tau.
+"""Signal-dependent motor noise (docs/formulation.md §2): the command tau is executed as (I + E) tau.
 
 Three forms of the noise covariance N(tau) (n, n) of the executed-torque error E tau, kappa the variance
 of each entry of E (dimensionless, so the standard deviation of the error grows in proportion to ||tau||):

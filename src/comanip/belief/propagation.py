@@ -1,4 +1,4 @@
-"""Mean and covariance of the state under signal-dependent motor noise (SPEC §2, paper eq. 6).
+"""Mean and covariance of the state under signal-dependent motor noise (docs/formulation.md §2, paper eq. 6).
 
 s_i ~ N(mu_i, Sigma_i), mu_0 = s_0, Sigma_0 = 0, and for i = 0..H-1, with f the body's discrete step:
 

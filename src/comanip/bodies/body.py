@@ -54,7 +54,7 @@ class Body(ABC):
 
         M is symmetric positive definite, so the solve is an LDLᵀ factorisation (``ca.ldl``): for the Panda its
         step with Jacobians is a third fewer operations than CasADi's general symbolic QR (``ca.solve``), and
-        every evaluation of the belief and its derivatives is that much cheaper (benchmarks/README.md).
+        every evaluation of the belief and its derivatives is that much cheaper (benchmarks/warm_breakdown.py times it).
         """
         q, qdot = s[: self.n], s[self.n :]
         D, Lt, p = ca.ldl(self.mass_matrix(q))

@@ -31,24 +31,24 @@ READY_POSE = (0.0, -np.pi / 4, 0.0, -3 * np.pi / 4, 0.0, np.pi / 2, np.pi / 4)
 class Panda(Body):
     """Franka Emika Panda arm: ``(M_urdf(q) + diag(armature)) qddot + D qdot + G(q) = tau``.
 
-    Stability of the explicit Euler step (SPEC §10): the URDF has no rotor inertia, its wrist inertia is
+    Stability of the explicit Euler step (docs/formulation.md §10): the URDF has no rotor inertia, its wrist inertia is
     M₇₇ ≈ 0.0067 kg·m², and with D = 0.3 I, h = 0.035 s the velocity factor I − h M⁻¹ D of the step then
     has an eigenvalue near −0.6, so the wrist's mean velocity flips sign every step. The real drives add
     their reflected rotor inertia (:data:`PANDA_ARMATURE`) to the diagonal of M, which bounds M's smallest
     eigenvalue below by min(armature) = 0.074 kg·m², so h·D/M ≤ 0.15 and every eigenvalue lies in (0.85, 1).
     We add the armature rather than integrate the damping implicitly because it is physics the URDF left
-    out, and it keeps the SPEC §2 discretisation (and its A_i, B_i) unchanged for every body.
+    out, and it keeps the docs/formulation.md §2 discretisation (and its A_i, B_i) unchanged for every body.
 
-    Coriolis and centrifugal terms are left out, as in the paper's model (SPEC §2); gravity G(q) is
+    Coriolis and centrifugal terms are left out, as in the paper's model (docs/formulation.md §2); gravity G(q) is
     zero by default because the Panda's controller compensates it.
 
     Args:
-        damping: D as a scalar (N·m·s/rad, times the identity) or a (7, 7) matrix. Default 0.3 I (SPEC §5).
+        damping: D as a scalar (N·m·s/rad, times the identity) or a (7, 7) matrix. Default 0.3 I (docs/formulation.md §5).
         armature: reflected rotor inertia (7,) kg·m², ≥ 0, added to M's diagonal; zeros give the bare URDF.
         tcp_offset: end-effector point (3,) in the flange frame ``panda_link8``, m. Default: the Franka
             Hand's TCP between the fingertips (0, 0, 0.1034); (0, 0, 0) is the flange itself.
         hand: include the Franka Hand's inertia (0.76 kg with closed fingers); False for a bare flange.
-        gravity: include G(q) in the dynamics (False: the controller compensates gravity, SPEC §2).
+        gravity: include G(q) in the dynamics (False: the controller compensates gravity, docs/formulation.md §2).
     """
 
     n = 7

@@ -1,4 +1,4 @@
-"""Perpendicular dispersion of reaches over path progress, and its peak: the transition point (SPEC §8).
+"""Perpendicular dispersion of reaches over path progress, and its peak: the transition point (docs/formulation.md §8).
 
 Reaches go from a common start x_0 to a goal g (d,), m, along the unit direction u = (g - x_0) / D,
 D = ||g - x_0||. A hand position x splits into progress p = (x - x_0)·u (m along the path) and a

@@ -1,4 +1,4 @@
-"""Robot→person authority handover at the predicted transition point (paper VI-B, SPEC §8).
+"""Robot→person authority handover at the predicted transition point (paper VI-B, docs/formulation.md §8).
 
 The robot leads a reach planned with the motor-control model (the Cartesian preset): the planned mean hand
 path is the rest position x_r(t) (m) of a Cartesian impedance controller whose translational stiffness K(t)

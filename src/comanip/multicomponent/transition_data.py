@@ -2,9 +2,9 @@
 
 The person is the closed-loop reacher of :func:`comanip.execution.execute_receding_horizon`: at every step
 it replans the whole H-step reach from its current noisy state (visual feedback) and executes the first
-torque with signal-dependent noise (SPEC §2). The fast first part of the reach spreads the hand across the
+torque with signal-dependent noise (docs/formulation.md §2). The fast first part of the reach spreads the hand across the
 path; the replanning then corrects it, so the perpendicular dispersion rises and falls, and its peak marks
-the transition (Peternel & Babič 2019; SPEC §8).
+the transition (Peternel & Babič 2019; docs/formulation.md §8).
 
 The person is any point-mass model (default the planar preset; with activation stages the state
 [q; qdot; a_1..a_m] starts at rest with zero force). A condition is a goal at distance D = (D/L)·L along x
@@ -32,13 +32,13 @@ from comanip.progress import progress_bar
 #: Default arm length L (m) that normalises the goal distance.
 ARM_LENGTH = 0.7
 
-#: Settling criterion (SPEC §6): final speed below this fraction of the trial's peak speed.
+#: Settling criterion (docs/formulation.md §6): final speed below this fraction of the trial's peak speed.
 SETTLED_SPEED_FRACTION = 0.05
 
 
 def default_steps(model: ReachingModel) -> int:
     """Executed steps per reach: 2H. The receding window stays H long, so a person executes more steps than
-    H to finish slow, narrow-goal reaches (30 steps left w = 0.005 m reaches unsettled, SPEC §9)."""
+    H to finish slow, narrow-goal reaches (30 steps left w = 0.005 m reaches unsettled, docs/formulation.md §9)."""
     return 2 * model.H
 
 

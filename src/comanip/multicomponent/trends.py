@@ -1,4 +1,4 @@
-"""Check transition data and a fitted transition model against the published trends (SPEC §8).
+"""Check transition data and a fitted transition model against the published trends (docs/formulation.md §8).
 
 Peternel & Babič (2019) measured that a farther goal moves the peak perpendicular dispersion farther from
 the goal and makes it larger, and that a larger goal moves it closer to the goal and makes it larger.
@@ -38,7 +38,7 @@ def trend_report(model: TransitionModel, grid_points: int = 11) -> dict:
         entry["data"] = data_trend(data, inp, out, sign) if out in data else None
         entry["model"] = model_trend(model, inp, sign, grid_points) if out == "transition_distance_m" else None
         trends.append(entry)
-    return {"source": "Peternel & Babič 2019 (SPEC §8)", "method": METHOD,
+    return {"source": "Peternel & Babič 2019 (docs/formulation.md §8)", "method": METHOD,
             "rows": int(len(data["width_m"])), "trends": trends}
 
 

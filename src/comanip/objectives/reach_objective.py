@@ -1,4 +1,4 @@
-"""The minimised objective (SPEC §4, paper eq. 8–10): discounted expected reward, negated, plus effort.
+"""The minimised objective (docs/formulation.md §4, paper eq. 8–10): discounted expected reward, negated, plus effort.
 
     J(tau_{0:H-1}) = Σ_{i=0..H} -w_i R(mu_x,i, Sigma_x,i) + nu Σ_{i=0..H-1} ||tau_i||²
 
@@ -25,7 +25,7 @@ def reach_objective(ee_means, ee_covs, torques, goal, width, weights, nu, reward
 
 
 def velocity_cost(velocity_means, velocity_covs, stop_weight, joint_velocity_weight):
-    """The model's speed cost before its |J_best| scale (SPEC §4 options ``stop_weight`` c_s and
+    """The model's speed cost before its |J_best| scale (docs/formulation.md §4 options ``stop_weight`` c_s and
     ``joint_velocity_weight`` c_v), over the velocity beliefs of steps i = 1..H:
 
         c_s E||qdot_H||² + c_v (1/H) Σ_{i=1..H} E||qdot_i||²,   E||qdot_i||² = ||mu_qdot,i||² + tr Sigma_qdot,i.

@@ -1,4 +1,4 @@
-"""Expected reward of hitting a goal of width w (SPEC §3, paper eq. 7 and appendix).
+"""Expected reward of hitting a goal of width w (docs/formulation.md §3, paper eq. 7 and appendix).
 
 The goal is a Gaussian g ~ N(g_bar, W); the end effector is x ~ N(mu_x, Sigma_x). The expected reward is
 the density of their difference at zero,
@@ -97,7 +97,9 @@ class GoalReward:
         d: task-space dimension.
         form: 'gaussian' (paper eq. 7, m^-d) or 'hit' (probability of a hand inside the ball of radius w,
             through the flat-topped kernel of this module's docstring; dimensionless).
-        goal_covariance, effective_k: how W is built from w for the Gaussian form (see :func:`goal_covariance`).
+        goal_covariance: how W is built from w for the Gaussian form (see :func:`goal_covariance`).
+        effective_k: the number of standard deviations the full width 2w spans, for
+            ``goal_covariance='effective'``.
     """
 
     def __init__(self, d: int, form: str = "gaussian", goal_covariance: str = "std", effective_k: float = EFFECTIVE_WIDTH_K):

@@ -23,7 +23,7 @@ def _label(reach: ArmReach) -> str:
 
 def plot_arm_speed_profiles(reaches: list[ArmReach], path: str | Path, title: str = "") -> Path:
     """Save a PNG of the hand speed ||J(mu_q) mu_qdot|| (m/s) against time for every reach, with a dot at
-    the peak and a dotted line at the movement time (SPEC §6)."""
+    the peak and a dotted line at the movement time (docs/formulation.md §6)."""
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for color, reach in zip(_colors(reaches), reaches):
         plan, metrics = reach.plan, reach.metrics

@@ -2,8 +2,8 @@
 
 The effective ID uses the goal's standard deviation sqrt(W) in place of w: log2(2D / sqrt(W)), with
 sqrt(W) = w under the 'std' reading and sqrt(w) under 'cov'. Plotted this way the two readings fall on
-one curve per execution mode, which shows why the early peak and Fitts' law part ways (README, "Model and
-calibration")."""
+one curve per execution mode, which shows why the early peak and Fitts' law part ways
+(docs/results/calibration.md)."""
 
 from __future__ import annotations
 

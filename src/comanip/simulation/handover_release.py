@@ -1,4 +1,4 @@
-"""When the handover scenario's robot lets go (issue 12, item 6): two release triggers behind one protocol.
+"""When the handover scenario's robot lets go: two release triggers behind one protocol.
 
 - ``goal_distance`` (:class:`GoalDistanceRelease`): the handle is within the schedule's predicted transition
   distance T of the goal the robot planned to (the known goal).

@@ -1,4 +1,4 @@
-"""Scenario ``handover`` (paper VI-B, SPEC §8): the robot leads, then hands the fine positioning to the person.
+"""Scenario ``handover`` (paper VI-B, docs/formulation.md §8): the robot leads, then hands the fine positioning to the person.
 
 The robot plans a reach to the nominal goal with the Cartesian preset and holds the handle to it at
 400 N/m (:func:`comanip.multicomponent.handover.plan_handover` gives the rest motion and the predicted

@@ -1,4 +1,4 @@
-"""Measures of one co-manipulation trial that say how the robot helped the person (issue 12).
+"""Measures of one co-manipulation trial that say how the robot helped the person.
 
 All come from a :class:`~comanip.simulation.scenario.TrialRecord` (K samples, time step dt, s):
 
@@ -20,7 +20,7 @@ that every robot is passive alike), the other measures over the whole trial.
 - **completion time** (s): when the handle comes within w/2 of the goal on every axis and stays there
   (NaN if it never does); **final placement error** ||x(end) - g|| (m).
 
-MT is SPEC §6's movement time of the handle's speed (the trial's end if it never settles).
+MT is docs/formulation.md §6's movement time of the handle's speed (the trial's end if it never settles).
 """
 
 from __future__ import annotations
@@ -53,7 +53,7 @@ def first_passage(t: np.ndarray, values: np.ndarray, level: float) -> float:
 
 
 def movement_time(record: TrialRecord) -> float:
-    """SPEC §6's movement time of the handle (s), or the trial's end if its speed never settles."""
+    """docs/formulation.md §6's movement time of the handle (s), or the trial's end if its speed never settles."""
     timing = speed_metrics(record.t, np.linalg.norm(record.velocity, axis=1))
     return float(timing.movement_time) if timing.settled else float(record.t[-1])
 

@@ -1,7 +1,7 @@
 """A simulated person holding the handle: the paper's motor-control model drives an arm impedance.
 
 The person's *intended* hand motion x_d(t) is the state of their internal model, the reaching model's point
-mass (the Cartesian preset, 2 kg) in the model's own discrete time (SPEC §2, forward Euler with step h),
+mass (the Cartesian preset, 2 kg) in the model's own discrete time (docs/formulation.md §2, forward Euler with step h),
 driven by the commands they plan, executed with signal-dependent motor noise (I + E) tau:
 
     v_{j+1} = v_j + h M_p^-1 ((I + E_j) tau_j - D_p v_j),   x_{j+1} = x_j + h v_j

@@ -1,4 +1,4 @@
-"""Robot policies compared on the synchronisation scenario over the same trials and person seeds (issue 12).
+"""Robot policies compared on the synchronisation scenario over the same trials and person seeds.
 
 Every policy meets the same people: trial k of a goal uses seed + k whatever the robot does, so the
 differences between policies are the robot's. Each measure (:mod:`comanip.simulation.measures`) is

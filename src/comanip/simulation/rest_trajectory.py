@@ -1,4 +1,4 @@
-"""A planned reach as the impedance controller's rest motion (SPEC §8: the plan's mean is the rest position).
+"""A planned reach as the impedance controller's rest motion (docs/formulation.md §8: the plan's mean is the rest position).
 
 The plan gives the mean end effector x_i at the steps t_i = i·h. Between steps the rest position follows
 a C² cubic spline through the x_i (leaving and arriving with the plan's first and last velocities), so

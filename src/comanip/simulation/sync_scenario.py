@@ -1,11 +1,11 @@
-"""Scenario ``sync`` (paper VI-A, SPEC §8): the person leads x–y, the robot predicts the goal and leads z.
+"""Scenario ``sync`` (paper VI-A, docs/formulation.md §8): the person leads x–y, the robot predicts the goal and leads z.
 
 The robot starts with zero translational stiffness and the person starts their reach. From t_o = 0.2 s on,
 a robot policy (:mod:`comanip.simulation.policies`) predicts the goal and a rest motion; the robot sends that
 motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. The default policy,
 ``one-shot``, is the paper's: it estimates the goal and the person's whole trajectory once, at t_o
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
-baselines of issue 12 (prior goal only, constant velocity, minimum-jerk fit) and the passive robot.
+baselines (prior goal only, constant velocity, minimum-jerk fit) and the passive robot.
 
 Per trial: the goal estimate, the error between the predicted trajectory and the handle over time
 normalised by the movement time (paper Fig. 7, per axis), the time each axis reaches the goal, the

@@ -1,4 +1,4 @@
-"""The human-likeness section of a validation run (issue 11): the run's model scored on the targets
+"""The human-likeness section of a validation run: the run's model scored on the targets
 (:mod:`comanip.analysis.human_targets`) beside a reference preset (the paper's ``planar`` by default), and the
 section's report dictionary (rendered by :func:`comanip.validation.markdown.human_targets_markdown`); its figure is
 drawn by :mod:`comanip.plots.validation_figures`.

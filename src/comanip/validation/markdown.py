@@ -1,7 +1,8 @@
 """``report.md``: the validation report dictionary of :func:`comanip.validation.run.run_validation` as tables.
 
-The human-likeness section's verdict table (:func:`verdict_table`) is also what ``docs/make_calibration_table.py``
-writes into the README."""
+The human-likeness section's verdict table (:func:`verdict_table`) is also what
+``studies/which_model_options_make_reaching_human_like/make_calibration_table.py`` writes into
+docs/results/calibration.md."""
 
 from __future__ import annotations
 
@@ -38,7 +39,7 @@ def _model_line(model: dict) -> str:
 def _point_mass_sections(report: dict) -> list[str]:
     settings, grid = report["settings"], report["fitts_grid"]
     return ["## Velocity profiles and asymmetry (paper Fig. 3, top; `velocity_profiles.png`)", "",
-            "Open-loop plans from rest. MT: first time after the peak with speed below 5 % of the peak (SPEC §6). "
+            "Open-loop plans from rest. MT: first time after the peak with speed below 5 % of the peak (docs/formulation.md §6). "
             f"A minimum-jerk reach has t_peak/MT = {_num(grid['minimum_jerk_asymmetry'], 3)} under this definition.", "",
             _table(["D (m)", "w (m)", "ID Fitts", "ID Shannon", "t_peak (s)", "MT (s)", "t_peak/MT", "min-jerk t_peak/MT",
                     "peak speed (m/s)", "final error (mm)", "converged"],
@@ -85,7 +86,7 @@ def _franka_section(section: dict, run_model: dict) -> list[str]:
         f"Reaches from rest at the ready pose q = {[round(v, 4) for v in section['home_position_rad']]} rad (hand at "
         f"{[round(v, 3) for v in section['home_ee_m']]} m, base frame) to goals at the offsets below. The first goal is "
         "solved cold (multi-start), each later one warm-started from the plan before it. Speed: ||J(μ_q) μ_q̇||; "
-        "MT: first time after the peak with speed below 5 % of the peak (SPEC §6). Limit usage: largest fraction of the limit over the mean "
+        "MT: first time after the peak with speed below 5 % of the peak (docs/formulation.md §6). Limit usage: largest fraction of the limit over the mean "
         "path (1 = at the limit; joint positions measured from the middle of their range), with its joint; 'after MT': the "
         "fastest joint once the hand has stopped (motion in the arm's null space). "
         f"The paper reports 1.3 s per solve; {build}.", "",
@@ -141,9 +142,9 @@ def human_targets_markdown(section: dict) -> list[str]:
     """Lines of the report section."""
     models = section["models"]
     samples = models[0]["conditions"][0]["samples"]
-    lines = ["## Human-likeness targets (issue 11; `human_targets.png`)", "",
+    lines = ["## Human-likeness targets (`human_targets.png`)", "",
              f"Open-loop plans from rest, measured on the plan's mean; {section['definition']}. MT: first time after the "
-             "peak with speed below 5 % of the peak (SPEC §6; minimum jerk then has t_peak/MT = "
+             "peak with speed below 5 % of the peak (docs/formulation.md §6; minimum jerk then has t_peak/MT = "
              f"{minimum_jerk_asymmetry():.3f}). The hand is scored at the first step at or after MT: hit rate in closed "
              f"form (Gaussian with the plan's predicted mean and covariance, integrated over the ball) and over {samples} "
              "open-loop Monte Carlo executions of the planned torques under the model's noise. 'Onset': speed 50 ms "

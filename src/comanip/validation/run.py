@@ -1,5 +1,5 @@
 """A validation run: every analysis of the paper's Section IV-D on one model, the calibration study, the
-human-likeness targets (issue 11) and the Franka section (Section V-B), written as CSV files, ``report.json``
+human-likeness targets and the Franka section (Section V-B), written as CSV files, ``report.json``
 (every number) and ``report.md`` (the same, as tables). The run computes what its figures show
 (:class:`~comanip.validation.figure_data.ValidationFigureData`) and leaves the drawing to the caller's ``draw``
 step (``comanip validate`` passes :func:`comanip.plots.validation_figures.draw_validation_figures`).

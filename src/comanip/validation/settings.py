@@ -1,5 +1,5 @@
 """What ``comanip validate`` measures: the grids of the paper's Section IV-D, the calibration study, the
-human-likeness targets (issue 11) and the Franka section (Section V-B)."""
+human-likeness targets and the Franka section (Section V-B)."""
 
 from __future__ import annotations
 

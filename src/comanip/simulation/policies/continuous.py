@@ -17,9 +17,9 @@ from comanip.simulation.rest_trajectory import RestTrajectory
 
 PRIOR_STD = 0.25
 """The robot's prior goal's standard deviation per axis (m): things are placed within about ±0.5 m of the table
-centre (the scenario's goals lie 0.07–0.38 m from it). With the estimator's weak default (10 m) the first
-estimates, from 0.2 s of the reach, were farther off than the prior alone (medians 0.18–0.40 m over 20 trials
-per goal); with this prior 0.06–0.19 m, and the final error within 0.2 mm of before (README, policy comparison)."""
+centre. The estimator's weak default (10 m) leaves the first estimates, early in the reach, farther off than the
+prior alone; this one does not, and leaves the final error as it was (docs/results/policy_comparison.md, "How
+the continuous policy's constants were chosen")."""
 
 
 ROBOT_LED_AXES = (2,)
@@ -28,18 +28,17 @@ not the person's reach, so the estimator lets it stray by ROBOT_LED_DEVIATION_TI
 (OnlineOptions.led_axes): it counts for less while the hand moves and still pins the goal at rest."""
 
 ROBOT_LED_DEVIATION_TIME = 0.5
-"""sigma_t (s) along ROBOT_LED_AXES. Chosen on person seeds 20–24 (not the README table's) by replaying the
-continuous robot's recorded observations into the estimator: mean goal error t_o–MT 40.6/142/54.1/71.2 mm
-(near/far/right/high) with z read as the person's; 39.1/137/53.6/72.0 with 0.3 s, 39.3/131/51.7/71.4 with
-0.5 s, 40.8/129/49.5/87.5 with 1 s; final errors within 0.1 mm of the person's-z ones with 0.5 s. White
-observation noise on z (3 cm, 0.3 m/s) instead gave 37.2/126/47.5/66.3 mm but raised the final error at far
-from 2.3 to 3.9 mm."""
+"""sigma_t (s) along ROBOT_LED_AXES: how far, in time along its own motion, the robot-led axis may stray from
+the plan. Chosen on person seeds other than those of the results table, by replaying the continuous robot's
+recorded observations into the estimator: it lowers the goal error over the reach and keeps the final error of
+reading z as the person's (docs/results/policy_comparison.md)."""
 
 ROBOT_COVARIANCE_SCALE = 3.0
-"""OnlineOptions.covariance_scale of the policy's belief: the factor that brings the 95 % ellipsoid's coverage,
-on reaches sampled from the corrected process, to 90–98 %: chosen on sampling seed 1, 150 reaches (pooled over
-0.2–0.8 s 87.0 % unscaled, 93.0 / 94.3 / 95.8 % with 2 / 3 / 5 for z led from the start; with this belief,
-z led from 0.2 s, 94.2 %); ``docs/measure_goal_estimation.py --belief robot`` reports seed 0."""
+"""OnlineOptions.covariance_scale of the policy's belief: the factor that brings the 95 % ellipsoid's coverage, on
+reaches sampled from the corrected process, close to 95 % (the Laplace covariance alone covers too little),
+chosen on another sampling seed than the one the results page reports
+(``studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot``;
+docs/results/calibration.md)."""
 
 ROBOT_BELIEF = dataclasses.replace(CORRECTING_PERSON, led_axes=ROBOT_LED_AXES, led_deviation_time=ROBOT_LED_DEVIATION_TIME,
                                    led_from=0.2, covariance_scale=ROBOT_COVARIANCE_SCALE)

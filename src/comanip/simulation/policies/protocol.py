@@ -53,7 +53,7 @@ class PolicyContext:
 
     @cached_property
     def expected_movement_time(self) -> float:
-        """The movement time (SPEC §6) of the model's reach to the prior goal (s): how long the robot
+        """The movement time (docs/formulation.md §6) of the model's reach to the prior goal (s): how long the robot
         expects a reach to take before it has seen one."""
         timing = speed_metrics(self.prior_plan.t, self.prior_plan.ee_speed)
         return float(timing.movement_time if timing.settled else self.prior_plan.t[-1])

@@ -1,0 +1,97 @@
+"""Rewrite the measured blocks of the results pages (docs/results/*.md), so that no number in them is typed by hand.
+
+    PYTHONPATH=src python studies/regenerate_results.py [NAME ...] [--list]
+
+Each block between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` has one page and one script below that
+measures it and prints the block's markdown on stdout; this runs the scripts of the blocks named (default: all,
+in order; the slow ones take minutes) and replaces each block's text in its page with the output.
+``tests/test_docs.py`` checks that every table of numbers on a results page sits in such a block and that every
+block has its script here.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+sys.path.insert(0, str(HERE))
+
+from result_blocks import block_names, block_spans, replace_block  # noqa: E402  (a sibling script, not a package)
+
+#: block name: (what it shows, the command that prints it, run from the repository root)
+BLOCKS: dict[str, tuple[str, list[str]]] = {
+    "calibration-study": ("the calibration study of the planar preset's family (about 10 min)",
+                          ["studies/does_any_paper_configuration_peak_early/print_calibration_study.py"]),
+    "goal-calibration": ("coverage of the online goal estimate's 95 % ellipsoid (open-loop belief, and the sync robot's) and exact-observation errors (about 10 min)",
+                         ["studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py", "--markdown", "--reaches", "200"]),
+    "human-targets": ("the human-likeness targets, paper preset beside the human one and its variants (about 30 min)",
+                      ["studies/which_model_options_make_reaching_human_like/make_calibration_table.py", "planar", "human",
+                       *(f"studies/which_model_options_make_reaching_human_like/variants/human_{name}.yaml"
+                         for name in ("paper_damping", "hit_reward", "effective_width", "stopping", "hyperbolic")),
+                       "--trials", "20"]),
+    "feedback-cost": ("closed-loop reaches from the exact state against noisy, delayed observation (seconds)",
+                      ["studies/what_does_noisy_delayed_feedback_cost/measure_feedback.py", "--markdown"]),
+    "online-estimation-speed": ("one-shot against online goal estimates, cold and warm (about 2 min)",
+                                ["benchmarks/goal_estimation_times.py", "--markdown", "--reaches", "20"]),
+    "policy-comparison": ("robot policies compared on the sync scenario, 20 trials × 4 goals (about 10 min idle, an hour loaded)",
+                          ["studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py", "--trials", "20"]),
+    "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
+              ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
+               "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
+               "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,"
+               "franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
+    "transition-trends": ("Peternel & Babič's trends in the shipped transition data and the fitted model (seconds)",
+                          ["studies/are_the_published_transition_trends_reproduced/print_transition_trends.py"]),
+}
+
+RESULTS = ROOT / "docs" / "results"
+#: block name: the pages that show it (a results page, and for the solve times benchmarks/README.md too)
+PAGES: dict[str, tuple[Path, ...]] = {
+    "calibration-study": (RESULTS / "calibration.md",),
+    "human-targets": (RESULTS / "calibration.md",),
+    "goal-calibration": (RESULTS / "calibration.md",),
+    "transition-trends": (RESULTS / "calibration.md",),
+    "feedback-cost": (RESULTS / "calibration.md",),
+    "policy-comparison": (RESULTS / "policy_comparison.md",),
+    "speed": (RESULTS / "speed.md", ROOT / "benchmarks" / "README.md"),
+    "online-estimation-speed": (RESULTS / "speed.md",),
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("names", nargs="*", help=f"blocks to rewrite (default: all): {', '.join(BLOCKS)}")
+    parser.add_argument("--list", action="store_true", help="list the blocks and their commands, and stop")
+    args = parser.parse_args(argv)
+    if args.list:
+        for name, (what, command) in BLOCKS.items():
+            print(f"{name}: {what}\n    {' '.join(command)}")
+        return 0
+    unknown = sorted(set(args.names) - set(BLOCKS))
+    if unknown:
+        parser.error(f"unknown blocks {unknown}; known: {', '.join(BLOCKS)}")
+    for name, pages in PAGES.items():
+        for page in pages:
+            if name not in block_names(page.read_text(encoding="utf-8")):
+                parser.error(f"{page} lacks the block {name}")
+    for name in args.names or list(BLOCKS):
+        command = [sys.executable, *BLOCKS[name][1]]
+        began = time.perf_counter()
+        print(f"{name}: {' '.join(BLOCKS[name][1])} …", file=sys.stderr, flush=True)
+        # the script's progress goes to stderr, shown as it runs; its stdout is the block
+        block = subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.PIPE, text=True,
+                               env={**os.environ, "PYTHONPATH": str(ROOT / "src")}).stdout
+        for page in PAGES[name]:   # written after each block: a later failure keeps the earlier ones
+            page.write_text(replace_block(page.read_text(encoding="utf-8"), name, block), encoding="utf-8")
+        print(f"{name}: rewritten ({time.perf_counter() - began:.0f} s)", file=sys.stderr, flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
