@@ -107,3 +107,40 @@ def test_long_commands_check_inputs_before_making_their_folder(tmp_path, capsys,
     target = out / "data.csv" if argv[0] == "transition" else out
     assert_one_line_error(*run_cli([*argv, "--out", str(target)], capsys), *fragments)
     assert not out.exists()
+
+
+def _observations(path, time_scale=1.0, position_scale=1.0):
+    """A 0.3 m reach's states at 50 Hz in the CSV 'comanip estimate --observations' reads, times and
+    positions (and velocities) scaled."""
+    import numpy as np
+
+    t = np.arange(0.0, 0.42, 0.02)
+    s = t / 0.6
+    x, v = 0.3 * (10 * s**3 - 15 * s**4 + 6 * s**5), 0.3 / 0.6 * (30 * s**2 - 60 * s**3 + 30 * s**4)
+    lines = ["t_s,q0,q1,qdot0,qdot1"] + [f"{time_scale * a:.6g},{position_scale * b:.6g},0,{position_scale * c:.6g},0"
+                                         for a, b, c in zip(t, x, v)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("scales, fragments", [((1000.0, 1.0), ["column 't_s'", "look like milliseconds", "--skip-unit-check"]),
+                                               ((1.0, 1000.0), ["columns q0..q1", "look like millimetres"])])
+def test_observations_in_ms_or_mm_are_one_line(tmp_path, capsys, scales, fragments):
+    path = _observations(tmp_path / "observed.csv", *scales)
+    assert_one_line_error(*run_cli(["estimate", "--observations", str(path), "--out", str(tmp_path / "out")], capsys),
+                          "--observations", *fragments)
+    assert not (tmp_path / "out").exists()
+
+
+def test_read_observations_reads_unusual_units_when_told():
+    import tempfile
+    from pathlib import Path
+
+    from comanip.cli.estimate_command import read_observations
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = _observations(Path(folder) / "observed.csv", 1000.0)
+        times, states = read_observations(path, 2, check_units=False)
+        assert times[1] == pytest.approx(20.0) and states.shape == (21, 4)
+        with pytest.raises(ValueError, match="look like degrees"):
+            read_observations(_observations(Path(folder) / "degrees.csv", 1.0, 100.0), 2, joint_angles=True)

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import json
 
-from comanip.cli.options import add_model_arguments, input_file, input_file_or_folder, load_model
+from comanip.cli.options import add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model
 from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
 from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
 from comanip.fitting.movement_times import fit_movement_times
@@ -18,6 +18,7 @@ def add_parser(subparsers) -> None:
     data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
     data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
     parser.add_argument("--trials", type=input_file, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
+    add_unit_check_argument(parser, "the recordings")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
                         f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, kappa,gamma for an MT table)")
@@ -35,19 +36,27 @@ def names(text: str) -> tuple[str, ...]:
 
 
 def run(args) -> int:
+    from comanip.fitting.movement_times import MovementTimeTable
+    from comanip.fitting.recordings import load_recordings
+
     model = load_model(args)
-    out = output_dir(args.out, "fit", args.force)
     options = {"scheduler": args.scheduler, "progress": not args.no_progress}
     if args.max_evaluations is not None:
         options["max_evaluations"] = args.max_evaluations
     if args.parameters is not None:
         options["parameters"] = args.parameters
+    # the data are read and checked before the output folder is made
     if args.recordings is not None:
-        result = fit_model(model, args.recordings, trials=args.trials, sigma_obs=args.sigma_obs, **options)
+        data = load_recordings(args.recordings, args.trials, check_units=args.check_units)
+    elif args.trials is not None:
+        raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
     else:
-        if args.trials is not None:
-            raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
-        result = fit_movement_times(model, args.mt_table, **options)
+        data = MovementTimeTable.read(args.mt_table)
+    out = output_dir(args.out, "fit", args.force)
+    if args.recordings is not None:
+        result = fit_model(model, data, sigma_obs=args.sigma_obs, **options)
+    else:
+        result = fit_movement_times(model, data, **options)
     written = [result.save_json(out / "fit.json"), result.save_yaml(out / "model.yaml")]
     if result.conditions:
         from comanip.plots.fit_figure import plot_fit

@@ -30,6 +30,13 @@ def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out
     parser.add_argument("--png", action="store_true", help=f"also save {figures}")
 
 
+def add_unit_check_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """--skip-unit-check: read ``what`` as s and m even when its times look like ms or its positions like mm."""
+    parser.add_argument("--skip-unit-check", dest="check_units", action="store_false",
+                        help=f"read {what} as seconds and metres (radians for joints) even where the times look like "
+                             "ms or the positions like mm")
+
+
 def load_model(args: argparse.Namespace) -> ReachingModel:
     """The model named by --preset; a ValueError names the argument."""
     try:
