@@ -27,7 +27,7 @@ def assert_one_line_error(code: int, err: str, *fragments: str) -> None:
     ("name: [unclosed\n", ["--preset", "not valid YAML", "line 2"]),
     ("name: mine\nbody: {type: point_mass, n: 2}\nh: 0.02\nH: 30\n", ["--preset", "'gamma'", "'nu'", "'kappa'", "'width'"]),
     (GOOD_MODEL + "speed: 3\n", ["--preset", "unknown model fields ['speed']", "allowed"]),
-    (GOOD_MODEL.replace("h: 0.02", "h: fast"), ["--preset", "h must be a finite number > 0", "'fast'"]),
+    (GOOD_MODEL.replace("h: 0.02", "h: fast"), ["--preset", "h must be a number between 0.0001 and 1", "'fast'"]),
     (GOOD_MODEL.replace("H: 30", "H: 2.5"), ["--preset", "H must be an integer"]),
     (GOOD_MODEL.replace("n: 2}", "n: 2, size: 3}"), ["--preset", "body of type 'point_mass' takes the parameters", "size"]),
     (GOOD_MODEL.replace("{type: point_mass, n: 2}", "rocket"), ["--preset", "body must be a mapping"]),

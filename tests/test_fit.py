@@ -168,7 +168,7 @@ def test_cli_fits_kappa_to_a_movement_time_table(tmp_path, capsys):
     start = comanip.presets.save(comanip.presets.planar().replace(kappa=START_KAPPA), tmp_path / "start.yaml")
     out = tmp_path / "fit"
     assert main(["fit", "--mt-table", str(table), "--preset", str(start), "--parameters", "kappa",
-                 "--out", str(out), "--no-progress"]) == 0
+                 "--out", str(out), "--no-progress", "--verbose"]) == 0
     written = json.loads((out / "fit.json").read_text())
     assert written["values"]["kappa"] == pytest.approx(TRUE_KAPPA, rel=0.05)
     assert written["status"] == "converged" and len(written["conditions"]) == len(MT_DISTANCES)

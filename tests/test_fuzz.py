@@ -243,3 +243,26 @@ def test_transition_data_files(tmp_path_factory, capsys, text, command):
     assert "Traceback" not in err
     if code != 0:
         assert code == 2 and err.count("\n") == 1 and "error:" in err, err
+
+
+# --- regressions: inputs the fuzzing found -----------------------------------------------------------------------
+
+@pytest.mark.parametrize("goal", [[0.0, 1.3407807929942597e154], [1e200, 0.0], [0.0, -1.0000001e6]])
+def test_found_by_fuzzing_a_goal_whose_distance_overflows_is_a_value_error(small_planner, goal):
+    """Was OverflowError: the reach library's grid index of an infinite distance (reach_library.py)."""
+    with pytest.raises(ValueError, match="goal must lie within ±1e\\+06 m"):
+        small_planner.solve(np.zeros(4), goal)
+
+
+def test_the_reach_library_skips_a_distance_that_overflows():
+    from comanip.planning.reach_library import ReachLibrary
+
+    library = ReachLibrary(lambda *args: pytest.fail("no entry to solve"), 2, 4, 0.02)
+    assert library.guess(np.zeros(4), np.array([0.0, 1.35e154]), 0.02) is None
+
+
+@pytest.mark.parametrize("h", [1e-300, 1e-5, 2.0, 1e12, math.nan])
+def test_found_by_fuzzing_a_time_step_out_of_range_is_a_value_error(h):
+    """Was a plan ending 'failed' with NaN arrays (h = 1e-300 s: the torques overflow)."""
+    with pytest.raises(ValueError, match="h must be a number between 0.0001 and 1 \\(s, time step\\)"):
+        comanip.presets.planar().replace(h=h)

@@ -82,7 +82,7 @@ def test_readme_saved_model_plans_under_its_own_name(tmp_path, monkeypatch, caps
     source = fenced_blocks(README.read_text(encoding="utf-8"), "python")[0][1]
     monkeypatch.chdir(tmp_path)
     exec(compile(source, "README.md:first-block", "exec"), {})
-    assert main(["plan", "--preset", "my.yaml", "--out", str(tmp_path / "plan")]) == 0
+    assert main(["plan", "--preset", "my.yaml", "--out", str(tmp_path / "plan"), "--verbose"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["model"] == "my_model" and summary["success"]
 

@@ -74,6 +74,27 @@ def as_goal_width(name: str, value) -> float:
     return width
 
 
+def as_in_range(name: str, value, bounds: tuple[float, float], unit: str) -> float:
+    """value as a finite float with low ≤ value ≤ high, else ValueError naming the range."""
+    low, high = bounds
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not low <= value <= high:
+        raise ValueError(f"{name} must be a number between {low:g} and {high:g} ({unit}), got {value!r}")
+    return float(value)
+
+
+POSITION_LIMIT_M = 1e6
+"""Largest coordinate magnitude (m) of a goal a solve accepts: far past any reach, and far from where squared
+distances overflow (a coordinate of 1.4e154 m)."""
+
+
+def as_position(name: str, value, size: int) -> np.ndarray:
+    """A task-space position (size,), m, finite and within ±POSITION_LIMIT_M per coordinate, else ValueError."""
+    position = as_vector(name, value, size, "task-space position, m")
+    if np.any(np.abs(position) > POSITION_LIMIT_M):
+        raise ValueError(f"{name} must lie within ±{POSITION_LIMIT_M:g} m per coordinate, got {position.tolist()}")
+    return position
+
+
 def as_optional_positive(name: str, value, unit: str) -> float | None:
     return None if value is None else as_positive(name, value, unit)
 

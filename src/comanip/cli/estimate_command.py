@@ -16,8 +16,9 @@ from pathlib import Path
 
 import numpy as np
 
+from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
-from comanip.cli.outputs import output_dir, write_manifest
+from comanip.cli.outputs import output_dir, report, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
@@ -25,7 +26,7 @@ from comanip.units import check_angles_rad, check_positions_m, check_times_s
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("estimate", help="estimate a reach's goal from an observed state", description=__doc__)
+    parser = subparsers.add_parser("estimate", help=command_help("estimate"), description=__doc__)
     add_model_arguments(parser)
     add_reach_arguments(parser, "the CSV's t = 0 row, else at rest at the body's home position", "out/estimate", "figures")
     parser.add_argument("--observed", type=vector, help="observed state [q; qdot], comma-separated")
@@ -139,5 +140,9 @@ def run(args) -> int:
             written.append(plot_posterior(posterior, out / "posterior.png"))
     summary["files"] = [str(p) for p in written]
     write_manifest(out, "estimate", written)
-    print(json.dumps(summary, indent=1))
+    goal = ", ".join(f"{v:.4g}" for v in estimate.goal)
+    lines = [f"estimate ({model.name}, {args.method}): {estimate.status}, goal ({goal}) m from the state at t = {float(t_obs):.3g} s"]
+    if posterior is not None:
+        lines.append(f"most likely candidate: {int(posterior.most_likely[-1])} (p = {posterior.probabilities[-1].max():.3g})")
+    report(args, lines, summary, out, written)
     return 0 if estimate.success else 1

@@ -4,16 +4,14 @@ per condition (least squares); write fit.json (values, standard errors, residual
 
 from __future__ import annotations
 
-import json
-
+from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model
-from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
-from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
-from comanip.fitting.movement_times import fit_movement_times
+from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
+from comanip.fitting.parameters import DEFAULT_PARAMETERS
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("fit", help="fit model parameters to recordings or movement times", description=__doc__)
+    parser = subparsers.add_parser("fit", help=command_help("fit"), description=__doc__)
     data = parser.add_mutually_exclusive_group(required=True)
     data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
     data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
@@ -36,7 +34,8 @@ def names(text: str) -> tuple[str, ...]:
 
 
 def run(args) -> int:
-    from comanip.fitting.movement_times import MovementTimeTable
+    from comanip.fitting.fit import fit_model
+    from comanip.fitting.movement_times import MovementTimeTable, fit_movement_times
     from comanip.fitting.recordings import load_recordings
 
     model = load_model(args)
@@ -64,5 +63,6 @@ def run(args) -> int:
         written.append(plot_fit(result, out / "fit.png"))
     write_manifest(out, "fit", written)
     summary = {key: value for key, value in result.to_dict().items() if key not in ("model", "conditions", "trials")}
-    print(json.dumps(summary | {"files": [str(p) for p in written]}, indent=1))
+    report(args, [f"fit ({model.name}): {result.summary()}", result.message], summary | {"files": [str(p) for p in written]},
+           out, written)
     return 0 if result.success else 1

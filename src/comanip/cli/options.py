@@ -7,12 +7,15 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from comanip import presets
 from comanip.cli.outputs import add_output_arguments
-from comanip.model import ReachingModel
+
+if TYPE_CHECKING:
+    from comanip.model import ReachingModel
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, default_preset: str = "planar") -> None:

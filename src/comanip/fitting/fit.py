@@ -21,15 +21,13 @@ from comanip.arguments import as_count, as_positive
 from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.conditions import Condition, group_conditions
 from comanip.fitting.objective import RecordingsObjective
-from comanip.fitting.parameters import ParameterSpace
+from comanip.fitting.parameters import DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.recordings import Trial, load_recordings
 from comanip.fitting.residuals import condition_curves, condition_residuals, trial_residuals
 from comanip.fitting.progress import ProgressBar
 from comanip.fitting.result import FitResult, failed_result, fitted_model, identification, outcome_message
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
-
-DEFAULT_PARAMETERS = ("kappa", "nu", "gamma")
 
 #: Edge of Nelder-Mead's first simplex in transformed units (a factor e^0.5 = 1.65 for log parameters).
 SIMPLEX_STEP = 0.5

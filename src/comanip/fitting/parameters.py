@@ -10,11 +10,17 @@ and searched as its logarithm, so u = log(kappa) and the step from u to u + 0.1 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from comanip.arguments import as_positive
-from comanip.model import ReachingModel
+
+if TYPE_CHECKING:  # the CLI reads DEFAULT_PARAMETERS without loading the model's solvers
+    from comanip.model import ReachingModel
+
+DEFAULT_PARAMETERS = ("kappa", "nu", "gamma")
+"""The parameters a recordings fit frees by default."""
 
 #: Parameters searched as logit(value), in (0, 1); all others as log(value), > 0.
 UNIT_INTERVAL = ("gamma",)
