@@ -144,3 +144,57 @@ def test_read_observations_reads_unusual_units_when_told():
         assert times[1] == pytest.approx(20.0) and states.shape == (21, 4)
         with pytest.raises(ValueError, match="look like degrees"):
             read_observations(_observations(Path(folder) / "degrees.csv", 1.0, 100.0), 2, joint_angles=True)
+
+
+@pytest.mark.parametrize("goal, fragments", [
+    ("2,0", ["the goal is 2 m from the start, beyond a person's reach", "peak hand speed"]),
+    ("300,0", ["the goal is 300 m from the start", "is it in mm?"]),
+])
+def test_an_implausible_human_reach_is_planned_with_a_warning(tmp_path, capsys, goal, fragments):
+    """Were a silent 'solved' at 8.5 m/s (2 m) and a bare 'goal_not_reached' (300, meant as mm)."""
+    import json
+
+    code = main(["plan", "--goal", goal, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    warnings = [line for line in err.splitlines() if line.startswith("comanip plan: warning: ")]
+    assert warnings and "Traceback" not in err, err
+    for fragment in fragments:
+        assert fragment in err, (fragment, err)
+    saved = json.loads((tmp_path / "plan.json").read_text())
+    assert "warning:" in saved["message"] and code in (0, 1)
+
+
+def test_a_reach_within_a_persons_reach_has_no_warning(tmp_path, capsys):
+    assert main(["plan", "--goal", "0.45,0", "--out", str(tmp_path)]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_help_texts_name_no_issue_session_or_spec(capsys):
+    """Help is product text: no 'issue 11', 'session' or 'SPEC' (the formulation document's old name)."""
+    import re
+
+    from comanip.cli.main import build_parser
+
+    def parsers(parser):
+        yield parser
+        for action in parser._actions:
+            for sub in getattr(action, "choices", None) or {}:
+                if isinstance(action.choices, dict):
+                    yield from parsers(action.choices[sub])
+
+    for parser in parsers(build_parser()):
+        text = parser.format_help()
+        assert not re.search(r"\bissue\s*\d|\bsession|\bSPEC\b", text, re.IGNORECASE), (parser.prog, text)
+
+
+def test_numeric_arguments_out_of_range_are_one_line_before_any_work(tmp_path, capsys):
+    """Fuzzed numbers reach no solver: each is refused in one line and no output folder is made."""
+    out = tmp_path / "out"
+    for argv, fragment in [(["plan", "--goal", "1e300,0"], "goal must lie within"),
+                           (["plan", "--goal", "nan,0"], "goal must be finite"),
+                           (["plan", "--max-wall-time", "0"], "max_wall_time"),
+                           (["fit", "--mt-table", __file__, "--max-evaluations", "0", "--no-progress"], "--max-evaluations"),
+                           (["fit", "--mt-table", __file__, "--sigma-obs", "nan", "--no-progress"], "sigma_obs"),
+                           (["estimate", "--observed", "0.01,0,0.3,0", "--t-obs", "nan"], "t_obs")]:
+        assert_one_line_error(*run_cli([*argv, "--out", str(out)], capsys), fragment)
+        assert not out.exists(), argv

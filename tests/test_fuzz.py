@@ -5,11 +5,10 @@ exception or a silent NaN. The count of inputs tried is printed at the end of th
 """
 
 import math
-import os
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import comanip
@@ -19,9 +18,8 @@ from comanip.estimation import GoalEstimator
 pytestmark = pytest.mark.slow  # about 30 s: CI runs it; the fast subset (-m "not slow") leaves it out
 
 FUZZ_COUNT = {"inputs": 0}
-# CI draws the same inputs every run (a failure there is then reproducible, not luck); elsewhere they are new each run
-FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None,
-                derandomize=os.environ.get("CI") == "true")
+# whether the inputs are the same every run (CI) or new each run (locally) is the profile's choice: tests/conftest.py
+FAST = settings(max_examples=150)
 
 numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**12, 10**12),
                     st.sampled_from([0.0, -0.0, 1e-300, 1e300, -1e300]))
@@ -102,7 +100,7 @@ arguments = st.lists(st.one_of(st.sampled_from(["--goal", "--start", "--width", 
                                st.text(alphabet="0123456789.,;-e naif", max_size=12)), max_size=6)
 
 
-@settings(max_examples=400, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@settings(max_examples=400)
 @given(command=st.sampled_from(["plan", "estimate"]), argv=arguments)
 def test_cli_never_tracebacks(tmp_path_factory, capsys, command, argv):
     FUZZ_COUNT["inputs"] += 1
@@ -151,8 +149,7 @@ def franka_poses():
                      st.lists(joint, min_size=0, max_size=9))
 
 
-@settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck), database=None,
-          derandomize=os.environ.get("CI") == "true")
+@settings(max_examples=30)
 @given(q=franka_poses(), qdot=st.one_of(st.just(np.zeros(7)), st.lists(st.floats(-5.0, 5.0), min_size=7, max_size=7).map(np.array)),
        goal=st.one_of(st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3), vectors))
 def test_franka_any_pose(franka_planner, q, qdot, goal):
@@ -184,7 +181,7 @@ LONG_COMMANDS = {
     "handover": (["handover"], {"--start": VECTORS, "--goal": VECTORS, "--width": SCALARS, "--ramp-time": SCALARS,
                                 "--stiffness": SCALARS, "--rate": SCALARS, "--arm-length": SCALARS,
                                 "--max-wall-time": SCALARS, "--preset": ["planar", "cartesian", "human", "nope"]},
-                 ("comanip.cli.handover_command", "Planner")),
+                 ("comanip.planning.planner", "Planner")),
     "transition generate": (["transition", "generate"], {"--distances": VECTORS, "--widths": VECTORS, "--trials": SCALARS,
                                                          "--arm-length": SCALARS, "--steps": SCALARS, "--seed": SCALARS,
                                                          "--workers": SCALARS, "--preset": ["planar", "cartesian", "franka"]},
@@ -197,8 +194,7 @@ LONG_COMMANDS = {
 OUT_FILES = {"transition generate": "data.csv", "library": "library.npz"}
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), database=None,
-          derandomize=os.environ.get("CI") == "true")
+@settings(max_examples=300)
 @given(command=st.sampled_from(sorted(LONG_COMMANDS)), data=st.data())
 def test_long_commands_give_one_line_errors(tmp_path_factory, capsys, monkeypatch, command, data):
     """simulate, handover, transition generate and library: a user mistake is one line and exit status 2, never a

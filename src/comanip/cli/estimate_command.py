@@ -108,10 +108,11 @@ def run(args) -> int:
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
-    out = output_dir(args.out, "estimate", args.force)
-
+    out = output_dir(args.out, "estimate", args.force, create=False)
+    # the estimator checks every input before its work: a mistake is a ValueError before the folder is made
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, prior_std=args.prior_std, method=args.method,
                                   max_wall_time=args.max_wall_time)
+    out.mkdir(parents=True, exist_ok=True)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
                "prior_std": args.prior_std if args.prior_std is None or isinstance(args.prior_std, (str, float)) else args.prior_std.tolist(),

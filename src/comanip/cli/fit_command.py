@@ -4,10 +4,11 @@ per condition (least squares); write fit.json (values, standard errors, residual
 
 from __future__ import annotations
 
+from comanip.arguments import as_count
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
-from comanip.fitting.parameters import DEFAULT_PARAMETERS
+from comanip.fitting.parameters import DEFAULT_PARAMETERS, MT_DEFAULT_PARAMETERS, ParameterSpace
 
 
 def add_parser(subparsers) -> None:
@@ -19,7 +20,7 @@ def add_parser(subparsers) -> None:
     add_unit_check_argument(parser, "the recordings")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
-                        f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, kappa,gamma for an MT table)")
+                        f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, {','.join(MT_DEFAULT_PARAMETERS)} for an MT table)")
     parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
     parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings, 100 for an MT table)")
     parser.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
@@ -44,7 +45,9 @@ def run(args) -> int:
         options["max_evaluations"] = args.max_evaluations
     if args.parameters is not None:
         options["parameters"] = args.parameters
-    # the data are read and checked before the output folder is made
+    # the arguments, then the data, are checked before the output folder is made
+    as_count("--max-evaluations", args.max_evaluations, optional=True)
+    ParameterSpace(model, options.get("parameters", DEFAULT_PARAMETERS if args.recordings else MT_DEFAULT_PARAMETERS), args.sigma_obs)
     if args.recordings is not None:
         data = load_recordings(args.recordings, args.trials, check_units=args.check_units)
     elif args.trials is not None:

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 
 from comanip.cli.commands import command_help
@@ -21,18 +19,19 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from comanip.planning.planner import Planner
+    from comanip.arguments import as_optional_positive
+    from comanip.planning.planner import Planner, reach_inputs
 
     model = load_model(args)
-    out = output_dir(args.out, "plan", args.force)
-    planner = Planner(model)
     start = np.concatenate([model.body.home_position, np.zeros(model.n)]) if args.start is None else args.start
-    if args.goal is None:
-        start_x = np.asarray(model.body.kinematics_function(planner.check_inputs(start, np.zeros(model.d), None)[0][: model.n])[0]).ravel()
-        goal = start_x + 0.3 * np.eye(model.d)[0]
-    else:
-        goal = args.goal
-    plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)
+    goal = args.goal
+    if goal is None:
+        start_q = reach_inputs(model, start, np.zeros(model.d), None)[0][: model.n]
+        goal = np.asarray(model.body.kinematics_function(start_q)[0]).ravel() + 0.3 * np.eye(model.d)[0]
+    reach_inputs(model, start, goal, args.width)  # every input checked before the folder is made
+    as_optional_positive("max_wall_time", args.max_wall_time, "s")
+    out = output_dir(args.out, "plan", args.force)
+    plan = Planner(model).solve(start, goal, args.width, max_wall_time=args.max_wall_time)
     plan.save_json(out / "plan.json")
     plan.save_csv(out / "plan.csv")
     written = [out / "plan.json", out / "plan.csv"]

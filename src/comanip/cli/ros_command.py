@@ -12,8 +12,8 @@ from __future__ import annotations
 
 import argparse
 
-from comanip.cli.commands import command_help
 from comanip.arguments import as_positive
+from comanip.cli.commands import command_help
 from comanip.cli.options import add_unit_check_argument, input_file
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 

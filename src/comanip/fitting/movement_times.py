@@ -23,7 +23,7 @@ from scipy.optimize import least_squares
 from comanip.arguments import as_count, as_positive, as_positive_array
 from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.csv_table import read_table
-from comanip.fitting.parameters import ParameterSpace
+from comanip.fitting.parameters import MT_DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.progress import ProgressBar
 from comanip.fitting.residuals import movement_time
 from comanip.fitting.result import FitResult, failed_result, fitted_model, identification, outcome_message
@@ -51,7 +51,7 @@ class MovementTimeTable:
         return cls(*(as_positive_array(f"{name} in {str(path)!r}", table[name], "m or s") for name in MT_COLUMNS))
 
 
-def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTable, parameters: Sequence[str] = ("kappa", "gamma"),
+def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTable, parameters: Sequence[str] = MT_DEFAULT_PARAMETERS,
                        *, bounds: dict | None = None, max_evaluations: int = 100, diff_step: float = 0.01,
                        scheduler=None, progress: bool = True) -> FitResult:
     """Least-squares fit of model fields to movement times per condition.

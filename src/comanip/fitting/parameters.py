@@ -21,6 +21,8 @@ if TYPE_CHECKING:  # the CLI reads DEFAULT_PARAMETERS without loading the model'
 
 DEFAULT_PARAMETERS = ("kappa", "nu", "gamma")
 """The parameters a recordings fit frees by default."""
+MT_DEFAULT_PARAMETERS = ("kappa", "gamma")
+"""The parameters a movement-time fit frees by default."""
 
 #: Parameters searched as logit(value), in (0, 1); all others as log(value), > 0.
 UNIT_INTERVAL = ("gamma",)

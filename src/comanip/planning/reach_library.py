@@ -87,7 +87,8 @@ class ReachLibrary:
         start's position, for the start at rest there (a moving start adds its own correction); None when the
         goal is at the start (or its distance overflows), or when the entry is not solved yet and not ``solve_missing``."""
         offset = np.asarray(goal, dtype=float) - start[: self.n]
-        distance = float(np.linalg.norm(offset))
+        with np.errstate(over="ignore"):
+            distance = float(np.linalg.norm(offset))
         if not 0.0 < distance < np.inf:  # at the start, or so far that the distance overflows: no entry
             return None
         key = (int(np.round(np.log(distance / width) / np.log(GRID_RATIO))),
