@@ -262,3 +262,53 @@ def test_found_by_fuzzing_a_time_step_out_of_range_is_a_value_error(h):
     """Was a plan ending 'failed' with NaN arrays (h = 1e-300 s: the torques overflow)."""
     with pytest.raises(ValueError, match="h must be a number between 0.0001 and 1 \\(s, time step\\)"):
         comanip.presets.planar().replace(h=h)
+
+
+# --- fitting: every argument and recording checked before any plan --------------------------------------------------
+
+def _trial():
+    from comanip.fitting import Trial
+
+    t = np.arange(0.0, 0.62, 0.02)
+    return Trial("a", t, np.column_stack([0.3 * t / 0.6, 0 * t]), np.array([0.3, 0.0]), 0.02)
+
+
+@FAST
+@given(sigma_obs=numbers, start_tolerance=numbers, max_evaluations=st.one_of(numbers, st.booleans()), step=numbers,
+       bounds=st.one_of(st.none(), st.dictionaries(st.sampled_from(["kappa", "gamma", "nu"]),
+                                                   st.one_of(st.tuples(numbers, numbers), numbers, st.text(max_size=3)), max_size=2)),
+       parameters=st.one_of(st.lists(st.sampled_from(["kappa", "gamma", "nu", "sigma_obs", "H", "bogus", "kappa.0"]), max_size=3),
+                            st.text(max_size=6)))
+def test_fit_model_arguments(monkeypatch, sigma_obs, start_tolerance, max_evaluations, step, bounds, parameters):
+    """fit_model refuses a bad argument with a ValueError before it plans anything (planning is replaced by
+    InputsAccepted here)."""
+    import comanip.fitting.fit as fit
+
+    FUZZ_COUNT["inputs"] += 1
+    with monkeypatch.context() as patch:
+        patch.setattr(fit, "ConditionPlanner", _accept)
+        try:
+            fit.fit_model(comanip.presets.planar(), [_trial()], parameters, sigma_obs=sigma_obs, bounds=bounds,
+                          start_tolerance=start_tolerance, max_evaluations=max_evaluations, step=step, progress=False)
+        except InputsAccepted:
+            return
+        except ValueError as error:
+            assert str(error) and "\n" not in str(error)
+
+
+@FAST
+@given(text=st.one_of(st.text(max_size=120), st.lists(st.tuples(st.sampled_from(["a", "b"]), numbers, numbers, numbers),
+                                                      min_size=1, max_size=8).map(
+    lambda rows: "trial,t,x,y,goal_x,goal_y,width\n" + "".join(f"{r[0]},{r[1]},{r[2]},{r[3]},0.3,0,0.02\n" for r in rows))))
+def test_load_recordings_any_file(tmp_path_factory, text):
+    from comanip.fitting import load_recordings
+
+    FUZZ_COUNT["inputs"] += 1
+    path = tmp_path_factory.mktemp("rec") / "r.csv"
+    path.write_text(text)
+    try:
+        trials = load_recordings(path)
+    except ValueError as error:
+        assert str(error) and "\n" not in str(error)
+    else:
+        assert all(np.all(np.isfinite(trial.t)) and np.all(np.diff(trial.t) > 0) for trial in trials)

@@ -2,6 +2,8 @@
 
 import json
 
+import pytest
+
 from comanip.cli.main import build_parser, main
 
 
@@ -127,3 +129,22 @@ def test_help_is_fast_because_the_cli_imports_lazily():
             "'dask', 'sklearn', 'rclpy'))))")
     heavy = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout.split()
     assert heavy == [], heavy
+
+
+@pytest.mark.slow
+def test_simulate_again_into_its_folder_keeps_only_this_runs_files_and_leaks_no_warning(tmp_path, capsys):
+    """Were 67 files after 'simulate sync --policy all' then 'simulate sync', the manifest naming the last run's
+    only, and numpy's 'All-NaN slice encountered' on the terminal (the comparison figure's error percentiles
+    before the first estimate)."""
+    import warnings
+
+    out = tmp_path / "sim"
+    argv = ["simulate", "sync", "--trials", "1", "--goal", "near", "--no-frames", "--out", str(out)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        assert main([*argv, "--policy", "all"]) == 0
+    assert len(capsys.readouterr().out.splitlines()) <= 4
+    assert main(argv) == 0
+    listed = set(json.loads((out / "manifest.json").read_text())["files"])
+    assert {p.name for p in out.iterdir()} == listed | {"manifest.json"}
+    assert "sync_policies.md" not in listed

@@ -60,7 +60,11 @@ class ParameterSpace:
         if natural is None:
             half = LOGIT_RANGE if name in UNIT_INTERVAL else LOG_RANGE
             return (-half, half) if name in UNIT_INTERVAL else (u0 - half, u0 + half)
-        low, high = (_to_transformed(name, v) for v in natural)
+        try:
+            low, high = (_to_transformed(name, float(v)) for v in natural)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"bounds of {name} must be (low, high) in natural units within its domain, got {natural!r} "
+                             f"({error})") from None
         if not low <= u0 <= high:
             raise ValueError(f"bounds of {name} are {tuple(natural)}, which exclude its start value {self.start_values[name]}")
         return low, high
