@@ -307,6 +307,10 @@ def test_cli_fit_refuses_recordings_in_ms_and_skip_unit_check_reads_them(tmp_pat
     err = capsys.readouterr().err
     assert err.count("\n") == 1 and "look like milliseconds" in err and "--skip-unit-check" in err
     assert not (tmp_path / "out").exists()
+    assert main(["fit", "--recordings", str(path), "--out", str(tmp_path / "out"), "--no-progress", "--skip-unit-check",
+                 "--parameters", "kappa", "--max-evaluations", "20"]) == 1        # read as s: nothing to fit
+    assert json.loads((tmp_path / "out" / "fit.json").read_text())["status"] == "unidentified"
+    assert capsys.readouterr().out.startswith("fit (planar): unidentified")
 
 
 def test_a_fit_that_scores_no_sample_is_not_converged(tmp_path):

@@ -246,7 +246,7 @@ def test_transition_data_files(tmp_path_factory, capsys, text, command):
 @pytest.mark.parametrize("goal", [[0.0, 1.3407807929942597e154], [1e200, 0.0], [0.0, -1.0000001e6]])
 def test_found_by_fuzzing_a_goal_whose_distance_overflows_is_a_value_error(small_planner, goal):
     """Was OverflowError: the reach library's grid index of an infinite distance (reach_library.py)."""
-    with pytest.raises(ValueError, match="goal must lie within ±1e\\+06 m"):
+    with pytest.raises(ValueError, match="goal must lie within ±1e\\+06 per coordinate"):
         small_planner.solve(np.zeros(4), goal)
 
 
@@ -312,3 +312,8 @@ def test_load_recordings_any_file(tmp_path_factory, text):
         assert str(error) and "\n" not in str(error)
     else:
         assert all(np.all(np.isfinite(trial.t)) and np.all(np.diff(trial.t) > 0) for trial in trials)
+
+
+def test_a_start_beyond_the_documented_range_is_a_value_error(small_planner):
+    with pytest.raises(ValueError, match="start must lie within ±1e\\+06 per coordinate"):
+        small_planner.solve([1e300, 0.0, 0.0, 0.0], [0.3, 0.0])

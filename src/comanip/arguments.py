@@ -82,17 +82,22 @@ def as_in_range(name: str, value, bounds: tuple[float, float], unit: str) -> flo
     return float(value)
 
 
-POSITION_LIMIT_M = 1e6
-"""Largest coordinate magnitude (m) of a goal a solve accepts: far past any reach, and far from where squared
-distances overflow (a coordinate of 1.4e154 m)."""
+MAGNITUDE_LIMIT = 1e6
+"""Largest magnitude of a coordinate of a start state or goal a solve accepts (m, m/s, rad, rad/s): far past any
+reach, and far from where squared distances overflow (a coordinate of 1.4e154)."""
 
 
 def as_position(name: str, value, size: int) -> np.ndarray:
-    """A task-space position (size,), m, finite and within ±POSITION_LIMIT_M per coordinate, else ValueError."""
-    position = as_vector(name, value, size, "task-space position, m")
-    if np.any(np.abs(position) > POSITION_LIMIT_M):
-        raise ValueError(f"{name} must lie within ±{POSITION_LIMIT_M:g} m per coordinate, got {position.tolist()}")
-    return position
+    """A task-space position (size,), m, finite and within ±MAGNITUDE_LIMIT per coordinate, else ValueError."""
+    return as_bounded_vector(name, value, size, "task-space position, m")
+
+
+def as_bounded_vector(name: str, value, size: int, unit: str) -> np.ndarray:
+    """:func:`as_vector`, each entry also within ±MAGNITUDE_LIMIT, else ValueError."""
+    array = as_vector(name, value, size, unit)
+    if np.any(np.abs(array) > MAGNITUDE_LIMIT):
+        raise ValueError(f"{name} must lie within ±{MAGNITUDE_LIMIT:g} per coordinate ({unit}), got {array.tolist()}")
+    return array
 
 
 def as_optional_positive(name: str, value, unit: str) -> float | None:

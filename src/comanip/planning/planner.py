@@ -37,7 +37,8 @@ import numpy as np
 
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_count, as_goal_width, as_matrix, as_optional_positive, as_position, as_positive, as_vector
+from comanip.arguments import (as_bounded_vector, as_count, as_goal_width, as_matrix, as_optional_positive, as_position,
+                               as_positive)
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
@@ -621,7 +622,7 @@ def reach_inputs(model: ReachingModel, start, goal, width) -> tuple[np.ndarray, 
 
     A start of [q; qdot] (2n,) for a model with activation stages gets them at zero force."""
     size = 2 * model.n if np.shape(start) == (2 * model.n,) else model.state_size
-    start = model.full_state(as_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
+    start = model.full_state(as_bounded_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
                                        + (f", optionally followed by the {model.state_size - 2 * model.n} activation states"
                                           if size != 2 * model.n else "")))
     goal = as_position("goal", goal, model.d)
