@@ -317,3 +317,8 @@ def test_load_recordings_any_file(tmp_path_factory, text):
 def test_a_start_beyond_the_documented_range_is_a_value_error(small_planner):
     with pytest.raises(ValueError, match="start must lie within ±1e\\+06 per coordinate"):
         small_planner.solve([1e300, 0.0, 0.0, 0.0], [0.3, 0.0])
+
+
+def test_a_horizon_beyond_the_documented_range_is_a_value_error():
+    with pytest.raises(ValueError, match="H must be ≤ 1000"):
+        comanip.presets.planar().replace(H=10**9)

@@ -23,6 +23,8 @@ MAX_ACTIVATION_STEPS = 1000
 #: time steps h (s) a model takes: a reach of 0.1-10 s in 10 to 1000 steps lies well inside; far below, the
 #: torques a reach needs grow as 1/h² until they overflow (h = 1e-300 s), far above no reach fits in one step
 STEP_RANGE_S = (1e-4, 1.0)
+#: longest horizon (steps): the solver's dense Newton system has (H·n)² entries, 0.4 GB for the Panda at 1000
+MAX_HORIZON_STEPS = 1000
 
 
 @dataclass(frozen=True)
@@ -34,7 +36,7 @@ class ReachingModel:
     h: float
     """Time step (s), within STEP_RANGE_S (1e-4 to 1 s)."""
     H: int
-    """Planning horizon (steps), ≥ 1; the plan spans H·h seconds."""
+    """Planning horizon (steps), 1 to MAX_HORIZON_STEPS (1000); the plan spans H·h seconds."""
     gamma: float
     """Discount per step of the reward, in (0, 1]; the time cost of the cost–benefit trade-off."""
     nu: float
@@ -91,6 +93,8 @@ class ReachingModel:
             raise ValueError(f"activation time constants must be ≤ {MAX_ACTIVATION_STEPS} h = {MAX_ACTIVATION_STEPS * self.h:g} s "
                              f"(a slower stage never responds within a plan), got {slow}")
         object.__setattr__(self, "H", as_count("H", self.H, 1, "horizon in steps"))
+        if self.H > MAX_HORIZON_STEPS:
+            raise ValueError(f"H must be ≤ {MAX_HORIZON_STEPS} (horizon in steps), got {self.H}")
         if not (isinstance(self.gamma, (int, float)) and 0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1] (discount per step), got {self.gamma!r}")
         as_nonnegative("nu", self.nu, "reward per N²")
