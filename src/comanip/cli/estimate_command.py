@@ -18,7 +18,7 @@ import numpy as np
 
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
-from comanip.cli.outputs import output_dir, report, write_manifest
+from comanip.cli.outputs import output_dir, point_text, report, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
@@ -141,8 +141,8 @@ def run(args) -> int:
             written.append(plot_posterior(posterior, out / "posterior.png"))
     summary["files"] = [str(p) for p in written]
     write_manifest(out, "estimate", written)
-    goal = ", ".join(f"{v:.4g}" for v in estimate.goal)
-    lines = [f"estimate ({model.name}, {args.method}): {estimate.status}, goal ({goal}) m from the state at t = {float(t_obs):.3g} s"]
+    lines = [f"estimate ({model.name}, {args.method}): {estimate.status}, goal {point_text(estimate.goal)} m from the state at "
+             f"t = {float(t_obs):.3g} s"]
     if posterior is not None:
         lines.append(f"most likely candidate: {int(posterior.most_likely[-1])} (p = {posterior.probabilities[-1].max():.3g})")
     report(args, lines, summary, out, written)

@@ -64,10 +64,6 @@ def add_output_arguments(parser: argparse.ArgumentParser, default: str | None, w
     """--out (default ``default``, described as ``default_text`` when given), --force and --verbose."""
     parser.add_argument("--out", default=default, help=f"{what} (default: {default_text or '%(default)s'})")
     parser.add_argument("--force", action="store_true", help="write into an output folder that holds another command's results")
-    add_verbose_argument(parser)
-
-
-def add_verbose_argument(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--verbose", action="store_true", help="print the full results (JSON, tables) instead of a short summary")
 
 

@@ -6,6 +6,7 @@ over trials) and a figure comparing the policies over the same trials and person
 
 from __future__ import annotations
 
+import json
 import time
 
 from comanip.cli.commands import command_help
@@ -34,8 +35,6 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    import json
-
     from comanip.simulation import SCENARIOS, ScenarioSetup, resolve_goal, scenario
 
     from comanip.simulation.policies import POLICIES, check_policy
