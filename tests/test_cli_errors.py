@@ -198,3 +198,10 @@ def test_numeric_arguments_out_of_range_are_one_line_before_any_work(tmp_path, c
                            (["estimate", "--observed", "0.01,0,0.3,0", "--t-obs", "nan"], "t_obs")]:
         assert_one_line_error(*run_cli([*argv, "--out", str(out)], capsys), fragment)
         assert not out.exists(), argv
+
+
+def test_an_observation_in_mm_gives_an_estimate_with_a_warning(tmp_path, capsys):
+    """--observed in mm (10 mm, 300 mm/s read as m and m/s): the estimated reach is no person's, and says so."""
+    main(["estimate", "--observed", "10,0,300,0", "--t-obs", "0.1", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert "comanip estimate: warning: the goal is" in err and "peak hand speed" in err and "Traceback" not in err

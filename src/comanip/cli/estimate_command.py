@@ -18,10 +18,11 @@ import numpy as np
 
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
-from comanip.cli.outputs import output_dir, point_text, report, write_manifest
+from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
+from comanip.plausibility import human_plausibility
 from comanip.units import check_angles_rad, check_positions_m, check_times_s
 
 
@@ -141,6 +142,7 @@ def run(args) -> int:
             written.append(plot_posterior(posterior, out / "posterior.png"))
     summary["files"] = [str(p) for p in written]
     write_manifest(out, "estimate", written)
+    warn("estimate", human_plausibility(model, estimate))  # of the estimated goal and the predicted reach
     lines = [f"estimate ({model.name}, {args.method}): {estimate.status}, goal {point_text(estimate.goal)} m from the state at "
              f"t = {float(t_obs):.3g} s"]
     if posterior is not None:
