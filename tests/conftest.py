@@ -4,8 +4,17 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 import comanip
+
+# Hypothesis: in CI (CI=true) every run draws the same inputs (derandomized, no example database), so a red run
+# is the code's fault and reproduces anywhere; elsewhere each run draws new inputs and the database in
+# .hypothesis/ replays a failure until it is fixed. HYPOTHESIS_PROFILE=ci (or dev) chooses explicitly.
+settings.register_profile("ci", derandomize=True, database=None, deadline=None, print_blob=True,
+                          suppress_health_check=list(HealthCheck))
+settings.register_profile("dev", deadline=None, print_blob=True, suppress_health_check=list(HealthCheck))
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "ci" if os.environ.get("CI") == "true" else "dev"))
 
 
 def pytest_configure(config):
@@ -36,9 +45,11 @@ def activation_planner():
 
 
 def pytest_terminal_summary(terminalreporter):
-    """Report how many generated inputs the fuzz suite (tests/test_fuzz.py) tried, when it ran."""
+    """Report the Hypothesis profile and how many generated inputs the fuzz suite (tests/test_fuzz.py) tried,
+    when it ran."""
     import sys
 
     fuzz = sys.modules.get("test_fuzz") or sys.modules.get("tests.test_fuzz")
     if fuzz is not None and fuzz.FUZZ_COUNT["inputs"]:
-        terminalreporter.write_line(f"fuzz: {fuzz.FUZZ_COUNT['inputs']} generated inputs tried")
+        terminalreporter.write_line(f"fuzz: {fuzz.FUZZ_COUNT['inputs']} generated inputs tried "
+                                    f"(hypothesis profile {settings.get_current_profile_name()!r})")

@@ -27,7 +27,7 @@ def assert_one_line_error(code: int, err: str, *fragments: str) -> None:
     ("name: [unclosed\n", ["--preset", "not valid YAML", "line 2"]),
     ("name: mine\nbody: {type: point_mass, n: 2}\nh: 0.02\nH: 30\n", ["--preset", "'gamma'", "'nu'", "'kappa'", "'width'"]),
     (GOOD_MODEL + "speed: 3\n", ["--preset", "unknown model fields ['speed']", "allowed"]),
-    (GOOD_MODEL.replace("h: 0.02", "h: fast"), ["--preset", "h must be a finite number > 0", "'fast'"]),
+    (GOOD_MODEL.replace("h: 0.02", "h: fast"), ["--preset", "h must be a number between 0.0001 and 1", "'fast'"]),
     (GOOD_MODEL.replace("H: 30", "H: 2.5"), ["--preset", "H must be an integer"]),
     (GOOD_MODEL.replace("n: 2}", "n: 2, size: 3}"), ["--preset", "body of type 'point_mass' takes the parameters", "size"]),
     (GOOD_MODEL.replace("{type: point_mass, n: 2}", "rocket"), ["--preset", "body must be a mapping"]),
@@ -107,3 +107,101 @@ def test_long_commands_check_inputs_before_making_their_folder(tmp_path, capsys,
     target = out / "data.csv" if argv[0] == "transition" else out
     assert_one_line_error(*run_cli([*argv, "--out", str(target)], capsys), *fragments)
     assert not out.exists()
+
+
+def _observations(path, time_scale=1.0, position_scale=1.0):
+    """A 0.3 m reach's states at 50 Hz in the CSV 'comanip estimate --observations' reads, times and
+    positions (and velocities) scaled."""
+    import numpy as np
+
+    t = np.arange(0.0, 0.42, 0.02)
+    s = t / 0.6
+    x, v = 0.3 * (10 * s**3 - 15 * s**4 + 6 * s**5), 0.3 / 0.6 * (30 * s**2 - 60 * s**3 + 30 * s**4)
+    lines = ["t_s,q0,q1,qdot0,qdot1"] + [f"{time_scale * a:.6g},{position_scale * b:.6g},0,{position_scale * c:.6g},0"
+                                         for a, b, c in zip(t, x, v)]
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("scales, fragments", [((1000.0, 1.0), ["column 't_s'", "look like milliseconds", "--skip-unit-check"]),
+                                               ((1.0, 1000.0), ["columns q0..q1", "look like millimetres"])])
+def test_observations_in_ms_or_mm_are_one_line(tmp_path, capsys, scales, fragments):
+    path = _observations(tmp_path / "observed.csv", *scales)
+    assert_one_line_error(*run_cli(["estimate", "--observations", str(path), "--out", str(tmp_path / "out")], capsys),
+                          "--observations", *fragments)
+    assert not (tmp_path / "out").exists()
+
+
+def test_read_observations_reads_unusual_units_when_told():
+    import tempfile
+    from pathlib import Path
+
+    from comanip.cli.estimate_command import read_observations
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = _observations(Path(folder) / "observed.csv", 1000.0)
+        times, states = read_observations(path, 2, check_units=False)
+        assert times[1] == pytest.approx(20.0) and states.shape == (21, 4)
+        with pytest.raises(ValueError, match="look like degrees"):
+            read_observations(_observations(Path(folder) / "degrees.csv", 1.0, 100.0), 2, joint_angles=True)
+
+
+@pytest.mark.parametrize("goal, fragments", [
+    ("2,0", ["the goal is 2 m from the start, beyond a person's reach", "peak hand speed"]),
+    ("300,0", ["the goal is 300 m from the start", "is it in mm?"]),
+])
+def test_an_implausible_human_reach_is_planned_with_a_warning(tmp_path, capsys, goal, fragments):
+    """Were a silent 'solved' at 8.5 m/s (2 m) and a bare 'goal_not_reached' (300, meant as mm)."""
+    import json
+
+    code = main(["plan", "--goal", goal, "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    warnings = [line for line in err.splitlines() if line.startswith("comanip plan: warning: ")]
+    assert warnings and "Traceback" not in err, err
+    for fragment in fragments:
+        assert fragment in err, (fragment, err)
+    saved = json.loads((tmp_path / "plan.json").read_text())
+    assert "warning:" in saved["message"] and code in (0, 1)
+
+
+def test_a_reach_within_a_persons_reach_has_no_warning(tmp_path, capsys):
+    assert main(["plan", "--goal", "0.45,0", "--out", str(tmp_path)]) == 0
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_help_texts_name_no_issue_session_or_spec(capsys):
+    """Help is product text: no 'issue 11', 'session' or 'SPEC' (the formulation document's old name)."""
+    import re
+
+    from comanip.cli.main import build_parser
+
+    def parsers(parser):
+        yield parser
+        for action in parser._actions:
+            for sub in getattr(action, "choices", None) or {}:
+                if isinstance(action.choices, dict):
+                    yield from parsers(action.choices[sub])
+
+    for parser in parsers(build_parser()):
+        text = parser.format_help()
+        assert not re.search(r"\bissue\s*\d|\bsession|\bSPEC\b", text, re.IGNORECASE), (parser.prog, text)
+
+
+def test_numeric_arguments_out_of_range_are_one_line_before_any_work(tmp_path, capsys):
+    """Fuzzed numbers reach no solver: each is refused in one line and no output folder is made."""
+    out = tmp_path / "out"
+    for argv, fragment in [(["plan", "--goal", "1e300,0"], "goal must lie within"),
+                           (["plan", "--goal", "nan,0"], "goal must be finite"),
+                           (["plan", "--max-wall-time", "0"], "max_wall_time"),
+                           (["fit", "--mt-table", __file__, "--max-evaluations", "0", "--no-progress"], "--max-evaluations"),
+                           (["fit", "--mt-table", __file__, "--sigma-obs", "nan", "--no-progress"], "sigma_obs"),
+                           (["estimate", "--observed", "0.01,0,0.3,0", "--t-obs", "nan"], "t_obs")]:
+        assert_one_line_error(*run_cli([*argv, "--out", str(out)], capsys), fragment)
+        assert not out.exists(), argv
+
+
+def test_an_observation_in_mm_gives_an_estimate_with_a_warning(tmp_path, capsys):
+    """--observed in mm (10 mm, 300 mm/s read as m and m/s): the estimated reach is no person's, and says so."""
+    main(["estimate", "--observed", "10,0,300,0", "--t-obs", "0.1", "--out", str(tmp_path)])
+    err = capsys.readouterr().err
+    assert "comanip estimate: warning: the goal is" in err and "peak hand speed" in err and "Traceback" not in err

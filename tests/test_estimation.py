@@ -251,7 +251,7 @@ def test_cli_estimate_writes_the_estimate_posterior_and_figures(tmp_path, capsys
     plan = planar_planner.solve(np.zeros(4), [0.2, 0.1])
     plan.save_csv(tmp_path / "observed.csv")
     code = main(["estimate", "--observations", str(tmp_path / "observed.csv"), "--t-obs", "0.21",
-                 "--candidates", "0.2,0.1;0.3,0.1;0.2,0.25", "--out", str(tmp_path / "out"), "--png"])
+                 "--candidates", "0.2,0.1;0.3,0.1;0.2,0.25", "--out", str(tmp_path / "out"), "--png", "--verbose"])
     summary = json.loads(capsys.readouterr().out)
     assert code == 0 and summary["success"]
     assert summary["observed_step"] == 10 and summary["t_obs_s"] == pytest.approx(0.2)

@@ -168,7 +168,7 @@ def test_cli_fits_kappa_to_a_movement_time_table(tmp_path, capsys):
     start = comanip.presets.save(comanip.presets.planar().replace(kappa=START_KAPPA), tmp_path / "start.yaml")
     out = tmp_path / "fit"
     assert main(["fit", "--mt-table", str(table), "--preset", str(start), "--parameters", "kappa",
-                 "--out", str(out), "--no-progress"]) == 0
+                 "--out", str(out), "--no-progress", "--verbose"]) == 0
     written = json.loads((out / "fit.json").read_text())
     assert written["values"]["kappa"] == pytest.approx(TRUE_KAPPA, rel=0.05)
     assert written["status"] == "converged" and len(written["conditions"]) == len(MT_DISTANCES)
@@ -278,3 +278,56 @@ def test_three_parameter_fit_finds_the_likelihood_maximum_and_says_nu_is_unconst
     # unconstrained: at the bound (flagged, no error) or with a standard error at least its value
     at_bound = "['nu'] ended at a search bound" in fit.message and np.isnan(fit.std_errors["nu"])
     assert at_bound or fit.std_errors["nu"] >= fit.values["nu"]
+
+
+def _recording(tmp_path, time_scale=1.0, position_scale=1.0):
+    """A 0.6 s, 0.3 m reach at 50 Hz as a recordings CSV, its times and positions (goal and width too) scaled."""
+    t = np.arange(0.0, 0.62, 0.02)
+    x = 0.3 * (10 * (t / 0.6) ** 3 - 15 * (t / 0.6) ** 4 + 6 * (t / 0.6) ** 5)
+    rows = [f"a,{float(time_scale * ti)!r},{float(position_scale * xi)!r},0,{position_scale * 0.3},0,{position_scale * 0.02}"
+            for ti, xi in zip(t, x)]
+    path = tmp_path / "reach.csv"
+    path.write_text(HEADER + "\n".join(rows) + "\n")
+    return path
+
+
+@pytest.mark.parametrize("scales, message", [((1000.0, 1.0), "column 't': .*look like milliseconds"),
+                                             ((1.0, 1000.0), r"columns \['x', 'y'\] and the goal: .*look like millimetres")])
+def test_recordings_in_ms_or_mm_are_refused_with_an_override(tmp_path, scales, message):
+    path = _recording(tmp_path, *scales)
+    with pytest.raises(ValueError, match=message) as error:
+        load_recordings(path)
+    assert "\n" not in str(error.value) and "trial 'a'" in str(error.value)
+    assert len(load_recordings(path, check_units=False)) == 1
+
+
+def test_cli_fit_refuses_recordings_in_ms_and_skip_unit_check_reads_them(tmp_path, capsys, monkeypatch):
+    path = _recording(tmp_path, 1000.0)
+    assert main(["fit", "--recordings", str(path), "--out", str(tmp_path / "out"), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "look like milliseconds" in err and "--skip-unit-check" in err
+    assert not (tmp_path / "out").exists()
+    assert main(["fit", "--recordings", str(path), "--out", str(tmp_path / "out"), "--no-progress", "--skip-unit-check",
+                 "--parameters", "kappa", "--max-evaluations", "20"]) == 1        # read as s: nothing to fit
+    assert json.loads((tmp_path / "out" / "fit.json").read_text())["status"] == "unidentified"
+    assert capsys.readouterr().out.startswith("fit (planar): unidentified")
+
+
+def test_a_fit_that_scores_no_sample_is_not_converged(tmp_path):
+    """Times in ms read as s (the unit check skipped): every sample after the first lies past the horizon, the
+    likelihood is flat, and the fit says so instead of 'converged' with kappa at its start."""
+    fit = fit_model(comanip.presets.planar().replace(H=10), _recording(tmp_path, 1000.0), ["kappa"], progress=False,
+                    check_units=False)
+    assert (fit.status, fit.success) == ("unidentified", False)
+    assert "no recorded sample" in fit.message
+    assert all(row["samples_used"] == 0 for row in fit.trials)
+
+
+def test_identification_names_parameters_left_at_their_start_without_an_error():
+    from comanip.fitting.result import identification
+
+    assert identification({"kappa": 0.01}, {"kappa": 0.01}, {"kappa": 0.002}, 30) is None
+    assert identification({"kappa": 0.02}, {"kappa": 0.01}, {"kappa": np.nan}, 30) is None
+    assert "['kappa'] stayed at their start values" in identification({"kappa": 0.01, "nu": 1.0}, {"kappa": 0.01, "nu": 2.0},
+                                                                      {"kappa": np.nan, "nu": 0.1}, 30)
+    assert "no recorded sample" in identification({"kappa": 0.02}, {"kappa": 0.01}, {"kappa": 0.001}, 0)

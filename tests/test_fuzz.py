@@ -5,11 +5,10 @@ exception or a silent NaN. The count of inputs tried is printed at the end of th
 """
 
 import math
-import os
 
 import numpy as np
 import pytest
-from hypothesis import HealthCheck, given, settings
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import comanip
@@ -19,9 +18,8 @@ from comanip.estimation import GoalEstimator
 pytestmark = pytest.mark.slow  # about 30 s: CI runs it; the fast subset (-m "not slow") leaves it out
 
 FUZZ_COUNT = {"inputs": 0}
-# CI draws the same inputs every run (a failure there is then reproducible, not luck); elsewhere they are new each run
-FAST = settings(max_examples=150, deadline=None, suppress_health_check=list(HealthCheck), database=None,
-                derandomize=os.environ.get("CI") == "true")
+# whether the inputs are the same every run (CI) or new each run (locally) is the profile's choice: tests/conftest.py
+FAST = settings(max_examples=150)
 
 numbers = st.one_of(st.floats(allow_nan=True, allow_infinity=True), st.integers(-10**12, 10**12),
                     st.sampled_from([0.0, -0.0, 1e-300, 1e300, -1e300]))
@@ -102,7 +100,7 @@ arguments = st.lists(st.one_of(st.sampled_from(["--goal", "--start", "--width", 
                                st.text(alphabet="0123456789.,;-e naif", max_size=12)), max_size=6)
 
 
-@settings(max_examples=400, deadline=None, suppress_health_check=list(HealthCheck), database=None)
+@settings(max_examples=400)
 @given(command=st.sampled_from(["plan", "estimate"]), argv=arguments)
 def test_cli_never_tracebacks(tmp_path_factory, capsys, command, argv):
     FUZZ_COUNT["inputs"] += 1
@@ -151,8 +149,7 @@ def franka_poses():
                      st.lists(joint, min_size=0, max_size=9))
 
 
-@settings(max_examples=30, deadline=None, suppress_health_check=list(HealthCheck), database=None,
-          derandomize=os.environ.get("CI") == "true")
+@settings(max_examples=30)
 @given(q=franka_poses(), qdot=st.one_of(st.just(np.zeros(7)), st.lists(st.floats(-5.0, 5.0), min_size=7, max_size=7).map(np.array)),
        goal=st.one_of(st.lists(st.floats(-2.0, 2.0), min_size=3, max_size=3), vectors))
 def test_franka_any_pose(franka_planner, q, qdot, goal):
@@ -184,7 +181,7 @@ LONG_COMMANDS = {
     "handover": (["handover"], {"--start": VECTORS, "--goal": VECTORS, "--width": SCALARS, "--ramp-time": SCALARS,
                                 "--stiffness": SCALARS, "--rate": SCALARS, "--arm-length": SCALARS,
                                 "--max-wall-time": SCALARS, "--preset": ["planar", "cartesian", "human", "nope"]},
-                 ("comanip.cli.handover_command", "Planner")),
+                 ("comanip.planning.planner", "Planner")),
     "transition generate": (["transition", "generate"], {"--distances": VECTORS, "--widths": VECTORS, "--trials": SCALARS,
                                                          "--arm-length": SCALARS, "--steps": SCALARS, "--seed": SCALARS,
                                                          "--workers": SCALARS, "--preset": ["planar", "cartesian", "franka"]},
@@ -197,8 +194,7 @@ LONG_COMMANDS = {
 OUT_FILES = {"transition generate": "data.csv", "library": "library.npz"}
 
 
-@settings(max_examples=300, deadline=None, suppress_health_check=list(HealthCheck), database=None,
-          derandomize=os.environ.get("CI") == "true")
+@settings(max_examples=300)
 @given(command=st.sampled_from(sorted(LONG_COMMANDS)), data=st.data())
 def test_long_commands_give_one_line_errors(tmp_path_factory, capsys, monkeypatch, command, data):
     """simulate, handover, transition generate and library: a user mistake is one line and exit status 2, never a
@@ -243,3 +239,86 @@ def test_transition_data_files(tmp_path_factory, capsys, text, command):
     assert "Traceback" not in err
     if code != 0:
         assert code == 2 and err.count("\n") == 1 and "error:" in err, err
+
+
+# --- regressions: inputs the fuzzing found -----------------------------------------------------------------------
+
+@pytest.mark.parametrize("goal", [[0.0, 1.3407807929942597e154], [1e200, 0.0], [0.0, -1.0000001e6]])
+def test_found_by_fuzzing_a_goal_whose_distance_overflows_is_a_value_error(small_planner, goal):
+    """Was OverflowError: the reach library's grid index of an infinite distance (reach_library.py)."""
+    with pytest.raises(ValueError, match="goal must lie within ±1e\\+06 per coordinate"):
+        small_planner.solve(np.zeros(4), goal)
+
+
+def test_the_reach_library_skips_a_distance_that_overflows():
+    from comanip.planning.reach_library import ReachLibrary
+
+    library = ReachLibrary(lambda *args: pytest.fail("no entry to solve"), 2, 4, 0.02)
+    assert library.guess(np.zeros(4), np.array([0.0, 1.35e154]), 0.02) is None
+
+
+@pytest.mark.parametrize("h", [1e-300, 1e-5, 2.0, 1e12, math.nan])
+def test_found_by_fuzzing_a_time_step_out_of_range_is_a_value_error(h):
+    """Was a plan ending 'failed' with NaN arrays (h = 1e-300 s: the torques overflow)."""
+    with pytest.raises(ValueError, match="h must be a number between 0.0001 and 1 \\(s, time step\\)"):
+        comanip.presets.planar().replace(h=h)
+
+
+# --- fitting: every argument and recording checked before any plan --------------------------------------------------
+
+def _trial():
+    from comanip.fitting import Trial
+
+    t = np.arange(0.0, 0.62, 0.02)
+    return Trial("a", t, np.column_stack([0.3 * t / 0.6, 0 * t]), np.array([0.3, 0.0]), 0.02)
+
+
+@FAST
+@given(sigma_obs=numbers, start_tolerance=numbers, max_evaluations=st.one_of(numbers, st.booleans()), step=numbers,
+       bounds=st.one_of(st.none(), st.dictionaries(st.sampled_from(["kappa", "gamma", "nu"]),
+                                                   st.one_of(st.tuples(numbers, numbers), numbers, st.text(max_size=3)), max_size=2)),
+       parameters=st.one_of(st.lists(st.sampled_from(["kappa", "gamma", "nu", "sigma_obs", "H", "bogus", "kappa.0"]), max_size=3),
+                            st.text(max_size=6)))
+def test_fit_model_arguments(monkeypatch, sigma_obs, start_tolerance, max_evaluations, step, bounds, parameters):
+    """fit_model refuses a bad argument with a ValueError before it plans anything (planning is replaced by
+    InputsAccepted here)."""
+    import comanip.fitting.fit as fit
+
+    FUZZ_COUNT["inputs"] += 1
+    with monkeypatch.context() as patch:
+        patch.setattr(fit, "ConditionPlanner", _accept)
+        try:
+            fit.fit_model(comanip.presets.planar(), [_trial()], parameters, sigma_obs=sigma_obs, bounds=bounds,
+                          start_tolerance=start_tolerance, max_evaluations=max_evaluations, step=step, progress=False)
+        except InputsAccepted:
+            return
+        except ValueError as error:
+            assert str(error) and "\n" not in str(error)
+
+
+@FAST
+@given(text=st.one_of(st.text(max_size=120), st.lists(st.tuples(st.sampled_from(["a", "b"]), numbers, numbers, numbers),
+                                                      min_size=1, max_size=8).map(
+    lambda rows: "trial,t,x,y,goal_x,goal_y,width\n" + "".join(f"{r[0]},{r[1]},{r[2]},{r[3]},0.3,0,0.02\n" for r in rows))))
+def test_load_recordings_any_file(tmp_path_factory, text):
+    from comanip.fitting import load_recordings
+
+    FUZZ_COUNT["inputs"] += 1
+    path = tmp_path_factory.mktemp("rec") / "r.csv"
+    path.write_text(text)
+    try:
+        trials = load_recordings(path)
+    except ValueError as error:
+        assert str(error) and "\n" not in str(error)
+    else:
+        assert all(np.all(np.isfinite(trial.t)) and np.all(np.diff(trial.t) > 0) for trial in trials)
+
+
+def test_a_start_beyond_the_documented_range_is_a_value_error(small_planner):
+    with pytest.raises(ValueError, match="start must lie within ±1e\\+06 per coordinate"):
+        small_planner.solve([1e300, 0.0, 0.0, 0.0], [0.3, 0.0])
+
+
+def test_a_horizon_beyond_the_documented_range_is_a_value_error():
+    with pytest.raises(ValueError, match="H must be ≤ 1000"):
+        comanip.presets.planar().replace(H=10**9)

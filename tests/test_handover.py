@@ -111,7 +111,7 @@ def test_handover_needs_a_plan_and_a_fitted_model(plan, transition_model):
 
 
 def test_handover_command_writes_the_schedule(tmp_path, capsys):
-    code = main(["handover", "--goal", "0.25,0.1,0", "--rate", "500", "--out", str(tmp_path), "--no-plot"])
+    code = main(["handover", "--goal", "0.25,0.1,0", "--rate", "500", "--out", str(tmp_path), "--no-plot", "--verbose"])
     assert code == 0
     report = json.loads(capsys.readouterr().out)
     saved = json.loads((tmp_path / "handover_0.json").read_text())

@@ -356,7 +356,7 @@ def test_cli_estimate_takes_prior_std(tmp_path, capsys, planar_planner):
     goals = {}
     for prior_std in ("0.001", "10", "width"):
         code = main(["estimate", "--observations", str(tmp_path / "observed.csv"), "--t-obs", "0.21", "--prior", "0.3,0.0",
-                     "--prior-std", prior_std, "--out", str(tmp_path / prior_std)])
+                     "--prior-std", prior_std, "--out", str(tmp_path / prior_std), "--verbose"])
         summary = json.loads(capsys.readouterr().out)
         assert code == 0 and np.array(summary["goal_covariance"]).shape == (2, 2)
         goals[prior_std] = np.array(summary["estimated_goal"])

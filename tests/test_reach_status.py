@@ -39,7 +39,7 @@ def test_the_check_leaves_unconverged_and_reaching_plans_alone(planar_planner):
 
 
 def test_cli_plan_reports_the_goal_not_reached(tmp_path, capsys):
-    assert main(["plan", "--goal", "1000,0", "--out", str(tmp_path)]) == 1
+    assert main(["plan", "--goal", "1000,0", "--out", str(tmp_path), "--verbose"]) == 1
     summary = json.loads(capsys.readouterr().out)
     assert (summary["success"], summary["status"], summary["reaches_goal"]) == (False, "goal_not_reached", False)
 

@@ -81,7 +81,7 @@ def test_generate_and_fit_with_a_preset_yaml_of_a_model_with_activation_stages(t
     rows = read_transition_csv(csv)
     assert len(rows["width_m"]) == 4 and np.all(rows["failed_replans"] == 0)
     assert np.all((rows["transition_distance_m"] > 0) & (rows["transition_distance_m"] < 0.43 * 0.7))
-    assert main(["transition", "fit", "--data", str(csv), "--out", str(tmp_path / "fit")]) == 0
+    assert main(["transition", "fit", "--data", str(csv), "--out", str(tmp_path / "fit"), "--verbose"]) == 0
     assert json.loads(capsys.readouterr().out)["data_made_by"]["model"] == "planar_activation"
 
 
@@ -197,7 +197,7 @@ def test_shipped_data_and_model_against_the_published_trends(shipped_model):
 
 
 def test_transition_commands_fit_save_and_plot(tmp_path, capsys):
-    assert main(["transition", "fit", "--out", str(tmp_path)]) == 0
+    assert main(["transition", "fit", "--out", str(tmp_path), "--verbose"]) == 0
     printed = json.loads(capsys.readouterr().out)
     assert printed["rows"] == len(read_transition_csv(shipped_dataset_path())["width_m"])
     assert printed["data_made_by"] == {"model": "planar",

@@ -4,12 +4,30 @@ Haninger & Peternel, "Planning Human-Robot Co-manipulation with Human Motor Cont
 Multi-component Reaching Strategies". See ``comanip.planning.planner`` for the problem statement.
 """
 
-from comanip import presets
-from comanip.estimation import OnlineGoalEstimator, estimate_goal, goal_posterior
-from comanip.fitting import FitResult, fit_model, fit_movement_times
-from comanip.model import ReachingModel
-from comanip.multicomponent.transition_model import TransitionModel
-from comanip.planning import Plan, Planner, SolverOptions, plan_reach
+from importlib import import_module
+
+#: the public names and the modules that define them, imported on first use (``import comanip`` stays light,
+#: so that ``comanip --help`` does not load the solvers)
+_EXPORTS = {
+    "presets": "comanip.presets", "ReachingModel": "comanip.model", "Plan": "comanip.planning", "Planner": "comanip.planning",
+    "SolverOptions": "comanip.planning", "plan_reach": "comanip.planning", "TransitionModel": "comanip.multicomponent.transition_model",
+    "estimate_goal": "comanip.estimation", "goal_posterior": "comanip.estimation", "OnlineGoalEstimator": "comanip.estimation",
+    "fit_model": "comanip.fitting", "fit_movement_times": "comanip.fitting", "FitResult": "comanip.fitting",
+}
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'comanip' has no attribute {name!r}")
+    module = import_module(_EXPORTS[name])
+    value = module if name == "presets" else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))
+
 
 __version__ = "0.1.0"
 

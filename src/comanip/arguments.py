@@ -74,6 +74,32 @@ def as_goal_width(name: str, value) -> float:
     return width
 
 
+def as_in_range(name: str, value, bounds: tuple[float, float], unit: str) -> float:
+    """value as a finite float with low ≤ value ≤ high, else ValueError naming the range."""
+    low, high = bounds
+    if isinstance(value, bool) or not isinstance(value, (int, float, np.integer, np.floating)) or not low <= value <= high:
+        raise ValueError(f"{name} must be a number between {low:g} and {high:g} ({unit}), got {value!r}")
+    return float(value)
+
+
+MAGNITUDE_LIMIT = 1e6
+"""Largest magnitude of a coordinate of a start state or goal a solve accepts (m, m/s, rad, rad/s): far past any
+reach, and far from where squared distances overflow (a coordinate of 1.4e154)."""
+
+
+def as_position(name: str, value, size: int) -> np.ndarray:
+    """A task-space position (size,), m, finite and within ±MAGNITUDE_LIMIT per coordinate, else ValueError."""
+    return as_bounded_vector(name, value, size, "task-space position, m")
+
+
+def as_bounded_vector(name: str, value, size: int, unit: str) -> np.ndarray:
+    """:func:`as_vector`, each entry also within ±MAGNITUDE_LIMIT, else ValueError."""
+    array = as_vector(name, value, size, unit)
+    if np.any(np.abs(array) > MAGNITUDE_LIMIT):
+        raise ValueError(f"{name} must lie within ±{MAGNITUDE_LIMIT:g} per coordinate ({unit}), got {array.tolist()}")
+    return array
+
+
 def as_optional_positive(name: str, value, unit: str) -> float | None:
     return None if value is None else as_positive(name, value, unit)
 

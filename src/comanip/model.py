@@ -11,7 +11,7 @@ from dataclasses import MISSING, dataclass, field, replace
 
 import numpy as np
 
-from comanip.arguments import as_count, as_goal_width, as_nonnegative, as_positive
+from comanip.arguments import as_count, as_goal_width, as_in_range, as_nonnegative, as_positive
 from comanip.belief.noise import check_noise_form
 from comanip.bodies import Body, MuscleActuatedBody, body_from_config
 from comanip.objectives.discounting import check_discount_form
@@ -20,6 +20,11 @@ from comanip.objectives.reward import check_goal_covariance_form, check_reward_f
 #: the slowest activation stage allowed, in time steps h (slower ones make the plant unresponsive and the
 #: activation inverse divide by zero)
 MAX_ACTIVATION_STEPS = 1000
+#: time steps h (s) a model takes: a reach of 0.1-10 s in 10 to 1000 steps lies well inside; far below, the
+#: torques a reach needs grow as 1/h² until they overflow (h = 1e-300 s), far above no reach fits in one step
+STEP_RANGE_S = (1e-4, 1.0)
+#: longest horizon (steps): the solver's dense Newton system has (H·n)² entries, 0.4 GB for the Panda at 1000
+MAX_HORIZON_STEPS = 1000
 
 
 @dataclass(frozen=True)
@@ -29,9 +34,9 @@ class ReachingModel:
     body: Body
     """Arm dynamics and kinematics (point mass or Panda)."""
     h: float
-    """Time step (s), > 0."""
+    """Time step (s), within STEP_RANGE_S (1e-4 to 1 s)."""
     H: int
-    """Planning horizon (steps), ≥ 1; the plan spans H·h seconds."""
+    """Planning horizon (steps), 1 to MAX_HORIZON_STEPS (1000); the plan spans H·h seconds."""
     gamma: float
     """Discount per step of the reward, in (0, 1]; the time cost of the cost–benefit trade-off."""
     nu: float
@@ -82,12 +87,14 @@ class ReachingModel:
         if not isinstance(self.body, Body):
             raise ValueError(f"body must be a comanip.bodies.Body, got {type(self.body).__name__}")
         self._attach_activation()
-        as_positive("h", self.h, "s")
+        as_in_range("h", self.h, STEP_RANGE_S, "s, time step")
         slow = [t for t in self.activation if t > MAX_ACTIVATION_STEPS * self.h]
         if slow:
             raise ValueError(f"activation time constants must be ≤ {MAX_ACTIVATION_STEPS} h = {MAX_ACTIVATION_STEPS * self.h:g} s "
                              f"(a slower stage never responds within a plan), got {slow}")
         object.__setattr__(self, "H", as_count("H", self.H, 1, "horizon in steps"))
+        if self.H > MAX_HORIZON_STEPS:
+            raise ValueError(f"H must be ≤ {MAX_HORIZON_STEPS} (horizon in steps), got {self.H}")
         if not (isinstance(self.gamma, (int, float)) and 0 < self.gamma <= 1):
             raise ValueError(f"gamma must be in (0, 1] (discount per step), got {self.gamma!r}")
         as_nonnegative("nu", self.nu, "reward per N²")

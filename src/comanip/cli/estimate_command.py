@@ -16,19 +16,23 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.options import add_model_arguments, add_reach_arguments, input_file, load_model, vector
-from comanip.cli.outputs import output_dir, write_manifest
+from comanip.cli.commands import command_help
+from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
+from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
+from comanip.plausibility import human_plausibility
+from comanip.units import check_angles_rad, check_positions_m, check_times_s
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("estimate", help="estimate a reach's goal from an observed state", description=__doc__)
+    parser = subparsers.add_parser("estimate", help=command_help("estimate"), description=__doc__)
     add_model_arguments(parser)
     add_reach_arguments(parser, "the CSV's t = 0 row, else at rest at the body's home position", "out/estimate", "figures")
     parser.add_argument("--observed", type=vector, help="observed state [q; qdot], comma-separated")
     parser.add_argument("--observations", type=input_file, help="CSV of timestamped states (header t_s, q0.., qdot0..)")
+    add_unit_check_argument(parser, "--observations")
     parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, "
                         "the paper's); before the model's step h it says nothing about the goal and needs --prior")
     parser.add_argument("--prior", type=vector, help="prior goal g_bar (m), comma-separated (default: no regulariser)")
@@ -56,8 +60,11 @@ def candidate_list(text: str) -> np.ndarray:
     return np.array(rows)
 
 
-def read_observations(path: Path, n: int) -> tuple[np.ndarray, np.ndarray]:
-    """Times (K,) s and states (K, 2n) from a CSV with columns t_s, q0..q{n-1}, qdot0..qdot{n-1}, sorted by time."""
+def read_observations(path: Path, n: int, *, check_units: bool = True, joint_angles: bool = False) -> tuple[np.ndarray, np.ndarray]:
+    """Times (K,) s and states (K, 2n) from a CSV with columns t_s, q0..q{n-1}, qdot0..qdot{n-1}, sorted by time.
+
+    ``check_units`` refuses times that look like ms and positions q that look like mm, or like degrees when
+    ``joint_angles`` (an arm's q in rad), with a one-line ValueError (:mod:`comanip.units`)."""
     columns = ["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
     with open(path, newline="") as f:
         reader = csv.DictReader(f)
@@ -66,11 +73,21 @@ def read_observations(path: Path, n: int) -> tuple[np.ndarray, np.ndarray]:
             raise ValueError(f"--observations needs the columns {columns}; {str(path)!r} lacks {missing}")
         try:
             rows = np.array([[float(row[c]) for c in columns] for row in reader])
-        except ValueError as error:
-            raise ValueError(f"--observations: a value in {str(path)!r} is not a number ({error})") from None
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"--observations: a value in {str(path)!r} is missing or not a number ({error})") from None
     if rows.size == 0:
         raise ValueError(f"--observations file {str(path)!r} has no rows")
+    if not np.all(np.isfinite(rows)):
+        raise ValueError(f"--observations file {str(path)!r} holds NaN or inf; every value must be a finite number")
     rows = rows[np.argsort(rows[:, 0], kind="stable")]
+    if check_units:
+        where = f"--observations file {str(path)!r}"
+        check_times_s(rows[:, 0], f"{where}, column 't_s'")
+        positions = rows[:, 1: n + 1]
+        if joint_angles:
+            check_angles_rad(positions, f"{where}, columns q0..q{n - 1}")
+        else:
+            check_positions_m(positions, f"{where}, columns q0..q{n - 1}")
     return rows[:, 0], rows[:, 1:]
 
 
@@ -81,7 +98,7 @@ def run(args) -> int:
     at_rest = np.r_[body.home_position, np.zeros(n)]
     times = states = None
     if args.observations is not None:
-        times, states = read_observations(args.observations, n)
+        times, states = read_observations(args.observations, n, check_units=args.check_units, joint_angles=not body.is_linear)
         before = np.flatnonzero((times > 0) & (times <= args.t_obs))
         if before.size == 0:
             raise ValueError(f"--observations has no row with 0 < t_s ≤ --t-obs = {args.t_obs:g} s")
@@ -92,10 +109,11 @@ def run(args) -> int:
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
-    out = output_dir(args.out, "estimate", args.force)
-
+    out = output_dir(args.out, "estimate", args.force, create=False)
+    # the estimator checks every input before its work: a mistake is a ValueError before the folder is made
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, prior_std=args.prior_std, method=args.method,
                                   max_wall_time=args.max_wall_time)
+    out.mkdir(parents=True, exist_ok=True)
     written = [estimate.save_json(out / "estimate.json"), estimate.save_csv(out / "estimate.csv")]
     summary = {"model": model.name, "estimated_goal": estimate.goal.tolist(), "prior_goal": None if args.prior is None else args.prior.tolist(),
                "prior_std": args.prior_std if args.prior_std is None or isinstance(args.prior_std, (str, float)) else args.prior_std.tolist(),
@@ -124,5 +142,10 @@ def run(args) -> int:
             written.append(plot_posterior(posterior, out / "posterior.png"))
     summary["files"] = [str(p) for p in written]
     write_manifest(out, "estimate", written)
-    print(json.dumps(summary, indent=1))
+    warn("estimate", human_plausibility(model, estimate))  # of the estimated goal and the predicted reach
+    lines = [f"estimate ({model.name}, {args.method}): {estimate.status}, goal {point_text(estimate.goal)} m from the state at "
+             f"t = {float(t_obs):.3g} s"]
+    if posterior is not None:
+        lines.append(f"most likely candidate: {int(posterior.most_likely[-1])} (p = {posterior.probabilities[-1].max():.3g})")
+    report(args, lines, summary, out, written)
     return 0 if estimate.success else 1

@@ -4,23 +4,23 @@ per condition (least squares); write fit.json (values, standard errors, residual
 
 from __future__ import annotations
 
-import json
-
-from comanip.cli.options import add_model_arguments, input_file, input_file_or_folder, load_model
-from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
-from comanip.fitting.fit import DEFAULT_PARAMETERS, fit_model
-from comanip.fitting.movement_times import fit_movement_times
+from comanip.arguments import as_count
+from comanip.cli.commands import command_help
+from comanip.cli.options import add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model
+from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
+from comanip.fitting.parameters import DEFAULT_PARAMETERS, MT_DEFAULT_PARAMETERS, ParameterSpace
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("fit", help="fit model parameters to recordings or movement times", description=__doc__)
+    parser = subparsers.add_parser("fit", help=command_help("fit"), description=__doc__)
     data = parser.add_mutually_exclusive_group(required=True)
     data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
     data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
     parser.add_argument("--trials", type=input_file, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
+    add_unit_check_argument(parser, "the recordings")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
-                        f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, kappa,gamma for an MT table)")
+                        f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, {','.join(MT_DEFAULT_PARAMETERS)} for an MT table)")
     parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
     parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings, 100 for an MT table)")
     parser.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
@@ -35,19 +35,30 @@ def names(text: str) -> tuple[str, ...]:
 
 
 def run(args) -> int:
+    from comanip.fitting.fit import fit_model
+    from comanip.fitting.movement_times import MovementTimeTable, fit_movement_times
+    from comanip.fitting.recordings import load_recordings
+
     model = load_model(args)
-    out = output_dir(args.out, "fit", args.force)
     options = {"scheduler": args.scheduler, "progress": not args.no_progress}
     if args.max_evaluations is not None:
         options["max_evaluations"] = args.max_evaluations
     if args.parameters is not None:
         options["parameters"] = args.parameters
+    # the arguments, then the data, are checked before the output folder is made
+    as_count("--max-evaluations", args.max_evaluations, optional=True)
+    ParameterSpace(model, options.get("parameters", DEFAULT_PARAMETERS if args.recordings else MT_DEFAULT_PARAMETERS), args.sigma_obs)
     if args.recordings is not None:
-        result = fit_model(model, args.recordings, trials=args.trials, sigma_obs=args.sigma_obs, **options)
+        data = load_recordings(args.recordings, args.trials, check_units=args.check_units)
+    elif args.trials is not None:
+        raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
     else:
-        if args.trials is not None:
-            raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
-        result = fit_movement_times(model, args.mt_table, **options)
+        data = MovementTimeTable.read(args.mt_table)
+    out = output_dir(args.out, "fit", args.force)
+    if args.recordings is not None:
+        result = fit_model(model, data, sigma_obs=args.sigma_obs, **options)
+    else:
+        result = fit_movement_times(model, data, **options)
     written = [result.save_json(out / "fit.json"), result.save_yaml(out / "model.yaml")]
     if result.conditions:
         from comanip.plots.fit_figure import plot_fit
@@ -55,5 +66,6 @@ def run(args) -> int:
         written.append(plot_fit(result, out / "fit.png"))
     write_manifest(out, "fit", written)
     summary = {key: value for key, value in result.to_dict().items() if key not in ("model", "conditions", "trials")}
-    print(json.dumps(summary | {"files": [str(p) for p in written]}, indent=1))
+    report(args, [f"fit ({model.name}): {result.summary()}", result.message], summary | {"files": [str(p) for p in written]},
+           out, written)
     return 0 if result.success else 1

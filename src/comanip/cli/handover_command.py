@@ -9,24 +9,23 @@ figure over distance to the goal (paper Fig. 8 layout).
 from __future__ import annotations
 
 import argparse
-import json
 import warnings
 
 import numpy as np
 
 from comanip.arguments import as_optional_positive, as_positive
+from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, input_file, load_model, vector
-from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
+from comanip.cli.outputs import add_output_arguments, output_dir, point_text, report, warn, write_manifest
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH
-from comanip.planning.planner import Planner, reach_inputs
 
 #: A near and a far goal from the origin (m), as in the paper's experiment (Fig. 8).
 DEFAULT_GOALS = ("0.2,0.1,0", "0.4,0.25,-0.1")
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("handover", help="robot→person authority handover at the predicted transition",
+    parser = subparsers.add_parser("handover", help=command_help("handover"),
                                    description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_model_arguments(parser, default_preset="cartesian")
     parser.add_argument("--start", type=vector, help="start state [x; xdot] (m, m/s), comma-separated (default: at rest at the origin)")
@@ -49,6 +48,7 @@ def add_parser(subparsers) -> None:
 
 def run(args) -> int:
     from comanip.multicomponent.transition_model import ExtrapolationWarning, TransitionModel
+    from comanip.planning.planner import Planner, reach_inputs
 
     check_schedule_arguments(args.ramp_time, args.stiffness, args.rate)
     arm_length = None if args.arm_length is None else as_positive("arm_length", args.arm_length, "m")
@@ -63,7 +63,7 @@ def run(args) -> int:
         reach_inputs(model, start, goal, args.width)
     planner = Planner(model)
     out = output_dir(args.out, "handover", args.force)
-    plans, schedules, report = [], [], []
+    plans, schedules, results, written, lines = [], [], [], [], []
     for k, goal in enumerate(goals):
         plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)
         with warnings.catch_warnings(record=True) as caught:
@@ -73,13 +73,19 @@ def run(args) -> int:
         files = [schedule.save_json(out / f"handover_{k}.json"), schedule.save_csv(out / f"handover_{k}.csv")]
         plans.append(plan)
         schedules.append(schedule)
-        report.append({**schedule.summary(), "plan_status": plan.status, "plan_success": plan.success,
-                       "warnings": [str(w.message) for w in caught], "files": [str(f) for f in files]})
+        warnings_k = plan.extras.get("warnings", []) + [str(w.message) for w in caught]
+        warn("handover", [f"goal {k}: {text}" for text in warnings_k])
+        results.append({**schedule.summary(), "plan_status": plan.status, "plan_success": plan.success,
+                        "warnings": warnings_k, "files": [str(f) for f in files]})
+        written += files
+        lines.append(f"goal {k} {point_text(goal)} m: plan {plan.status}, release starts {schedule.transition_distance:.3g} m "
+                     f"from the goal at t = {schedule.transition_time:.3g} s")
     if not args.no_plot:
         from comanip.plots.handover_figure import plot_handover
 
         figure = plot_handover(plans, schedules, out / "handover.png")
-        report.append({"figure": str(figure)})
-    write_manifest(out, "handover", [f for entry in report for f in entry.get("files", [entry.get("figure")]) if f])
-    print(json.dumps(report, indent=1))
+        results.append({"figure": str(figure)})
+        written.append(figure)
+    write_manifest(out, "handover", written)
+    report(args, lines, results, out, written)
     return 0 if all(p.success for p in plans) else 1

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, load_model
 from comanip.planning.arm_reach_library import FILE_PREFIX, GRID_SPACING, SHELL, build_library, grid_goals
 from comanip.planning.planner import Planner, SolverOptions
@@ -22,7 +23,7 @@ from comanip.progress import progress_bar
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("library", help="solve an arm's reach library for cold solves from its ready pose",
+    parser = subparsers.add_parser("library", help=command_help("library"),
                                    description=__doc__)
     add_model_arguments(parser, default_preset="franka_rest")
     parser.add_argument("--spacing", type=float, default=GRID_SPACING, help="grid spacing of the goals (m) (default: %(default)s)")

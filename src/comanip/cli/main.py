@@ -1,5 +1,7 @@
 """Entry point of the ``comanip`` command. Each subcommand lives in its own module with
-``add_parser(subparsers)``, which registers the subcommand and sets ``func(args) -> int``.
+``add_parser(subparsers)``, which registers the subcommand and sets ``func(args) -> int``; :mod:`comanip.cli.commands`
+lists them. A run imports only the module of the subcommand it runs (``comanip --help`` imports none), so that
+the command starts without loading the solvers of the others.
 
 Every user mistake ends the command with one line on stderr, ``comanip <command>: error: ...``, and exit
 status 2: argparse's own errors (through :class:`OneLineParser`) and the ValueError, OSError and YAML errors
@@ -14,18 +16,7 @@ from importlib import import_module
 
 import yaml
 
-#: subcommand modules, in the order ``comanip --help`` lists them
-SUBCOMMAND_MODULES = [
-    "comanip.cli.plan_command",
-    "comanip.cli.validate_command",
-    "comanip.cli.transition_command",
-    "comanip.cli.handover_command",
-    "comanip.cli.estimate_command",
-    "comanip.cli.simulate_command",
-    "comanip.cli.fit_command",
-    "comanip.cli.library_command",
-    "comanip.cli.ros_command",
-]
+from comanip.cli.commands import COMMANDS
 
 #: errors that mean the user gave something wrong (an argument, a file): one line, exit status 2
 USER_ERRORS = (ValueError, OSError, yaml.YAMLError)
@@ -42,12 +33,18 @@ class OneLineParser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {one_line(message)} (see '{self.prog} --help')\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
+    """The ``comanip`` parser with every subcommand; given the ``argv`` to parse, only the subcommand it names
+    is built in full (the others are listed with their one-line help)."""
     parser = OneLineParser(prog="comanip", description="Human reaching prediction and co-manipulation planning.")
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     subparsers = parser.add_subparsers(dest="command", required=True)
-    for module in SUBCOMMAND_MODULES:
-        import_module(module).add_parser(subparsers)
+    chosen = None if argv is None else next((word for word in argv if not word.startswith("-")), "")
+    for name, (module, help_text) in COMMANDS.items():
+        if chosen is None or chosen == name:
+            import_module(module).add_parser(subparsers)
+        else:
+            subparsers.add_parser(name, help=help_text)
     return parser
 
 
@@ -62,8 +59,9 @@ def one_line(error) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     """Run ``comanip argv``; returns the exit status (2 for a user mistake, after one line on stderr)."""
+    argv = sys.argv[1:] if argv is None else list(argv)
     try:
-        args = build_parser().parse_args(argv)
+        args = build_parser(argv).parse_args(argv)
     except SystemExit as stop:  # --help, or an argument error already printed
         return stop.code if isinstance(stop.code, int) else 2
     try:

@@ -7,12 +7,15 @@ from __future__ import annotations
 import argparse
 import os
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from comanip import presets
 from comanip.cli.outputs import add_output_arguments
-from comanip.model import ReachingModel
+
+if TYPE_CHECKING:
+    from comanip.model import ReachingModel
 
 
 def add_model_arguments(parser: argparse.ArgumentParser, default_preset: str = "planar") -> None:
@@ -28,6 +31,13 @@ def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out
     parser.add_argument("--max-wall-time", type=float, help="solve budget (s)")
     add_output_arguments(parser, out_default)
     parser.add_argument("--png", action="store_true", help=f"also save {figures}")
+
+
+def add_unit_check_argument(parser: argparse.ArgumentParser, what: str) -> None:
+    """--skip-unit-check: read ``what`` as s and m even when its times look like ms or its positions like mm."""
+    parser.add_argument("--skip-unit-check", dest="check_units", action="store_false",
+                        help=f"read {what} as seconds and metres (radians for joints) even where the times look like "
+                             "ms or the positions like mm")
 
 
 def load_model(args: argparse.Namespace) -> ReachingModel:

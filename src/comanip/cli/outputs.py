@@ -1,6 +1,11 @@
 """Output folders of the subcommands: each command has its own default folder (``out/<command>``), a folder
 holding another command's results is written into only with ``--force``, and every folder gets a
-``manifest.json`` saying which command wrote it, when, and what each file is."""
+``manifest.json`` saying which command wrote it, when, and what each file is.
+
+A command run again into its own folder replaces its previous outputs: the files its last run listed in the
+manifest and this run does not write are removed, so the manifest lists exactly the files of this run (for
+``transition``, whose actions share a folder, of each action's last run). On the terminal a command prints
+a short summary and where the files are (:func:`report`); ``--verbose`` prints the full results instead."""
 
 from __future__ import annotations
 
@@ -9,6 +14,7 @@ import json
 import shlex
 import sys
 import time
+from collections.abc import Sequence
 from fnmatch import fnmatch
 from pathlib import Path
 
@@ -53,10 +59,12 @@ FILE_KINDS = (
 )
 
 
-def add_output_arguments(parser: argparse.ArgumentParser, default: str, what: str = "output folder") -> None:
-    """--out (default ``default``) and --force."""
-    parser.add_argument("--out", default=default, help=f"{what} (default: %(default)s)")
+def add_output_arguments(parser: argparse.ArgumentParser, default: str | None, what: str = "output folder",
+                         default_text: str | None = None) -> None:
+    """--out (default ``default``, described as ``default_text`` when given), --force and --verbose."""
+    parser.add_argument("--out", default=default, help=f"{what} (default: {default_text or '%(default)s'})")
     parser.add_argument("--force", action="store_true", help="write into an output folder that holds another command's results")
+    parser.add_argument("--verbose", action="store_true", help="print the full results (JSON, tables) instead of a short summary")
 
 
 def output_dir(path: str | Path, command: str, force: bool = False, create: bool = True) -> Path:
@@ -75,18 +83,69 @@ def output_dir(path: str | Path, command: str, force: bool = False, create: bool
     return out
 
 
-def write_manifest(out: Path, command: str, files) -> Path:
+def write_manifest(out: Path, command: str, files, action: str | None = None) -> Path:
     """Write ``out/manifest.json``: the command, its arguments, the time, and a description of each of ``files``
-    (paths in out); the entries of an earlier run of the same command are kept."""
-    path = Path(out) / MANIFEST
-    entries = _read(path).get("files", {}) if _owner(Path(out)) == command else {}
-    for file in files:
-        name = Path(file).resolve().relative_to(Path(out).resolve()).as_posix()
-        entries[name] = _describe(name, command)
+    (paths in out). The files an earlier run of the same command (and ``action``, e.g. 'fit' of 'transition')
+    listed and this run did not write are removed; another action's files stay listed."""
+    out = Path(out)
+    path = out / MANIFEST
+    names = [Path(file).resolve().relative_to(out.resolve()).as_posix() for file in files]
+    previous = _read(path) if _owner(out) == command else {}
+    runs = dict(previous.get("runs", {})) if action else {}
+    key = f"{command} {action}" if action else command
+    earlier = runs.get(key, []) if action else list(previous.get("files", {}))
+    _remove_stale(out, [name for name in earlier if name not in names and name != MANIFEST])
+    kept = {name: text for name, text in previous.get("files", {}).items()
+            if action and name not in earlier and (out / name).exists()}
+    entries = kept | {name: _describe(name, command) for name in names}
     manifest = {"command": command, "arguments": shlex.join(sys.argv[1:]), "written": time.strftime("%Y-%m-%d %H:%M:%S"),
                 "files": dict(sorted(entries.items()))}
+    if action:
+        runs[key] = sorted(names)
+        manifest["runs"] = {name: files for name, files in sorted(runs.items()) if set(files) & set(entries)}
     path.write_text(json.dumps(manifest, indent=1))
     return path
+
+
+def report(args: argparse.Namespace, lines: Sequence[str], full, out: Path, files: Sequence) -> None:
+    """Print the outcome: with ``--verbose`` ``full`` (a dict or list as JSON, or text as it is), else the
+    short summary ``lines`` and where the files are."""
+    if getattr(args, "verbose", False):
+        print(full if isinstance(full, str) else json.dumps(full, indent=1, default=_plain))
+        return
+    for line in lines:
+        print(line)
+    print(f"wrote {len(files)} file{'s' if len(files) != 1 else ''} to {out} (listed in {Path(out) / MANIFEST}; --verbose prints the full results)")
+
+
+def point_text(x) -> str:
+    """A point (d,) as '(0.3, 0.1)' for a summary line."""
+    return "(" + ", ".join(f"{float(v):.4g}" for v in x) + ")"
+
+
+def warn(command: str, warnings: Sequence[str]) -> None:
+    """One line on stderr per warning: 'comanip <command>: warning: ...'."""
+    for text in warnings:
+        print(f"comanip {command}: warning: {text}", file=sys.stderr)
+
+
+def _plain(value):
+    """JSON for numpy scalars and arrays."""
+    return value.tolist() if hasattr(value, "tolist") else str(value)
+
+
+def _remove_stale(out: Path, names: list[str]) -> None:
+    """Remove the files ``names`` (relative to out) of an earlier run, and any folder in out they leave empty."""
+    root = out.resolve()
+    for name in names:
+        file = (out / name).resolve()
+        if root not in file.parents or not file.is_file():
+            continue
+        file.unlink()
+        folder = file.parent
+        while folder != root and folder.is_dir() and not any(folder.iterdir()):
+            folder.rmdir()
+            folder = folder.parent
 
 
 def _describe(name: str, command: str) -> str:

@@ -11,18 +11,19 @@ extra: pip install -e ".[ros]".
 from __future__ import annotations
 
 import argparse
-import json
 
 from comanip.arguments import as_positive
-from comanip.cli.options import input_file
-from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
+from comanip.cli.commands import command_help
+from comanip.cli.options import add_unit_check_argument, input_file
+from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("ros", help="the ROS 2 goal node (needs the 'ros' extra)", description=__doc__,
+    parser = subparsers.add_parser("ros", help=command_help("ros"), description=__doc__,
                                    formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--params", type=input_file, help="the node's parameters, a YAML file (default: the defaults)")
     parser.add_argument("--replay", type=input_file, help="replay this CSV of hand states (t_s, q0.., qdot0..) through the node")
+    add_unit_check_argument(parser, "the --replay CSV")
     parser.add_argument("--speed", type=float, help="replay at this multiple of real time (default: in lock step with the node)")
     add_output_arguments(parser, "out/ros", "replay output folder")
     parser.add_argument("--ros-args", nargs=argparse.REMAINDER, default=[], help="everything after it goes to ROS (remappings, -p name:=value)")
@@ -44,13 +45,14 @@ def run(args) -> int:
         from comanip.ros.replay import replay_csv
 
         out = output_dir(args.out, "ros", args.force)
-        recording, written = replay_csv(settings, args.replay, out, speed)
+        recording, written = replay_csv(settings, args.replay, out, speed, check_units=args.check_units)
         write_manifest(out, "ros", written)
         last = recording.statuses[-1][3] if recording.statuses else {}
-        print(json.dumps({"estimates": len(recording.goals), "last_goal_m": recording.goals[-1][1].tolist() if recording.goals else None,
-                          "rejected": int(last.get("rejected", 0)), "failed": int(last.get("failed", 0)),
-                          "wall_time_s": recording.wall_time,
-                          "files": [str(p) for p in written]}, indent=1))
+        full = {"estimates": len(recording.goals), "last_goal_m": recording.goals[-1][1].tolist() if recording.goals else None,
+                "rejected": int(last.get("rejected", 0)), "failed": int(last.get("failed", 0)),
+                "wall_time_s": recording.wall_time, "files": [str(p) for p in written]}
+        report(args, [f"ros replay: {full['estimates']} goal estimates published ({full['rejected']} inputs rejected, "
+                      f"{full['failed']} failed solves) in {recording.wall_time:.3g} s"], full, out, written)
         return 0 if recording.goals else 1
     from comanip.ros.node import spin
 

@@ -9,11 +9,12 @@ from __future__ import annotations
 import json
 import time
 
-from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
+from comanip.cli.commands import command_help
+from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("simulate", help="simulate the sync or handover co-manipulation scenario", description=__doc__)
+    parser = subparsers.add_parser("simulate", help=command_help("simulate"), description=__doc__)
     parser.add_argument("scenario", help="sync (paper VI-A) or handover (paper VI-B)")
     parser.add_argument("--trials", type=int, default=5, help="trials per goal, each with its own seed (default: %(default)s)")
     parser.add_argument("--goal", action="append",
@@ -84,7 +85,6 @@ def run(args) -> int:
             for name, trials in runs.items():
                 if name != all_settings[label].policy:
                     files += write_trials([trial.record for trial in trials], out, f"sync_{label}_{name}")
-        print((out / "sync_policies.md").read_text())
     for label, result in results.items():
         trials = result if args.scenario == "sync" else result.trials
         stem = f"{args.scenario}_{label}"
@@ -131,10 +131,15 @@ def run(args) -> int:
         first = next(iter(results.values()))
         record = (first if args.scenario == "sync" else first.trials)[0].record
         print(replay_in_viewer(setup.world.model, record.t, record.qpos))
-    print(json.dumps({label: {"summary": _headline(goals_out[label]["summary"]), "timing": timing[label]}
-                      for label in goals_out}, indent=1, default=float))
     write_manifest(out, "simulate", files)
-    print(f"wrote {len(files)} files to {out}")
+    full = {label: {"summary": _headline(goals_out[label]["summary"]), "timing": timing[label]} for label in goals_out}
+    lines = [f"simulate {args.scenario}, goal {label}: {all_settings[label].trials} trials"
+             f"{'' if policies is None else f' x {len(policies)} policies'} in {timing[label]['wall_s']:.1f} s "
+             f"({timing[label]['real_time_factor']:.1f}x real time)" for label in goals_out]
+    if by_policy:
+        lines.append(f"policy comparison (median [q25, q75]) in {out / 'sync_policies.md'}")
+        full = (out / "sync_policies.md").read_text() + "\n" + json.dumps(full, indent=1, default=float)
+    report(args, lines, full, out, files)
     return 0
 
 

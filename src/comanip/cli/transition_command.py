@@ -17,8 +17,9 @@ import sys
 import time
 from pathlib import Path
 
+from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, input_file, load_model, vector
-from comanip.cli.outputs import add_output_arguments, output_dir, write_manifest
+from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.multicomponent.transition_csv import read_transition_metadata, shipped_dataset_path, write_transition_csv
 from comanip.multicomponent.transition_data import ARM_LENGTH, checked_sweep, generate_transition_data
 
@@ -27,7 +28,7 @@ DEFAULT_WIDTHS = "0.005,0.01,0.02,0.03,0.04,0.05"
 
 
 def add_parser(subparsers) -> None:
-    parser = subparsers.add_parser("transition", help="transition-point data, model and figure (multi-component reaching)",
+    parser = subparsers.add_parser("transition", help=command_help("transition"),
                                    description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     actions = parser.add_subparsers(dest="action", required=True)
 
@@ -76,11 +77,14 @@ def run_generate(args) -> int:
                   "at the origin, goal D along x",
     }
     path = write_transition_csv(rows, args.out, metadata)
-    write_manifest(folder, "transition", [path, path.with_suffix(".json")])
+    written = [path, path.with_suffix(".json")]
+    write_manifest(folder, "transition", written, action="generate")
     unsettled = sum(r["n_trials"] - r["settled_trials"] for r in rows)
-    print(json.dumps({"rows": len(rows), "csv": str(path), "metadata": str(path.with_suffix(".json")),
-                      "wall_time_s": metadata["wall_time_s"], "unsettled_trials": unsettled,
-                      "failed_replans": sum(r["failed_replans"] for r in rows)}, indent=1))
+    failed = sum(r["failed_replans"] for r in rows)
+    report(args, [f"transition generate ({model.name}): {len(rows)} conditions in {metadata['wall_time_s']} s, "
+                  f"{unsettled} unsettled trials, {failed} failed replans"],
+           {"rows": len(rows), "csv": str(path), "metadata": str(path.with_suffix(".json")), "wall_time_s": metadata["wall_time_s"],
+            "unsettled_trials": unsettled, "failed_replans": failed}, folder, written)
     return 0
 
 
@@ -92,14 +96,16 @@ def run_fit(args) -> int:
     model = TransitionModel(data, arm_length=args.arm_length)
     out = output_dir(args.out, "transition", args.force)
     model.save(out / "model.json")
-    report = trend_report(model)
-    (out / "trends.json").write_text(json.dumps(report, indent=1))
-    write_manifest(out, "transition", [out / "model.json", out / "trends.json"])
+    trends = trend_report(model)
+    (out / "trends.json").write_text(json.dumps(trends, indent=1))
+    written = [out / "model.json", out / "trends.json"]
+    write_manifest(out, "transition", written, action="fit")
     made = read_transition_metadata(data)
     made_by = None if made is None else {"model": made.get("model", {}).get("name"), "command": made.get("command")}
-    print(json.dumps({"data": str(data), "data_made_by": made_by, "rows": len(model.training_data["width_m"]),
-                      "kernel": model.kernel_description,
-                      "trends": report, "files": [str(out / "model.json"), str(out / "trends.json")]}, indent=1))
+    rows = len(model.training_data["width_m"])
+    report(args, [f"transition fit: {rows} rows of {data}, kernel {model.kernel_description}"],
+           {"data": str(data), "data_made_by": made_by, "rows": rows, "kernel": model.kernel_description,
+            "trends": trends, "files": [str(p) for p in written]}, out, written)
     return 0
 
 
@@ -110,7 +116,7 @@ def run_plot(args) -> int:
     model = TransitionModel.load(args.model) if args.model else TransitionModel(args.data or shipped_dataset_path())
     folder = output_dir(Path(args.out).parent, "transition", args.force)
     figure = plot_transition_model(model, args.out)
-    write_manifest(folder, "transition", [figure])
-    print(json.dumps({"figure": str(figure)}))
+    write_manifest(folder, "transition", [figure], action="plot")
+    report(args, ["transition plot: predicted transition distance over (D/L, w)"], {"figure": str(figure)}, folder, [figure])
     return 0
 

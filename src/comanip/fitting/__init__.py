@@ -2,9 +2,24 @@
 :func:`fit_model`) or published movement times per condition (least squares, :func:`fit_movement_times`).
 The recording format and the method are described in docs/fitting.md."""
 
-from comanip.fitting.fit import fit_model, recordings_nll
-from comanip.fitting.movement_times import MovementTimeTable, fit_movement_times
-from comanip.fitting.recordings import Trial, load_recordings
-from comanip.fitting.result import FitResult
+from importlib import import_module
+
+#: the public names and their modules, imported on first use (the CLI reads DEFAULT_PARAMETERS without scipy)
+_EXPORTS = {"fit_model": "comanip.fitting.fit", "recordings_nll": "comanip.fitting.fit",
+            "fit_movement_times": "comanip.fitting.movement_times", "MovementTimeTable": "comanip.fitting.movement_times",
+            "Trial": "comanip.fitting.recordings", "load_recordings": "comanip.fitting.recordings",
+            "FitResult": "comanip.fitting.result"}
 
 __all__ = ["fit_model", "recordings_nll", "fit_movement_times", "MovementTimeTable", "Trial", "load_recordings", "FitResult"]
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module 'comanip.fitting' has no attribute {name!r}")
+    value = getattr(import_module(_EXPORTS[name]), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(_EXPORTS))

@@ -21,15 +21,13 @@ from comanip.arguments import as_count, as_positive
 from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.conditions import Condition, group_conditions
 from comanip.fitting.objective import RecordingsObjective
-from comanip.fitting.parameters import ParameterSpace
+from comanip.fitting.parameters import DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.recordings import Trial, load_recordings
 from comanip.fitting.residuals import condition_curves, condition_residuals, trial_residuals
 from comanip.fitting.progress import ProgressBar
-from comanip.fitting.result import FitResult, failed_result, fitted_model, outcome_message
+from comanip.fitting.result import FitResult, failed_result, fitted_model, identification, outcome_message
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
-
-DEFAULT_PARAMETERS = ("kappa", "nu", "gamma")
 
 #: Edge of Nelder-Mead's first simplex in transformed units (a factor e^0.5 = 1.65 for log parameters).
 SIMPLEX_STEP = 0.5
@@ -40,7 +38,7 @@ NLL_KIND = "negative log-likelihood (nats)"
 def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], parameters: Sequence[str] = DEFAULT_PARAMETERS,
               *, trials: str | Path | None = None, sigma_obs: float = 1e-3, bounds: dict | None = None,
               start_tolerance: float = 0.005, max_evaluations: int = 200, step: float = 0.05,
-              scheduler=None, progress: bool = True) -> FitResult:
+              scheduler=None, progress: bool = True, check_units: bool = True) -> FitResult:
     """Fit model fields to recorded reaches by maximum (pseudo-)likelihood.
 
     Args:
@@ -56,12 +54,13 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         step: finite-difference step for the standard errors, in transformed units (0.05: 5 % in a log parameter).
         scheduler: None plans locally; a Dask scheduler address or Client plans the conditions on that cluster.
         progress: show a tqdm line with the evaluations and the best NLL so far.
+        check_units: refuse recordings whose times look like ms or positions like mm (:mod:`comanip.units`).
 
     Returns:
         A :class:`FitResult`. Input errors raise ValueError before any planning; a fit that fails later
-        returns a result with status 'failed'.
+        returns a result with status 'failed'; one whose data do not determine a parameter, 'unidentified'.
     """
-    data, conditions = _grouped(model, recordings, trials, start_tolerance)
+    data, conditions = _grouped(model, recordings, trials, start_tolerance, check_units)
     space = ParameterSpace(model, parameters, sigma_obs, bounds)
     max_evaluations = as_count("max_evaluations", max_evaluations)
     step = as_positive("step", step, "transformed units")
@@ -79,10 +78,14 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
     fitted = fitted_model(space.model_for(u), model, f"{len(data)} recorded trials in {len(conditions)} conditions")
     curves = [condition_curves(data, c, plan) for c, plan in zip(conditions, plans)]
     trial_rows = trial_residuals(data, conditions, plans)
+    values, std_errors = space.values(u), space.natural_std_errors(u, spread.robust_std())
+    message = outcome_message(message, space, u)
+    unidentified = identification(values, space.start_values, std_errors, sum(row["samples_used"] for row in trial_rows))
+    if unidentified:
+        status, message = "unidentified", f"{message}; but {unidentified}"
     return FitResult(
         success=status == "converged" and all(plan.converged for plan in plans), status=status,
-        message=outcome_message(message, space, u), model=fitted, values=space.values(u), initial_values=space.start_values,
-        std_errors=space.natural_std_errors(u, spread.robust_std()),
+        message=message, model=fitted, values=values, initial_values=space.start_values, std_errors=std_errors,
         laplace_std_errors=space.natural_std_errors(u, spread.laplace_std()),
         objective=objective(u), objective_kind=NLL_KIND, evaluations=objective.evaluations,
         fit_time=time.perf_counter() - t_begin, conditions=condition_residuals(trial_rows, conditions, plans, curves),
@@ -90,20 +93,20 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
 
 
 def recordings_nll(model: ReachingModel, recordings: str | Path | Sequence[Trial], *, trials: str | Path | None = None,
-                   sigma_obs: float = 1e-3, start_tolerance: float = 0.005, scheduler=None) -> float:
+                   sigma_obs: float = 1e-3, start_tolerance: float = 0.005, scheduler=None, check_units: bool = True) -> float:
     """The negative log-likelihood (nats) :func:`fit_model` minimises, at the model as given."""
-    data, conditions = _grouped(model, recordings, trials, start_tolerance)
+    data, conditions = _grouped(model, recordings, trials, start_tolerance, check_units)
     space = ParameterSpace(model, ("sigma_obs",), sigma_obs)
     with ConditionPlanner([(c.start_state(model), c.goal, c.width) for c in conditions], scheduler) as planner:
         return RecordingsObjective(data, conditions, space, planner)(space.initial)
 
 
-def _grouped(model, recordings, trials_table, start_tolerance) -> tuple[list[Trial], list[Condition]]:
+def _grouped(model, recordings, trials_table, start_tolerance, check_units) -> tuple[list[Trial], list[Condition]]:
     """Checked trials and their conditions."""
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")
     if isinstance(recordings, (str, Path)):
-        trials = load_recordings(recordings, trials_table)
+        trials = load_recordings(recordings, trials_table, check_units=check_units)
     else:
         trials = list(recordings)
         if not trials or not all(isinstance(trial, Trial) for trial in trials):

@@ -23,10 +23,10 @@ from scipy.optimize import least_squares
 from comanip.arguments import as_count, as_positive, as_positive_array
 from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.csv_table import read_table
-from comanip.fitting.parameters import ParameterSpace
+from comanip.fitting.parameters import MT_DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.progress import ProgressBar
 from comanip.fitting.residuals import movement_time
-from comanip.fitting.result import FitResult, failed_result, fitted_model, outcome_message
+from comanip.fitting.result import FitResult, failed_result, fitted_model, identification, outcome_message
 from comanip.model import ReachingModel
 
 MT_COLUMNS = ("distance_m", "width_m", "mt_s")
@@ -51,7 +51,7 @@ class MovementTimeTable:
         return cls(*(as_positive_array(f"{name} in {str(path)!r}", table[name], "m or s") for name in MT_COLUMNS))
 
 
-def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTable, parameters: Sequence[str] = ("kappa", "gamma"),
+def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTable, parameters: Sequence[str] = MT_DEFAULT_PARAMETERS,
                        *, bounds: dict | None = None, max_evaluations: int = 100, diff_step: float = 0.01,
                        scheduler=None, progress: bool = True) -> FitResult:
     """Least-squares fit of model fields to movement times per condition.
@@ -94,15 +94,18 @@ def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTab
                                  time.perf_counter() - t_begin, SSE_KIND)
     std = _least_squares_std(result.fun, result.jac)
     status = "converged" if result.status > 0 else "max_evaluations"
+    message = outcome_message(str(result.message), space, result.x)
+    values, std_errors = space.values(result.x), space.natural_std_errors(result.x, std)
+    unidentified = identification(values, space.start_values, std_errors)
+    if unidentified:
+        status, message = "unidentified", f"{message}; but {unidentified}"
     rows = [{"condition": c, "distance_m": float(D), "width_m": float(w), "mt_recorded_s": float(mt),
              "mt_predicted_s": movement_time(plan.t, plan.ee_speed), "plan_status": plan.status, "plan_success": plan.success}
             for c, (D, w, mt, plan) in enumerate(zip(table.distance, table.width, table.mt, plans))]
     return FitResult(
         success=status == "converged" and all(plan.converged for plan in plans), status=status,
-        message=outcome_message(str(result.message), space, result.x),
-        model=fitted_model(space.model_for(result.x), model, f"movement times of {len(table.mt)} conditions"),
-        values=space.values(result.x), initial_values=space.start_values,
-        std_errors=space.natural_std_errors(result.x, std), laplace_std_errors=space.natural_std_errors(result.x, std),
+        message=message, model=fitted_model(space.model_for(result.x), model, f"movement times of {len(table.mt)} conditions"),
+        values=values, initial_values=space.start_values, std_errors=std_errors, laplace_std_errors=dict(std_errors),
         objective=float(np.sum(result.fun**2)), objective_kind=SSE_KIND, evaluations=residuals.evaluations,
         fit_time=time.perf_counter() - t_begin, conditions=rows)
 

@@ -10,11 +10,19 @@ and searched as its logarithm, so u = log(kappa) and the step from u to u + 0.1 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from comanip.arguments import as_positive
-from comanip.model import ReachingModel
+
+if TYPE_CHECKING:  # the CLI reads DEFAULT_PARAMETERS without loading the model's solvers
+    from comanip.model import ReachingModel
+
+DEFAULT_PARAMETERS = ("kappa", "nu", "gamma")
+"""The parameters a recordings fit frees by default."""
+MT_DEFAULT_PARAMETERS = ("kappa", "gamma")
+"""The parameters a movement-time fit frees by default."""
 
 #: Parameters searched as logit(value), in (0, 1); all others as log(value), > 0.
 UNIT_INTERVAL = ("gamma",)
@@ -52,7 +60,11 @@ class ParameterSpace:
         if natural is None:
             half = LOGIT_RANGE if name in UNIT_INTERVAL else LOG_RANGE
             return (-half, half) if name in UNIT_INTERVAL else (u0 - half, u0 + half)
-        low, high = (_to_transformed(name, v) for v in natural)
+        try:
+            low, high = (_to_transformed(name, float(v)) for v in natural)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"bounds of {name} must be (low, high) in natural units within its domain, got {natural!r} "
+                             f"({error})") from None
         if not low <= u0 <= high:
             raise ValueError(f"bounds of {name} are {tuple(natural)}, which exclude its start value {self.start_values[name]}")
         return low, high

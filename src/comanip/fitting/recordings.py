@@ -5,7 +5,8 @@ start, positions in m. A ``trial`` column names the trial of each row (rows of o
 without it the whole file is one trial, named after the file. The first sample of a trial is its start,
 where the hand is taken to be at rest. Each trial's goal and width come from columns
 ``goal_x, goal_y[, goal_z], width`` (m) repeated on its rows, or from a separate trials table with the
-columns ``trial, goal_x, goal_y[, goal_z], width``. See docs/fitting.md.
+columns ``trial, goal_x, goal_y[, goal_z], width``. Times that look like ms or positions that look like mm
+(:mod:`comanip.units`) are refused unless ``check_units=False``. See docs/fitting.md.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 
 from comanip.arguments import as_positive
 from comanip.fitting.csv_table import read_table
+from comanip.units import check_positions_m, check_times_s
 
 AXES = ("x", "y", "z")
 GOAL_COLUMNS = tuple(f"goal_{a}" for a in AXES)
@@ -43,13 +45,15 @@ class Trial:
         return self.position[0]
 
 
-def load_recordings(path: str | Path, trials: str | Path | None = None) -> list[Trial]:
+def load_recordings(path: str | Path, trials: str | Path | None = None, *, check_units: bool = True) -> list[Trial]:
     """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name).
 
     Args:
         path: a recordings file, or a folder of recordings files.
         trials: a trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal and
             width columns; a file of that name inside the folder is not read as recordings.
+        check_units: refuse a trial whose times look like ms or whose positions and goal look like mm
+            (:mod:`comanip.units`); False reads them as s and m whatever they look like.
 
     Returns:
         The trials, in file order and then in order of first appearance.
@@ -57,7 +61,8 @@ def load_recordings(path: str | Path, trials: str | Path | None = None) -> list[
     Raises:
         ValueError (one line) for a missing or empty path, missing columns, non-numeric or non-finite
         values, times that do not increase within a trial, a goal or width that changes within a trial,
-        a trial without goal and width, or the same trial name twice.
+        a trial without goal and width, the same trial name twice, or (``check_units``) times in ms or
+        positions in mm.
     """
     path = Path(path)
     if path.is_dir():
@@ -72,7 +77,7 @@ def load_recordings(path: str | Path, trials: str | Path | None = None) -> list[
     targets = None if trials is None else read_trials_table(trials)
     result: list[Trial] = []
     for file in files:
-        result += _trials_in_file(file, targets)
+        result += _trials_in_file(file, targets, check_units)
     names = [trial.name for trial in result]
     repeated = sorted({name for name in names if names.count(name) > 1})
     if repeated:
@@ -94,7 +99,7 @@ def read_trials_table(path: str | Path) -> dict[str, tuple[np.ndarray, float]]:
     return {name: (goal[k], as_positive(f"width of trial {name!r}", table["width"][k], "m")) for k, name in enumerate(names)}
 
 
-def _trials_in_file(path: Path, targets: dict | None) -> list[Trial]:
+def _trials_in_file(path: Path, targets: dict | None, check_units: bool = True) -> list[Trial]:
     """The trials of one recordings file; goal and width from its columns or from ``targets``."""
     table = read_table(path, "recordings", ("t", "x", "y"), ("t",) + AXES + GOAL_COLUMNS + ("width",))
     d = 3 if "z" in table else 2
@@ -108,14 +113,18 @@ def _trials_in_file(path: Path, targets: dict | None) -> list[Trial]:
     trials = []
     for name in dict.fromkeys(labels):
         rows = np.flatnonzero(labels == name)
-        where = f"recordings file {str(path)!r}, trial {name!r}"
+        where = f"recordings file {str(path)!r}, trial {str(name)!r}"
         if has_targets:
             goal, width = _constant_targets(table, rows, d, where)
         elif name not in targets:
             raise ValueError(f"{where} is not in the trials table")
         else:
             goal, width = targets[name]
-        trials.append(_checked_trial(str(name), table["t"][rows], position[rows], goal, width, where))
+        trial = _checked_trial(str(name), table["t"][rows], position[rows], goal, width, where)
+        if check_units:
+            check_times_s(trial.t, f"{where}, column 't'")
+            check_positions_m(np.vstack([trial.position, trial.goal]), f"{where}, columns {list(AXES[:d])} and the goal")
+        trials.append(trial)
     return trials
 
 

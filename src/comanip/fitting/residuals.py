@@ -41,7 +41,7 @@ def trial_residuals(trials: list[Trial], conditions: list[Condition], plans: lis
             keep = scored_samples(plan, trial)
             error = trial.position[keep] - predicted_mean(plan, trial, trial.start - condition.start)
             rows.append({"trial": trial.name, "condition": c, "samples": len(trial.t), "samples_used": int(keep.sum()),
-                         "rms_error_m": float(np.sqrt(np.mean(np.sum(error**2, axis=1)))),
+                         "rms_error_m": float(np.sqrt(np.mean(np.sum(error**2, axis=1)))) if keep.any() else np.nan,
                          "mt_recorded_s": movement_time(*recorded_speed(trial.t, trial.position)),
                          "mt_predicted_s": mt_predicted})
     return rows
@@ -69,7 +69,7 @@ def condition_residuals(trial_rows: list[dict], conditions: list[Condition], pla
     rows = []
     for c, (condition, plan, curve) in enumerate(zip(conditions, plans, curves)):
         members = [row for row in trial_rows if row["condition"] == c]
-        squared = sum(row["rms_error_m"] ** 2 * row["samples_used"] for row in members)
+        squared = sum(row["rms_error_m"] ** 2 * row["samples_used"] for row in members if row["samples_used"])
         used = sum(row["samples_used"] for row in members)
         mt_recorded = movement_time(curve["recorded_t"], curve["recorded_speed"])
         mt_predicted = movement_time(plan.t, plan.ee_speed)

@@ -12,9 +12,11 @@ from comanip import presets
 from comanip.fitting.parameters import ParameterSpace
 from comanip.model import ReachingModel
 
-#: Statuses: 'converged' (the optimiser met its tolerances), 'max_evaluations' (it ran out of
+#: Statuses: 'converged' (the optimiser met its tolerances and the data determine every parameter),
+#: 'unidentified' (the optimiser stopped, but no recorded sample was scored, or a parameter stayed at its start
+#: value without a standard error: the data say nothing about it), 'max_evaluations' (it ran out of
 #: evaluations; the values are the best found), 'failed' (an error stopped the fit; values are the start).
-FIT_STATUSES = ("converged", "max_evaluations", "failed")
+FIT_STATUSES = ("converged", "unidentified", "max_evaluations", "failed")
 
 
 @dataclass
@@ -22,7 +24,7 @@ class FitResult:
     """Fitted parameters of a :class:`ReachingModel` and how well the fitted model matches the data."""
 
     success: bool
-    """True when the optimiser converged and every condition's plan at the fitted values succeeded."""
+    """True when the fit converged (status 'converged') and every condition's plan at the fitted values succeeded."""
     status: str
     """One of :data:`FIT_STATUSES`."""
     message: str
@@ -83,6 +85,21 @@ def outcome_message(optimiser: str, space: ParameterSpace, u) -> str:
         return optimiser
     return (f"{optimiser} {bounded} ended at a search bound: the data hardly constrain them there or the bounds are "
             f"too tight (their standard errors are NaN)")
+
+
+def identification(values: dict[str, float], start: dict[str, float], std_errors: dict[str, float],
+                   samples_used: int | None = None) -> str | None:
+    """Why the data do not determine the fit, in words, or None when they do: no sample scored
+    (``samples_used`` 0; e.g. times in ms, all past the horizon), or parameters left at their start values
+    (to 1e-9 relative) with no finite standard error (the objective does not change with them)."""
+    if samples_used == 0:
+        return ("no recorded sample lies within the plans' horizon, so the likelihood ignores the data "
+                "(times in ms instead of s?)")
+    stuck = [name for name, value in values.items()
+             if np.isclose(value, start[name], rtol=1e-9, atol=0.0) and not np.isfinite(std_errors.get(name, np.nan))]
+    if stuck:
+        return f"{stuck} stayed at their start values without a standard error: the data do not determine them"
+    return None
 
 
 def fitted_model(fitted: ReachingModel, start: ReachingModel, data: str) -> ReachingModel:

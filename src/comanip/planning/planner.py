@@ -37,8 +37,10 @@ import numpy as np
 
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import as_count, as_goal_width, as_matrix, as_optional_positive, as_positive, as_vector
+from comanip.arguments import (as_bounded_vector, as_count, as_goal_width, as_matrix, as_optional_positive, as_position,
+                               as_positive)
 from comanip.model import ReachingModel
+from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.initial_guess import (brake_durations, braked_torques, guess_durations, linear_dynamics_of,
@@ -278,7 +280,9 @@ class Planner:
                 entries solved before (:meth:`_cold_start`): a new one would be a whole solve outside the budget.
 
         Returns:
-            A :class:`Plan`; never raises on a failed solve (check ``plan.success``: converged and reaching).
+            A :class:`Plan`; never raises on a failed solve (check ``plan.success``: converged and reaching). For a
+            point mass, a reach no person makes (too far, too fast) keeps its status and gets a warning in its
+            message and ``extras['warnings']`` (:mod:`comanip.plausibility`).
         """
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
@@ -293,7 +297,7 @@ class Planner:
         plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
                                                  until_converged=from_library))
         self._count_solving_time(plan.solve_time)
-        return plan
+        return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
 
     def _count_solving_time(self, seconds: float) -> None:
         """Add a solve's time; past ``compile_after`` seconds, start the point mass's background compile."""
@@ -618,10 +622,10 @@ def reach_inputs(model: ReachingModel, start, goal, width) -> tuple[np.ndarray, 
 
     A start of [q; qdot] (2n,) for a model with activation stages gets them at zero force."""
     size = 2 * model.n if np.shape(start) == (2 * model.n,) else model.state_size
-    start = model.full_state(as_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
+    start = model.full_state(as_bounded_vector("start", start, size, "state [q; qdot] in m and m/s, or rad and rad/s"
                                        + (f", optionally followed by the {model.state_size - 2 * model.n} activation states"
                                           if size != 2 * model.n else "")))
-    goal = as_vector("goal", goal, model.d, "task-space position, m")
+    goal = as_position("goal", goal, model.d)
     width = model.width if width is None else as_goal_width("width", width)
     return start, goal, width
 

@@ -85,10 +85,11 @@ class ReachLibrary:
     def guess(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> np.ndarray | None:
         """Torques (H, n) of the nearest entry turned towards goal (n,) and scaled to its distance from the
         start's position, for the start at rest there (a moving start adds its own correction); None when the
-        goal is at the start, or when the entry is not solved yet and not ``solve_missing``."""
+        goal is at the start (or its distance overflows), or when the entry is not solved yet and not ``solve_missing``."""
         offset = np.asarray(goal, dtype=float) - start[: self.n]
-        distance = float(np.linalg.norm(offset))
-        if distance == 0.0:
+        with np.errstate(over="ignore"):
+            distance = float(np.linalg.norm(offset))
+        if not 0.0 < distance < np.inf:  # at the start, or so far that the distance overflows: no entry
             return None
         key = (int(np.round(np.log(distance / width) / np.log(GRID_RATIO))),
                int(np.round(np.log(width / self.width) / np.log(WIDTH_RATIO))))

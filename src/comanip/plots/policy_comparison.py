@@ -33,8 +33,9 @@ def plot_policy_comparison(results: dict[str, dict[str, list[SyncTrial]]], path:
                 continue
             t = trials[0].record.t
             error = 1e3 * np.linalg.norm(estimates - np.stack([trial.record.goal for trial in trials])[:, None], axis=2)
-            with np.errstate(all="ignore"):
-                q25, median, q75 = np.nanpercentile(error, [25, 50, 75], axis=0)
+            q25, median, q75 = np.full((3, t.size), np.nan)
+            seen = np.any(np.isfinite(error), axis=0)  # before the first estimate no trial has one
+            q25[seen], median[seen], q75[seen] = np.nanpercentile(error[:, seen], [25, 50, 75], axis=0)
             ax.plot(t, median, color=colors[name], lw=1.6, label=name)
             ax.fill_between(t, q25, q75, color=colors[name], alpha=0.2, lw=0)
         mt = np.median([trial.metrics["movement_time_s"] for trials in results[goal].values() for trial in trials])

@@ -9,10 +9,12 @@
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import yaml
 
-from comanip.model import ReachingModel
+if TYPE_CHECKING:  # imported where a model is made: listing the presets (comanip --help) needs no solver
+    from comanip.model import ReachingModel
 
 PRESET_DIR = Path(__file__).parent
 
@@ -44,6 +46,8 @@ def load(name_or_path: str | Path) -> ReachingModel:
         raise ValueError(f"{str(path)!r} is empty; a model YAML is a mapping such as the one `comanip.presets.save` writes")
     if not isinstance(config, dict):
         raise ValueError(f"{str(path)!r} does not hold a model mapping (got a {type(config).__name__})")
+    from comanip.model import ReachingModel
+
     return ReachingModel.from_config(config)
 
 

@@ -262,10 +262,11 @@ class Replay:
 
 
 def replay_csv(settings: NodeSettings, observations: str | Path, out: str | Path, speed: float | None = None,
-               transition_model=None) -> tuple[Recording, list[Path]]:
-    """Replay a CSV of hand states (``comanip estimate`` format) through the node; write the recording to ``out``."""
+               transition_model=None, check_units: bool = True) -> tuple[Recording, list[Path]]:
+    """Replay a CSV of hand states (``comanip estimate`` format) through the node; write the recording to ``out``.
+    ``check_units`` refuses times that look like ms and positions like mm (or angles like degrees)."""
     model = settings.model()
-    times, states = read_observations(Path(observations), model.n)
+    times, states = read_observations(Path(observations), model.n, check_units=check_units, joint_angles=not model.body.is_linear)
     with Replay(settings, transition_model) as replay:
         recording = replay.run(times, states, speed)
     return recording, recording.write(out, model.d)
