@@ -127,7 +127,7 @@ def test_readme_saved_model_plans_under_its_own_name(workdir, monkeypatch, capsy
     monkeypatch.chdir(workdir)
     exec(compile(fenced_blocks(README.read_text(encoding="utf-8"), "python")[0][1], "README.md:first-block", "exec"), {})
     capsys.readouterr()
-    assert main(["plan", "--preset", "my.yaml", "--out", str(workdir / "plan")]) == 0
+    assert main(["plan", "--preset", "my.yaml", "--out", str(workdir / "plan"), "--verbose"]) == 0
     summary = json.loads(capsys.readouterr().out)
     assert summary["model"] == "my_model" and summary["success"]
 
