@@ -47,6 +47,7 @@ from dataclasses import dataclass
 
 import numpy as np
 from scipy.linalg import lapack
+from scipy.stats import chi2
 from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_positive, as_vector
@@ -57,7 +58,10 @@ from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
+from comanip.estimation.endpoint_baselines import MOVING_SPEED
+from comanip.estimation.paced_model import PacedFit, PacedModel
 from comanip.estimation.people_model import shipped_people_model
+from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
@@ -122,18 +126,24 @@ class OnlineOptions:
     timing: str = "estimated"
     """"model": the reach starts at t = 0 and moves at the model's pace (the estimate above, exact for the
     model's own reaches). "estimated": that estimate while the model at its own pace explains the observations
-    (whitened misfit at most ``mismatch_threshold``), and from the first update on which it does not, the
-    estimate of the model fitted to recorded people (:mod:`comanip.estimation.people_model`), whose pace, onset
-    and shape are the person's own; its status is then ``people_model``."""
+    (whitened misfit at most ``mismatch_threshold``, and the model's timing not rejected by a fit of its reach
+    at a free pace and onset); from the first update on which it does not, the model's reach at the person's
+    own pace and onset (:mod:`comanip.estimation.paced_model`) where that explains the hand (misfit at most
+    ``paced_threshold``), else the model fitted to recorded people (:mod:`comanip.estimation.people_model`),
+    status ``people_model``. Goals from either are combined with the prior."""
     mismatch_threshold: float = 9.0
     """With ``timing="estimated"``: the largest mean squared whitened residual (per observed number) at which
     the model at its own pace still explains the observations (about 1 for the model's own reaches)."""
+    paced_threshold: float = 0.3
+    """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
+    at which the model's reach at the person's pace explains the observations."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
         if self.timing not in TIMINGS:
             raise ValueError(f"timing must be one of {TIMINGS}, got {self.timing!r}")
         as_positive("mismatch_threshold", self.mismatch_threshold, "mean squared whitened residual")
+        as_positive("paced_threshold", self.paced_threshold, "chi² per observed number")
         if not (math.isfinite(self.led_from) and self.led_from >= 0):
             raise ValueError(f"led_from must be a finite time ≥ 0 s, got {self.led_from!r}")
         if not (math.isfinite(self.led_deviation_time) and self.led_deviation_time >= 0):
@@ -195,6 +205,10 @@ class FamilyCache(ModelCache[ModelFamilies]):
 DEFAULT_FAMILIES = FamilyCache()
 """The cache :class:`OnlineGoalEstimator` uses when given none."""
 
+#: A paced fit whose relative std of the goal's distance is at most this pins the goal.
+SETTLED_SPREAD = 0.1
+#: |log pace| beyond which a settled paced fit contradicts the model's own pace.
+PACE_TOLERANCE = 0.14
 #: Observed speed and displacement beyond this many noise standard deviations count as movement.
 _MOVEMENT_SIGMAS = 3.0
 #: Whitenings rebuilt per update at most (each at the goal the previous round ended at).
@@ -273,7 +287,8 @@ class OnlineGoalEstimator:
         self._last_time = -math.inf
         self._last_observation = np.zeros(2 * n)
         self._history: list[np.ndarray] = []       # [t, position, velocity] of every observation, for the people model
-        self._off_model: float | None = None        # the misfit that showed the model's pace does not explain the hand
+        self._off_model: str | None = None          # why the model at its own pace does not explain the hand
+        self._paced = PacedModel(self.family)
         self._whitening: ObservationWhitening | None = None
         self._blas = ThreadpoolController()
         self._whitening_goal = np.zeros(d)
@@ -326,28 +341,71 @@ class OnlineGoalEstimator:
         return self.latest
 
     def _estimate(self, t_begin: float) -> GoalEstimate:
-        if self._off_model is not None:
-            return self._people_estimate(t_begin)
-        estimate, misfit = self._model_estimate(t_begin)
-        if (self.options.timing == "estimated" and misfit is not None and misfit > self.options.mismatch_threshold):
-            self._off_model = misfit
-            return self._people_estimate(t_begin)
-        return estimate
-
-    def _people_estimate(self, t_begin: float) -> GoalEstimate:
-        """The estimate of the model fitted to recorded people (:mod:`comanip.estimation.people_model`) from
-        every observation so far; before the hand moves, the prior."""
+        if self.options.timing == "model":
+            return self._model_estimate(t_begin)[0]
         n = self.model.n
         history = np.asarray(self._history)
-        prediction = shipped_people_model().predict(history[:, 0], history[:, 1:1 + n], history[:, 1 + n:1 + 2 * n],
-                                                    self.start_position)
-        if prediction is None:
+        t, position, velocity = history[:, 0], history[:, 1:1 + n], history[:, 1 + n:1 + 2 * n]
+        onset = detected_onset(t, np.sqrt((velocity * velocity).sum(axis=1)), MOVING_SPEED)
+        previous = self.latest
+        if self._off_model is None:
+            estimate, misfit = self._model_estimate(t_begin)
+            if onset is None or misfit is None:
+                return estimate
+            paced = self._paced_fit(t, position, velocity, onset, estimate.goal)
+            contradiction = self._contradiction(estimate, paced)
+            if misfit <= self.options.mismatch_threshold and contradiction is None:
+                return estimate
+            self._off_model = contradiction or (f"the model at its own pace does not explain the hand (misfit {misfit:.3g} "
+                                                f"per observed number)")
+        elif onset is None:
             return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE,
                                 "no observation shows movement: the estimate is the prior", 0, t_begin)
-        return self._result(prediction.goal, prediction.covariance, Status.PEOPLE_MODEL,
-                            f"the model at its own pace does not explain the hand (misfit {self._off_model:.3g} per "
-                            f"observed number, above {self.options.mismatch_threshold:g}): the goal is the people model's",
-                            0, t_begin)
+        else:
+            paced = self._paced_fit(t, position, velocity, onset, None if previous is None else previous.goal)
+        if paced.misfit <= self.options.paced_threshold and self._settled(paced):
+            goal, covariance = self._with_prior(paced.goal, paced.covariance)
+            return self._result(goal, covariance, Status.SOLVED, f"{self._off_model}; the model's reach at the person's "
+                                f"pace (×{paced.pace:.3g}, onset {paced.onset:.3g} s) does", 0, t_begin)
+        people = shipped_people_model().predict(t, position, velocity, self.start_position)
+        goal, covariance = self._with_prior(people.goal, people.covariance)
+        return self._result(goal, covariance, Status.PEOPLE_MODEL, f"{self._off_model}, nor does it clearly at the "
+                            f"person's pace (misfit {paced.misfit:.3g}): the goal is the people model's", 0, t_begin)
+
+    def _settled(self, paced: PacedFit) -> bool:
+        """Whether a paced fit pins the goal's distance: its relative std along the reach at most
+        :data:`SETTLED_SPREAD` (before the speed peaks, a shorter quicker and a longer slower reach fit alike)."""
+        offset = paced.goal - self.start_position
+        distance = float(np.linalg.norm(offset))
+        return distance > 0 and math.sqrt(float(offset @ paced.covariance @ offset)) / distance**2 <= SETTLED_SPREAD
+
+    def _contradiction(self, estimate: GoalEstimate, paced: PacedFit) -> str | None:
+        """Why the model at its own pace is contradicted by its reach at the person's pace, or None: that fit
+        explains the hand (misfit at most ``paced_threshold``), pins the goal (:meth:`_settled`), finds a pace
+        off the model's by more than :data:`PACE_TOLERANCE` and a goal the model-pace estimate's 99.9 % region
+        (with the paced fit's) does not hold."""
+        if paced.misfit > self.options.paced_threshold or not self._settled(paced) or abs(math.log(paced.pace)) <= PACE_TOLERANCE:
+            return None
+        difference = paced.goal - estimate.goal
+        distance2 = float(difference @ np.linalg.solve(paced.covariance + estimate.goal_covariance, difference))
+        if distance2 <= chi2.ppf(0.999, len(difference)):
+            return None
+        return (f"the model at its own pace is contradicted by its reach at the person's pace (×{paced.pace:.3g}), "
+                f"whose goal lies {math.sqrt(distance2):.3g} standard deviations away")
+
+    def _paced_fit(self, t, position, velocity, onset: float, goal) -> PacedFit:
+        """The model's reach fitted at the person's pace (:mod:`comanip.estimation.paced_model`), its shape taken
+        at the distance of ``goal`` (1.5 times the hand's displacement when None), kept between 1 and 3 times
+        the displacement (a shape far from the distance it fits can lock into a wrong pace and distance)."""
+        displacement = max(float(np.linalg.norm(position[-1] - self.start_position)), 1e-3)
+        guess = 1.5 * displacement if goal is None else float(np.linalg.norm(np.asarray(goal) - self.start_position))
+        return self._paced.fit(t, position, velocity, self.start_position, onset, [min(max(guess, displacement), 3 * displacement)])
+
+    def _with_prior(self, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A Gaussian goal estimate (d,) m, (d, d) m², combined with the prior (g_bar, P0)."""
+        precision = np.linalg.inv(covariance) + self._prior_precision
+        combined = np.linalg.inv(precision)
+        return combined @ (np.linalg.solve(covariance, goal) + self._prior_precision @ self.prior_mean), combined
 
     def _model_estimate(self, t_begin: float) -> tuple[GoalEstimate, float | None]:
         """The estimate of the model at its own pace (module docstring) and its misfit (mean squared whitened

@@ -8,7 +8,8 @@ straightness |x_K - x_0| / L, the angle between the velocity and the displacemen
 Two gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
 them how far beyond the hand the endpoint lies along the direction of motion u (the hand's displacement over
 the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
-endpoint is never behind the hand along u. Its covariance is isotropic: the predicted squared error times a
+endpoint is never behind the hand along u, and a hand that has stopped (speed below ``REST_FRACTION`` of its
+peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors).
 
 The fitted model ships with comanip (``comanip/data/people_endpoint_model.pkl``), fitted on the development
@@ -42,6 +43,10 @@ DIRECTION_WINDOW = 0.05
 QUANTILE = 0.3
 """The along regressor predicts this quantile of the distance still to go: below the median, since a goal
 predicted beyond where the hand stops costs a robot more than one predicted short of it."""
+REST_FRACTION, REST_TIME = 0.05, 0.1
+"""A hand whose speed has stayed below this fraction of its peak speed for this long (s) has stopped."""
+REST_SPREAD = 0.03
+"""Standard deviation of a stopped hand's endpoint estimate, a fraction of the path length."""
 _MIN_PATH = 1e-4
 _MIN_RECENT = 2e-3
 _ONE_THREAD = ThreadpoolController()
@@ -121,6 +126,10 @@ class PeopleModel:
         if described is None:
             return None
         features, u, path = described
+        speed = np.sqrt((velocity * velocity).sum(axis=1))
+        if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
+            # a hand that has stopped is at its endpoint (until it moves again)
+            return EndpointPrediction(position[-1].copy(), (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
         with _ONE_THREAD.limit(limits=1, user_api="openmp"):      # threads cost more than one row takes
             along = float(self.along.predict(features[None])[0])
             log_squared = float(self.spread.predict(features[None])[0])

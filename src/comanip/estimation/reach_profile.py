@@ -21,12 +21,12 @@ _POINTS = 201
 
 @dataclass(frozen=True)
 class ReachProfile:
-    """r(phi) sampled at ``phase`` (P,) from 0 to 1, non-decreasing from 0 to 1, with its derivative."""
+    """r(phi) sampled at ``phase`` (P,) from 0 to 1, from 0 to 1 (above 1 during an overshoot), with its derivative."""
 
     phase: np.ndarray
     """Normalised times (P,) from 0 to 1."""
     fraction: np.ndarray
-    """r at ``phase`` (P,), from 0 to 1."""
+    """r at ``phase`` (P,), from 0 at phi = 0 to 1 at phi = 1."""
     rate: np.ndarray
     """dr/dphi at ``phase`` (P,)."""
     name: str = "profile"
@@ -43,6 +43,17 @@ class ReachProfile:
         fraction = np.interp(phase, (t - t[0]) / (t[-1] - t[0]), covered / covered[-1])
         rate = np.interp(phase, (t - t[0]) / (t[-1] - t[0]), speed * (t[-1] - t[0]) / covered[-1])
         return cls(phase, fraction, rate, name)
+
+    @classmethod
+    def from_path(cls, t, position, velocity, name: str) -> "ReachProfile":
+        """The shape of a straight movement from its positions (K,) m and velocities (K,) m/s along its line at
+        times (K,) s, the first and last samples its onset and end (an overshoot stays in: r may pass 1)."""
+        t, position, velocity = (np.asarray(a, dtype=float) for a in (t, position, velocity))
+        duration, distance = t[-1] - t[0], position[-1] - position[0]
+        phase = np.linspace(0.0, 1.0, _POINTS)
+        normalised = (t - t[0]) / duration
+        return cls(phase, np.interp(phase, normalised, (position - position[0]) / distance),
+                   np.interp(phase, normalised, velocity * duration / distance), name)
 
     @classmethod
     def minimum_jerk(cls) -> "ReachProfile":
