@@ -364,7 +364,7 @@ class OnlineGoalEstimator:
         else:
             paced = self._paced_fit(t, position, velocity, onset, None if previous is None else previous.goal)
         if paced.misfit <= self.options.paced_threshold and self._settled(paced):
-            goal, covariance = self._with_prior(paced.goal, paced.covariance)
+            goal, covariance = self._with_prior(self._not_behind(paced.goal, position[-1]), paced.covariance)
             return self._result(goal, covariance, Status.SOLVED, f"{self._off_model}; the model's reach at the person's "
                                 f"pace (×{paced.pace:.3g}, onset {paced.onset:.3g} s) does", 0, t_begin)
         people = shipped_people_model().predict(t, position, velocity, self.start_position)
@@ -394,12 +394,24 @@ class OnlineGoalEstimator:
                 f"whose goal lies {math.sqrt(distance2):.3g} standard deviations away")
 
     def _paced_fit(self, t, position, velocity, onset: float, goal) -> PacedFit:
-        """The model's reach fitted at the person's pace (:mod:`comanip.estimation.paced_model`), its shape taken
-        at the distance of ``goal`` (1.5 times the hand's displacement when None), kept between 1 and 3 times
-        the displacement (a shape far from the distance it fits can lock into a wrong pace and distance)."""
+        """The model's reach fitted at the person's pace (:mod:`comanip.estimation.paced_model`), its shape tried
+        at the distance of ``goal`` (kept between 1 and 3 times the hand's displacement: a shape far from the
+        distance it fits can lock into a wrong pace and distance) and at 1.5 times the displacement."""
         displacement = max(float(np.linalg.norm(position[-1] - self.start_position)), 1e-3)
-        guess = 1.5 * displacement if goal is None else float(np.linalg.norm(np.asarray(goal) - self.start_position))
-        return self._paced.fit(t, position, velocity, self.start_position, onset, [min(max(guess, displacement), 3 * displacement)])
+        guesses = [1.5 * displacement]
+        if goal is not None:
+            guesses.insert(0, min(max(float(np.linalg.norm(np.asarray(goal) - self.start_position)), displacement), 3 * displacement))
+        return self._paced.fit(t, position, velocity, self.start_position, onset, guesses)
+
+    def _not_behind(self, goal: np.ndarray, hand: np.ndarray) -> np.ndarray:
+        """``goal`` moved along the line from the start through it up to the ``hand``'s projection on that line
+        when the hand is farther along (a hand that has moved on is not heading for a goal behind it)."""
+        offset = goal - self.start_position
+        distance = float(np.linalg.norm(offset))
+        if distance == 0:
+            return goal
+        along = float((hand - self.start_position) @ offset) / distance
+        return goal + max(along - distance, 0.0) * offset / distance
 
     def _with_prior(self, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """A Gaussian goal estimate (d,) m, (d, d) m², combined with the prior (g_bar, P0)."""

@@ -5,8 +5,9 @@ A reach of onset t_0, duration T and displacement Delta = g - x_0 puts the hand 
     x(t) = x_0 + Delta r(phi),   x'(t) = Delta r'(phi) / T,   phi = (t - t_0) / T,
 
 with r(phi) = 0 before the onset (phi ≤ 0) and 1 after the end (phi ≥ 1). Here T is the movement time MT
-(the speed is at 5 % of its peak at phi = 0 and 1, docs/formulation.md §6), and r(1) = 1 means g is where
-the hand stops. Three sources of a shape: the minimum-jerk reach, a reaching model's mean plan, and the mean
+(for a recorded movement or a model's plan the speed is at 5 % of its peak at phi = 0 and 1,
+docs/formulation.md §6; the minimum-jerk shape runs from rest to rest), and r(1) = 1 means g is where the
+hand stops. Three sources of a shape: the minimum-jerk reach, a reaching model's mean plan, and the mean
 of recorded movements (:meth:`ReachProfile.from_recordings`).
 """
 
@@ -57,11 +58,9 @@ class ReachProfile:
 
     @classmethod
     def minimum_jerk(cls) -> "ReachProfile":
-        """The minimum-jerk reach, its ends at 5 % of the peak speed."""
-        s = np.linspace(0.0, 1.0, 2001)
-        speed = 30 * s**2 * (1 - s) ** 2
-        inside = speed >= 0.05 * speed.max()
-        return cls.from_speed(s[inside], speed[inside], "minimum jerk")
+        """The minimum-jerk reach, phi from its start to its end (speed 0 at both)."""
+        s = np.linspace(0.0, 1.0, _POINTS)
+        return cls(s, 10 * s**3 - 15 * s**4 + 6 * s**5, 30 * s**2 * (1 - s) ** 2, "minimum jerk")
 
     @classmethod
     def from_recordings(cls, recordings, name: str = "recorded people") -> "ReachProfile":
