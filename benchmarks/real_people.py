@@ -32,7 +32,7 @@ FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 WORSE_MARGIN = 0.05
 
 
-def predictors(model_names, library, exclude_self: bool):
+def predictors(model_names, library, exclude_self: bool, people):
     """{name: factory(recording) -> online predictor with update(t, position, velocity)}."""
     import comanip
     from comanip.estimation.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
@@ -43,12 +43,28 @@ def predictors(model_names, library, exclude_self: bool):
         "constant velocity": lambda r: ConstantVelocity(r.position[0]),
         "minimum jerk": lambda r: MinimumJerkFit(r.position[0]),
         "template matching": lambda r: TemplateMatching(r.position[0], library, exclude=r.name if exclude_self else None),
+        "people model": lambda r: _People(people, r.position[0]),
     }
     for name in model_names:
         model = comanip.presets.load(name)
         made[f"OnlineGoalEstimator ({name})"] = (lambda m: lambda r: _Online(comanip.OnlineGoalEstimator(
             m, np.r_[r.position[0], np.zeros(m.state_size - m.n)])))(model)
     return made
+
+
+class _People:
+    """The people endpoint model alone, fed the whole prefix at every update."""
+
+    def __init__(self, model, start):
+        from comanip.estimation.endpoint_baselines import CurrentPosition
+        self.model, self.start, self.history = model, start, CurrentPosition(start)
+
+    def update(self, t, position, velocity):
+        now = self.history.update(t, position, velocity)
+        history = self.history
+        answer = self.model.predict(np.asarray(history._t), np.asarray(history._position), np.asarray(history._velocity),
+                                    self.start)
+        return (now.goal, None) if answer is None else (answer.goal, answer.covariance)
 
 
 class _Online:
@@ -189,7 +205,9 @@ def main(argv=None):
     if args.limit:
         recordings = recordings[:args.limit]
     library = TemplateLibrary(development)
-    made = predictors([m for m in args.models.split(",") if m], library, exclude_self=args.split == "development")
+    from comanip.estimation.people_model import shipped_people_model
+    made = predictors([m for m in args.models.split(",") if m], library, exclude_self=args.split == "development",
+                      people=shipped_people_model())
     if args.only:
         made = {k: v for k, v in made.items() if any(o.strip() in k for o in args.only.split(","))}
     names = list(made)

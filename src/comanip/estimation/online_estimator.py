@@ -66,6 +66,7 @@ from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
 from comanip.optim import CONVERGED, Status
+from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
 from comanip.planning.cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
@@ -207,6 +208,8 @@ DEFAULT_FAMILIES = FamilyCache()
 
 #: A paced fit whose relative std of the goal's distance is at most this pins the goal.
 SETTLED_SPREAD = 0.1
+#: Observations since the onset a paced fit needs to pin the goal.
+SETTLED_OBSERVATIONS = 8
 #: |log pace| beyond which a settled paced fit contradicts the model's own pace.
 PACE_TOLERANCE = 0.14
 #: Observed speed and displacement beyond this many noise standard deviations count as movement.
@@ -350,7 +353,7 @@ class OnlineGoalEstimator:
         previous = self.latest
         if self._off_model is None:
             estimate, misfit = self._model_estimate(t_begin)
-            if onset is None or misfit is None:
+            if onset is None or misfit is None or not self._humanlike(position, velocity):
                 return estimate
             paced = self._paced_fit(t, position, velocity, onset, estimate.goal)
             contradiction = self._contradiction(estimate, paced)
@@ -372,9 +375,19 @@ class OnlineGoalEstimator:
         return self._result(goal, covariance, Status.PEOPLE_MODEL, f"{self._off_model}, nor does it clearly at the "
                             f"person's pace (misfit {paced.misfit:.3g}): the goal is the people model's", 0, t_begin)
 
+    def _humanlike(self, position: np.ndarray, velocity: np.ndarray) -> bool:
+        """Whether the observed hand stays within the reach family's distances and a person's hand speeds
+        (beyond them no model explains it better than the model at its own pace, which says so)."""
+        offset = position - self.start_position
+        return bool(np.sqrt((offset * offset).sum(axis=1)).max() <= self.family.distances[-1]
+                    and np.sqrt((velocity * velocity).sum(axis=1)).max() <= MAX_HUMAN_HAND_SPEED_M_S)
+
     def _settled(self, paced: PacedFit) -> bool:
         """Whether a paced fit pins the goal's distance: its relative std along the reach at most
-        :data:`SETTLED_SPREAD` (before the speed peaks, a shorter quicker and a longer slower reach fit alike)."""
+        :data:`SETTLED_SPREAD` (before the speed peaks, a shorter quicker and a longer slower reach fit alike),
+        from at least :data:`SETTLED_OBSERVATIONS` observations since the onset."""
+        if paced.observations < SETTLED_OBSERVATIONS:
+            return False
         offset = paced.goal - self.start_position
         distance = float(np.linalg.norm(offset))
         return distance > 0 and math.sqrt(float(offset @ paced.covariance @ offset)) / distance**2 <= SETTLED_SPREAD

@@ -26,6 +26,9 @@ from comanip.estimation.reach_profile import ReachProfile
 
 PACE_STD = 0.35
 """Standard deviation of log(pace) a priori: people take their own time, within about ×0.5–×2 of the model's."""
+GOAL_FLOOR = 0.01
+"""Standard deviation added to the goal in every direction, a fraction of its distance: the shape is the
+model's at a nearby distance, and a person's reach is never exactly the model's."""
 _SHAPE_BINS = 0.05
 """Shapes are kept per bin of this width in log D."""
 
@@ -57,6 +60,8 @@ class PacedFit:
     """chi² per observed number of the fit (:mod:`comanip.estimation.profile_fit`)."""
     timing_evidence: float
     """How strongly the observations reject the model's own timing (about chi²(2) when it is right)."""
+    observations: int
+    """Observations at or after the fitted onset."""
 
 
 class PacedModel:
@@ -105,9 +110,11 @@ class PacedModel:
                 best = (found, fit, shape)
         _, fit, shape = best
         scale = shape.goal_over_end
-        return PacedFit(goal=start + scale * (fit.goal - start), covariance=scale**2 * fit.covariance,
-                        pace=fit.duration / shape.duration, onset=fit.onset, misfit=fit.misfit,
-                        timing_evidence=float(fit.timing_evidence))
+        goal = start + scale * (fit.goal - start)
+        floor = (GOAL_FLOOR * float(np.linalg.norm(goal - start))) ** 2 * np.eye(len(goal))
+        return PacedFit(goal=goal, covariance=scale**2 * fit.covariance + floor, pace=fit.duration / shape.duration,
+                        onset=fit.onset, misfit=fit.misfit, timing_evidence=float(fit.timing_evidence),
+                        observations=int(np.count_nonzero(np.asarray(t) >= fit.onset)))
 
     def _key(self, distance: float) -> int:
         low, high = self.family.distances[0], self.family.distances[-1]
