@@ -22,6 +22,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import sys
 import time
 from pathlib import Path
 
@@ -32,7 +33,7 @@ FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 WORSE_MARGIN = 0.05
 
 
-def predictors(model_names, library, exclude_self: bool, people):
+def predictors(model_names, library, exclude_self: bool, people_for):
     """{name: factory(recording) -> online predictor with update(t, position, velocity)}."""
     import comanip
     from comanip.estimation.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
@@ -43,12 +44,13 @@ def predictors(model_names, library, exclude_self: bool, people):
         "constant velocity": lambda r: ConstantVelocity(r.position[0]),
         "minimum jerk": lambda r: MinimumJerkFit(r.position[0]),
         "template matching": lambda r: TemplateMatching(r.position[0], library, exclude=r.name if exclude_self else None),
-        "people model": lambda r: _People(people, r.position[0]),
+        "people model": lambda r: _People(people_for(r), r.position[0]),
     }
+    from comanip.estimation import OnlineOptions
     for name in model_names:
         model = comanip.presets.load(name)
         made[f"OnlineGoalEstimator ({name})"] = (lambda m: lambda r: _Online(comanip.OnlineGoalEstimator(
-            m, np.r_[r.position[0], np.zeros(m.state_size - m.n)])))(model)
+            m, np.r_[r.position[0], np.zeros(m.state_size - m.n)], options=OnlineOptions(people_model=people_for(r)))))(model)
     return made
 
 
@@ -189,7 +191,10 @@ def main(argv=None):
     parser.add_argument("--scale", type=float, default=None, help="cursory pixels to metres (m/px)")
     parser.add_argument("--count", type=int, default=100, help="simulated reaches")
     parser.add_argument("--out", type=Path, default=None)
+    parser.add_argument("--markdown", action="store_true", help="print only the table on stdout (progress on stderr)")
+    parser.add_argument("--figure", type=Path, default=None, help="also save the figure here (e.g. under docs/figures)")
     args = parser.parse_args(argv)
+    log = sys.stderr if args.markdown else sys.stdout
     from comanip.estimation.template_matching import TemplateLibrary
     from comanip.recordings import load_cursory
     from comanip.recordings.cursory_data import SCALE
@@ -205,9 +210,17 @@ def main(argv=None):
     if args.limit:
         recordings = recordings[:args.limit]
     library = TemplateLibrary(development)
-    from comanip.estimation.people_model import shipped_people_model
+    from comanip.estimation.people_model import PeopleModel, shipped_people_model
+    if args.source == "cursory" and args.split == "development":
+        # the shipped people model was fitted on this split: score each movement with one fitted on the other half
+        print("fitting the people model on each half of the development split ...", flush=True, file=log)
+        folds = [PeopleModel.fit(development[1 - k::2]) for k in (0, 1)]
+        half = {r.name: k % 2 for k, r in enumerate(development)}
+        people_for = lambda r: folds[half[r.name]]
+    else:
+        people_for = lambda r: shipped_people_model()
     made = predictors([m for m in args.models.split(",") if m], library, exclude_self=args.split == "development",
-                      people=shipped_people_model())
+                      people_for=people_for)
     if args.only:
         made = {k: v for k, v in made.items() if any(o.strip() in k for o in args.only.split(","))}
     names = list(made)
@@ -239,7 +252,7 @@ def main(argv=None):
         for row in rows[-len(names) * len(FRACTIONS):]:
             row["current_error"] = current[FRACTIONS.index(row["fraction"])] if current else math.nan
         if (i + 1) % 50 == 0 or i + 1 == len(recordings):
-            print(f"  {i + 1}/{len(recordings)} movements, {time.perf_counter() - begin:.0f} s", flush=True)
+            print(f"  {i + 1}/{len(recordings)} movements, {time.perf_counter() - begin:.0f} s", flush=True, file=log)
     summary = summarise(rows, names)
     lat = {name: {"median": float(np.median(v)) if v else math.nan, "p95": float(np.percentile(v, 95)) if v else math.nan,
                   "first_median": float(np.median(first[name]))} for name, v in latency.items()}
@@ -255,7 +268,9 @@ def main(argv=None):
                                                  indent=1))
     (out / "summary.md").write_text(table + "\n")
     figure(summary, out / "error_by_fraction.png", title)
-    print(f"wrote {out}")
+    if args.figure:
+        figure(summary, args.figure, title)
+    print(f"wrote {out}", file=log)
 
 
 if __name__ == "__main__":

@@ -46,6 +46,16 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
                "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,"
                "franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
+    "real-people-development": ("goal prediction on recorded people, development split, 400 movements (about 20 min)",
+                                ["benchmarks/real_people.py", "--markdown", "--limit", "400", "--figure",
+                                 "docs/figures/real_people_development.png"]),
+    "real-people-held-out": ("goal prediction on recorded people, the held-out split: run once per claimed improvement (about 25 min)",
+                             ["benchmarks/real_people.py", "--markdown", "--split", "held_out", "--figure",
+                              "docs/figures/real_people_held_out.png"]),
+    "real-people-simulated": ("the same predictors on reaches sampled from the planar preset's own noise (about 5 min)",
+                              ["benchmarks/real_people.py", "--markdown", "--source", "simulated", "--count", "100"]),
+    "people-vs-presets": ("recorded people's timing and speed profiles against the presets' mean reaches (a minute)",
+                          ["studies/do_the_presets_move_like_people/compare.py", "--markdown"]),
     "transition-trends": ("Peternel & Babič's trends in the shipped transition data and the fitted model (seconds)",
                           ["studies/are_the_published_transition_trends_reproduced/print_transition_trends.py"]),
 }
@@ -57,6 +67,10 @@ PAGES: dict[str, tuple[Path, ...]] = {
     "human-targets": (RESULTS / "calibration.md",),
     "goal-calibration": (RESULTS / "calibration.md",),
     "transition-trends": (RESULTS / "calibration.md",),
+    "real-people-development": (RESULTS / "real_people.md",),
+    "real-people-held-out": (RESULTS / "real_people.md",),
+    "real-people-simulated": (RESULTS / "real_people.md",),
+    "people-vs-presets": (RESULTS / "real_people.md",),
     "feedback-cost": (RESULTS / "calibration.md",),
     "policy-comparison": (RESULTS / "policy_comparison.md",),
     "speed": (RESULTS / "speed.md", ROOT / "benchmarks" / "README.md"),

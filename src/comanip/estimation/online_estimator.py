@@ -60,7 +60,7 @@ from comanip.estimation.observation import OBSERVATION_STD, observation_covarian
 from comanip.estimation.observation_whitening import ObservationWhitening
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.paced_model import PacedFit, PacedModel
-from comanip.estimation.people_model import shipped_people_model
+from comanip.estimation.people_model import PeopleModel, shipped_people_model
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.estimation.shared import checked_model, estimation_planner
@@ -135,6 +135,9 @@ class OnlineOptions:
     mismatch_threshold: float = 9.0
     """With ``timing="estimated"``: the largest mean squared whitened residual (per observed number) at which
     the model at its own pace still explains the observations (about 1 for the model's own reaches)."""
+    people_model: PeopleModel | None = None
+    """With ``timing="estimated"``: the model of people's movements (:class:`comanip.estimation.people_model.PeopleModel`,
+    e.g. fitted to your own recordings); None: the one that ships with comanip."""
     paced_threshold: float = 0.3
     """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
@@ -145,6 +148,8 @@ class OnlineOptions:
             raise ValueError(f"timing must be one of {TIMINGS}, got {self.timing!r}")
         as_positive("mismatch_threshold", self.mismatch_threshold, "mean squared whitened residual")
         as_positive("paced_threshold", self.paced_threshold, "chi² per observed number")
+        if self.people_model is not None and not isinstance(self.people_model, PeopleModel):
+            raise ValueError(f"people_model must be a PeopleModel or None, got {type(self.people_model).__name__}")
         if not (math.isfinite(self.led_from) and self.led_from >= 0):
             raise ValueError(f"led_from must be a finite time ≥ 0 s, got {self.led_from!r}")
         if not (math.isfinite(self.led_deviation_time) and self.led_deviation_time >= 0):
@@ -370,8 +375,8 @@ class OnlineGoalEstimator:
             goal, covariance = self._with_prior(self._not_behind(paced.goal, position[-1]), paced.covariance)
             return self._result(goal, covariance, Status.SOLVED, f"{self._off_model}; the model's reach at the person's "
                                 f"pace (×{paced.pace:.3g}, onset {paced.onset:.3g} s) does", 0, t_begin)
-        people = shipped_people_model().predict(t, position, velocity, self.start_position)
-        goal, covariance = self._with_prior(people.goal, people.covariance)
+        people = (self.options.people_model or shipped_people_model()).predict(t, position, velocity, self.start_position)
+        goal, covariance = self._with_prior(self._not_behind(people.goal, position[-1]), people.covariance)
         return self._result(goal, covariance, Status.PEOPLE_MODEL, f"{self._off_model}, nor does it clearly at the "
                             f"person's pace (misfit {paced.misfit:.3g}): the goal is the people model's", 0, t_begin)
 
