@@ -151,3 +151,17 @@ def test_a_corrective_sub_movement_is_followed_and_the_estimate_never_lags_the_h
             assert estimate.goal @ u >= position[k] @ u - 0.02 * D, (t[k], estimate.goal, position[k], estimate.message)
     assert np.linalg.norm(estimate.goal - GOAL) < 0.02 * D
     assert statuses - {"uninformative", "solved"}, "the model at its own pace cannot have explained this reach"
+
+
+def test_a_recorded_hand_that_stalls_after_a_failed_update_keeps_the_whitening_in_step():
+    """A recorded movement whose first millimetres end in a failed model-pace update and then many updates
+    with the hand nearly still: the whitening must take every observation in (it once missed them: a crash)."""
+    pytest.importorskip("cursory")
+    from comanip.recordings import load_cursory
+    [recording] = [r for r in load_cursory("development", limit=210) if r.name == "cursory/258"]
+    for preset in ("planar", "human"):
+        model = comanip.presets.load(preset)
+        estimator = comanip.OnlineGoalEstimator(model, np.r_[recording.position[0], np.zeros(model.state_size - model.n)])
+        for k in range(recording.seen_until(0.9)):
+            estimate = estimator.update(recording.t[k], recording.position[k], recording.velocity[k])
+            assert np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.goal_covariance))

@@ -100,6 +100,7 @@ def main(argv=None):
     ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(HERE / "speed_profiles.png", dpi=120)
+    fig.savefig(HERE.parents[1] / "docs" / "figures" / "speed_profiles_people_presets.png", dpi=120)
     (HERE / "comparison.json").write_text(json.dumps({
         "people": {"movements": len(recordings), "peak_fraction_median": float(np.median(peaks)),
                    "mt_log_slope": float(slope), "mt_log_intercept": float(intercept)},

@@ -300,6 +300,7 @@ class OnlineGoalEstimator:
         self._whitening: ObservationWhitening | None = None
         self._blas = ThreadpoolController()
         self._whitening_goal = np.zeros(d)
+        self._whitened_observations = 0             # observations the whitening holds
         self.latest: GoalEstimate | None = None
         """The last estimate, None before the first update."""
 
@@ -473,8 +474,10 @@ class OnlineGoalEstimator:
         return self._result(goal, 0.5 * (covariance + covariance.T), status, message, iterations, t_begin), misfit
 
     def _stale(self, goal: np.ndarray) -> bool:
-        """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance."""
-        if self._whitening is None:
+        """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance, or
+        misses more than the newest observation (updates that ended before the Newton iteration, e.g. with the
+        hand at rest after a failed update, leave it behind)."""
+        if self._whitening is None or self._whitened_observations < self.observation_count - 1:
             return True
         distance = np.linalg.norm(goal - self.start_position)
         return bool(np.linalg.norm(goal - self._whitening_goal) > self.options.covariance_tolerance * max(distance, self.width))
@@ -501,6 +504,7 @@ class OnlineGoalEstimator:
                 whitening.redo_last(noise, fraction)
             else:
                 whitening.append(last, noise, fraction)
+        self._whitened_observations = self.observation_count
         return whitening
 
     def _step_noise(self, i: int, cov: np.ndarray) -> np.ndarray:
