@@ -97,7 +97,11 @@ def recording_from_samples(name: str, t, position, *, step: float = STEP, window
         name: the movement's identifier.
         t: raw sample times (N,), s.
         position: raw positions (N, d), m.
-        step, window, order, hold_gap, onset_fraction: the preprocessing's settings (module docstring).
+        step: resampling step (s).
+        window: Savitzky–Golay window (s).
+        order: Savitzky–Golay polynomial order.
+        hold_gap: a gap between raw samples longer than this (s) is a pause.
+        onset_fraction: onset and end threshold, a fraction of the peak speed.
         width: target width (m) when known.
         target: the target (d,), m, when known.
     """
