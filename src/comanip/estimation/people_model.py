@@ -14,7 +14,7 @@ factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (o
 
 The fitted model ships with comanip (``comanip/data/people_endpoint_model.pkl``), fitted on the development
 split of the ``cursory`` mouse recordings mapped to arm scale (:mod:`comanip.recordings.cursory_data`):
-``python -m comanip.estimation.people_model`` fits it again.
+``studies/how_far_beyond_the_hand_do_people_stop/fit_people_model.py`` fits it again.
 """
 
 from __future__ import annotations
@@ -176,25 +176,3 @@ def shipped_people_model() -> PeopleModel:
     if SHIPPED not in _LOADED:
         _LOADED[SHIPPED] = pickle.loads((resources.files("comanip") / "data" / SHIPPED).read_bytes())
     return _LOADED[SHIPPED]
-
-
-def main(argv=None):
-    """Fit the shipped model on the development split of the cursory recordings and write it into the package."""
-    import argparse
-
-    from comanip.recordings import load_cursory
-
-    parser = argparse.ArgumentParser(description="Fit the people endpoint model on the cursory development split.")
-    parser.add_argument("--out", type=Path, default=Path(str(resources.files("comanip") / "data" / SHIPPED)))
-    args = parser.parse_args(argv)
-    recordings = load_cursory("development")
-    print(f"fitting on {len(recordings)} development movements ...", flush=True)
-    from comanip.estimation import people_model     # the class under its importable name, not __main__'s, for the pickle
-
-    model = people_model.PeopleModel.fit(recordings, trained_on=f"cursory 2.1.0 development split ({len(recordings)} movements)",
-                            progress=lambda line: print(f"  {line}", flush=True))
-    print(f"coverage factor {model.coverage_factor:.3f}; wrote {model.save(args.out)}")
-
-
-if __name__ == "__main__":
-    main()
