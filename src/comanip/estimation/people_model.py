@@ -104,7 +104,11 @@ class PeopleModel:
         """Fit on recordings (:class:`comanip.recordings.Recording`), every sample from each one's onset to its
         end: the spread and the coverage factor on two-fold out-of-sample errors of the along regressor, then
         the along regressor on all samples. ``progress``: called with a line of text per stage."""
-        say = progress or (lambda line: None)
+        with _ONE_THREAD.limit(limits=1, user_api="openmp"):    # reproducible, and no spinning threads on a busy machine
+            return cls._fit(recordings, trained_on, seed, progress or (lambda line: None))
+
+    @classmethod
+    def _fit(cls, recordings, trained_on: str, seed: int, say) -> "PeopleModel":
         X, along, across, owner = _samples(recordings)
         fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
         predicted = np.zeros(len(X))
