@@ -260,6 +260,10 @@ def test_bad_construction_raises(online, kwargs, match):
     (dict(correction_time=0.3, led_axes=(2,), led_deviation_time=-0.1), "led_deviation_time"),
     (dict(covariance_scale=0.0), "covariance_scale"),
     (dict(correction_time=0.3, led_axes=(2,), led_from=-1.0), "led_from"),
+    (dict(timing="person"), "timing must be one of"),
+    (dict(mismatch_threshold=0.0), "mismatch_threshold"),
+    (dict(paced_threshold=float("nan")), "paced_threshold"),
+    (dict(people_model="shipped"), "people_model must be a PeopleModel"),
 ])
 def test_bad_options_raise(options, match):
     with pytest.raises(ValueError, match=match):
@@ -336,6 +340,25 @@ def test_estimate_goal_reports_a_covariance_and_takes_prior_std(cartesian_planne
     assert np.all(np.linalg.eigvalsh(estimate.goal_covariance) > 0)
     with pytest.raises(ValueError, match="prior_std"):
         comanip.estimate_goal(cartesian_planner, np.zeros(6), plan.mean[5], plan.t[5], prior_std=0.0)
+
+
+def test_model_timing_keeps_the_model_at_its_own_pace():
+    """timing="model" never changes the explanation: on a reach 40 % slower than the model's it keeps the
+    model-pace estimate (solved or not), where the default moves to an explanation at the person's pace."""
+    model = comanip.presets.planar()
+    planner = comanip.Planner(model)
+    plan = planner.solve(np.zeros(4), [0.3, 0.1], 0.02)
+    t = np.arange(0.0, plan.t[-1] * 1.4, 0.01)
+    position = np.column_stack([np.interp(t, plan.t * 1.4, plan.ee_mean[:, i]) for i in range(2)])
+    velocity = np.column_stack([np.interp(t, plan.t * 1.4, plan.ee_velocity[:, i]) for i in range(2)]) / 1.4
+    fixed = OnlineGoalEstimator(planner, np.zeros(4), options=OnlineOptions(timing="model"))
+    free = OnlineGoalEstimator(planner, np.zeros(4))
+    messages = set()
+    for k in range(len(t)):
+        fixed_estimate = fixed.update(t[k], position[k], velocity[k])
+        messages.add(free.update(t[k], position[k], velocity[k]).message)
+        assert "pace" not in fixed_estimate.message
+    assert any("person's pace" in m for m in messages)
 
 
 def test_arbitrary_observations_never_raise(online):
