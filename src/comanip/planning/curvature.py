@@ -69,9 +69,13 @@ class ReachCurvature:
         self.size = n * H
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
         self._tag = model_key(model)
+        self._noise_hessian = _noise_second_derivatives(model)
+        self._G = _constant_sensitivities(model)
+        self._velocity_hessian = _velocity_cost_hessian(problem)
+        self._build_constant_products()
+        params = ca.vertcat(problem.s0, problem.goal, problem.width)
         functions = [self._terms_function(problem),
-                     ca.Function("reach_value", [ca.vec(problem.tau), problem.s0, problem.goal, problem.width],
-                                 [problem.objective / -problem.best_objective])]
+                     ca.Function("reach_value", [ca.vec(problem.tau), params], [problem.objective / -problem.best_objective])]
         if compile:
             functions = [compiled_or_cached(function, self._tag) for function in functions]
         elif compile is None:
@@ -79,30 +83,34 @@ class ReachCurvature:
             functions = cached if all(f is not None for f in cached) else functions
         self._terms, self._value = (BufferedFunction(function) for function in functions)
         self._compiling = None  # the background build's future (compile_in_background)
-        self._effort = 2 * model.nu
-        self._noise_hessian = _noise_second_derivatives(model)
-        self._G = _constant_sensitivities(model)
-        self._velocity_hessian = _velocity_cost_hessian(problem)
-        self._build_constant_products()
 
     # -- the compiled per-solve function -------------------------------------------------------------
     def _terms_function(self, problem: ReachProblem) -> ca.Function:
-        """``(x, s0, goal, width) -> (f, grad f, ∇²phi_i stacked (nz, nz·(H+1)), ∇phi_i stacked (nz, H+1))``."""
+        """``(x, p) -> (f, grad f, Q~, blocks, ∂f/∂g)``, everything the Hessian and the goal derivatives read, in one
+        call (:class:`~comanip.planning.terms.ReachTerms` names the outputs): Q~_i = T_iᵀ ∇²phi_i T_i in the reduced
+        coordinates z~_i stacked as (H+1)·(d+r)² entries (step, row, column), and the Hessian's block-diagonal part
+        (the noise's own curvature plus the effort) as H·n² entries (step, row, column)."""
         model = problem.model
+        n, d, H = model.n, model.d, model.H
         x = ca.vec(problem.tau)
         scale = -problem.best_objective
         f = problem.objective / scale
         step_terms = _reward_derivatives_function(model)
-        weights = problem.weights
-        hessians, gradients = [], []
-        for w, mu_x, Sigma_x in zip(weights, problem.ee_means, problem.ee_covs):
+        reduced, noise_weights, goal_gradient = [], [], 0
+        for i, (w, mu_x, Sigma_x) in enumerate(zip(problem.weights, problem.ee_means, problem.ee_covs)):
             vech = ca.vertcat(*[Sigma_x[a, b] for a, b in self._triangle])
             hess, grad = step_terms(mu_x, vech, problem.goal, problem.width, w / scale)
-            hessians.append(hess)
-            gradients.append(grad)
-        return ca.Function("reach_terms", [x, problem.s0, problem.goal, problem.width],
-                           [f, ca.gradient(f, x), ca.horzcat(*hessians), ca.horzcat(*gradients)],
-                           ["x", "s0", "goal", "width"], ["f", "grad", "phi_hess", "phi_grad"])
+            T = ca.DM(self._T[i])
+            reduced.append(ca.vec(ca.mtimes([T.T, hess, T])))
+            noise_weights.append(ca.mtimes(ca.DM(self._U[i]).T, grad[d:]))
+            goal_gradient -= grad[:d]  # phi_i depends on the goal through mu_x,i - g
+        rank = self._U.shape[2]
+        # Σ_i Σ_r (U_iᵀ dphi_i/dvech)_r K[i, r, k] (H·n·n,): ∇²_tau of the noise's covariance terms, per step k
+        blocks = ca.mtimes(ca.DM(self._K.reshape((H + 1) * rank, H * n * n)).T, ca.vertcat(*noise_weights))
+        blocks += ca.DM(np.tile(np.eye(n).ravel(), H)) * (self._effort / scale)
+        return ca.Function("reach_terms", [x, ca.vertcat(problem.s0, problem.goal, problem.width)],
+                           [f, ca.gradient(f, x), ca.vertcat(*reduced), blocks, goal_gradient],
+                           ["x", "p"], ["f", "grad", "reduced_hessians", "blocks", "goal_gradient"])
 
     def _build_constant_products(self) -> None:
         """Z's mean rows and the coefficients of its covariance rows (linear in tau), fixed for a linear body.
@@ -114,6 +122,7 @@ class ReachCurvature:
         """
         model, G = self.model, self._G
         n, d, H = model.n, model.d, model.H
+        self._effort = 2 * model.nu
         a, b = self._triangle.T
         # dvech Sigma_x,i[v] / dtau_k[j] = Σ_l K[i, v, k, j, l] tau_k[l], v = (a, b) in vech order
         K = np.einsum("ikar,jlrs,ikbs->iabkjl", G, self._noise_hessian, G, optimize=True)[:, a, b]
@@ -131,6 +140,9 @@ class ReachCurvature:
         self._T = np.zeros((H + 1, d + len(a), d + rank))
         self._T[:, :d, :d] = np.eye(d)
         self._T[:, d:, d:] = self._U
+        # flat indices of the Hessian's block-diagonal entries (k·n + j, k·n + l), in the order of the blocks output
+        k, j, l = np.meshgrid(np.arange(H), np.arange(n), np.arange(n), indexing="ij")
+        self._block_entries = ((k * n + j) * (H * n) + k * n + l).ravel()
 
     def compile_in_background(self) -> None:
         """Build the per-solve function and the value-only one as C in a background thread
@@ -160,36 +172,27 @@ class ReachCurvature:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
-        s0, goal, width = self._split(params)
-        f, grad, phi_hess, phi_grad = self._terms(x, s0, goal, width)
-        return float(f.item()), grad.ravel(), ReachTerms(x, width, phi_hess, phi_grad)
+        f, grad, reduced, blocks, goal_gradient = self._terms(x, params)
+        m = self._T.shape[2]
+        return float(f[0, 0]), grad.ravel(), ReachTerms(x, params[-1], reduced.reshape(-1, m, m), blocks.ravel(),
+                                                        goal_gradient.ravel())
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         """f at torques x (H·n,) alone."""
-        return float(self._value(x, *self._split(params))[0].item())
+        return float(self._value(x, params)[0][0, 0])
 
     def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, None]:
         """(f, None) at torques x: a point mass has no path limits, so a line-search trial needs no data."""
         return self.value(x, params), None
 
     def hessian(self, data: ReachTerms) -> np.ndarray:
-        """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
-        x, width, phi_hess, phi_grad = data.x, data.width, data.phi_hess, data.phi_grad
-        model = self.model
-        n, d, H = model.n, model.d, model.H
-        nz = phi_hess.shape[0]
-        rank = self._U.shape[2]
-        T = self._T
-        Q = np.swapaxes(T, 1, 2) @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
-        Z = self._reduced_rows(x)
-        QZ = np.matmul(Q, Z)
-        hessian = _causal_gram(Z.reshape(-1, H * n), QZ.reshape(-1, H * n), d + rank, n)
-        # ∇²_tau Σ_i Σ_v (dphi_i/dvech_v) Sigma_x,i[v]: the noise's own curvature, block-diagonal in k
-        weights = np.einsum("ivr,vi->ir", self._U, phi_grad[d:])
-        blocks = weights.reshape(1, -1) @ self._K.reshape((H + 1) * rank, H * n * n)
-        steps = np.arange(H)
-        hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks.reshape(H, n, n)
-        hessian[np.diag_indices(H * n)] += self._effort / self.normaliser(width)
+        """∇²f (H·n, H·n) from the data :meth:`evaluate` returned: Σ_i Z~_iᵀ Q~_i Z~_i, plus the block-diagonal
+        noise and effort curvature and the constant speed-cost curvature."""
+        size = self.size
+        Z = self._reduced_rows(data)
+        QZ = np.matmul(data.reduced_hessians, Z)
+        hessian = _causal_gram(Z.reshape(-1, size), QZ.reshape(-1, size), Z.shape[1], self.model.n)
+        hessian.ravel()[self._block_entries] += data.blocks
         if self._velocity_hessian is not None:  # the speed cost is scaled by |J_best| already
             hessian += self._velocity_hessian
         return hessian
@@ -201,33 +204,31 @@ class ReachCurvature:
         ∂phi_i/∂g = -∂phi_i/∂mu_x,i, ∂²phi_i/∂z_i∂g = -∂²phi_i/∂z_i∂mu_x,i and ∂²phi_i/∂g² = ∂²phi_i/∂mu_x,i²:
         columns of the per-step derivatives the Hessian uses anyway. Then ∂f/∂g = Σ_i ∂phi_i/∂g,
         ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
+        In the reduced coordinates z~_i = (mu_x,i, U_iᵀ vech Sigma_x,i) the mean block is unchanged (T_i's first
+        block is the identity), so these are the first d columns of Q~_i.
         """
-        x, phi_hess, phi_grad = data.x, data.phi_hess, data.phi_grad
-        H, d = self.model.H, self.model.d
-        nz = phi_hess.shape[0]
-        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
-        Z = self._reduced_rows(x)
-        # Z_iᵀ M = Z~_iᵀ T_iᵀ M: the rows are kept in the reduced basis z~_i (see _build_constant_products)
-        goal_columns = -np.swapaxes(self._T, 1, 2) @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
-        cross = Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
-        return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
+        d = self.model.d
+        Z = self._reduced_rows(data)
+        goal_columns = data.reduced_hessians[:, :, :d]  # ∂²phi_i/∂z~_i∂mu_x,i (H+1, d + r, d)
+        cross = -(Z.reshape(-1, self.size).T @ goal_columns.reshape(-1, d))
+        return data.goal_gradient, cross, goal_columns[:, :d].sum(axis=0)
 
-    def _reduced_rows(self, x: np.ndarray) -> np.ndarray:
-        """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n): mean rows fixed, covariance rows linear in tau."""
+    def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
+        """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear
+        in tau; computed once per evaluation and kept in the data."""
+        if data.rows is not None:
+            return data.rows
         model = self.model
         n, d, H = model.n, model.d, model.H
-        tau = np.asarray(x).reshape(H, n)
+        tau = np.asarray(data.x).reshape(H, n)
         Z = np.empty((H + 1, d + self._U.shape[2], H, n))
         Z[:, :d] = self._mean_rows
         if self._K_diagonal is not None:
             np.multiply(self._K_diagonal, tau, out=Z[:, d:])
         else:
             np.einsum("irkjl,kl->irkj", self._K, tau, out=Z[:, d:])
-        return Z.reshape(H + 1, d + self._U.shape[2], H * n)
-
-    def _split(self, params):
-        n2, d = self.model.state_size, self.model.d
-        return params[:n2], params[n2:n2 + d], params[-1]
+        data.rows = Z.reshape(H + 1, d + self._U.shape[2], H * n)
+        return data.rows
 
 
 def _is_compiled(function: ca.Function) -> bool:
@@ -294,14 +295,18 @@ def _constant_sensitivities(model) -> np.ndarray:
     return np.einsum("ar,ikrb->ikab", J, state_sensitivity[:, :, :n, :])
 
 
-def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int, chunks: int = 4) -> np.ndarray:
+def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int) -> np.ndarray:
     """Σ_i Z_iᵀ QZ_i for Z, QZ ((H+1)·nz, H·n) stacking per-step blocks of ``rows_per_step`` rows, where
     step i's block is zero beyond column n·i (causality).
 
-    Steps are taken in a few chunks so the products skip most of the zero upper part; the 2-D slices
-    are views, which BLAS reads in place.
+    A small problem (up to 64 unknowns, the planar point masses) takes one product: a call costs more there
+    than the zeros it would skip. Larger ones are taken in up to four chunks of steps so the products skip most
+    of the zero upper part; the 2-D slices are views, which BLAS reads in place.
     """
     size = Z.shape[1]
+    chunks = min(4, size // 40)
+    if chunks <= 1:
+        return Z.T @ QZ
     steps = Z.shape[0] // rows_per_step
     out = np.zeros((size, size))
     bounds = [steps * k // chunks for k in range(chunks + 1)]

@@ -60,7 +60,8 @@ f must be finite at x0; a trial point where f is not finite is treated as a fail
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
@@ -140,6 +141,16 @@ class _Iterate:
     data: Any
     c: np.ndarray
     rows: Callable[[np.ndarray], np.ndarray]
+    largest: float = field(init=False)
+    """max c (-inf without constraints): the working set, the violation and the merit's penalty read it first."""
+
+    def __post_init__(self):
+        self.largest = float(self.c.max(initial=-np.inf))
+
+    @property
+    def violation(self) -> float:
+        """max(0, c): the largest violation, bounds included."""
+        return max(0.0, self.largest)
 
 
 @dataclass
@@ -171,7 +182,7 @@ class _ActiveSetNewton:
         stepped_with = None  # the factorisation of the last step taken
 
         def result(status, message, optimality):
-            return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c),
+            return SolverResult(point.x, point.f, status, message, iterations, optimality, point.violation,
                                 (stepped_with, point.data))
 
         while True:
@@ -180,7 +191,7 @@ class _ActiveSetNewton:
             if expired():
                 return result(Status.MAX_WALL_TIME, "wall-time budget spent", np.inf)
             iterations += 1
-            free = not (point.c > -self.margin).any()
+            free = point.largest <= -self.margin
             if free:
                 # no constraint in the working set: the Lagrangian's gradient is the gradient, and a converged
                 # point needs no Hessian (a warm point-mass solve's last of about five)
@@ -246,7 +257,7 @@ class _ActiveSetNewton:
             alpha, accepted = self._line_search(point, step, working, correct, merit_weight, full_steps)
             model_held = alpha == 1.0 and len(working) == 0
             full_steps = alpha == 1.0
-            if accepted is None and self.problem.violation(point.c) > self.constraint_tolerance:
+            if accepted is None and point.violation > self.constraint_tolerance:
                 accepted = self._restore(point)
             elif accepted is not None:
                 recoveries = 0
@@ -264,7 +275,7 @@ class _ActiveSetNewton:
 
     def _converged(self, optimality: float, point: _Iterate, history: list[float]) -> tuple[Status, str] | None:
         """(status, message) when the point is a solution (module docstring, Convergence), else None."""
-        violation = self.problem.violation(point.c)
+        violation = point.violation
         if violation > self.constraint_tolerance:
             return None
         if optimality <= self.tolerance:
@@ -276,16 +287,18 @@ class _ActiveSetNewton:
 
     def _final_status(self, optimality: float, point: _Iterate) -> tuple[Status, str]:
         """(status, message) when no step decreases the merit, even after the recoveries."""
-        violation = self.problem.violation(point.c)
+        violation = point.violation
         if optimality <= max(100 * self.tolerance, _STALL_GRADIENT) and violation <= self.constraint_tolerance:
             return Status.SOLVED_ACCEPTABLE, "no step decreases the objective any further"
         status = Status.CONSTRAINTS_VIOLATED if violation > self.constraint_tolerance else Status.FAILED
         return status, f"no step decreases the merit any further (violation {violation:.3g}, gradient {optimality:.3g})"
 
-    def _penalty(self, c: np.ndarray) -> float:
+    def _penalty(self, point: _Iterate) -> float:
         """The merit's l1 violation, counted from half the tolerance: violations the solution may keep cost
         nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
-        return float(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0).sum())
+        if point.largest <= 0.5 * self.constraint_tolerance:
+            return 0.0
+        return float(np.maximum(point.c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct,
                      merit_weight: float, full_step_likely: bool) -> tuple[float, _Iterate | None]:
@@ -296,7 +309,7 @@ class _ActiveSetNewton:
         step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
         working set: that trial is evaluated with its gradient at once, saving the value-only call (a fifth of
         an evaluation on the Panda) on most iterations for a wasted gradient on the few whose full step fails."""
-        penalty = self._penalty(point.c)
+        penalty = self._penalty(point)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
         if not slope < -1e-16 * max(1.0, abs(merit)):
@@ -306,14 +319,14 @@ class _ActiveSetNewton:
             trial = self._trial(point.x + alpha * step, with_gradient=full_step_likely and alpha == 1.0 and not len(working))
             if trial is None:
                 return None
-            if len(working) and self._penalty(trial.c) > penalty:
+            if len(working) and self._penalty(trial) > penalty:
                 # second-order correction: the step broke the curved constraints; pull it back onto their
                 # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
                 # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
                 corrected = self._trial(trial.x + correct(trial.c[working]))
-                if corrected is not None and corrected.f + merit_weight * self._penalty(corrected.c) <= bound:
+                if corrected is not None and corrected.f + merit_weight * self._penalty(corrected) <= bound:
                     trial = corrected
-            if trial.f + merit_weight * self._penalty(trial.c) > bound:
+            if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
             if trial.g is None:
                 trial = self.at(trial.x, *self.evaluate(trial.x))
@@ -342,13 +355,13 @@ class _ActiveSetNewton:
             f, g, data = self.evaluate(x)
             if np.isfinite(f) and np.all(np.isfinite(g)):
                 trial = self.at(x, f, g, data)
-                if self.problem.violation(trial.c) < 0.5 * self.problem.violation(point.c):
+                if trial.violation < 0.5 * point.violation:
                     return trial
         return None
 
 
 def _finite(f: float, g: np.ndarray | None) -> bool:
-    return bool(np.isfinite(f)) and (g is None or bool(np.isfinite(g).all()))
+    return math.isfinite(f) and (g is None or bool(np.isfinite(g).all()))
 
 
 class _Constraints:
@@ -388,10 +401,6 @@ class _Constraints:
         out[np.flatnonzero(upper), self.upper[indices[upper]]] = 1.0
         out[np.flatnonzero(~upper), self.lower[indices[~upper] - n_upper]] = -1.0
         return out
-
-    @staticmethod
-    def violation(c) -> float:
-        return float(max(0.0, c.max(initial=0.0)))
 
 
 def _constrained_step(solve, g, c, A, margin: float, tolerance: float):

@@ -183,7 +183,7 @@ class Planner:
         # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
         self._task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
             if body.is_linear else None
-        self._blas = ThreadpoolController()
+        self._blas = _SingleThreadBlas()
         self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
         self._library = self._reach_library()
         ranked_arm = self.options.cold_search == "ranked" and not body.is_linear
@@ -531,7 +531,7 @@ class Planner:
         iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
         # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
-        with self._blas.limit(limits=1, user_api="blas"):
+        with self._blas:
             for guess in guesses:
                 if time.perf_counter() > deadline and best is not None:
                     break
@@ -600,6 +600,31 @@ class Planner:
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
+
+
+class _SingleThreadBlas:
+    """A context in which the BLAS libraries loaded when it was made run on one thread (their thread counts are
+    restored on leaving; nested contexts leave them to the outermost). threadpoolctl's own ``limit`` looks the
+    libraries up on every entry, which costs about as much as a point mass's Newton step."""
+
+    def __init__(self):
+        self._libraries = ThreadpoolController().select(user_api="blas").lib_controllers
+        self._depth, self._restore = 0, []
+
+    def __enter__(self):
+        if self._depth == 0:
+            self._restore = [(library, library.num_threads) for library in self._libraries if library.num_threads != 1]
+            for library, _ in self._restore:
+                library.set_num_threads(1)
+        self._depth += 1
+        return self
+
+    def __exit__(self, *exception):
+        self._depth -= 1
+        if self._depth == 0:
+            for library, threads in self._restore:
+                library.set_num_threads(threads)
+        return False
 
 
 def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
