@@ -295,18 +295,14 @@ def _constant_sensitivities(model) -> np.ndarray:
     return np.einsum("ar,ikrb->ikab", J, state_sensitivity[:, :, :n, :])
 
 
-def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int) -> np.ndarray:
+def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int, chunks: int = 4) -> np.ndarray:
     """Σ_i Z_iᵀ QZ_i for Z, QZ ((H+1)·nz, H·n) stacking per-step blocks of ``rows_per_step`` rows, where
     step i's block is zero beyond column n·i (causality).
 
-    A small problem (up to 64 unknowns, the planar point masses) takes one product: a call costs more there
-    than the zeros it would skip. Larger ones are taken in up to four chunks of steps so the products skip most
-    of the zero upper part; the 2-D slices are views, which BLAS reads in place.
+    Steps are taken in a few chunks so the products skip most of the zero upper part; the 2-D slices
+    are views, which BLAS reads in place.
     """
     size = Z.shape[1]
-    chunks = min(4, size // 40)
-    if chunks <= 1:
-        return Z.T @ QZ
     steps = Z.shape[0] // rows_per_step
     out = np.zeros((size, size))
     bounds = [steps * k // chunks for k in range(chunks + 1)]

@@ -77,6 +77,8 @@ _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
 _REUSE_RATIO = 0.1
 """An exact Hessian's factor is reused while each step cuts the gradient by at least this factor."""
+_NO_ROWS, _NO_MULTIPLIERS = np.zeros(0, dtype=int), np.zeros(0)
+"""An empty working set and its multipliers (read only)."""
 
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
@@ -204,7 +206,7 @@ class _ActiveSetNewton:
                     # well enough (a chord step, Kelley 2003, sec. 5.4), at a third of a point mass's iteration
                     step = -cholesky_solve(kept[0], point.g)
                     kept = (kept[0], optimality)
-                    alpha, accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight, full_steps)
+                    alpha, accepted = self._line_search(point, step, _NO_ROWS, None, merit_weight, full_steps)
                     full_steps = alpha == 1.0
                     if accepted is not None:
                         point, stepped_with = accepted, kept[0]
@@ -244,16 +246,20 @@ class _ActiveSetNewton:
                 factor, solve = updated.factor, updated.solve
             else:
                 solve = lambda b, factor=factor: cholesky_solve(factor, b)  # noqa: E731
-            step, multipliers, working, correct = _constrained_step(solve, point.g, point.c, point.rows, self.margin,
-                                                                    self.constraint_tolerance)
-            lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
-            optimality = float(np.abs(lagrangian_gradient).max())
-            converged = self._converged(optimality, point, history)
-            if converged is not None:
-                return result(*converged, optimality)
-            if free and not secant and len(working) == 0:
+            if free:  # the Newton step; its optimality was tested above
+                step, multipliers, working, correct = -solve(point.g), _NO_MULTIPLIERS, _NO_ROWS, None
+            else:
+                step, multipliers, working, correct = _constrained_step(solve, point.g, point.c, point.rows, self.margin,
+                                                                        self.constraint_tolerance)
+                lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
+                optimality = float(np.abs(lagrangian_gradient).max())
+                converged = self._converged(optimality, point, history)
+                if converged is not None:
+                    return result(*converged, optimality)
+            if free and not secant:
                 kept = (factor, optimality)
-            merit_weight = max(merit_weight, 2 * float(np.max(multipliers, initial=0.0)))
+            if len(multipliers):
+                merit_weight = max(merit_weight, 2 * float(np.max(multipliers)))
             alpha, accepted = self._line_search(point, step, working, correct, merit_weight, full_steps)
             model_held = alpha == 1.0 and len(working) == 0
             full_steps = alpha == 1.0

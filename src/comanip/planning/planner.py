@@ -30,7 +30,7 @@ Symbols, shapes and units: ``docs/notation.md``.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -590,7 +590,8 @@ class Planner:
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                                  constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
                                  value=value)
-        return replace(result, x=result.x.reshape(self.model.H, self.model.n))
+        result.x = result.x.reshape(self.model.H, self.model.n)
+        return result
 
     def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
         solver = self._ipopt

@@ -66,6 +66,7 @@ class ReachProblem:
         self._ee_velocity = BufferedFunction(ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1))
         # NumPy in and out without CasADi's DM conversions (they cost more than a point mass's rollout itself)
         self._trajectory = BufferedFunction(self.trajectory)
+        self._trajectory_outputs = self.trajectory.name_out()
         self._ee_belief = BufferedFunction(ee.map(H + 1))
 
     def normaliser(self, width: float) -> float:
@@ -80,7 +81,7 @@ class ReachProblem:
     def _rollout(self, torque: np.ndarray, start, goal, width) -> dict[str, np.ndarray]:
         """:attr:`trajectory`'s outputs by name: mean (nx, H+1), cov (nx, nx·(H+1)), ee_mean (d, H+1),
         ee_cov (d, d·(H+1)), J."""
-        return dict(zip(self.trajectory.name_out(), self._trajectory(np.ravel(torque), start, goal, width)))
+        return dict(zip(self._trajectory_outputs, self._trajectory(np.ravel(torque), start, goal, width)))
 
     def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
                   solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
