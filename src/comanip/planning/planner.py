@@ -45,6 +45,7 @@ from comanip.planning.initial_guess import (brake_durations, braked_torques, gue
                                           minimum_jerk_torques, retargeted_torques)
 from comanip.optim import SolverResult, Status, cholesky_solve
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
+from comanip.planning.compiled import BufferedFunction
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
@@ -189,7 +190,8 @@ class Planner:
         ranked_arm = self.options.cold_search == "ranked" and not body.is_linear
         self._arm_library = self._arm_reach_library() if ranked_arm else None
         self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
-        self._goal_sensitivity = None  # (torques (H, n) of the last plan, their d tau/d goal (H·n, d)): _predicted
+        self._last_solution: _LastSolution | None = None  # the last point-mass plan's, for _predicted
+        self._kinematics = BufferedFunction(body.kinematics_function)
 
     def _arm_reach_library(self) -> ArmReachLibrary | None:
         """The arm's reach library: ``options.arm_library`` (it must be this model's) or the shipped one."""
@@ -376,16 +378,27 @@ class Planner:
         model = self.model
         return warm_start.torque + (remembered[1] @ (goal - warm_start.goal)).reshape(model.H, model.n)
 
-    def _goal_sensitivity_at(self, result: SolverResult) -> np.ndarray | None:
-        """d tau*/d goal (H·n, d) = -∇²f⁻¹ ∂²f/∂tau∂goal at a converged point-mass solve (the implicit function
-        theorem, with the Newton method's last factorisation), which :meth:`_solve_from` keeps with the plan's
-        torques for :meth:`_predicted`; None otherwise. About 0.05 ms."""
+    @property
+    def _goal_sensitivity(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(torques (H, n) of the planner's last plan, their d tau*/d goal (H·n, d)) if that was a converged
+        point-mass solve (:class:`_LastSolution`), else None; the sensitivity is computed on the first request."""
+        last = self._last_solution
+        if last is None:
+            return None
+        if last.sensitivity is None:
+            with self._blas:
+                last.sensitivity = -cholesky_solve(last.factor, self._curvature.goal_derivatives(last.data)[1])
+        return last.torque, last.sensitivity
+
+    def _solution_of(self, result: SolverResult, torque: np.ndarray) -> _LastSolution | None:
+        """What :meth:`_goal_sensitivity` needs of a converged point-mass solve (the Newton method's last
+        factorisation and the evaluation at the plan), kept for the planner's last plan; None otherwise."""
         curvature = self._curvature
         if curvature is None or not curvature.exact or not result.success or result.local_model is None \
                 or result.local_model[0] is None:
             return None
         factor, data = result.local_model
-        return -cholesky_solve(factor, curvature.goal_derivatives(data)[1])
+        return _LastSolution(torque, factor, data)
 
     def _retargeted(self, torque: np.ndarray, mean: np.ndarray, planned_goal: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
         """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
@@ -498,8 +511,7 @@ class Planner:
 
     def _narrow(self, start, goal, width) -> bool:
         """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
-        model = self.model
-        position = np.asarray(model.body.kinematics_function(start[: model.n])[0]).ravel()
+        position = self._kinematics(start[: self.model.n])[0].ravel()
         return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
 
     def _cold_guesses(self, start, goal, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
@@ -548,11 +560,10 @@ class Planner:
                     best = candidate
                 if until_converged and best.status == Status.SOLVED and self._ends_at_goal(best.x, params):
                     break
-        sensitivity = self._goal_sensitivity_at(best)
         evaluation = None if best.local_model is None else (best.fun, best.local_model[1])
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
-        self._goal_sensitivity = None if sensitivity is None else (plan.torque, sensitivity)
+        self._last_solution = self._solution_of(best, plan.torque)
         return plan
 
     def _ends_at_goal(self, torque: np.ndarray, params: np.ndarray) -> bool:
@@ -601,6 +612,19 @@ class Planner:
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
+
+
+@dataclass(eq=False)
+class _LastSolution:
+    """A converged point-mass plan's torques (H, n), the Cholesky factor of its solve's last Newton step and the
+    evaluation at the plan: d tau*/d goal = -∇²f⁻¹ ∂²f/∂tau∂goal by the implicit function theorem (about 0.05 ms),
+    computed when a warm start from the plan asks for it (:meth:`Planner._predicted`), not after every solve."""
+
+    torque: np.ndarray
+    factor: tuple
+    data: object
+    sensitivity: np.ndarray | None = None
+    """d tau*/d goal (H·n, d) once computed."""
 
 
 class _SingleThreadBlas:
