@@ -179,6 +179,7 @@ class Planner:
         self._curvature = self._newton_terms() if self.options.method == "newton" else None
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
+        self._torque_box = tuple(bound.reshape(H, body.n) for bound in self._torque_bounds)  # the same, (H, n)
         self._limits = PathLimits.of(self.model)
         self._linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
         # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
@@ -415,9 +416,8 @@ class Planner:
     def _lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
         """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
         path keeps the joint limits (all candidates if none does)."""
-        model = self.model
         params = np.concatenate([start, goal, [width]])
-        low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
+        low, high = self._torque_box
         return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._start_rank(c, params))
 
     def _start_rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
