@@ -119,7 +119,8 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         no step was taken or its matrix had secant updates since it was factored) and the evaluation's ``data``
         at x.
     """
-    hessian_refresh = as_count("hessian_refresh", hessian_refresh, unit="iterations")
+    if type(hessian_refresh) is not int or hessian_refresh != 1:
+        hessian_refresh = as_count("hessian_refresh", hessian_refresh, unit="iterations")
     if hessian_refresh > 1 and not secant:
         raise ValueError(f"hessian_refresh must be 1 without secant corrections (an exact Hessian is assembled at "
                          f"every iteration), got {hessian_refresh}")
@@ -147,7 +148,7 @@ class _Iterate:
     """max c (-inf without constraints): the working set, the violation and the merit's penalty read it first."""
 
     def __post_init__(self):
-        self.largest = float(self.c.max(initial=-np.inf))
+        self.largest = float(self.c.max()) if len(self.c) else -math.inf
 
     @property
     def violation(self) -> float:
@@ -379,9 +380,12 @@ class _Constraints:
         self.lower = np.flatnonzero(np.isfinite(lb))
         self.lb, self.ub, self.size = lb, ub, len(lb)
         self.all_finite = len(self.upper) == len(self.lower) == self.size
+        self.unbounded = len(self.upper) == len(self.lower) == 0
 
     def __call__(self, x, data):
-        if self.all_finite:  # the usual case (torque bounds): no index arrays to gather through
+        if self.unbounded:  # no finite bound (the point masses' torques): no rows at all
+            bounds = _NO_MULTIPLIERS
+        elif self.all_finite:  # the usual bounded case (torque bounds): no index arrays to gather through
             bounds = np.concatenate([x - self.ub, self.lb - x])
         else:
             bounds = np.concatenate([x[self.upper] - self.ub[self.upper], self.lb[self.lower] - x[self.lower]])

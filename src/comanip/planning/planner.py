@@ -538,7 +538,6 @@ class Planner:
         of the full search (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         params = np.concatenate([start, goal, [width]])
-        normaliser = self.problem.normaliser(width)
         best = None
         iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
@@ -550,7 +549,8 @@ class Planner:
                 candidate = self._run_solver(guess, params, deadline)
                 iterations += candidate.nit
                 if not np.all(np.isfinite(candidate.x)) or not np.isfinite(candidate.fun):
-                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width) / normaliser,
+                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width)
+                                             / self.problem.normaliser(width),
                                              Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
                                              candidate.nit, np.inf)
                 # The plan within the limits with the lowest objective wins, whatever its status: a start that
