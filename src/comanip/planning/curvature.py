@@ -73,6 +73,9 @@ class ReachCurvature:
         self._G = _constant_sensitivities(model)
         self._velocity_hessian = _velocity_cost_hessian(problem)
         self._build_constant_products()
+        rank = self._U.shape[2]
+        # where the terms' output vector's pieces end: the gradient, the reduced Hessians, the blocks
+        self._term_ends = np.cumsum([1 + n * H, (H + 1) * (d + rank) ** 2, H * n * n])
         params = ca.vertcat(problem.s0, problem.goal, problem.width)
         functions = [self._terms_function(problem),
                      ca.Function("reach_value", [ca.vec(problem.tau), params], [problem.objective / -problem.best_objective])]
@@ -108,9 +111,10 @@ class ReachCurvature:
         # Σ_i Σ_r (U_iᵀ dphi_i/dvech)_r K[i, r, k] (H·n·n,): ∇²_tau of the noise's covariance terms, per step k
         blocks = ca.mtimes(ca.DM(self._K.reshape((H + 1) * rank, H * n * n)).T, ca.vertcat(*noise_weights))
         blocks += ca.DM(np.tile(np.eye(n).ravel(), H)) * (self._effort / scale)
+        # one output vector, sliced by evaluate: a call then copies one array out instead of five
         return ca.Function("reach_terms", [x, ca.vertcat(problem.s0, problem.goal, problem.width)],
-                           [f, ca.gradient(f, x), ca.vertcat(*reduced), blocks, goal_gradient],
-                           ["x", "p"], ["f", "grad", "reduced_hessians", "blocks", "goal_gradient"])
+                           [ca.vertcat(f, ca.gradient(f, x), ca.vertcat(*reduced), blocks, goal_gradient)],
+                           ["x", "p"], ["f_grad_reduced_hessians_blocks_goal_gradient"])
 
     def _build_constant_products(self) -> None:
         """Z's mean rows and the coefficients of its covariance rows (linear in tau), fixed for a linear body.
@@ -172,10 +176,11 @@ class ReachCurvature:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
-        f, grad, reduced, blocks, goal_gradient = self._terms(x, params)
+        out = self._terms(x, params)[0].ravel()
+        ends = self._term_ends
         m = self._T.shape[2]
-        return float(f[0, 0]), grad.ravel(), ReachTerms(x, params[-1], reduced.reshape(-1, m, m), blocks.ravel(),
-                                                        goal_gradient.ravel())
+        return float(out[0]), out[1:ends[0]], ReachTerms(x, params[-1], out[ends[0]:ends[1]].reshape(-1, m, m),
+                                                         out[ends[1]:ends[2]], out[ends[2]:])
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         """f at torques x (H·n,) alone."""

@@ -126,9 +126,10 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
                          f"every iteration), got {hessian_refresh}")
     solver = _ActiveSetNewton(evaluate, hessian, _Constraints(lb, ub, constraints), value, tolerance=tolerance,
                               constraint_tolerance=constraint_tolerance, margin=margin, hessian_refresh=hessian_refresh)
-    x = np.clip(np.asarray(x0, dtype=float), lb, ub)
+    problem = solver.problem
+    x = np.array(x0, dtype=float) if problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
-    if not (np.isfinite(f) and np.all(np.isfinite(g))):
+    if not _finite(f, g):
         return SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf)
     return solver.run(solver.at(x, f, g, data), max_iterations, secant, expired)
 

@@ -180,6 +180,7 @@ class Planner:
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._torque_box = tuple(bound.reshape(H, body.n) for bound in self._torque_bounds)  # the same, (H, n)
+        self._unbounded = not np.isfinite(body.tau_max).any()
         self._limits = PathLimits.of(self.model)
         self._linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
         # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
@@ -418,6 +419,8 @@ class Planner:
         path keeps the joint limits (all candidates if none does)."""
         params = np.concatenate([start, goal, [width]])
         low, high = self._torque_box
+        if self._unbounded:  # no torque bound (the point masses): clipping would only copy
+            return min(candidates, key=lambda c: self._start_rank(c, params))
         return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._start_rank(c, params))
 
     def _start_rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
