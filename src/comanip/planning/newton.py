@@ -369,7 +369,8 @@ class _ActiveSetNewton:
 
 
 def _finite(f: float, g: np.ndarray | None) -> bool:
-    return math.isfinite(f) and (g is None or bool(np.isfinite(g).all()))
+    """f and every entry of g finite (a sum of finite gradient entries is finite short of overflow, 1e308)."""
+    return math.isfinite(f) and (g is None or math.isfinite(g.sum()))
 
 
 class _Constraints:

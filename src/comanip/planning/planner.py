@@ -291,11 +291,12 @@ class Planner:
         unreachable = self._unreachable_plan(start, goal, width, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
-        guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
-                                        goal_q=goal_q if warm_start is None else None)
-        from_library = warm_start is None and self._arm_library is not None and self._arm_library.serves(start)
-        plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
-                                                 until_converged=from_library))
+        with self._blas:  # the starts' small products too: one BLAS switch per solve
+            guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
+                                            goal_q=goal_q if warm_start is None else None)
+            from_library = warm_start is None and self._arm_library is not None and self._arm_library.serves(start)
+            plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
+                                                     until_converged=from_library))
         self._count_solving_time(plan.solve_time)
         return plan
 
