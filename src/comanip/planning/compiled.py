@@ -231,6 +231,16 @@ class BufferedFunction:
         for i, array in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(array))
 
+    def vector(self, *args) -> np.ndarray:
+        """The first output's entries in column-major order (a fresh array; dense outputs only): a call without the
+        list of outputs and their reshaping, for a function whose first output is a vector."""
+        for array, value in zip(self._inputs, args):
+            array[:] = value.ravel(order="F") if getattr(value, "ndim", 0) > 1 else value
+        self._evaluate()
+        if self._buffer.ret() != 0:
+            raise RuntimeError(f"evaluating {self.function.name()} failed")
+        return self._outputs[0].copy()
+
     def __call__(self, *args) -> list[np.ndarray]:
         for array, value in zip(self._inputs, args):
             # vectors and scalars as they are (np.ravel costs more than the copy); matrices column by column

@@ -176,7 +176,7 @@ class ReachCurvature:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
-        out = self._terms(x, params)[0].ravel()
+        out = self._terms.vector(x, params)
         ends = self._term_ends
         m = self._T.shape[2]
         return float(out[0]), out[1:ends[0]], ReachTerms(x, params[-1], out[ends[0]:ends[1]].reshape(-1, m, m),
@@ -184,7 +184,7 @@ class ReachCurvature:
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         """f at torques x (H·n,) alone."""
-        return float(self._value(x, params)[0][0, 0])
+        return float(self._value.vector(x, params)[0])
 
     def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, None]:
         """(f, None) at torques x: a point mass has no path limits, so a line-search trial needs no data."""

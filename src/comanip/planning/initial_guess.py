@@ -47,8 +47,9 @@ def _step_times(durations: tuple[float, ...], h: float, H: int) -> _QuinticTimes
     return _QuinticTimes(np.array(durations), h * np.arange(H))
 
 
-def _quintic(x0, v0, x1, times: _QuinticTimes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Position, velocity and acceleration (m, K, k) of :func:`minimum_jerk` for every duration of ``times``."""
+def _quintic(x0, v0, x1, times: _QuinticTimes, positions: bool = True) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
+    """Position (None unless ``positions``), velocity and acceleration (m, K, k) of :func:`minimum_jerk` for every
+    duration of ``times``."""
     x0, v0, x1 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (x0, v0, x1))
     T, tc = times.T, times.tc
     # the quintic's coefficients in closed form (x(0) = x0, x'(0) = v0, x''(0) = 0, x(T) = x1, x'(T) = x''(T) = 0)
@@ -56,7 +57,7 @@ def _quintic(x0, v0, x1, times: _QuinticTimes) -> tuple[np.ndarray, np.ndarray, 
     a3 = (10 * delta - 6 * v0 * T) / times.T3
     a4 = (-15 * delta + 8 * v0 * T) / times.T4
     a5 = (6 * delta - 3 * v0 * T) / times.T5
-    pos = x0 + v0 * tc + times.tc3 * (a3 + tc * (a4 + tc * a5))
+    pos = x0 + v0 * tc + times.tc3 * (a3 + tc * (a4 + tc * a5)) if positions else None
     vel = v0 + times.tc2 * (3 * a3 + tc * (4 * a4 + tc * 5 * a5))
     acc = tc * (6 * a3 + tc * (12 * a4 + tc * 20 * a5))
     vel[times.after] = 0.0
@@ -73,9 +74,9 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
     once by a caller that makes many guesses; None evaluates them here."""
     durations = np.asarray(duration, dtype=float)
     q, qdot, qddot = _quintic(start[: body.n], start[body.n:2 * body.n], goal_q,
-                              _step_times(tuple(durations.ravel().tolist()), h, H))
+                              _step_times(tuple(durations.ravel().tolist()), h, H), positions=not body.is_linear)
     if not durations.ndim:
-        q, qdot, qddot = q[0], qdot[0], qddot[0]
+        q, qdot, qddot = None if q is None else q[0], qdot[0], qddot[0]
     if body.is_linear:  # constant M and G: inverse dynamics of all steps (and durations) at once
         M, G = linear_dynamics or linear_dynamics_of(body)
         force = qddot @ M.T + qdot @ body.damping.T + G
