@@ -213,10 +213,14 @@ class ReachCurvature:
         block is the identity), so these are the first d columns of Q~_i.
         """
         d = self.model.d
+        return data.goal_gradient, self.goal_cross_derivative(data), data.reduced_hessians[:, :d, :d].sum(axis=0)
+
+    def goal_cross_derivative(self, data: ReachTerms) -> np.ndarray:
+        """∂²f/∂x∂g (H·n, d) of :meth:`goal_derivatives` alone (what the tangential predictor needs)."""
+        d = self.model.d
         Z = self._reduced_rows(data)
         goal_columns = data.reduced_hessians[:, :, :d]  # ∂²phi_i/∂z~_i∂mu_x,i (H+1, d + r, d)
-        cross = -(Z.reshape(-1, self.size).T @ goal_columns.reshape(-1, d))
-        return data.goal_gradient, cross, goal_columns[:, :d].sum(axis=0)
+        return -(Z.reshape(-1, self.size).T @ goal_columns.reshape(-1, d))
 
     def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
         """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear

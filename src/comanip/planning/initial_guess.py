@@ -35,10 +35,17 @@ class _QuinticTimes:
 
     def __init__(self, durations: np.ndarray, t: np.ndarray):
         T = self.T = durations.reshape(-1, 1, 1)  # (m, 1, 1)
-        self.T3, self.T4, self.T5 = T**3, T**4, T**5
+        self.powers = np.stack([T**3, T**4, T**5])  # (3, m, 1, 1)
         tc = self.tc = np.minimum(np.maximum(t, 0.0)[None, :, None], T)  # (m, K, 1)
         self.tc2, self.tc3 = tc**2, tc**3
+        self.tc_scaled = np.stack([tc * 5, tc * 20])  # (2, m, K, 1): the a5 factors of velocity and acceleration
         self.after = t[None, :] > T[:, :, 0]
+
+
+_COEFFICIENTS = np.array([[10.0, -15.0, 6.0], [6.0, -8.0, 3.0]]).reshape(2, 3, 1, 1, 1)
+"""The quintic's coefficients a3, a4, a5 = (c·delta - c'·v0·T) / (T³, T⁴, T⁵): rows c and c'."""
+_DERIVATIVE_FACTORS = np.array([[3.0, 6.0], [4.0, 12.0]]).reshape(2, 2, 1, 1, 1)
+"""The factors of a3 (first row) and a4 (second row) in the velocity and the acceleration."""
 
 
 @functools.lru_cache(maxsize=32)
@@ -49,17 +56,21 @@ def _step_times(durations: tuple[float, ...], h: float, H: int) -> _QuinticTimes
 
 def _quintic(x0, v0, x1, times: _QuinticTimes, positions: bool = True) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
     """Position (None unless ``positions``), velocity and acceleration (m, K, k) of :func:`minimum_jerk` for every
-    duration of ``times``."""
+    duration of ``times``.
+
+    Velocity and acceleration are computed side by side (stacked on a first axis), each entry by the same
+    floating-point operations as the formulas in the comments (x - (-y) is x + y exactly)."""
     x0, v0, x1 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (x0, v0, x1))
-    T, tc = times.T, times.tc
-    # the quintic's coefficients in closed form (x(0) = x0, x'(0) = v0, x''(0) = 0, x(T) = x1, x'(T) = x''(T) = 0)
-    delta = x1 - x0
-    a3 = (10 * delta - 6 * v0 * T) / times.T3
-    a4 = (-15 * delta + 8 * v0 * T) / times.T4
-    a5 = (6 * delta - 3 * v0 * T) / times.T5
+    tc = times.tc
+    # the quintic's coefficients in closed form (x(0) = x0, x'(0) = v0, x''(0) = 0, x(T) = x1, x'(T) = x''(T) = 0):
+    # a3 = (10 delta - 6 v0 T) / T³, a4 = (-15 delta + 8 v0 T) / T⁴, a5 = (6 delta - 3 v0 T) / T⁵
+    a3, a4, a5 = (_COEFFICIENTS[0] * (x1 - x0) - _COEFFICIENTS[1] * v0 * times.T) / times.powers
+    # velocity v0 + tc² (3 a3 + tc (4 a4 + tc·5 a5)), acceleration tc (6 a3 + tc (12 a4 + tc·20 a5))
+    inner = _DERIVATIVE_FACTORS[1] * a4 + times.tc_scaled * a5
+    outer = _DERIVATIVE_FACTORS[0] * a3 + tc * inner
+    vel = v0 + times.tc2 * outer[0]
+    acc = tc * outer[1]
     pos = x0 + v0 * tc + times.tc3 * (a3 + tc * (a4 + tc * a5)) if positions else None
-    vel = v0 + times.tc2 * (3 * a3 + tc * (4 * a4 + tc * 5 * a5))
-    acc = tc * (6 * a3 + tc * (12 * a4 + tc * 20 * a5))
     vel[times.after] = 0.0
     acc[times.after] = 0.0
     return pos, vel, acc

@@ -390,7 +390,7 @@ class Planner:
             return None
         if last.sensitivity is None:
             with self._blas:
-                last.sensitivity = -cholesky_solve(last.factor, self._curvature.goal_derivatives(last.data)[1])
+                last.sensitivity = -cholesky_solve(last.factor, self._curvature.goal_cross_derivative(last.data))
         return last.torque, last.sensitivity
 
     def _solution_of(self, result: SolverResult, torque: np.ndarray) -> _LastSolution | None:
