@@ -14,7 +14,7 @@ Two solvers (``SolverOptions.method``):
   (:mod:`comanip.planning.newton`) on a Hessian assembled from per-step pieces: exact for point masses
   (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
   (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
-  Two to four times faster than IPOPT on the point masses (benchmarks/README.md).
+  Several times faster than IPOPT on the point masses, to the same optimum (benchmarks/README.md).
 - ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference,
   point masses only.
 

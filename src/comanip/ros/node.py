@@ -7,8 +7,8 @@ stamp is t = 0. Every later pose, paired with the twist of (nearly) the same sta
 t = stamp - start stamp. ``estimation_rate`` of them per second of input time go to the estimator: the due times
 lie on a grid of 1 / estimation_rate from the reach's start, and the pose nearest each due time (the first within
 half the input's spacing of it) is estimated, so a tracker whose stamps jitter still gets the configured rate
-(a rule of 'one period since the last estimated pose' loses up to a pose spacing every period: 17.6 instead of 20
-estimates a second from a 100 Hz tracker). After a gap longer than a period the grid restarts at the next pose.
+(a rule of 'one period since the last estimated pose' loses up to a pose spacing every period). After a gap longer
+than a period the grid restarts at the next pose.
 
 The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
 far, any time; the reach starts at rest at the first pose's position) and run in a worker thread, so the
