@@ -14,7 +14,10 @@ initial guesses). Solves run in blocks of ``--block`` consecutive problems by on
 solver called again and again, as in a control loop, with its data in the processor's caches), and the blocks
 take turns: block b by each process's Newton method and IPOPT (which goes first alternates), then block b + 1,
 so every number of a row sees the same machine load within a few tens of milliseconds. Each planner's first
-solve (compiling, if needed) is not timed.
+solve (compiling, if needed) is not timed. The processes run with ``OPENBLAS_NUM_THREADS=1`` and
+``OMP_NUM_THREADS=1`` (``--blas-threads``): the planner limits its own BLAS to one thread anyway, while IPOPT's
+linear solver (MUMPS, on CasADi's own OpenBLAS) would otherwise start a thread per core and, on a loaded machine,
+wait for them (two to three times slower here), which would flatter the ratio.
 
 Columns: medians and p90 of ``plan.solve_time`` (ms), the ratio of the IPOPT median to the Newton median, and the
 objective gap |J_newton − J_ipopt| / |J_ipopt| per problem (its largest value, and on how many problems it is
@@ -89,9 +92,10 @@ def _reply(worker: subprocess.Popen):
             return json.loads(line)
 
 
-def rows(preset: str, sources: dict[str, Path], repeats: int, block: int) -> list[str]:
-    workers = {label: subprocess.Popen([sys.executable, __file__, "--serve", preset], stdin=subprocess.PIPE,
-                                       stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(src)})
+def rows(preset: str, sources: dict[str, Path], repeats: int, block: int, blas_threads: int) -> list[str]:
+    threads = {name: str(blas_threads) for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
+    workers = {label: subprocess.Popen([sys.executable, __file__, "--serve", preset], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                       text=True, env={**os.environ, **threads, "PYTHONPATH": str(src)})
                for label, src in sources.items()}
     for worker in workers.values():
         _reply(worker)
@@ -125,6 +129,7 @@ def main(argv=None) -> None:
     parser.add_argument("--presets", default="planar", help="comma-separated point-mass presets (default: %(default)s)")
     parser.add_argument("--repeats", type=int, default=40, help="problems per case (default: %(default)s)")
     parser.add_argument("--block", type=int, default=10, help="consecutive problems per solver and turn (default: %(default)s)")
+    parser.add_argument("--blas-threads", type=int, default=1, help="OpenBLAS and OpenMP threads of the processes (default: %(default)s)")
     parser.add_argument("--compare", type=Path, default=None, help="another checkout to run side by side (its src/)")
     parser.add_argument("--serve", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
@@ -139,7 +144,7 @@ def main(argv=None) -> None:
           f"| largest J gap | gaps ≤ {GAP:g} | ok Newton / IPOPT |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for preset in args.presets.split(","):
-        rows(preset, sources, args.repeats, args.block)
+        rows(preset, sources, args.repeats, args.block, args.blas_threads)
     print(f"load average at end: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
