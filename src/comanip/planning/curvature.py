@@ -144,6 +144,8 @@ class ReachCurvature:
         self._T = np.zeros((H + 1, d + len(a), d + rank))
         self._T[:, :d, :d] = np.eye(d)
         self._T[:, d:, d:] = self._U
+        self._rows = np.empty((H + 1, d + rank, H, n))  # Z~ (_reduced_rows), its mean rows fixed
+        self._rows[:, :d] = self._mean_rows
         # flat indices of the Hessian's block-diagonal entries (k·n + j, k·n + l), in the order of the blocks output
         k, j, l = np.meshgrid(np.arange(H), np.arange(n), np.arange(n), indexing="ij")
         self._block_entries = ((k * n + j) * (H * n) + k * n + l).ravel()
@@ -224,20 +226,16 @@ class ReachCurvature:
 
     def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
         """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear
-        in tau; computed once per evaluation and kept in the data."""
-        if data.rows is not None:
-            return data.rows
+        in tau. The array is the curvature's own, its mean rows written once: valid until the next call."""
         model = self.model
         n, d, H = model.n, model.d, model.H
         tau = np.asarray(data.x).reshape(H, n)
-        Z = np.empty((H + 1, d + self._U.shape[2], H, n))
-        Z[:, :d] = self._mean_rows
+        Z = self._rows
         if self._K_diagonal is not None:
             np.multiply(self._K_diagonal, tau, out=Z[:, d:])
         else:
             np.einsum("irkjl,kl->irkj", self._K, tau, out=Z[:, d:])
-        data.rows = Z.reshape(H + 1, d + self._U.shape[2], H * n)
-        return data.rows
+        return Z.reshape(H + 1, d + self._U.shape[2], H * n)
 
 
 def _is_compiled(function: ca.Function) -> bool:

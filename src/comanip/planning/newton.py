@@ -134,7 +134,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     return solver.run(solver.at(x, f, g, data), max_iterations, secant, expired)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Iterate:
     """A point x (N,) and what was evaluated there: f, its gradient (None after a value-only trial), the
     evaluation's data, the constraints c (bounds first) and rows(indices) of their Jacobian."""
@@ -324,7 +324,8 @@ class _ActiveSetNewton:
             return 0.0, None
 
         def attempt(alpha: float, bound: float) -> _Iterate | None:
-            trial = self._trial(point.x + alpha * step, with_gradient=full_step_likely and alpha == 1.0 and not len(working))
+            trial = self._trial(point.x + step if alpha == 1.0 else point.x + alpha * step,
+                                with_gradient=full_step_likely and alpha == 1.0 and not len(working))
             if trial is None:
                 return None
             if len(working) and self._penalty(trial) > penalty:
@@ -336,9 +337,10 @@ class _ActiveSetNewton:
                     trial = corrected
             if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
-            if trial.g is None:
+            if trial.g is None:  # a trial evaluated with its gradient was checked finite by _trial
                 trial = self.at(trial.x, *self.evaluate(trial.x))
-            return trial if _finite(trial.f, trial.g) else None
+                return trial if _finite(trial.f, trial.g) else None
+            return trial
 
         alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
         return (alpha, accepted) if accepted is not None else (0.0, None)

@@ -35,8 +35,6 @@ class ReachTerms:
     """The Hessian's block-diagonal part (noise curvature and effort) as H·n·n entries (step, row, column)."""
     goal_gradient: np.ndarray
     """∂f/∂g (d,)."""
-    rows: np.ndarray | None = field(default=None, repr=False)
-    """dz~_i/dx stacked (H+1, d + r, H·n), computed on first request and kept with its evaluation."""
 
 
 @dataclass(eq=False)
