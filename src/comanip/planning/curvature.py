@@ -73,9 +73,10 @@ class ReachCurvature:
         self._G = _constant_sensitivities(model)
         self._velocity_hessian = _velocity_cost_hessian(problem)
         self._build_constant_products()
-        rank = self._U.shape[2]
-        # where the terms' output vector's pieces end: the gradient, the reduced Hessians, the blocks
-        self._term_ends = np.cumsum([1 + n * H, (H + 1) * (d + rank) ** 2, H * n * n])
+        nz = self._nz = d + len(self._triangle)
+        # where the terms' output vector's pieces end: the gradient, the per-step Hessians, the per-step gradients
+        self._term_ends = np.cumsum([1 + n * H, nz * nz * (H + 1), nz * (H + 1)])
+        self._diagonal = np.diag_indices(H * n)
         params = ca.vertcat(problem.s0, problem.goal, problem.width)
         functions = [self._terms_function(problem),
                      ca.Function("reach_value", [ca.vec(problem.tau), params], [problem.objective / -problem.best_objective])]
@@ -89,32 +90,21 @@ class ReachCurvature:
 
     # -- the compiled per-solve function -------------------------------------------------------------
     def _terms_function(self, problem: ReachProblem) -> ca.Function:
-        """``(x, p) -> (f, grad f, Q~, blocks, ∂f/∂g)``, everything the Hessian and the goal derivatives read, in one
-        call (:class:`~comanip.planning.terms.ReachTerms` names the outputs): Q~_i = T_iᵀ ∇²phi_i T_i in the reduced
-        coordinates z~_i stacked as (H+1)·(d+r)² entries (step, row, column), and the Hessian's block-diagonal part
-        (the noise's own curvature plus the effort) as H·n² entries (step, row, column)."""
-        model = problem.model
-        n, d, H = model.n, model.d, model.H
+        """``(x, p) -> [f; grad f; ∇²phi_i stacked (nz, nz·(H+1)); ∇phi_i stacked (nz, H+1)]``, the matrices column
+        by column in one output vector (:meth:`evaluate` slices it: a call copies one array out instead of four)."""
         x = ca.vec(problem.tau)
         scale = -problem.best_objective
         f = problem.objective / scale
-        step_terms = _reward_derivatives_function(model)
-        reduced, noise_weights, goal_gradient = [], [], 0
-        for i, (w, mu_x, Sigma_x) in enumerate(zip(problem.weights, problem.ee_means, problem.ee_covs)):
+        step_terms = _reward_derivatives_function(problem.model)
+        hessians, gradients = [], []
+        for w, mu_x, Sigma_x in zip(problem.weights, problem.ee_means, problem.ee_covs):
             vech = ca.vertcat(*[Sigma_x[a, b] for a, b in self._triangle])
             hess, grad = step_terms(mu_x, vech, problem.goal, problem.width, w / scale)
-            T = ca.DM(self._T[i])
-            reduced.append(ca.vec(ca.mtimes([T.T, hess, T])))
-            noise_weights.append(ca.mtimes(ca.DM(self._U[i]).T, grad[d:]))
-            goal_gradient -= grad[:d]  # phi_i depends on the goal through mu_x,i - g
-        rank = self._U.shape[2]
-        # Σ_i Σ_r (U_iᵀ dphi_i/dvech)_r K[i, r, k] (H·n·n,): ∇²_tau of the noise's covariance terms, per step k
-        blocks = ca.mtimes(ca.DM(self._K.reshape((H + 1) * rank, H * n * n)).T, ca.vertcat(*noise_weights))
-        blocks += ca.DM(np.tile(np.eye(n).ravel(), H)) * (self._effort / scale)
-        # one output vector, sliced by evaluate: a call then copies one array out instead of five
+            hessians.append(hess)
+            gradients.append(grad)
         return ca.Function("reach_terms", [x, ca.vertcat(problem.s0, problem.goal, problem.width)],
-                           [ca.vertcat(f, ca.gradient(f, x), ca.vertcat(*reduced), blocks, goal_gradient)],
-                           ["x", "p"], ["f_grad_reduced_hessians_blocks_goal_gradient"])
+                           [ca.vertcat(f, ca.gradient(f, x), ca.vec(ca.horzcat(*hessians)), ca.vec(ca.horzcat(*gradients)))],
+                           ["x", "p"], ["f_grad_phi_hess_phi_grad"])
 
     def _build_constant_products(self) -> None:
         """Z's mean rows and the coefficients of its covariance rows (linear in tau), fixed for a linear body.
@@ -179,10 +169,10 @@ class ReachCurvature:
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
         out = self._terms.vector(x, params)
-        ends = self._term_ends
-        m = self._T.shape[2]
-        return float(out[0]), out[1:ends[0]], ReachTerms(x, params[-1], out[ends[0]:ends[1]].reshape(-1, m, m),
-                                                         out[ends[1]:ends[2]], out[ends[2]:])
+        ends, nz, steps = self._term_ends, self._nz, self.model.H + 1
+        # the per-step pieces as views, column by column (as the compiled function wrote them)
+        return float(out[0]), out[1:ends[0]], ReachTerms(x, params[-1], out[ends[0]:ends[1]].reshape((nz, nz * steps), order="F"),
+                                                         out[ends[1]:ends[2]].reshape((nz, steps), order="F"))
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         """f at torques x (H·n,) alone."""
@@ -193,13 +183,22 @@ class ReachCurvature:
         return self.value(x, params), None
 
     def hessian(self, data: ReachTerms) -> np.ndarray:
-        """∇²f (H·n, H·n) from the data :meth:`evaluate` returned: Σ_i Z~_iᵀ Q~_i Z~_i, plus the block-diagonal
-        noise and effort curvature and the constant speed-cost curvature."""
-        size = self.size
+        """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
+        phi_hess, phi_grad = self._pieces(data)
+        model = self.model
+        n, d, H = model.n, model.d, model.H
+        nz = phi_hess.shape[0]
+        rank = self._U.shape[2]
+        T = self._T
+        Q = np.swapaxes(T, 1, 2) @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
         Z = self._reduced_rows(data)
-        QZ = np.matmul(data.reduced_hessians, Z)
-        hessian = _causal_gram(Z.reshape(-1, size), QZ.reshape(-1, size), Z.shape[1], self.model.n)
-        hessian.ravel()[self._block_entries] += data.blocks
+        QZ = np.matmul(Q, Z)
+        hessian = _causal_gram(Z.reshape(-1, H * n), QZ.reshape(-1, H * n), d + rank, n)
+        # ∇²_tau Σ_i Σ_v (dphi_i/dvech_v) Sigma_x,i[v]: the noise's own curvature, block-diagonal in k
+        weights = np.einsum("ivr,vi->ir", self._U, phi_grad[d:])
+        blocks = weights.reshape(1, -1) @ self._K.reshape((H + 1) * rank, H * n * n)
+        hessian.ravel()[self._block_entries] += blocks.ravel()
+        hessian[self._diagonal] += self._effort / self.normaliser(data.width)
         if self._velocity_hessian is not None:  # the speed cost is scaled by |J_best| already
             hessian += self._velocity_hessian
         return hessian
@@ -211,18 +210,28 @@ class ReachCurvature:
         ∂phi_i/∂g = -∂phi_i/∂mu_x,i, ∂²phi_i/∂z_i∂g = -∂²phi_i/∂z_i∂mu_x,i and ∂²phi_i/∂g² = ∂²phi_i/∂mu_x,i²:
         columns of the per-step derivatives the Hessian uses anyway. Then ∂f/∂g = Σ_i ∂phi_i/∂g,
         ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
-        In the reduced coordinates z~_i = (mu_x,i, U_iᵀ vech Sigma_x,i) the mean block is unchanged (T_i's first
-        block is the identity), so these are the first d columns of Q~_i.
         """
-        d = self.model.d
-        return data.goal_gradient, self.goal_cross_derivative(data), data.reduced_hessians[:, :d, :d].sum(axis=0)
+        phi_hess, phi_grad = self._pieces(data)
+        H, d = self.model.H, self.model.d
+        Q = phi_hess.reshape(phi_hess.shape[0], H + 1, phi_hess.shape[0]).transpose(1, 0, 2)
+        return -phi_grad[:d].sum(axis=1), self.goal_cross_derivative(data), Q[:, :d, :d].sum(axis=0)
 
     def goal_cross_derivative(self, data: ReachTerms) -> np.ndarray:
         """∂²f/∂x∂g (H·n, d) of :meth:`goal_derivatives` alone (what the tangential predictor needs)."""
-        d = self.model.d
+        phi_hess, _ = self._pieces(data)
+        H, d = self.model.H, self.model.d
+        nz = phi_hess.shape[0]
+        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
         Z = self._reduced_rows(data)
-        goal_columns = data.reduced_hessians[:, :, :d]  # ∂²phi_i/∂z~_i∂mu_x,i (H+1, d + r, d)
-        return -(Z.reshape(-1, self.size).T @ goal_columns.reshape(-1, d))
+        # Z_iᵀ M = Z~_iᵀ T_iᵀ M: the rows are kept in the reduced basis z~_i (see _build_constant_products)
+        goal_columns = -np.swapaxes(self._T, 1, 2) @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
+        return Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
+
+    @staticmethod
+    def _pieces(data: ReachTerms) -> tuple[np.ndarray, np.ndarray]:
+        """The data's per-step Hessians (nz, nz·(H+1)) and gradients (nz, H+1), row by row in memory (the products
+        above then run through the same code paths, and round the same, whatever the views' layout)."""
+        return np.ascontiguousarray(data.phi_hess), np.ascontiguousarray(data.phi_grad)
 
     def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
         """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear

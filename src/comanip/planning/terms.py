@@ -21,20 +21,16 @@ import numpy as np
 
 @dataclass(eq=False)
 class ReachTerms:
-    """One evaluation at torques x: what the Hessian and the goal derivatives need (point masses), in the
-    reduced per-step coordinates z~_i = (mu_x,i, U_iᵀ vech Sigma_x,i) of dimension d + r
-    (:class:`~comanip.planning.curvature.ReachCurvature`)."""
+    """One evaluation at torques x: what the Hessian and the goal derivatives need (point masses)."""
 
     x: np.ndarray
     """Torques evaluated (H·n,), N·m or N."""
     width: float
     """Goal width w (m)."""
-    reduced_hessians: np.ndarray
-    """∇²_z~ phi_i stacked (H+1, d + r, d + r)."""
-    blocks: np.ndarray
-    """The Hessian's block-diagonal part (noise curvature and effort) as H·n·n entries (step, row, column)."""
-    goal_gradient: np.ndarray
-    """∂f/∂g (d,)."""
+    phi_hess: np.ndarray
+    """∇²_z phi_i stacked (nz, nz·(H+1))."""
+    phi_grad: np.ndarray
+    """∇_z phi_i stacked (nz, H+1)."""
 
 
 @dataclass(eq=False)
