@@ -50,6 +50,7 @@ class ReachProblem:
         # normalise J for the solver so its tolerances mean the same for every width; the minimiser is unchanged.
         self.best_objective = -float(np.sum(weights)) * self.reward.peak(self.width)
         self._weight_sum = float(np.sum(weights))
+        self._normalised = (float("nan"), float("nan"))  # (width, |J_best|) of the last normaliser call
         self.normaliser_function = ca.Function("normaliser", [self.width], [-self.best_objective])
         """``width -> |J_best(w)|`` as a CasADi function (for building other functions of the width)."""
         if model.has_velocity_cost:  # relative to the best reward, so it means the same for every width
@@ -76,8 +77,11 @@ class ReachProblem:
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)| (> 0) for a goal width w (m): the solvers divide J by it, so their tolerances mean the same
-        for every width."""
-        return self._weight_sum * self.reward.peak(float(width))
+        for every width. The last width's value is kept (a solve asks at every Hessian, always the same width)."""
+        width = float(width)
+        if width != self._normalised[0]:
+            self._normalised = (width, self._weight_sum * self.reward.peak(width))
+        return self._normalised[1]
 
     def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
         """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
