@@ -134,6 +134,7 @@ class ReachCurvature:
         self._T = np.zeros((H + 1, d + len(a), d + rank))
         self._T[:, :d, :d] = np.eye(d)
         self._T[:, d:, d:] = self._U
+        self._T_transposed = np.swapaxes(self._T, 1, 2)  # a view
         self._rows = np.empty((H + 1, d + rank, H, n))  # Z~ (_reduced_rows), its mean rows fixed
         self._rows[:, :d] = self._mean_rows
         # flat indices of the Hessian's block-diagonal entries (k·n + j, k·n + l), in the order of the blocks output
@@ -190,7 +191,7 @@ class ReachCurvature:
         nz = phi_hess.shape[0]
         rank = self._U.shape[2]
         T = self._T
-        Q = np.swapaxes(T, 1, 2) @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
+        Q = self._T_transposed @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
         Z = self._reduced_rows(data)
         QZ = np.matmul(Q, Z)
         hessian = _causal_gram(Z.reshape(-1, H * n), QZ.reshape(-1, H * n), d + rank, n)
@@ -224,7 +225,7 @@ class ReachCurvature:
         Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
         Z = self._reduced_rows(data)
         # Z_iᵀ M = Z~_iᵀ T_iᵀ M: the rows are kept in the reduced basis z~_i (see _build_constant_products)
-        goal_columns = -np.swapaxes(self._T, 1, 2) @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
+        goal_columns = -self._T_transposed @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
         return Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
 
     @staticmethod

@@ -462,7 +462,9 @@ class Planner:
         if moving and self._drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
             return guesses
         params = np.concatenate([start, goal, [width]])
-        best_guess = min(guesses, key=lambda guess: self._objective(guess, params))
+        objectives = [self._objective(guess, params) for guess in guesses]
+        first_best = min(range(len(guesses)), key=objectives.__getitem__)
+        best_guess = guesses[first_best]
         turned = self._library.guess(start, goal, width, solve_missing=not budgeted)
         if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
             return guesses if self._narrow(start, goal, width) else [best_guess]
@@ -471,7 +473,9 @@ class Planner:
             candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
                                                             guess_durations(model.duration, self.options.n_starts),
                                                             self._linear_dynamics))
-        best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
+        scored = [(self._objective(candidate, params), candidate) for candidate in candidates] + \
+            [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
+        best = min(scored, key=lambda pair: pair[0])[1]
         return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
 
     def _arm_library_starts(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
@@ -552,7 +556,7 @@ class Planner:
                     break
                 candidate = self._run_solver(guess, params, deadline)
                 iterations += candidate.nit
-                if not np.all(np.isfinite(candidate.x)) or not np.isfinite(candidate.fun):
+                if not np.isfinite(candidate.x).all() or not np.isfinite(candidate.fun):
                     candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width)
                                              / self.problem.normaliser(width),
                                              Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
