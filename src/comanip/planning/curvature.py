@@ -50,6 +50,9 @@ class ReachCurvature:
             faster per solve, at a few seconds' build per new model. None: load them if an earlier build for
             this model is in the disk cache, else run CasADi's virtual machine until
             :meth:`compile_in_background` has built them. False: the virtual machine.
+
+    One curvature serves one thread at a time: its evaluations and Hessians go through arrays it owns (the
+    compiled functions' buffers, the rows of Z~).
     """
 
     exact = True
