@@ -1,25 +1,28 @@
 """The ROS 2 goal node's achieved rate and latency in replay (needs the 'ros' extra).
 
-    .venv/bin/python benchmarks/ros_node_rate.py [--repeats 3] [--tracker-rate 100]
+    .venv/bin/python benchmarks/ros_node_rate.py [--repeats 3] [--tracker-rate 100] [--rates 20,50] [--compare ../main]
 
 The hand: the Cartesian preset's plan from rest to (0.4, 0.25, -0.1) m, sampled by a tracker at
 ``--tracker-rate`` Hz (the plan's mean positions and velocities interpolated linearly between its 55 ms
-steps), replayed through the node in-process (:mod:`comanip.ros.replay`) for the whole 2.75 s reach:
+steps), replayed through the node for the whole 2.75 s reach:
 
-- lock step, every pose estimated (estimation_rate above the tracker's): each pose waits for the node to
-  finish with it, so this is the node's throughput, estimates per second of wall time;
-- real time, two processes, as on a robot: the node started by ``comanip ros`` in its own process, this
-  script publishing the poses (stamped with the wall clock) and receiving the estimates over DDS.
+- lock step, in-process, every pose estimated (estimation_rate above the tracker's): each pose waits for the
+  node to finish with it (:mod:`comanip.ros.replay`), so this is the node's throughput, estimates per second of
+  wall time;
+- real time, two processes, as on a robot, at each of ``--rates`` (estimation_rate, Hz): the node started by
+  ``python -m comanip.ros`` in its own process, this script publishing the poses (stamped with the wall clock) and
+  receiving the estimates over DDS.
 
-For the real-time rows, at estimation_rate 20 Hz (the default) and at every pose: the estimates the node
-published per second of wall time, the poses it skipped (beyond the rate limit, or because an estimate was
-still running: the newest pose replaces a queued one). (The replay's own real-time mode, ``--speed 1``, puts
-the player, its /clock and the node in one Python process and one executor; on this loaded 2-core machine
-at 100 poses/s that process falls behind by a second, so it is not used for rates here.)
-
-Latency: wall time from publishing a pose to receiving the goal estimate made from it (the first estimate
-of a reach, a cold start, apart; in two processes, receipt time minus the pose's wall-clock stamp). Rows print medians over ``--repeats`` replays; the node is built once per
-replay (build time apart). Default budget max_wall_time 0.25 s.
+For the real-time rows: the delivered estimation rate, (N - 1) / (last - first) over the input stamps of the N
+estimates received (each goal message carries the stamp of the pose it was made from; the first three
+estimates of a reach are 'uninformative', the hand not having moved yet, and not published), and that rate over
+estimation_rate; the poses the node skipped (between the rate's due times, or because an estimate was still
+running: the newest pose replaces a queued one); the rate and median latency the node reports in its own status
+at the end of the reach (blank for a node without them). Latency: wall time from publishing a pose to receiving
+the goal estimate made from it (the first estimate of a reach, a cold start, apart). Rows print medians over
+``--repeats`` replays; the node is built once per replay (build time apart). ``--compare REF`` runs the real-time
+rows a second time with the node from the checkout REF (its ``src`` on PYTHONPATH), the two nodes taking turns
+replay by replay.
 """
 
 from __future__ import annotations
@@ -63,8 +66,9 @@ def replay_once(settings: NodeSettings, transition: TransitionModel, times, stat
 }
 
 
-def two_processes(rate: float, times, states) -> dict:
-    """Real time with the node in its own process (``python -m comanip.ros``) at ``estimation_rate`` rate."""
+def two_processes(rate: float, times, states, src: Path | None = None) -> dict:
+    """Real time with the node in its own process (``python -m comanip.ros``) at ``estimation_rate`` rate; ``src``:
+    the checkout's source folder the node imports (None: this environment's)."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
@@ -76,8 +80,10 @@ def two_processes(rate: float, times, states) -> dict:
     params.write_text(f"estimation_rate: {rate}\n")
     t0 = time.time()
     domain = private_domain()
-    node = subprocess.Popen([sys.executable, "-m", "comanip.ros", "--params", str(params)], stderr=subprocess.DEVNULL,
-                            env={**os.environ, "ROS_DOMAIN_ID": str(domain)})
+    env = {**os.environ, "ROS_DOMAIN_ID": str(domain)}
+    if src is not None:
+        env["PYTHONPATH"] = str(src)
+    node = subprocess.Popen([sys.executable, "-m", "comanip.ros", "--params", str(params)], stderr=subprocess.DEVNULL, env=env)
     rclpy.init(domain_id=domain)
     player = Node("comanip_rate_benchmark")
     goals, statuses = {}, []
@@ -105,7 +111,6 @@ def two_processes(rate: float, times, states) -> dict:
         end = time.time() + 1.0
         while time.time() < end:
             rclpy.spin_once(player, timeout_sec=0.01)
-        wall = max(received for received, _ in goals.values()) - begin
         last = statuses[-1]
     finally:
         node.terminate()
@@ -114,36 +119,58 @@ def two_processes(rate: float, times, states) -> dict:
         rclpy.try_shutdown()
     stamps = sorted(goals)
     latencies = np.array([goals[s][0] - s for s in stamps])
-    return {"build_s": build, "wall_s": wall, "estimates": len(goals), "rate_hz": len(goals) / wall, "skipped": int(last["skipped"]),
-            "lost": float("nan"), "cold_ms": 1e3 * latencies[0], "median_ms": 1e3 * np.median(latencies[1:]),
-            "p95_ms": 1e3 * np.percentile(latencies[1:], 95), "goal_error_mm": 1e3 * np.linalg.norm(goals[stamps[-1]][1] - GOAL)}
+    delivered = (len(stamps) - 1) / (stamps[-1] - stamps[0])
+    return {"build_s": build, "estimates": len(goals), "rate_hz": delivered, "ratio": delivered / rate,
+            "skipped": int(last["skipped"]), "cold_ms": 1e3 * latencies[0], "median_ms": 1e3 * np.median(latencies[1:]),
+            "p95_ms": 1e3 * np.percentile(latencies[1:], 95), "goal_error_mm": 1e3 * np.linalg.norm(goals[stamps[-1]][1] - GOAL),
+            "status_rate_hz": float(last.get("achieved_rate_hz", "nan")),
+            "status_latency_ms": 1e3 * float(last.get("latency_median_s", "nan"))}
+
+
+def lock_step(times, states, repeats: int, tracker_rate: float) -> str:
+    settings = NodeSettings(estimation_rate=10 * tracker_rate)
+    transition = TransitionModel()
+    runs = [replay_once(settings, transition, times, states, None) for _ in range(repeats)]
+    m = {key: float(np.median([r[key] for r in runs])) for key in runs[0]}
+    return (f"| lock step, in-process | this | every pose | {m['estimates']:.0f} | {m['rate_hz']:.1f} | – | {m['skipped']:.0f} "
+            f"| {m['median_ms']:.1f} | {m['p95_ms']:.1f} | {m['cold_ms']:.0f} | | | {m['goal_error_mm']:.2g} | {m['build_s']:.1f} |")
+
+
+def _optional(value: float, digits: int) -> str:
+    """A table cell: blank for NaN (a node that does not report the value)."""
+    return "" if np.isnan(value) else f"{value:.{digits}f}"
 
 
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--repeats", type=int, default=3, help="replays per mode (default: %(default)s)")
+    parser.add_argument("--repeats", type=int, default=3, help="replays per row (default: %(default)s)")
     parser.add_argument("--tracker-rate", type=float, default=100.0, help="hand poses per second (default: %(default)s)")
+    parser.add_argument("--rates", default="20,50", help="estimation rates (Hz) of the real-time rows (default: %(default)s)")
+    parser.add_argument("--compare", type=Path, default=None, help="another checkout whose node runs the real-time rows too")
+    parser.add_argument("--no-lock-step", action="store_true", help="only the real-time rows")
     args = parser.parse_args(argv)
     times, states = tracker_samples(args.tracker_rate)
-    transition = TransitionModel()
-    every = 10 * args.tracker_rate
-    modes = [("lock step, in-process", None, every), ("real time, two processes", "processes", 20.0),
-             ("real time, two processes", "processes", every)]
-    print(f"{len(times)} hand poses at {args.tracker_rate:g} Hz over {times[-1]:.2f} s of reach; medians of {args.repeats} replays\n")
-    print("| replay | estimation_rate (Hz) | estimates | achieved estimate rate (Hz) | skipped poses | lost poses | latency median (ms) "
-          "| latency p95 (ms) | first (cold) estimate (ms) | final goal error (mm) | node build (s) |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
-    for name, speed, rate in modes:
-        settings = NodeSettings(estimation_rate=rate)
-        if speed == "processes":
-            runs = [two_processes(rate, times, states) for _ in range(args.repeats)]
-        else:
-            runs = [replay_once(settings, transition, times, states, speed) for _ in range(args.repeats)]
-        m = {key: float(np.median([r[key] for r in runs])) for key in runs[0]}
-        lost = "–" if np.isnan(m["lost"]) else f"{m['lost']:.0f}"
-        shown = "every pose" if rate > args.tracker_rate else f"{rate:g}"
-        print(f"| {name} | {shown} | {m['estimates']:.0f} | {m['rate_hz']:.1f} | {m['skipped']:.0f} | {lost} | {m['median_ms']:.1f} "
-              f"| {m['p95_ms']:.1f} | {m['cold_ms']:.0f} | {m['goal_error_mm']:.2g} | {m['build_s']:.1f} |")
+    print(f"{len(times)} hand poses at {args.tracker_rate:g} Hz over {times[-1]:.2f} s of reach; medians of {args.repeats} replays; "
+          f"load average {' '.join(f'{v:.2f}' for v in os.getloadavg())}\n")
+    print("| replay | code | estimation_rate (Hz) | estimates | delivered rate (Hz) | delivered / configured | skipped poses "
+          "| latency median (ms) | latency p95 (ms) | first (cold) estimate (ms) | status: rate (Hz) | status: latency median (ms) "
+          "| final goal error (mm) | node build (s) |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|")
+    if not args.no_lock_step:
+        print(lock_step(times, states, args.repeats, args.tracker_rate), flush=True)
+    codes = {"this": None} if args.compare is None else {"new": None, "ref": args.compare.resolve() / "src"}
+    for rate in (float(r) for r in args.rates.split(",")):
+        runs = {label: [] for label in codes}
+        for _ in range(args.repeats):
+            for label, src in codes.items():
+                runs[label].append(two_processes(rate, times, states, src))
+        for label, results in runs.items():
+            m = {key: float(np.median([r[key] for r in results])) for key in results[0]}
+            print(f"| real time, two processes | {label} | {rate:g} | {m['estimates']:.0f} | {m['rate_hz']:.2f} | {m['ratio']:.3f} "
+                  f"| {m['skipped']:.0f} | {m['median_ms']:.1f} | {m['p95_ms']:.1f} | {m['cold_ms']:.0f} "
+                  f"| {_optional(m['status_rate_hz'], 2)} | {_optional(m['status_latency_ms'], 1)} "
+                  f"| {m['goal_error_mm']:.2g} | {m['build_s']:.1f} |", flush=True)
+    print(f"\nload average at end {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
 
 
 if __name__ == "__main__":

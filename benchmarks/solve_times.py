@@ -238,6 +238,8 @@ CASES: dict[str, Callable[[], Case]] = {
     "planar_cold": cold_case("planar", 0.04, options=COMPILED, label=" compiled"),
     "cartesian_cold": cold_case("cartesian", 0.20, options=COMPILED, label=" compiled"),
     "planar_cold_uncompiled": cold_case("planar", 0.04, options=UNCOMPILED, label=" uncompiled"),
+    "planar_cold_ipopt": cold_case("planar", 0.04, options=SolverOptions(method="ipopt"), label=" IPOPT"),
+    "cartesian_cold_ipopt": cold_case("cartesian", 0.20, options=SolverOptions(method="ipopt"), label=" IPOPT"),
     "cartesian_cold_uncompiled": cold_case("cartesian", 0.20, options=UNCOMPILED, label=" uncompiled"),
     "human": reach_case("human", None, COMPILED, " compiled"),
     "human_cold": cold_case("human", options=COMPILED, label=" compiled"),

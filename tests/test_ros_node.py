@@ -103,6 +103,25 @@ def test_the_replay_writes_what_was_published(replayed):
     assert np.all(goals["latency_s"] > 0)
 
 
+def test_a_jittering_tracker_gets_the_configured_estimation_rate(reach, transition):
+    """Poses from a 100 Hz tracker whose stamps jitter by up to ±3 ms, at estimation_rate 20 Hz: the estimates lie
+    on the rate's grid of due times (the pose nearest each), 20 a second of input time, and the status says so.
+    A rule of one period since the last estimated pose gives about 17 a second here."""
+    settings, _, plan = reach
+    rng = np.random.default_rng(0)
+    times = np.arange(0.0, 2.0, 0.01) + np.r_[0.0, rng.uniform(-0.003, 0.003, 199)]
+    states = np.column_stack([np.interp(times, plan.t, plan.mean[:, k]) for k in range(6)])
+    with Replay(NodeSettings(estimation_rate=20.0), transition) as replay:
+        recording = replay.run(times, states, None)
+        status = replay.node.status()[1]
+    stamps = np.array([stamp for stamp, *_ in recording.goals])
+    assert len(stamps) > 30
+    assert (len(stamps) - 1) / (stamps[-1] - stamps[0]) == pytest.approx(20.0, abs=0.3)
+    assert np.all(np.abs(np.diff(stamps) - 0.05) < 0.02)  # each the pose nearest its due time: within 8 ms of it
+    assert status["achieved_rate_hz"] == pytest.approx(20.0, abs=0.3) and status["configured_rate_hz"] == 20.0
+    assert status["latency_median_s"] > 0
+
+
 def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, transition, capfd):
     settings, _, plan = reach
     nan = np.full(3, np.nan)

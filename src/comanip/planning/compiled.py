@@ -223,11 +223,23 @@ class BufferedFunction:
         for i in range(function.n_out()):
             sparsity = function.sparsity_out(i)
             self._entries.append(None if sparsity.is_dense() else tuple(np.array(v) for v in sparsity.get_triplet()))
+        # a dense output with one row or column needs no reordering: copied as it is, then given its shape
+        self._vectors = [entries is None and min(shape) == 1 for entries, shape in zip(self._entries, self._shapes)]
         self._buffer, self._evaluate = function.buffer()
         for i, array in enumerate(self._inputs):
             self._buffer.set_arg(i, memoryview(array))
         for i, array in enumerate(self._outputs):
             self._buffer.set_res(i, memoryview(array))
+
+    def vector(self, *args) -> np.ndarray:
+        """The first output's entries in column-major order (a fresh array; dense outputs only): a call without the
+        list of outputs and their reshaping, for a function whose first output is a vector."""
+        for array, value in zip(self._inputs, args):
+            array[:] = value.ravel(order="F") if getattr(value, "ndim", 0) > 1 else value
+        self._evaluate()
+        if self._buffer.ret() != 0:
+            raise RuntimeError(f"evaluating {self.function.name()} failed")
+        return self._outputs[0].copy()
 
     def __call__(self, *args) -> list[np.ndarray]:
         for array, value in zip(self._inputs, args):
@@ -237,8 +249,10 @@ class BufferedFunction:
         if self._buffer.ret() != 0:
             raise RuntimeError(f"evaluating {self.function.name()} failed")
         results = []
-        for values, shape, entries in zip(self._outputs, self._shapes, self._entries):
-            if entries is None:
+        for values, shape, entries, vector in zip(self._outputs, self._shapes, self._entries, self._vectors):
+            if vector:
+                results.append(values.copy().reshape(shape))
+            elif entries is None:
                 results.append(values.reshape(shape, order="F").copy())
             else:
                 dense = np.zeros(shape)

@@ -50,6 +50,9 @@ class ReachCurvature:
             faster per solve, at a few seconds' build per new model. None: load them if an earlier build for
             this model is in the disk cache, else run CasADi's virtual machine until
             :meth:`compile_in_background` has built them. False: the virtual machine.
+
+    One curvature serves one thread at a time: its evaluations and Hessians go through arrays it owns (the
+    compiled functions' buffers, the rows of Z~).
     """
 
     exact = True
@@ -69,9 +72,17 @@ class ReachCurvature:
         self.size = n * H
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
         self._tag = model_key(model)
+        self._noise_hessian = _noise_second_derivatives(model)
+        self._G = _constant_sensitivities(model)
+        self._velocity_hessian = _velocity_cost_hessian(problem)
+        self._build_constant_products()
+        nz = self._nz = d + len(self._triangle)
+        # where the terms' output vector's pieces end: the gradient, the per-step Hessians, the per-step gradients
+        self._term_ends = np.cumsum([1 + n * H, nz * nz * (H + 1), nz * (H + 1)])
+        self._diagonal = np.diag_indices(H * n)
+        params = ca.vertcat(problem.s0, problem.goal, problem.width)
         functions = [self._terms_function(problem),
-                     ca.Function("reach_value", [ca.vec(problem.tau), problem.s0, problem.goal, problem.width],
-                                 [problem.objective / -problem.best_objective])]
+                     ca.Function("reach_value", [ca.vec(problem.tau), params], [problem.objective / -problem.best_objective])]
         if compile:
             functions = [compiled_or_cached(function, self._tag) for function in functions]
         elif compile is None:
@@ -79,30 +90,24 @@ class ReachCurvature:
             functions = cached if all(f is not None for f in cached) else functions
         self._terms, self._value = (BufferedFunction(function) for function in functions)
         self._compiling = None  # the background build's future (compile_in_background)
-        self._effort = 2 * model.nu
-        self._noise_hessian = _noise_second_derivatives(model)
-        self._G = _constant_sensitivities(model)
-        self._velocity_hessian = _velocity_cost_hessian(problem)
-        self._build_constant_products()
 
     # -- the compiled per-solve function -------------------------------------------------------------
     def _terms_function(self, problem: ReachProblem) -> ca.Function:
-        """``(x, s0, goal, width) -> (f, grad f, ∇²phi_i stacked (nz, nz·(H+1)), ∇phi_i stacked (nz, H+1))``."""
-        model = problem.model
+        """``(x, p) -> [f; grad f; ∇²phi_i stacked (nz, nz·(H+1)); ∇phi_i stacked (nz, H+1)]``, the matrices column
+        by column in one output vector (:meth:`evaluate` slices it: a call copies one array out instead of four)."""
         x = ca.vec(problem.tau)
         scale = -problem.best_objective
         f = problem.objective / scale
-        step_terms = _reward_derivatives_function(model)
-        weights = problem.weights
+        step_terms = _reward_derivatives_function(problem.model)
         hessians, gradients = [], []
-        for w, mu_x, Sigma_x in zip(weights, problem.ee_means, problem.ee_covs):
+        for w, mu_x, Sigma_x in zip(problem.weights, problem.ee_means, problem.ee_covs):
             vech = ca.vertcat(*[Sigma_x[a, b] for a, b in self._triangle])
             hess, grad = step_terms(mu_x, vech, problem.goal, problem.width, w / scale)
             hessians.append(hess)
             gradients.append(grad)
-        return ca.Function("reach_terms", [x, problem.s0, problem.goal, problem.width],
-                           [f, ca.gradient(f, x), ca.horzcat(*hessians), ca.horzcat(*gradients)],
-                           ["x", "s0", "goal", "width"], ["f", "grad", "phi_hess", "phi_grad"])
+        return ca.Function("reach_terms", [x, ca.vertcat(problem.s0, problem.goal, problem.width)],
+                           [ca.vertcat(f, ca.gradient(f, x), ca.vec(ca.horzcat(*hessians)), ca.vec(ca.horzcat(*gradients)))],
+                           ["x", "p"], ["f_grad_phi_hess_phi_grad"])
 
     def _build_constant_products(self) -> None:
         """Z's mean rows and the coefficients of its covariance rows (linear in tau), fixed for a linear body.
@@ -114,6 +119,7 @@ class ReachCurvature:
         """
         model, G = self.model, self._G
         n, d, H = model.n, model.d, model.H
+        self._effort = 2 * model.nu
         a, b = self._triangle.T
         # dvech Sigma_x,i[v] / dtau_k[j] = Σ_l K[i, v, k, j, l] tau_k[l], v = (a, b) in vech order
         K = np.einsum("ikar,jlrs,ikbs->iabkjl", G, self._noise_hessian, G, optimize=True)[:, a, b]
@@ -131,6 +137,12 @@ class ReachCurvature:
         self._T = np.zeros((H + 1, d + len(a), d + rank))
         self._T[:, :d, :d] = np.eye(d)
         self._T[:, d:, d:] = self._U
+        self._T_transposed = np.swapaxes(self._T, 1, 2)  # a view
+        self._rows = np.empty((H + 1, d + rank, H, n))  # Z~ (_reduced_rows), its mean rows fixed
+        self._rows[:, :d] = self._mean_rows
+        # flat indices of the Hessian's block-diagonal entries (k·n + j, k·n + l), in the order of the blocks output
+        k, j, l = np.meshgrid(np.arange(H), np.arange(n), np.arange(n), indexing="ij")
+        self._block_entries = ((k * n + j) * (H * n) + k * n + l).ravel()
 
     def compile_in_background(self) -> None:
         """Build the per-solve function and the value-only one as C in a background thread
@@ -160,13 +172,15 @@ class ReachCurvature:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
-        s0, goal, width = self._split(params)
-        f, grad, phi_hess, phi_grad = self._terms(x, s0, goal, width)
-        return float(f.item()), grad.ravel(), ReachTerms(x, width, phi_hess, phi_grad)
+        out = self._terms.vector(x, params)
+        ends, nz, steps = self._term_ends, self._nz, self.model.H + 1
+        # the per-step pieces as views, column by column (as the compiled function wrote them)
+        return float(out[0]), out[1:ends[0]], ReachTerms(x, params[-1], out[ends[0]:ends[1]].reshape((nz, nz * steps), order="F"),
+                                                         out[ends[1]:ends[2]].reshape((nz, steps), order="F"))
 
     def value(self, x: np.ndarray, params: np.ndarray) -> float:
         """f at torques x (H·n,) alone."""
-        return float(self._value(x, *self._split(params))[0].item())
+        return float(self._value.vector(x, params)[0])
 
     def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, None]:
         """(f, None) at torques x: a point mass has no path limits, so a line-search trial needs no data."""
@@ -174,22 +188,21 @@ class ReachCurvature:
 
     def hessian(self, data: ReachTerms) -> np.ndarray:
         """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
-        x, width, phi_hess, phi_grad = data.x, data.width, data.phi_hess, data.phi_grad
+        phi_hess, phi_grad = self._pieces(data)
         model = self.model
         n, d, H = model.n, model.d, model.H
         nz = phi_hess.shape[0]
         rank = self._U.shape[2]
         T = self._T
-        Q = np.swapaxes(T, 1, 2) @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
-        Z = self._reduced_rows(x)
+        Q = self._T_transposed @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
+        Z = self._reduced_rows(data)
         QZ = np.matmul(Q, Z)
         hessian = _causal_gram(Z.reshape(-1, H * n), QZ.reshape(-1, H * n), d + rank, n)
         # ∇²_tau Σ_i Σ_v (dphi_i/dvech_v) Sigma_x,i[v]: the noise's own curvature, block-diagonal in k
         weights = np.einsum("ivr,vi->ir", self._U, phi_grad[d:])
         blocks = weights.reshape(1, -1) @ self._K.reshape((H + 1) * rank, H * n * n)
-        steps = np.arange(H)
-        hessian.reshape(H, n, H, n)[steps, :, steps, :] += blocks.reshape(H, n, n)
-        hessian[np.diag_indices(H * n)] += self._effort / self.normaliser(width)
+        hessian.ravel()[self._block_entries] += blocks.ravel()
+        hessian[self._diagonal] += self._effort / self.normaliser(data.width)
         if self._velocity_hessian is not None:  # the speed cost is scaled by |J_best| already
             hessian += self._velocity_hessian
         return hessian
@@ -202,32 +215,40 @@ class ReachCurvature:
         columns of the per-step derivatives the Hessian uses anyway. Then ∂f/∂g = Σ_i ∂phi_i/∂g,
         ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
         """
-        x, phi_hess, phi_grad = data.x, data.phi_hess, data.phi_grad
+        phi_hess, phi_grad = self._pieces(data)
+        H, d = self.model.H, self.model.d
+        Q = phi_hess.reshape(phi_hess.shape[0], H + 1, phi_hess.shape[0]).transpose(1, 0, 2)
+        return -phi_grad[:d].sum(axis=1), self.goal_cross_derivative(data), Q[:, :d, :d].sum(axis=0)
+
+    def goal_cross_derivative(self, data: ReachTerms) -> np.ndarray:
+        """∂²f/∂x∂g (H·n, d) of :meth:`goal_derivatives` alone (what the tangential predictor needs)."""
+        phi_hess, _ = self._pieces(data)
         H, d = self.model.H, self.model.d
         nz = phi_hess.shape[0]
         Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
-        Z = self._reduced_rows(x)
+        Z = self._reduced_rows(data)
         # Z_iᵀ M = Z~_iᵀ T_iᵀ M: the rows are kept in the reduced basis z~_i (see _build_constant_products)
-        goal_columns = -np.swapaxes(self._T, 1, 2) @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
-        cross = Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
-        return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
+        goal_columns = -self._T_transposed @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
+        return Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
 
-    def _reduced_rows(self, x: np.ndarray) -> np.ndarray:
-        """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n): mean rows fixed, covariance rows linear in tau."""
+    @staticmethod
+    def _pieces(data: ReachTerms) -> tuple[np.ndarray, np.ndarray]:
+        """The data's per-step Hessians (nz, nz·(H+1)) and gradients (nz, H+1), row by row in memory (the products
+        above then run through the same code paths, and round the same, whatever the views' layout)."""
+        return np.ascontiguousarray(data.phi_hess), np.ascontiguousarray(data.phi_grad)
+
+    def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
+        """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear
+        in tau. The array is the curvature's own, its mean rows written once: valid until the next call."""
         model = self.model
         n, d, H = model.n, model.d, model.H
-        tau = np.asarray(x).reshape(H, n)
-        Z = np.empty((H + 1, d + self._U.shape[2], H, n))
-        Z[:, :d] = self._mean_rows
+        tau = np.asarray(data.x).reshape(H, n)
+        Z = self._rows
         if self._K_diagonal is not None:
             np.multiply(self._K_diagonal, tau, out=Z[:, d:])
         else:
             np.einsum("irkjl,kl->irkj", self._K, tau, out=Z[:, d:])
         return Z.reshape(H + 1, d + self._U.shape[2], H * n)
-
-    def _split(self, params):
-        n2, d = self.model.state_size, self.model.d
-        return params[:n2], params[n2:n2 + d], params[-1]
 
 
 def _is_compiled(function: ca.Function) -> bool:

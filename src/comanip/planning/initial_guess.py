@@ -23,23 +23,57 @@ def minimum_jerk(x0, v0, x1, duration, t) -> tuple[np.ndarray, np.ndarray, np.nd
     may also be durations (m,), one profile each: the outputs are then (m, len(t), k).
     With v0 = 0 this is the Flash–Hogan minimum-jerk profile (peak speed at mid-movement).
     """
-    x0, v0, x1 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (x0, v0, x1))
     durations = np.asarray(duration, dtype=float)
-    T = durations.reshape(-1, 1, 1)  # (m, 1, 1)
-    # the quintic's coefficients in closed form (x(0) = x0, x'(0) = v0, x''(0) = 0, x(T) = x1, x'(T) = x''(T) = 0)
-    delta = x1 - x0
-    a3 = (10 * delta - 6 * v0 * T) / T**3
-    a4 = (-15 * delta + 8 * v0 * T) / T**4
-    a5 = (6 * delta - 3 * v0 * T) / T**5
-    t = np.asarray(t, dtype=float)
-    tc = np.minimum(np.maximum(t, 0.0)[None, :, None], T)  # (m, len(t), 1)
-    pos = x0 + v0 * tc + tc**3 * (a3 + tc * (a4 + tc * a5))
-    vel = v0 + tc**2 * (3 * a3 + tc * (4 * a4 + tc * 5 * a5))
-    acc = tc * (6 * a3 + tc * (12 * a4 + tc * 20 * a5))
-    after = t[None, :] > T[:, :, 0]
-    vel[after] = 0.0
-    acc[after] = 0.0
+    pos, vel, acc = _quintic(x0, v0, x1, _QuinticTimes(durations, np.asarray(t, dtype=float)))
     return (pos, vel, acc) if durations.ndim else (pos[0], vel[0], acc[0])
+
+
+class _QuinticTimes:
+    """The parts of :func:`minimum_jerk` that depend on the durations (m,) and times (K,) alone: powers of the
+    durations T and of the clipped times tc = min(max(t, 0), T), and where t is past T. A planner's guesses
+    use the same durations and steps every solve (:func:`_step_times` keeps them)."""
+
+    def __init__(self, durations: np.ndarray, t: np.ndarray):
+        T = self.T = durations.reshape(-1, 1, 1)  # (m, 1, 1)
+        self.powers = np.stack([T**3, T**4, T**5])  # (3, m, 1, 1)
+        tc = self.tc = np.minimum(np.maximum(t, 0.0)[None, :, None], T)  # (m, K, 1)
+        self.tc2, self.tc3 = tc**2, tc**3
+        self.tc_scaled = np.stack([tc * 5, tc * 20])  # (2, m, K, 1): the a5 factors of velocity and acceleration
+        self.after = t[None, :] > T[:, :, 0]
+
+
+_COEFFICIENTS = np.array([[10.0, -15.0, 6.0], [6.0, -8.0, 3.0]]).reshape(2, 3, 1, 1, 1)
+"""The quintic's coefficients a3, a4, a5 = (c·delta - c'·v0·T) / (T³, T⁴, T⁵): rows c and c'."""
+_DERIVATIVE_FACTORS = np.array([[3.0, 6.0], [4.0, 12.0]]).reshape(2, 2, 1, 1, 1)
+"""The factors of a3 (first row) and a4 (second row) in the velocity and the acceleration."""
+
+
+@functools.lru_cache(maxsize=32)
+def _step_times(durations: tuple[float, ...], h: float, H: int) -> _QuinticTimes:
+    """:class:`_QuinticTimes` of the durations (s) at the steps t_i = h·i, i < H, built once per arguments."""
+    return _QuinticTimes(np.array(durations), h * np.arange(H))
+
+
+def _quintic(x0, v0, x1, times: _QuinticTimes, positions: bool = True) -> tuple[np.ndarray | None, np.ndarray, np.ndarray]:
+    """Position (None unless ``positions``), velocity and acceleration (m, K, k) of :func:`minimum_jerk` for every
+    duration of ``times``.
+
+    Velocity and acceleration are computed side by side (stacked on a first axis), each entry by the same
+    floating-point operations as the formulas in the comments (x - (-y) is x + y exactly)."""
+    x0, v0, x1 = (np.atleast_1d(np.asarray(v, dtype=float)) for v in (x0, v0, x1))
+    tc = times.tc
+    # the quintic's coefficients in closed form (x(0) = x0, x'(0) = v0, x''(0) = 0, x(T) = x1, x'(T) = x''(T) = 0):
+    # a3 = (10 delta - 6 v0 T) / T³, a4 = (-15 delta + 8 v0 T) / T⁴, a5 = (6 delta - 3 v0 T) / T⁵
+    a3, a4, a5 = (_COEFFICIENTS[0] * (x1 - x0) - _COEFFICIENTS[1] * v0 * times.T) / times.powers
+    # velocity v0 + tc² (3 a3 + tc (4 a4 + tc·5 a5)), acceleration tc (6 a3 + tc (12 a4 + tc·20 a5))
+    inner = _DERIVATIVE_FACTORS[1] * a4 + times.tc_scaled * a5
+    outer = _DERIVATIVE_FACTORS[0] * a3 + tc * inner
+    vel = v0 + times.tc2 * outer[0]
+    acc = tc * outer[1]
+    pos = x0 + v0 * tc + times.tc3 * (a3 + tc * (a4 + tc * a5)) if positions else None
+    vel[times.after] = 0.0
+    acc[times.after] = 0.0
+    return pos, vel, acc
 
 
 def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration,
@@ -49,8 +83,11 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
 
     ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics_of`, evaluated
     once by a caller that makes many guesses; None evaluates them here."""
-    t = h * np.arange(H)
-    q, qdot, qddot = minimum_jerk(start[: body.n], start[body.n:2 * body.n], goal_q, duration, t)
+    durations = np.asarray(duration, dtype=float)
+    q, qdot, qddot = _quintic(start[: body.n], start[body.n:2 * body.n], goal_q,
+                              _step_times(tuple(durations.ravel().tolist()), h, H), positions=not body.is_linear)
+    if not durations.ndim:
+        q, qdot, qddot = None if q is None else q[0], qdot[0], qddot[0]
     if body.is_linear:  # constant M and G: inverse dynamics of all steps (and durations) at once
         M, G = linear_dynamics or linear_dynamics_of(body)
         force = qddot @ M.T + qdot @ body.damping.T + G
@@ -120,11 +157,13 @@ def brake_durations(horizon_s: float) -> np.ndarray:
     return np.array([1 / 6, 1 / 3]) * horizon_s
 
 
+@functools.lru_cache(maxsize=32)
 def guess_durations(horizon_s: float, count: int) -> np.ndarray:
-    """Reach durations (s) to try as initial guesses: spread over 25 %–75 % of the horizon."""
-    if count == 1:
-        return np.array([0.5 * horizon_s])
-    return np.linspace(0.25, 0.75, count) * horizon_s
+    """Reach durations (s) to try as initial guesses: spread over 25 %–75 % of the horizon (read only: one
+    array per arguments, shared by every caller)."""
+    durations = np.array([0.5 * horizon_s]) if count == 1 else np.linspace(0.25, 0.75, count) * horizon_s
+    durations.flags.writeable = False
+    return durations
 
 
 def _superposed(body: Body, h: float, torque: np.ndarray, inertia: np.ndarray, direction: np.ndarray,

@@ -60,7 +60,8 @@ f must be finite at x0; a trial point where f is not finite is treated as a fail
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+import math
+from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
@@ -76,6 +77,8 @@ _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
 _REUSE_RATIO = 0.1
 """An exact Hessian's factor is reused while each step cuts the gradient by at least this factor."""
+_NO_ROWS, _NO_MULTIPLIERS = np.zeros(0, dtype=int), np.zeros(0)
+"""An empty working set and its multipliers (read only)."""
 
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
@@ -116,20 +119,22 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
         no step was taken or its matrix had secant updates since it was factored) and the evaluation's ``data``
         at x.
     """
-    hessian_refresh = as_count("hessian_refresh", hessian_refresh, unit="iterations")
+    if type(hessian_refresh) is not int or hessian_refresh != 1:
+        hessian_refresh = as_count("hessian_refresh", hessian_refresh, unit="iterations")
     if hessian_refresh > 1 and not secant:
         raise ValueError(f"hessian_refresh must be 1 without secant corrections (an exact Hessian is assembled at "
                          f"every iteration), got {hessian_refresh}")
     solver = _ActiveSetNewton(evaluate, hessian, _Constraints(lb, ub, constraints), value, tolerance=tolerance,
                               constraint_tolerance=constraint_tolerance, margin=margin, hessian_refresh=hessian_refresh)
-    x = np.clip(np.asarray(x0, dtype=float), lb, ub)
+    problem = solver.problem
+    x = np.array(x0, dtype=float) if problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
-    if not (np.isfinite(f) and np.all(np.isfinite(g))):
+    if not _finite(f, g):
         return SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf)
     return solver.run(solver.at(x, f, g, data), max_iterations, secant, expired)
 
 
-@dataclass
+@dataclass(slots=True)
 class _Iterate:
     """A point x (N,) and what was evaluated there: f, its gradient (None after a value-only trial), the
     evaluation's data, the constraints c (bounds first) and rows(indices) of their Jacobian."""
@@ -140,6 +145,16 @@ class _Iterate:
     data: Any
     c: np.ndarray
     rows: Callable[[np.ndarray], np.ndarray]
+    largest: float = field(init=False)
+    """max c (-inf without constraints): the working set, the violation and the merit's penalty read it first."""
+
+    def __post_init__(self):
+        self.largest = float(self.c.max()) if len(self.c) else -math.inf
+
+    @property
+    def violation(self) -> float:
+        """max(0, c): the largest violation, bounds included."""
+        return max(0.0, self.largest)
 
 
 @dataclass
@@ -171,7 +186,7 @@ class _ActiveSetNewton:
         stepped_with = None  # the factorisation of the last step taken
 
         def result(status, message, optimality):
-            return SolverResult(point.x, point.f, status, message, iterations, optimality, self.problem.violation(point.c),
+            return SolverResult(point.x, point.f, status, message, iterations, optimality, point.violation,
                                 (stepped_with, point.data))
 
         while True:
@@ -180,7 +195,7 @@ class _ActiveSetNewton:
             if expired():
                 return result(Status.MAX_WALL_TIME, "wall-time budget spent", np.inf)
             iterations += 1
-            free = not (point.c > -self.margin).any()
+            free = point.largest <= -self.margin
             if free:
                 # no constraint in the working set: the Lagrangian's gradient is the gradient, and a converged
                 # point needs no Hessian (a warm point-mass solve's last of about five)
@@ -193,7 +208,7 @@ class _ActiveSetNewton:
                     # well enough (a chord step, Kelley 2003, sec. 5.4), at a third of a point mass's iteration
                     step = -cholesky_solve(kept[0], point.g)
                     kept = (kept[0], optimality)
-                    alpha, accepted = self._line_search(point, step, np.zeros(0, dtype=int), None, merit_weight, full_steps)
+                    alpha, accepted = self._line_search(point, step, _NO_ROWS, None, merit_weight, full_steps)
                     full_steps = alpha == 1.0
                     if accepted is not None:
                         point, stepped_with = accepted, kept[0]
@@ -233,20 +248,24 @@ class _ActiveSetNewton:
                 factor, solve = updated.factor, updated.solve
             else:
                 solve = lambda b, factor=factor: cholesky_solve(factor, b)  # noqa: E731
-            step, multipliers, working, correct = _constrained_step(solve, point.g, point.c, point.rows, self.margin,
-                                                                    self.constraint_tolerance)
-            lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
-            optimality = float(np.abs(lagrangian_gradient).max())
-            converged = self._converged(optimality, point, history)
-            if converged is not None:
-                return result(*converged, optimality)
-            if free and not secant and len(working) == 0:
+            if free:  # the Newton step; its optimality was tested above
+                step, multipliers, working, correct = -solve(point.g), _NO_MULTIPLIERS, _NO_ROWS, None
+            else:
+                step, multipliers, working, correct = _constrained_step(solve, point.g, point.c, point.rows, self.margin,
+                                                                        self.constraint_tolerance)
+                lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
+                optimality = float(np.abs(lagrangian_gradient).max())
+                converged = self._converged(optimality, point, history)
+                if converged is not None:
+                    return result(*converged, optimality)
+            if free and not secant:
                 kept = (factor, optimality)
-            merit_weight = max(merit_weight, 2 * float(np.max(multipliers, initial=0.0)))
+            if len(multipliers):
+                merit_weight = max(merit_weight, 2 * float(np.max(multipliers)))
             alpha, accepted = self._line_search(point, step, working, correct, merit_weight, full_steps)
             model_held = alpha == 1.0 and len(working) == 0
             full_steps = alpha == 1.0
-            if accepted is None and self.problem.violation(point.c) > self.constraint_tolerance:
+            if accepted is None and point.violation > self.constraint_tolerance:
                 accepted = self._restore(point)
             elif accepted is not None:
                 recoveries = 0
@@ -264,7 +283,7 @@ class _ActiveSetNewton:
 
     def _converged(self, optimality: float, point: _Iterate, history: list[float]) -> tuple[Status, str] | None:
         """(status, message) when the point is a solution (module docstring, Convergence), else None."""
-        violation = self.problem.violation(point.c)
+        violation = point.violation
         if violation > self.constraint_tolerance:
             return None
         if optimality <= self.tolerance:
@@ -276,16 +295,18 @@ class _ActiveSetNewton:
 
     def _final_status(self, optimality: float, point: _Iterate) -> tuple[Status, str]:
         """(status, message) when no step decreases the merit, even after the recoveries."""
-        violation = self.problem.violation(point.c)
+        violation = point.violation
         if optimality <= max(100 * self.tolerance, _STALL_GRADIENT) and violation <= self.constraint_tolerance:
             return Status.SOLVED_ACCEPTABLE, "no step decreases the objective any further"
         status = Status.CONSTRAINTS_VIOLATED if violation > self.constraint_tolerance else Status.FAILED
         return status, f"no step decreases the merit any further (violation {violation:.3g}, gradient {optimality:.3g})"
 
-    def _penalty(self, c: np.ndarray) -> float:
+    def _penalty(self, point: _Iterate) -> float:
         """The merit's l1 violation, counted from half the tolerance: violations the solution may keep cost
         nothing, so the curvature of many nearly active limits cannot block steps that lower f."""
-        return float(np.maximum(c - 0.5 * self.constraint_tolerance, 0.0).sum())
+        if point.largest <= 0.5 * self.constraint_tolerance:
+            return 0.0
+        return float(np.maximum(point.c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: _Iterate, step: np.ndarray, working: np.ndarray, correct,
                      merit_weight: float, full_step_likely: bool) -> tuple[float, _Iterate | None]:
@@ -296,28 +317,30 @@ class _ActiveSetNewton:
         step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
         working set: that trial is evaluated with its gradient at once, saving the value-only call (a fifth of
         an evaluation on the Panda) on most iterations for a wasted gradient on the few whose full step fails."""
-        penalty = self._penalty(point.c)
+        penalty = self._penalty(point)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
         if not slope < -1e-16 * max(1.0, abs(merit)):
             return 0.0, None
 
         def attempt(alpha: float, bound: float) -> _Iterate | None:
-            trial = self._trial(point.x + alpha * step, with_gradient=full_step_likely and alpha == 1.0 and not len(working))
+            trial = self._trial(point.x + step if alpha == 1.0 else point.x + alpha * step,
+                                with_gradient=full_step_likely and alpha == 1.0 and not len(working))
             if trial is None:
                 return None
-            if len(working) and self._penalty(trial.c) > penalty:
+            if len(working) and self._penalty(trial) > penalty:
                 # second-order correction: the step broke the curved constraints; pull it back onto their
                 # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
                 # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
                 corrected = self._trial(trial.x + correct(trial.c[working]))
-                if corrected is not None and corrected.f + merit_weight * self._penalty(corrected.c) <= bound:
+                if corrected is not None and corrected.f + merit_weight * self._penalty(corrected) <= bound:
                     trial = corrected
-            if trial.f + merit_weight * self._penalty(trial.c) > bound:
+            if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
-            if trial.g is None:
+            if trial.g is None:  # a trial evaluated with its gradient was checked finite by _trial
                 trial = self.at(trial.x, *self.evaluate(trial.x))
-            return trial if _finite(trial.f, trial.g) else None
+                return trial if _finite(trial.f, trial.g) else None
+            return trial
 
         alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
         return (alpha, accepted) if accepted is not None else (0.0, None)
@@ -342,13 +365,14 @@ class _ActiveSetNewton:
             f, g, data = self.evaluate(x)
             if np.isfinite(f) and np.all(np.isfinite(g)):
                 trial = self.at(x, f, g, data)
-                if self.problem.violation(trial.c) < 0.5 * self.problem.violation(point.c):
+                if trial.violation < 0.5 * point.violation:
                     return trial
         return None
 
 
 def _finite(f: float, g: np.ndarray | None) -> bool:
-    return bool(np.isfinite(f)) and (g is None or bool(np.isfinite(g).all()))
+    """f and every entry of g finite (a sum of finite gradient entries is finite short of overflow, 1e308)."""
+    return math.isfinite(f) and (g is None or math.isfinite(g.sum()))
 
 
 class _Constraints:
@@ -360,9 +384,12 @@ class _Constraints:
         self.lower = np.flatnonzero(np.isfinite(lb))
         self.lb, self.ub, self.size = lb, ub, len(lb)
         self.all_finite = len(self.upper) == len(self.lower) == self.size
+        self.unbounded = len(self.upper) == len(self.lower) == 0
 
     def __call__(self, x, data):
-        if self.all_finite:  # the usual case (torque bounds): no index arrays to gather through
+        if self.unbounded:  # no finite bound (the point masses' torques): no rows at all
+            bounds = _NO_MULTIPLIERS
+        elif self.all_finite:  # the usual bounded case (torque bounds): no index arrays to gather through
             bounds = np.concatenate([x - self.ub, self.lb - x])
         else:
             bounds = np.concatenate([x[self.upper] - self.ub[self.upper], self.lb[self.lower] - x[self.lower]])
@@ -388,10 +415,6 @@ class _Constraints:
         out[np.flatnonzero(upper), self.upper[indices[upper]]] = 1.0
         out[np.flatnonzero(~upper), self.lower[indices[~upper] - n_upper]] = -1.0
         return out
-
-    @staticmethod
-    def violation(c) -> float:
-        return float(max(0.0, c.max(initial=0.0)))
 
 
 def _constrained_step(solve, g, c, A, margin: float, tolerance: float):

@@ -14,6 +14,7 @@ iterations per warm Franka solve against 50–70 with the working set (benchmark
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -35,7 +36,7 @@ class PathLimits:
         upper = np.tile(np.concatenate([body.q_max, body.qdot_max]), (H, 1))
         return cls(lower, upper)
 
-    @property
+    @cached_property
     def active(self) -> bool:
         """True when any limit is finite."""
         return bool(np.isfinite(self.lower).any() or np.isfinite(self.upper).any())

@@ -14,7 +14,7 @@ Two solvers (``SolverOptions.method``):
   (:mod:`comanip.planning.newton`) on a Hessian assembled from per-step pieces: exact for point masses
   (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
   (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
-  Two to four times faster than IPOPT on the point masses (benchmarks/README.md).
+  Several times faster than IPOPT on the point masses, to the same optimum (benchmarks/README.md).
 - ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference,
   point masses only.
 
@@ -30,7 +30,7 @@ Symbols, shapes and units: ``docs/notation.md``.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import casadi as ca
 import numpy as np
@@ -47,6 +47,7 @@ from comanip.planning.initial_guess import (brake_durations, braked_torques, gue
                                           minimum_jerk_torques, retargeted_torques)
 from comanip.optim import SolverResult, Status, cholesky_solve
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
+from comanip.planning.compiled import BufferedFunction
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
@@ -180,18 +181,21 @@ class Planner:
         self._curvature = self._newton_terms() if self.options.method == "newton" else None
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
+        self._torque_box = tuple(bound.reshape(H, body.n) for bound in self._torque_bounds)  # the same, (H, n)
+        self._unbounded = not np.isfinite(body.tau_max).any()
         self._limits = PathLimits.of(self.model)
         self._linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
         # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
         self._task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
             if body.is_linear else None
-        self._blas = ThreadpoolController()
+        self._blas = _SingleThreadBlas()
         self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
         self._library = self._reach_library()
         ranked_arm = self.options.cold_search == "ranked" and not body.is_linear
         self._arm_library = self._arm_reach_library() if ranked_arm else None
         self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
-        self._goal_sensitivity = None  # (torques (H, n) of the last plan, their d tau/d goal (H·n, d)): _predicted
+        self._last_solution: _LastSolution | None = None  # the last point-mass plan's, for _predicted
+        self._kinematics = BufferedFunction(body.kinematics_function)
 
     def _arm_reach_library(self) -> ArmReachLibrary | None:
         """The arm's reach library: ``options.arm_library`` (it must be this model's) or the shipped one."""
@@ -291,11 +295,12 @@ class Planner:
         unreachable = self._unreachable_plan(start, goal, width, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
-        guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
-                                        goal_q=goal_q if warm_start is None else None)
-        from_library = warm_start is None and self._arm_library is not None and self._arm_library.serves(start)
-        plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
-                                                 until_converged=from_library))
+        with self._blas:  # the starts' small products too: one BLAS switch per solve
+            guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
+                                            goal_q=goal_q if warm_start is None else None)
+            from_library = warm_start is None and self._arm_library is not None and self._arm_library.serves(start)
+            plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
+                                                     until_converged=from_library))
         self._count_solving_time(plan.solve_time)
         return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
 
@@ -380,16 +385,27 @@ class Planner:
         model = self.model
         return warm_start.torque + (remembered[1] @ (goal - warm_start.goal)).reshape(model.H, model.n)
 
-    def _goal_sensitivity_at(self, result: SolverResult) -> np.ndarray | None:
-        """d tau*/d goal (H·n, d) = -∇²f⁻¹ ∂²f/∂tau∂goal at a converged point-mass solve (the implicit function
-        theorem, with the Newton method's last factorisation), which :meth:`_solve_from` keeps with the plan's
-        torques for :meth:`_predicted`; None otherwise. About 0.05 ms."""
+    @property
+    def _goal_sensitivity(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(torques (H, n) of the planner's last plan, their d tau*/d goal (H·n, d)) if that was a converged
+        point-mass solve (:class:`_LastSolution`), else None; the sensitivity is computed on the first request."""
+        last = self._last_solution
+        if last is None:
+            return None
+        if last.sensitivity is None:
+            with self._blas:
+                last.sensitivity = -cholesky_solve(last.factor, self._curvature.goal_cross_derivative(last.data))
+        return last.torque, last.sensitivity
+
+    def _solution_of(self, result: SolverResult, torque: np.ndarray) -> _LastSolution | None:
+        """What :meth:`_goal_sensitivity` needs of a converged point-mass solve (the Newton method's last
+        factorisation and the evaluation at the plan), kept for the planner's last plan; None otherwise."""
         curvature = self._curvature
         if curvature is None or not curvature.exact or not result.success or result.local_model is None \
                 or result.local_model[0] is None:
             return None
         factor, data = result.local_model
-        return -cholesky_solve(factor, curvature.goal_derivatives(data)[1])
+        return _LastSolution(torque, factor, data)
 
     def _retargeted(self, torque: np.ndarray, mean: np.ndarray, planned_goal: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
         """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
@@ -406,9 +422,10 @@ class Planner:
     def _lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
         """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
         path keeps the joint limits (all candidates if none does)."""
-        model = self.model
         params = np.concatenate([start, goal, [width]])
-        low, high = (bound.reshape(model.H, model.n) for bound in self._torque_bounds)
+        low, high = self._torque_box
+        if self._unbounded:  # no torque bound (the point masses): clipping would only copy
+            return min(candidates, key=lambda c: self._start_rank(c, params))
         return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._start_rank(c, params))
 
     def _start_rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
@@ -449,7 +466,9 @@ class Planner:
         if moving and self._drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
             return guesses
         params = np.concatenate([start, goal, [width]])
-        best_guess = min(guesses, key=lambda guess: self._objective(guess, params))
+        objectives = [self._objective(guess, params) for guess in guesses]
+        first_best = min(range(len(guesses)), key=objectives.__getitem__)
+        best_guess = guesses[first_best]
         turned = self._library.guess(start, goal, width, solve_missing=not budgeted)
         if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
             return guesses if self._narrow(start, goal, width) else [best_guess]
@@ -458,7 +477,9 @@ class Planner:
             candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
                                                             guess_durations(model.duration, self.options.n_starts),
                                                             self._linear_dynamics))
-        best = min(candidates + [best_guess], key=lambda guess: self._objective(guess, params))
+        scored = [(self._objective(candidate, params), candidate) for candidate in candidates] + \
+            [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
+        best = min(scored, key=lambda pair: pair[0])[1]
         return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
 
     def _arm_library_starts(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
@@ -502,8 +523,7 @@ class Planner:
 
     def _narrow(self, start, goal, width) -> bool:
         """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
-        model = self.model
-        position = np.asarray(model.body.kinematics_function(start[: model.n])[0]).ravel()
+        position = self._kinematics(start[: self.model.n])[0].ravel()
         return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
 
     def _cold_guesses(self, start, goal, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
@@ -530,19 +550,19 @@ class Planner:
         of the full search (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         params = np.concatenate([start, goal, [width]])
-        normaliser = self.problem.normaliser(width)
         best = None
         iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
         # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
-        with self._blas.limit(limits=1, user_api="blas"):
+        with self._blas:
             for guess in guesses:
                 if time.perf_counter() > deadline and best is not None:
                     break
                 candidate = self._run_solver(guess, params, deadline)
                 iterations += candidate.nit
-                if not np.all(np.isfinite(candidate.x)) or not np.isfinite(candidate.fun):
-                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width) / normaliser,
+                if not np.isfinite(candidate.x).all() or not np.isfinite(candidate.fun):
+                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width)
+                                             / self.problem.normaliser(width),
                                              Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
                                              candidate.nit, np.inf)
                 # The plan within the limits with the lowest objective wins, whatever its status: a start that
@@ -552,11 +572,10 @@ class Planner:
                     best = candidate
                 if until_converged and best.status == Status.SOLVED and self._ends_at_goal(best.x, params):
                     break
-        sensitivity = self._goal_sensitivity_at(best)
         evaluation = None if best.local_model is None else (best.fun, best.local_model[1])
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
-        self._goal_sensitivity = None if sensitivity is None else (plan.torque, sensitivity)
+        self._last_solution = self._solution_of(best, plan.torque)
         return plan
 
     def _ends_at_goal(self, torque: np.ndarray, params: np.ndarray) -> bool:
@@ -594,7 +613,8 @@ class Planner:
                                  constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                                  constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
                                  value=value)
-        return replace(result, x=result.x.reshape(self.model.H, self.model.n))
+        result.x = result.x.reshape(self.model.H, self.model.n)
+        return result
 
     def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
         solver = self._ipopt
@@ -604,6 +624,44 @@ class Planner:
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
+
+
+@dataclass(eq=False)
+class _LastSolution:
+    """A converged point-mass plan's torques (H, n), the Cholesky factor of its solve's last Newton step and the
+    evaluation at the plan: d tau*/d goal = -∇²f⁻¹ ∂²f/∂tau∂goal by the implicit function theorem (about 0.05 ms),
+    computed when a warm start from the plan asks for it (:meth:`Planner._predicted`), not after every solve."""
+
+    torque: np.ndarray
+    factor: tuple
+    data: object
+    sensitivity: np.ndarray | None = None
+    """d tau*/d goal (H·n, d) once computed."""
+
+
+class _SingleThreadBlas:
+    """A context in which the BLAS libraries loaded when it was made run on one thread (their thread counts are
+    restored on leaving; nested contexts leave them to the outermost). threadpoolctl's own ``limit`` looks the
+    libraries up on every entry, which costs about as much as a point mass's Newton step."""
+
+    def __init__(self):
+        self._libraries = ThreadpoolController().select(user_api="blas").lib_controllers
+        self._depth, self._restore = 0, []
+
+    def __enter__(self):
+        if self._depth == 0:
+            self._restore = [(library, library.num_threads) for library in self._libraries if library.num_threads != 1]
+            for library, _ in self._restore:
+                library.set_num_threads(1)
+        self._depth += 1
+        return self
+
+    def __exit__(self, *exception):
+        self._depth -= 1
+        if self._depth == 0:
+            for library, threads in self._restore:
+                library.set_num_threads(threads)
+        return False
 
 
 def _distance(body, q: np.ndarray, point: np.ndarray) -> float:

@@ -50,6 +50,7 @@ class ReachProblem:
         # normalise J for the solver so its tolerances mean the same for every width; the minimiser is unchanged.
         self.best_objective = -float(np.sum(weights)) * self.reward.peak(self.width)
         self._weight_sum = float(np.sum(weights))
+        self._normalised = (float("nan"), float("nan"))  # (width, |J_best|) of the last normaliser call
         self.normaliser_function = ca.Function("normaliser", [self.width], [-self.best_objective])
         """``width -> |J_best(w)|`` as a CasADi function (for building other functions of the width)."""
         if model.has_velocity_cost:  # relative to the best reward, so it means the same for every width
@@ -66,12 +67,21 @@ class ReachProblem:
         self._ee_velocity = BufferedFunction(ca.Function("ee_velocity", [q, qdot], [ca.mtimes(body.jacobian(q), qdot)]).map(H + 1))
         # NumPy in and out without CasADi's DM conversions (they cost more than a point mass's rollout itself)
         self._trajectory = BufferedFunction(self.trajectory)
+        self._trajectory_outputs = self.trajectory.name_out()
+        # a linear body's plan in one call: the trajectory with the end effector's mean velocity J(mu_q) mu_qdot
+        self._plan_rollout = BufferedFunction(ca.Function(
+            "plan_rollout", [ca.vec(self.tau), self.s0, self.goal, self.width],
+            self.trajectory.call([ca.vec(self.tau), self.s0, self.goal, self.width])
+            + [ca.horzcat(*[ca.mtimes(body.jacobian(m[:n]), m[n:2 * n]) for m in self.means])])) if body.is_linear else None
         self._ee_belief = BufferedFunction(ee.map(H + 1))
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)| (> 0) for a goal width w (m): the solvers divide J by it, so their tolerances mean the same
-        for every width."""
-        return self._weight_sum * self.reward.peak(float(width))
+        for every width. The last width's value is kept (a solve asks at every Hessian, always the same width)."""
+        width = float(width)
+        if width != self._normalised[0]:
+            self._normalised = (width, self._weight_sum * self.reward.peak(width))
+        return self._normalised[1]
 
     def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
         """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
@@ -80,7 +90,7 @@ class ReachProblem:
     def _rollout(self, torque: np.ndarray, start, goal, width) -> dict[str, np.ndarray]:
         """:attr:`trajectory`'s outputs by name: mean (nx, H+1), cov (nx, nx·(H+1)), ee_mean (d, H+1),
         ee_cov (d, d·(H+1)), J."""
-        return dict(zip(self.trajectory.name_out(), self._trajectory(np.ravel(torque), start, goal, width)))
+        return dict(zip(self._trajectory_outputs, self._trajectory(np.ravel(torque), start, goal, width)))
 
     def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
                   solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
@@ -92,7 +102,11 @@ class ReachProblem:
         model = self.model
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
-        if belief is None:
+        ee_velocity = None
+        if belief is None and self._plan_rollout is not None:
+            mean, cov, ee_mean, ee_cov, J, ee_velocity = self._plan_rollout(np.ravel(torque), start, goal, width)
+            mean, cov, ee_velocity = mean.T, cov.reshape(n2, H + 1, n2).transpose(1, 0, 2), ee_velocity.T
+        elif belief is None:
             rollout = self._rollout(torque, start, goal, width)
             ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
             mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
@@ -100,7 +114,8 @@ class ReachProblem:
             mean, cov = belief
             ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
             J = np.asarray(objective, dtype=float)
-        ee_velocity = self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)[0].T
+        if ee_velocity is None:
+            ee_velocity = self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)[0].T
         return Plan(
             success=bool(success), status=status, message=message, objective=float(J.item()),
             solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),

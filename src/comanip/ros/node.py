@@ -4,7 +4,11 @@ Inputs (topic names are parameters, :class:`~comanip.ros.settings.NodeSettings`)
 a prior goal, a reset. A reach starts at the first hand pose (after startup, a reset, or a gap in the input
 longer than ``input_timeout``): that pose and the twist paired with it are the start s_0 = [x; xdot], and its
 stamp is t = 0. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
-t = stamp - start stamp; at most ``estimation_rate`` of them per second of input time go to the estimator.
+t = stamp - start stamp. ``estimation_rate`` of them per second of input time go to the estimator: the due times
+lie on a grid of 1 / estimation_rate from the reach's start, and the pose nearest each due time (the first within
+half the input's spacing of it) is estimated, so a tracker whose stamps jitter still gets the configured rate
+(a rule of 'one period since the last estimated pose' loses up to a pose spacing every period). After a gap longer
+than a period the grid restarts at the next pose.
 
 The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
 far, any time; the reach starts at rest at the first pose's position) and run in a worker thread, so the
@@ -22,7 +26,9 @@ rejected input.
 
 Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed
 or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep
-being published.
+being published. The status also reports the estimation rate achieved (estimates per second of input time over
+the last ``RATE_WINDOW`` s, every estimate counted, published or not) and the latency (from a pose's arrival to
+its estimate's publication: the last one and the median over the same window).
 Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
 """
 
@@ -55,6 +61,8 @@ from comanip.ros.settings import NodeSettings
 
 QUEUE_DEPTH = 50
 """Depth of every subscription and publisher queue (messages)."""
+RATE_WINDOW = 1.0
+"""Input time (s) over which the status's achieved rate and median latency are taken."""
 
 
 def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width) -> OnlineGoalEstimator:
@@ -127,7 +135,10 @@ class GoalNode(Node):
         self._unpaired: list[tuple[Sample, float | None, float]] = []
         """Checked hand poses waiting for their twists: (sample, the previous pose's stamp, when it arrived)."""
         self._last_input_clock: float | None = None
-        self._last_queued: float | None = None
+        self._next_due: float | None = None
+        """Input stamp (s) of the next estimate's due time (the estimation_rate's grid)."""
+        self._recent: list[tuple[float, float]] = []
+        """(input stamp s, latency s or NaN) of the estimates of the last RATE_WINDOW s of input time."""
         self._pending: Observation | None = None
         self._busy = False
         self._good: GoodEstimate | None = None
@@ -213,7 +224,8 @@ class GoalNode(Node):
         if reach is None or (previous is not None and sample.stamp - previous > s.input_timeout):
             number = 1 if reach is None else reach.number + 1
             self._reach = Reach(number, sample.stamp, np.r_[sample.vector, np.zeros_like(velocity)], self._prior)
-            self._last_queued = sample.stamp
+            self._next_due = sample.stamp + 1.0 / s.estimation_rate
+            self._recent = []
             self._last["event"] = f"reach {number} started at stamp {sample.stamp:.6f} s"
             self.get_logger().info(self._last["event"])
             return
@@ -222,13 +234,15 @@ class GoalNode(Node):
             self._counts["ignored"] += 1
             self._last["event"] = f"pose at t = {t:.3f} s is past the model's horizon {self._horizon:g} s; waiting for a reset"
             return
-        if sample.stamp - self._last_queued < (1.0 - 1e-6) / s.estimation_rate:
+        period, due = 1.0 / s.estimation_rate, self._next_due
+        half_spacing = 0.5 * (sample.stamp - previous) if previous is not None else 0.0
+        if sample.stamp < due - half_spacing - 1e-9:  # the next pose is nearer the due time
             self._counts["skipped"] += 1
             return
         if self._pending is not None:
             self._counts["skipped"] += 1
         self._pending = Observation(reach, t, sample.stamp, sample.vector, velocity, received)
-        self._last_queued = sample.stamp
+        self._next_due = due + period if sample.stamp < due + period else sample.stamp + period
         self._lock.notify()
 
     def _on_prior(self, message: PointStamped) -> None:
@@ -244,7 +258,7 @@ class GoalNode(Node):
 
     def _on_reset(self, _message: Empty) -> None:
         with self._lock:
-            self._reach, self._pending, self._good, self._last_queued, self._unpaired = None, None, None, None, []
+            self._reach, self._pending, self._good, self._next_due, self._unpaired = None, None, None, None, []
             self._last["event"] = "reset: the next hand pose starts a reach"
             self.get_logger().info(self._last["event"])
 
@@ -264,17 +278,23 @@ class GoalNode(Node):
                 if self._stopping:
                     return
                 job, self._pending, self._busy = self._pending, None, True
+            latency = float("nan")
             try:
-                self._estimate(job)
+                latency = self._estimate(job)
             except Exception as error:  # noqa: BLE001 - the node must outlive any solver fault; it is logged
                 self._last.update(solve_ok=False, solve_status=f"error: {type(error).__name__}: {error}")
                 self._counts["failed"] += 1
                 self.get_logger().error(f"estimate at t = {job.t:.3f} s raised {type(error).__name__}: {error}")
             with self._lock:
                 self._busy = False
+                if self._reach is job.reach:
+                    self._recent = [(stamp, seconds) for stamp, seconds in self._recent if stamp > job.stamp - RATE_WINDOW]
+                    self._recent.append((job.stamp, latency))
             self._publish_status()
 
-    def _estimate(self, job: Observation) -> None:
+    def _estimate(self, job: Observation) -> float:
+        """Estimate from the observation and publish the estimate; returns the latency (s) from the pose's arrival to
+        the publication, NaN when nothing was published."""
         s = self.settings
         if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
             estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width)
@@ -285,10 +305,10 @@ class GoalNode(Node):
         except ValueError as error:
             self._last["solve_status"] = f"refused: {error}"
             self.get_logger().info(f"observation at t = {job.t:.3f} s not used: {error}")
-            return
+            return float("nan")
         if estimate.status == "uninformative":  # the hand has not moved yet: nothing to estimate, nothing failed
             self._last.update(solve_status=estimate.status, event=f"waiting for movement at t = {job.t:.3f} s")
-            return
+            return float("nan")
         ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.ee_mean)))
         self._last.update(solve_ok=ok, solve_status=estimate.status, solve_time_s=estimate.solve_time)
         if estimate.solve_time > s.max_wall_time:
@@ -297,7 +317,7 @@ class GoalNode(Node):
             self._counts["failed"] += 1
             self.get_logger().warning(f"estimate at t = {job.t:.3f} s failed ({estimate.status}: {estimate.message}); "
                                       "keeping the last good one, marked stale")
-            return
+            return float("nan")
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
             schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
@@ -307,11 +327,12 @@ class GoalNode(Node):
         good = GoodEstimate(estimate, schedule, job.reach, job.stamp, messages)
         with self._lock:
             if self._reach is not job.reach:
-                return  # a reset or a new reach came while solving
+                return float("nan")  # a reset or a new reach came while solving
             self._good = good
             self._counts["estimates"] += 1
-            self._last["latency_s"] = time.perf_counter() - job.received
         self._publish_estimate(good)
+        latency = self._last["latency_s"] = time.perf_counter() - job.received
+        return latency
 
     # ---- publishing
     def _publish_estimate(self, good: GoodEstimate) -> None:
@@ -366,8 +387,18 @@ class GoalNode(Node):
                                 goal_m=[] if good is None else good.estimate.goal.tolist(),
                                 transition_time_s=float("nan") if good is None else good.schedule.transition_time,
                                 last_solve_status=self._last["solve_status"], last_solve_time_s=self._last["solve_time_s"],
-                                last_latency_s=self._last["latency_s"], last_rejection=self._last["rejection"],
+                                last_latency_s=self._last["latency_s"], **self._achieved(), last_rejection=self._last["rejection"],
                                 last_event=self._last["event"])
+
+    def _achieved(self) -> dict:
+        """The status's achieved rate (estimates per second of input time) and median latency (s) over the estimates
+        of the last RATE_WINDOW s of input time (called holding the lock); NaN until there are two."""
+        stamps = [stamp for stamp, _ in self._recent]
+        latencies = [seconds for _, seconds in self._recent if not np.isnan(seconds)]
+        span = stamps[-1] - stamps[0] if len(stamps) > 1 else 0.0
+        return dict(achieved_rate_hz=(len(stamps) - 1) / span if span > 0 else float("nan"),
+                    configured_rate_hz=self.settings.estimation_rate,
+                    latency_median_s=float(np.median(latencies)) if latencies else float("nan"))
 
     def _publish_status(self) -> None:
         reason, values = self.status()
