@@ -165,3 +165,12 @@ def test_a_recorded_hand_that_stalls_after_a_failed_update_keeps_the_whitening_i
         for k in range(recording.seen_until(0.9)):
             estimate = estimator.update(recording.t[k], recording.position[k], recording.velocity[k])
             assert np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.goal_covariance))
+
+
+def test_the_people_models_tree_walk_equals_scikit_learns_predict(people):
+    from comanip.estimation.people_model import _Forest, _samples, shipped_people_model
+    X = _samples(people[:20])[0]
+    model = shipped_people_model()
+    for regressor in (model.along, model.spread):
+        walked = np.array([_Forest(regressor)(x) for x in X])
+        np.testing.assert_allclose(walked, regressor.predict(X), rtol=0, atol=1e-9)

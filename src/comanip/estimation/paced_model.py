@@ -9,8 +9,7 @@ the step after it last does (an overshoot and its return are inside)
 :func:`~comanip.estimation.profile_fit.fit_profile` fits that shape's displacement, duration and onset to the
 observed hand, log(pace) ~ N(0, ``PACE_STD``²) a priori, with the shape of the distance fitted before (it changes little with D); the goal is the start
 plus the displacement times D / (a(tau_end; D) - a(tau_on; D)), where the model's movement ends relative to
-its goal. Its timing
-evidence compares the model's own timing (the reach starts at t = 0 at the model's pace) with the fitted one.
+its goal.
 """
 
 from __future__ import annotations
@@ -58,8 +57,6 @@ class PacedFit:
     """Fitted onset (s) of the shape (the model's own: tau_on)."""
     misfit: float
     """chi² per observed number of the fit (:mod:`comanip.estimation.profile_fit`)."""
-    timing_evidence: float
-    """How strongly the observations reject the model's own timing (about chi²(2) when it is right)."""
     observations: int
     """Observations at or after the fitted onset."""
 
@@ -104,7 +101,7 @@ class PacedModel:
             tried.add(key)
             shape = self.shape(distance)
             fit: ProfileFit = fit_profile(t, position, velocity, start, shape.profile, onset,
-                                          timing=(shape.duration, shape.onset), duration_prior=(shape.duration, PACE_STD))
+                                          duration_prior=(shape.duration, PACE_STD))
             found = float(np.linalg.norm(fit.goal - start)) * shape.goal_over_end
             if best is None or fit.misfit < best[1].misfit:
                 best = (found, fit, shape)
@@ -113,7 +110,7 @@ class PacedModel:
         goal = start + scale * (fit.goal - start)
         floor = (GOAL_FLOOR * float(np.linalg.norm(goal - start))) ** 2 * np.eye(len(goal))
         return PacedFit(goal=goal, covariance=scale**2 * fit.covariance + floor, pace=fit.duration / shape.duration,
-                        onset=fit.onset, misfit=fit.misfit, timing_evidence=float(fit.timing_evidence),
+                        onset=fit.onset, misfit=fit.misfit,
                         observations=int(np.count_nonzero(np.asarray(t) >= fit.onset)))
 
     def _key(self, distance: float) -> int:

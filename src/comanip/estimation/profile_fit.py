@@ -8,16 +8,14 @@ Delta, so Delta is its weighted least-squares solution (variable projection) and
 
     chi²(T, t_0) = sum_k |x_k - x_0 - Delta r_k|² / sigma_x² + |v_k - Delta r'_k / T|² / sigma_v²
 
-fits best; the best grid pair is refined by a Nelder–Mead search over (log T, t_0). sigma_x is
+fits best; the best grid pair is refined by a pattern search over (log T, t_0). sigma_x is
 ``position_noise`` times the hand's largest displacement so far and sigma_v ``velocity_noise`` times its
 largest speed so far, so positions and velocities weigh alike at any scale.
 
 The estimate is the mean of a posterior over the grid (times an optional prior on log T) whose noise scale is
 estimated from the residual (s² = chi²_min / (number of observed numbers - d - 2), at least ``SHAPE_ERROR``²), each pair weighed
 by exp(-(chi² - chi²_min) / (2 s²)); its covariance is the spread of the pairs' Delta plus each one's
-least-squares covariance. ``timing_evidence`` compares a
-given (T, t_0) with the best: (chi²(T, t_0) - chi²_min) / s², about chi²-distributed with 2 degrees of freedom
-when the given timing is the true one.
+least-squares covariance (the points the pattern search visited join the grid).
 """
 
 from __future__ import annotations
@@ -26,13 +24,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import minimize
 
 from comanip.estimation.reach_profile import ReachProfile
 
 
-REFINEMENT_EVALUATIONS = 80
-"""Largest number of Nelder–Mead iterations refining the best grid pair."""
+REFINEMENT_ROUNDS = 24
+"""Largest number of pattern-search rounds refining the best grid pair."""
+REFINED_STEPS = (2e-3, 5e-4)
+"""The pattern search ends when its steps in log T and t_0 (s) are below these."""
 SHAPE_ERROR = 0.1
 """The smallest noise scale s of the fit's posterior, in units of the weights' sigma: a shape is taken to be
 known to a tenth of sigma_x (0.3 % of the displacement) even where it fits the observations better."""
@@ -66,8 +65,6 @@ class ProfileFit:
     """chi² per observed number."""
     covariance: np.ndarray
     """Covariance of ``goal`` (d, d), m² (module docstring)."""
-    timing_evidence: float | None = None
-    """(chi² at the ``timing`` asked for - chi²_min) / s²; None when no timing was asked for."""
 
 
 def detected_onset(t: np.ndarray, speed: np.ndarray, threshold: float) -> float | None:
@@ -77,8 +74,7 @@ def detected_onset(t: np.ndarray, speed: np.ndarray, threshold: float) -> float 
 
 
 def fit_profile(t, position, velocity, start, profile: ReachProfile, onset: float,
-                settings: FitSettings = FitSettings(), timing: tuple[float, float] | None = None,
-                duration_prior: tuple[float, float] | None = None) -> ProfileFit:
+                settings: FitSettings = FitSettings(), duration_prior: tuple[float, float] | None = None) -> ProfileFit:
     """Fit ``profile`` to observations (module docstring).
 
     Args:
@@ -89,7 +85,6 @@ def fit_profile(t, position, velocity, start, profile: ReachProfile, onset: floa
         profile: the shape r.
         onset: the detected onset (s), the centre of the onset grid.
         settings: weights and grids.
-        timing: a (T s, t_0 s) to compare with the best fit (``timing_evidence``).
         duration_prior: (T_ref s, std): log T ~ N(log T_ref, std²) weighs the grid; None: no prior.
     """
     t = np.asarray(t, dtype=float)
@@ -99,39 +94,54 @@ def fit_profile(t, position, velocity, start, profile: ReachProfile, onset: floa
     wv = 1.0 / (settings.velocity_noise * max(float(np.sqrt((v * v).sum(axis=1).max())), 1e-6)) ** 2
     total = wx * (y * y).sum() + wv * (v * v).sum()
 
-    def solve(T, T0):
-        """(Delta (G, d), chi² (G,), normal (G,)) at the pairs (T (G,), t_0 (G,))."""
+    def solve(log_T, T0):
+        """(Delta (G, d), chi² (G,), normal (G,)) at the pairs (log T (G,), t_0 (G,))."""
+        T = np.exp(log_T)
         r, dr = profile((t[None, :] - T0[:, None]) / T[:, None])
         dr = dr / T[:, None]
         normal = np.maximum(wx * (r * r).sum(axis=1) + wv * (dr * dr).sum(axis=1), 1e-300)
         delta = (wx * r @ y + wv * dr @ v) / normal[:, None]
         return delta, np.maximum(total - normal * (delta * delta).sum(axis=1), 0.0), normal
 
-    durations = np.geomspace(*settings.durations[:2], settings.durations[2])
+    durations = np.linspace(*np.log(settings.durations[:2]), settings.durations[2])
     onsets = onset + np.linspace(*settings.onset_window[:2], settings.onset_window[2])
-    TT, T0 = (a.ravel() for a in np.meshgrid(durations, onsets, indexing="ij"))
-    delta, chi2, normal = solve(TT, T0)
-    start_point = int(np.argmin(chi2))
-    refined = minimize(lambda p: float(solve(np.array([math.exp(p[0])]), np.array([p[1]]))[1][0]),
-                       [math.log(TT[start_point]), T0[start_point]], method="Nelder-Mead",
-                       options={"xatol": 1e-4, "fatol": 1e-12, "maxiter": REFINEMENT_EVALUATIONS})
-    T_best, t0_best = math.exp(refined.x[0]), float(refined.x[1])
-    extra = solve(np.array([T_best]), np.array([t0_best]))
-    delta, chi2, normal = np.r_[delta, extra[0]], np.r_[chi2, extra[1]], np.r_[normal, extra[2]]
-    TT, T0 = np.r_[TT, T_best], np.r_[T0, t0_best]
+    LT, T0 = (a.ravel() for a in np.meshgrid(durations, onsets, indexing="ij"))
+    delta, chi2, normal = solve(LT, T0)
+    refined = _pattern_search(solve, LT[int(np.argmin(chi2))], T0[int(np.argmin(chi2))],
+                              durations[1] - durations[0], onsets[1] - onsets[0])
+    delta, chi2, normal = (np.r_[a, b] for a, b in zip((delta, chi2, normal), refined[2:]))
+    LT, T0 = np.r_[LT, refined[0]], np.r_[T0, refined[1]]
     best = int(np.argmin(chi2))
     d = y.shape[1]
     s2 = max(float(chi2[best]) / max(y.size + v.size - d - 2, 1), SHAPE_ERROR**2)
     log_weight = -0.5 * (chi2 - chi2[best]) / s2
     if duration_prior is not None:
-        log_weight -= 0.5 * ((np.log(TT) - math.log(duration_prior[0])) / duration_prior[1]) ** 2
+        log_weight -= 0.5 * ((LT - math.log(duration_prior[0])) / duration_prior[1]) ** 2
     weight = np.exp(log_weight - log_weight.max())
     weight /= weight.sum()
     mean = weight @ delta
     spread = delta - mean
     covariance = (weight[:, None] * spread).T @ spread + s2 * float(weight @ (1.0 / normal)) * np.eye(d)
-    evidence = None
-    if timing is not None:
-        evidence = (float(solve(np.array([timing[0]]), np.array([timing[1]]))[1][0]) - float(chi2[best])) / s2
-    return ProfileFit(goal=np.asarray(start, dtype=float) + mean, duration=float(weight @ TT), onset=float(weight @ T0),
-                      misfit=float(chi2[best]) / max(y.size + v.size, 1), covariance=covariance, timing_evidence=evidence)
+    return ProfileFit(goal=np.asarray(start, dtype=float) + mean, duration=float(weight @ np.exp(LT)),
+                      onset=float(weight @ T0), misfit=float(chi2[best]) / max(y.size + v.size, 1), covariance=covariance)
+
+
+def _pattern_search(solve, log_T: float, t0: float, step_T: float, step_t0: float):
+    """Refine (log T, t_0) from a grid point: each round evaluates the 3 × 3 stencil of the current steps around
+    the best point (one vectorised call) and moves there, halving the steps when the centre stays best, until
+    the steps fall below :data:`REFINED_STEPS`. Returns the arrays (log T (P,), t_0 (P,), Delta (P, d),
+    chi² (P,), normal (P,)) of the points visited."""
+    offsets = np.array([(a, b) for a in (-1, 0, 1) for b in (-1, 0, 1)], dtype=float)
+    visited = []
+    for _ in range(REFINEMENT_ROUNDS):
+        points = np.array([log_T, t0]) + offsets * [step_T, step_t0]
+        values = solve(points[:, 0], points[:, 1])
+        visited.append((points, values))
+        k = int(np.argmin(values[1]))
+        if k == 4:
+            step_T, step_t0 = 0.5 * step_T, 0.5 * step_t0
+            if step_T < REFINED_STEPS[0] and step_t0 < REFINED_STEPS[1]:
+                break
+        log_T, t0 = points[k]
+    points = np.concatenate([p for p, _ in visited])
+    return (points[:, 0], points[:, 1], *(np.concatenate([v[i] for _, v in visited]) for i in range(3)))
