@@ -158,6 +158,22 @@ def markdown(summary, latency, count, title):
     return "\n".join(lines)
 
 
+PUBLISHED_PX = {0.5: 83, 0.75: 48, 0.9: 39}
+"""Kinematic template matching's published errors on mouse movements of 100–800 px (Pasqual & Wobbrock 2014), px."""
+
+
+def published_comparison(rows, scale: float) -> str:
+    """A line comparing template matching's median endpoint error in pixels, on the movements of 100–800 px,
+    with the published one."""
+    ours = []
+    for f, published in PUBLISHED_PX.items():
+        errors = [r["error"] * r["distance_m"] / scale for r in rows if r["predictor"] == "template matching"
+                  and r["fraction"] == f and 100 <= r["distance_m"] / scale <= 800]
+        ours.append(f"{np.median(errors):.0f} px at {int(100 * f)} % (published {published} px)")
+    return ("Template matching here, median endpoint error on the movements of 100–800 px: " + ", ".join(ours)
+            + "; published: Pasqual & Wobbrock 2014, their own mouse recordings.")
+
+
 def figure(summary, path: Path, title: str):
     import matplotlib
     matplotlib.use("Agg")
@@ -257,6 +273,8 @@ def main(argv=None):
     lat = {name: {"median": float(np.median(v)) if v else math.nan, "p95": float(np.percentile(v, 95)) if v else math.nan,
                   "first_median": float(np.median(first[name]))} for name, v in latency.items()}
     table = markdown(summary, lat, len(recordings), title)
+    if args.source == "cursory" and "template matching" in names:
+        table += "\n\n" + published_comparison(rows, scale)
     print(table)
     import csv
     with open(out / "errors.csv", "w", newline="") as stream:
