@@ -97,7 +97,7 @@ def run(args) -> int:
             if result.dispersion is not None:
                 # the lead at 400 N/m holds the spread down until the release, so this peak lies inside T by
                 # construction; the person's own transition is measured with a passive robot
-                # (docs/measure_handover_transition.py)
+                # (studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py)
                 goals_out[label]["transition"] = {
                     "predicted_distance_m": result.schedule.transition_distance,
                     "handover_spread_peak_distance_m": result.dispersion.transition_distance}

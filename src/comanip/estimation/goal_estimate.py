@@ -1,4 +1,4 @@
-"""Estimate the goal of a reach from its start and one state observed on the way (paper Section V-C, SPEC §7).
+"""Estimate the goal of a reach from its start and one state observed on the way (paper Section V-C, docs/formulation.md §7).
 
 The person started at s_0 and was seen in state s_o at time t_o (step n_o = floor(t_o / h), the nearest
 earlier step; :mod:`comanip.estimation.observation`). The estimate is a goal g_hat and the full predicted

@@ -1,7 +1,7 @@
 """Posterior over a few candidate goals from states observed during a reach (beyond the paper).
 
 Each candidate goal g_c gets the model's plan from the start, and with it a Gaussian belief over the arm's
-state at every step (SPEC §2). Observations s_1..s_K at steps n_1 ≤ … ≤ n_K (n_k = floor(t_k / h), see
+state at every step (docs/formulation.md §2). Observations s_1..s_K at steps n_1 ≤ … ≤ n_K (n_k = floor(t_k / h), see
 :mod:`comanip.estimation.observation`) are scored jointly under that belief:
 
     [s_1; …; s_K] ~ N([mu_n1; …; mu_nK], C + I_K ⊗ R),   C_jk = Phi(n_j, n_k) Sigma_nk  (n_j ≥ n_k)

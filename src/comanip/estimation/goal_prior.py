@@ -11,7 +11,7 @@
 - a number s > 0 (m): s² I; a sequence of d numbers (m): diag(s_1², ..., s_d²).
 - ``"width"`` (:data:`PAPER_PRIOR`): the paper's weighting, W from the goal width (W = w² I by default; the
   model's ``goal_covariance`` form): the prior is then as uncertain as the goal is wide, which dominates the
-  observation early in a slow reach (issue 12: Cartesian estimates 38–55 % short for a prior 0.2–0.45 m off).
+  observation early in a slow reach (how much: docs/results/calibration.md).
 """
 
 from __future__ import annotations

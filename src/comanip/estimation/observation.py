@@ -7,7 +7,7 @@ step (paper Section V-C: "the discrete time-step closest to the continuous time 
 n_o = floor(t_o / h)"). A time that is a multiple of h up to rounding (e.g. 0.2 s on h = 0.02 s, where
 0.2/0.02 = 9.999…) maps to that multiple: the division is given a relative slack of 1e-9 before flooring.
 
-What an observation can tell about the goal depends on its step (forward Euler, SPEC §2):
+What an observation can tell about the goal depends on its step (forward Euler, docs/formulation.md §2):
 
 - n_o ≥ 2 (t_o ≥ 2h): the whole state depends on the torques; an estimate holds its plan to all of it.
 - n_o = 1 (h ≤ t_o < 2h): q_1 = q_0 + h qdot_0 is fixed by the start, and only the velocity qdot_1 (through

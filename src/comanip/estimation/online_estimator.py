@@ -1,4 +1,4 @@
-"""Continuous goal estimation: the goal of a reach in progress, revised with every observation (issue 12).
+"""Continuous goal estimation: the goal of a reach in progress, revised with every observation.
 
 A person at rest at s_0 reaches for an unknown goal g; positions and velocities of their hand arrive one at a
 time, at any times t_k ≥ 0. After each, :meth:`OnlineGoalEstimator.update` returns the maximum a posteriori
@@ -20,10 +20,19 @@ estimate. The goal's covariance is the Laplace approximation, the inverse Hessia
 distance is still poorly known (relative std along the reach above 5 %) its variance along the reach comes
 from a 1-D quadrature of the posterior along the line from the start through g_hat, and the spread across
 the reach is scaled by the root-mean-square distance over |g_hat - x_0| (the curvature at the mode misses the
-posterior's long tail towards far goals). Over reaches sampled from the model, the 95 % ellipsoid holds the
-true goal 93.5–98 % of the time from 0.1 s on (docs/measure_goal_estimation.py); under the belief of a person
-who corrects it needs ``OnlineOptions.covariance_scale`` for that (docs/formulation.md). Axes someone else
-moves (``OnlineOptions.led_axes``, the sync robot's z) count for less while they move.
+posterior's long tail towards far goals). How often its 95 % ellipsoid holds the true goal of reaches
+sampled from the model is measured on docs/results/calibration.md (under the belief of a person who corrects
+it needs ``OnlineOptions.covariance_scale``). Axes someone else moves (``OnlineOptions.led_axes``, the sync
+robot's z) count for less while they move.
+
+That estimate assumes the reach started at t = 0 at the model's pace. People start when they like, move at
+their own pace and shape, pause and correct. With ``OnlineOptions(timing="estimated")`` (the default) each
+update weighs three explanations of the hand in turn: the model at its own pace (the estimate above) while
+its whitened misfit stays small and no settled fit of the model's reach at a free pace contradicts it; the
+model's reach at the person's own pace and onset (:mod:`comanip.estimation.paced_model`) where that explains
+the hand; else the model fitted to recorded people (:mod:`comanip.estimation.people_model`, status
+``people_model``). Goals from the last two are combined with the prior and never lie behind a hand that has
+moved past them.
 
 The plans come from a :class:`~comanip.estimation.reach_family.ReachFamily` of the model, built once per model
 and width: for a rotation-invariant point mass from rest, the plan to any goal is a 1-D reach turned onto its
@@ -122,7 +131,7 @@ class OnlineOptions:
     is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time it is not: on
     reaches sampled from that process most ellipsoids are too wide and about a tenth far too narrow (87–88 %
     pooled coverage of the 95 % ellipsoid at 0.2–0.8 s); the sync robot's belief uses 3
-    (comanip.simulation.policies.continuous.ROBOT_BELIEF; docs/measure_goal_estimation.py --belief robot)."""
+    (comanip.simulation.policies.continuous.ROBOT_BELIEF; studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot)."""
 
     timing: str = "estimated"
     """"model": the reach starts at t = 0 and moves at the model's pace (the estimate above, exact for the

@@ -47,7 +47,7 @@ class ReachPrediction:
     torque: np.ndarray
     """Command tau_i (H, n)."""
     objective: float
-    """J of the plan (SPEC §4 units)."""
+    """J of the plan (docs/formulation.md §4 units)."""
     mean_jacobian: np.ndarray | None = None
     """d mu_i / d g (H+1, nx, d): how the mean moves with the goal (m per m, ...); None when not asked for."""
     direction: np.ndarray | None = None

@@ -1,11 +1,11 @@
 """Goal estimation as inverse planning: the goal whose plan the observed state departs from least.
 
 Notation as in :mod:`comanip.planning.reach_problem` and ``docs/notation.md``: torques tau (H·n,) stacked
-step by step, start s_0, goal g (d,) m, width w (m), W = W(w) (d, d), the SPEC §4 objective J(tau, g), and
+step by step, start s_0, goal g (d,) m, width w (m), W = W(w) (d, d), the docs/formulation.md §4 objective J(tau, g), and
 the mean state mu_no(tau) at the observed step n_o. Objectives are divided by the planner's normaliser |J_best(w)| (the best
 attainable J), so the numbers the solver sees lie in about [-1, 0] for every width.
 
-**Why not eq. 11 as printed.** The paper (Section V-C, SPEC §7) estimates the goal by
+**Why not eq. 11 as printed.** The paper (Section V-C, docs/formulation.md §7) estimates the goal by
 
     min_{tau, g}  J(tau, g) + (g - g_bar)^T W^-1 (g - g_bar)   s.t.  mu_0 = s_0,  mu_no(tau) = s_o.
 

@@ -1,6 +1,6 @@
 """Objective, gradient and a structure-exploiting Hessian of the reaching problem, for Newton-type solvers.
 
-Notation (SPEC §2–4, ``docs/notation.md``): torques tau (H, n), flattened step by step into x (H·n,); the end-effector belief at
+Notation (docs/formulation.md §2–4, ``docs/notation.md``): torques tau (H, n), flattened step by step into x (H·n,); the end-effector belief at
 step i as z_i = (mu_x,i (d,), vech Sigma_x,i (d(d+1)/2,)); the per-step reward term
 phi_i(z_i) = -w_i R(mu_x,i, Sigma_x,i). Everything is divided by |J_best(w)| (the planner's normaliser), so
 

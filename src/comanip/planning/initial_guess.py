@@ -1,7 +1,7 @@
 """Initial guesses: minimum-jerk reaches (Flash & Hogan 1985) turned into torques by inverse dynamics.
 
 The zero-torque guess is a trap: far from a narrow goal the expected reward underflows, its gradient is
-~0, and a solver stops at once with the arm at rest (SPEC §9). A smooth reach of a chosen duration starts
+~0, and a solver stops at once with the arm at rest (docs/formulation.md §9). A smooth reach of a chosen duration starts
 the solver where the reward is felt; the duration selects among the local optima.
 """
 

@@ -17,7 +17,7 @@ dynamics along all of it (CasADi's: about 20 s per evaluation for the Panda). Th
 and leaves out the curvature of the dynamics and the dependence of A_i, B_i on the mean path. Along the
 eigenvectors of the exact Hessian it agrees to a few per cent except in a handful of directions of
 negative curvature (measured on the Panda, benchmarks/README.md); the Newton method's secant corrections
-learn those. The gradient is exact, so the optimum is that of the SPEC §4 objective.
+learn those. The gradient is exact, so the optimum is that of the docs/formulation.md §4 objective.
 
 The objective and gradient come from one CasADi function, the per-step pieces of the Hessian from a second one
 evaluated on the first one's rollout only when a Hessian is assembled (with ``hessian_refresh`` about one

@@ -34,7 +34,7 @@ class Plan:
     message: str
     """What the solver said, in words."""
     objective: float
-    """SPEC §4 objective J at the returned torques (lower is better)."""
+    """docs/formulation.md §4 objective J at the returned torques (lower is better)."""
     solve_time: float
     """Wall time of the solve (s), initial guesses included."""
     iterations: int

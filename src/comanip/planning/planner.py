@@ -1,12 +1,12 @@
 """The reaching planner: the belief-space optimal control problem, built once and solved many times.
 
     minimise over tau_{0:H-1}   J = Σ_{i=0..H} -w_i R(mu_i, Sigma_i; g, W(w)) + nu Σ ||tau_i||²
-    subject to                  mu_0 = s_0, Sigma_0 = 0, and the belief dynamics of SPEC §2,
+    subject to                  mu_0 = s_0, Sigma_0 = 0, and the belief dynamics of docs/formulation.md §2,
                                 |tau_i| ≤ tau_max and the joint limits on the mean (bodies that have them).
 
 Single shooting: the torques are the only decision variables and mu, Sigma are CasADi expressions of
 them, so Sigma stays positive semi-definite at every iterate (multiple shooting over Sigma lets iterates go
-indefinite, SPEC §9). Start state, goal and width are parameters, so one build serves every solve.
+indefinite, docs/formulation.md §9). Start state, goal and width are parameters, so one build serves every solve.
 
 Two solvers (``SolverOptions.method``):
 
@@ -22,7 +22,7 @@ Goals out of an arm's reach (inverse-kinematics residual beyond the goal width) 
 status 'unreachable' before any solver work.
 
 Both minimise the same objective, normalised by |J_best(w)| (the best attainable J) so that tolerances
-mean the same for every width; ``plan.objective`` is always the SPEC §4 J itself.
+mean the same for every width; ``plan.objective`` is always the docs/formulation.md §4 J itself.
 
 Symbols, shapes and units: ``docs/notation.md``.
 """

@@ -2,7 +2,7 @@
 
 Symbols: tau (n, H) torques, s0 (nx,) start state (nx = 2n, plus n per activation stage), goal (d,) m,
 width (scalar) m. From them, by single shooting through the belief dynamics: means[i] (nx,), covs[i] (nx, nx), ee_means[i] (d,),
-ee_covs[i] (d, d) for i = 0..H, and the SPEC §4 objective J. Which symbols are decision variables and
+ee_covs[i] (d, d) for i = 0..H, and the docs/formulation.md §4 objective J. Which symbols are decision variables and
 which are parameters is the caller's choice (the estimator makes the goal a decision variable).
 """
 
@@ -84,7 +84,7 @@ class ReachProblem:
         return self._normalised[1]
 
     def objective_value(self, torque: np.ndarray, start, goal, width) -> float:
-        """J (SPEC §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
+        """J (docs/formulation.md §4) of torques (H, n) from start (2n,) to goal (d,) of width w (m)."""
         return float(self._rollout(torque, start, goal, width)["J"].item())
 
     def _rollout(self, torque: np.ndarray, start, goal, width) -> dict[str, np.ndarray]:
