@@ -388,3 +388,17 @@ def test_a_point_mass_planner_compiles_in_the_background_after_its_solving_time(
 def test_bad_solver_options_name_the_field(kwargs, word):
     with pytest.raises(ValueError, match=word):
         SolverOptions(**kwargs)
+
+
+def test_the_compile_cache_survives_an_edit_outside_the_formulation(tmp_path):
+    """The fingerprint that keys compiled functions (the Panda's take minutes to build) changes with the code
+    they are built from, not with a plot module or a command."""
+    import shutil
+    package = tmp_path / "comanip"
+    shutil.copytree(compiled_module.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__", "*.pkl", "*.npz"))
+    before = compiled_module._source_fingerprint(package)
+    for outside in ("plots/__init__.py", "cli/main.py", "simulation/sync_scenario.py"):
+        (package / outside).write_text((package / outside).read_text() + "\n# an edit\n")
+        assert compiled_module._source_fingerprint.__wrapped__(package) == before, outside
+    (package / "objectives" / "reward.py").write_text((package / "objectives" / "reward.py").read_text() + "\n# an edit\n")
+    assert compiled_module._source_fingerprint.__wrapped__(package) != before

@@ -122,13 +122,19 @@ FUNCTION_SOURCES = ("casadi", "adam-robotics", "example-robot-data")
 dynamics come from adam and the URDF of example-robot-data)."""
 
 
+FORMULATION = ("bodies", "belief", "objectives", "optim", "planning", "estimation", "model.py", "arguments.py")
+"""The parts of the package (folders and files under ``comanip/``) the compiled functions are built from:
+only their source enters the fingerprint, so editing a plot, a command or a scenario keeps the cache."""
+PACKAGE = Path(__file__).resolve().parents[1]
+
+
 @functools.cache
-def _source_fingerprint() -> str:
-    """SHA-256 of every Python file of the comanip package and the versions of :data:`FUNCTION_SOURCES` (a
-    changed formulation or library is a changed fingerprint)."""
-    package = Path(__file__).resolve().parents[1]
+def _source_fingerprint(package: Path = PACKAGE) -> str:
+    """SHA-256 of the Python files of the :data:`FORMULATION` parts of ``package`` and the versions of
+    :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint)."""
     digest = hashlib.sha256()
-    for path in sorted(package.rglob("*.py")):
+    paths = [path for part in FORMULATION for path in ([package / part] if part.endswith(".py") else (package / part).rglob("*.py"))]
+    for path in sorted(paths):
         digest.update(str(path.relative_to(package)).encode())
         digest.update(path.read_bytes())
     for distribution in FUNCTION_SOURCES:
