@@ -187,7 +187,7 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
     trials = []
     for k in progress_bar(f"sync {settings.policy} to {np.round(goal, 2).tolist()}", settings.trials, "trial", progress,
                            iterable=range(settings.trials)):
-        person = setup.person(start, goal, settings.seed + k, first_plan)
+        person = setup.person(start, goal, settings.seed + k, first_plan, settings.person)
         policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials)))
         robot = PolicyRobot(setup.world.controller, policy, settings)
         record = run_trial(setup.world, start, person, robot, setup.duration)
