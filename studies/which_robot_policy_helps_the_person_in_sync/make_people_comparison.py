@@ -1,0 +1,123 @@
+"""Print the people-comparison block of docs/results/policy_comparison.md: the robot policies on the sync scenario
+with simulated people who are not the model (``studies/regenerate_results.py policy-people`` puts it on its page).
+
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py [--trials 8] [--seed 0]
+
+Needs the recordings (``pip install -e ".[data]"``). On a busy machine the people can run in separate processes
+and be merged afterwards:
+
+    ... make_people_comparison.py --people model,x0.7,x1.3 --save /tmp/a.pkl
+    ... make_people_comparison.py --people recorded,recorded-x2.5 --save /tmp/b.pkl
+    ... make_people_comparison.py --load /tmp/a.pkl /tmp/b.pkl
+
+Every policy of :data:`comanip.simulation.policies.POLICIES` meets every person of PEOPLE at every goal of GOALS,
+``--trials`` trials each (trial k: person seed + k for every policy; a recorded person's seed picks its
+recording of the development split). Prints, per person and goal, the continuous policy's mean goal error from
+t_o to MT against constant velocity's and every policy's RMS force change (mean ± std over the trials), with the
+verdicts; writes the table's CSV beside this script (progress on stderr).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import pickle
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from comanip.simulation import PersonParameters, ScenarioSetup, SyncSettings
+from comanip.simulation.policies import POLICIES
+from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE, compare_with_people, people_rows, people_table
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from make_policy_comparison import GOALS  # noqa: E402  (a sibling script, not a package)
+
+#: label -> the simulated person: the model's own, the model 30 % faster and slower, a recorded person at the
+#: recording's timing, and the same recordings played 2.5 times slower (their median movement, 0.56 s, then
+#: takes about the model person's time with the handle).
+PEOPLE = {
+    "model": PersonParameters(),
+    "x0.7": PersonParameters(pace=0.7),
+    "x1.3": PersonParameters(pace=1.3),
+    "recorded": PersonParameters(hand_path="recorded"),
+    "recorded-x2.5": PersonParameters(hand_path="recorded", pace=2.5),
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--trials", type=int, default=8, help="trials per person, goal and policy (default: %(default)s)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the first trial's person (default: %(default)s)")
+    parser.add_argument("--goals", default=",".join(GOALS), help="comma-separated labels of GOALS (default: all)")
+    parser.add_argument("--people", default=",".join(PEOPLE), help="comma-separated labels of PEOPLE (default: all)")
+    parser.add_argument("--save", type=Path, help="only simulate, and pickle the results here (for --load)")
+    parser.add_argument("--load", type=Path, nargs="+", help="merge pickled results instead of simulating")
+    args = parser.parse_args(argv)
+    if args.load:
+        runs = [pickle.loads(path.read_bytes()) for path in args.load]
+        results = {}
+        for run in runs:
+            results.update(run["results"])
+        results = {label: results[label] for label in PEOPLE if label in results}
+        wall, trials, seed = sum(run["wall_s"] for run in runs), runs[0]["trials"], runs[0]["seed"]
+        goals = list(next(iter(results.values())))
+    else:
+        goals = [label for label in args.goals.split(",") if label]
+        people = [label for label in args.people.split(",") if label]
+        unknown = sorted(set(goals) - set(GOALS)) + sorted(set(people) - set(PEOPLE))
+        if unknown:
+            raise ValueError(f"--goals must name goals of {list(GOALS)} and --people people of {list(PEOPLE)}, got {unknown}")
+        trials, seed = args.trials, args.seed
+        settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in goals}
+        began = time.perf_counter()
+        results = compare_with_people(settings, {label: PEOPLE[label] for label in people}, list(POLICIES),
+                                      ScenarioSetup(next(iter(settings.values()))), progress=True)
+        wall = time.perf_counter() - began
+        if args.save:
+            args.save.write_bytes(pickle.dumps({"results": results, "wall_s": wall, "trials": trials, "seed": seed}))
+            print(f"saved {args.save} ({wall / 60:.0f} min)")
+            return 0
+    policies = list(next(iter(next(iter(results.values())).values())))
+    rows = people_rows(results)
+    _write_csv(rows, HERE / "people_comparison_sync.csv")
+    goal_text = "; ".join(f"{label} {np.round(SyncSettings(goal=GOALS[label]).goal, 2).tolist()}" for label in goals)
+    misses = [row for row in rows if not row.get("goal_error_below", True)]
+    heavier = [row for row in rows if row.get("force_above")]
+    block = (f"Measured by `PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py "
+             f"--trials {trials} --seed {seed}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
+             f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; {wall / 60:.0f} min of simulation on "
+             f"the shared 2-core machine). Each cell: mean ± standard deviation over the trials; goal error averaged from "
+             f"t_o = 0.2 s to the movement time MT, force change from t_o on.\n\n"
+             f"{people_table(rows, policies)}\n"
+             f"`{CANDIDATE}` below `{GOAL_ERROR_BASELINE}` in mean goal error: {len(rows) - len(misses)} of {len(rows)} "
+             f"person–goal pairs; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}.\n")
+    print(block)
+    print("wrote", HERE / "people_comparison_sync.csv", file=sys.stderr)
+    return 0
+
+
+def _write_csv(rows: list[dict], path: Path) -> None:
+    """One line per person and goal; (mean, std) pairs split into two columns, lists joined by spaces."""
+    flat = []
+    for row in rows:
+        out = {}
+        for key, value in row.items():
+            if isinstance(value, tuple):
+                out[f"{key}_mean"], out[f"{key}_std"] = value
+            elif isinstance(value, list):
+                out[key] = " ".join(value)
+            else:
+                out[key] = value
+        flat.append(out)
+    with path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(dict.fromkeys(key for row in flat for key in row)))
+        writer.writeheader()
+        writer.writerows(flat)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
