@@ -14,7 +14,8 @@ Every policy of :data:`comanip.simulation.policies.POLICIES` meets every person 
 ``--trials`` trials each (trial k: person seed + k for every policy; a recorded person's seed picks its
 recording of the development split). Prints, per person and goal, the continuous policy's mean goal error from
 t_o to MT against constant velocity's and every policy's RMS force change (mean ± std over the trials), with the
-verdicts; writes the table's CSV beside this script (progress on stderr).
+verdicts; writes the table's CSV beside this script and docs/figures/policy_comparison_people.png (progress on
+stderr).
 """
 
 from __future__ import annotations
@@ -26,11 +27,16 @@ import sys
 import time
 from pathlib import Path
 
-import numpy as np
+import matplotlib
 
-from comanip.simulation import PersonParameters, ScenarioSetup, SyncSettings
-from comanip.simulation.policies import POLICIES
-from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE, compare_with_people, people_rows, people_table
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from comanip.plots.figure_file import save_figure  # noqa: E402
+from comanip.simulation import PersonParameters, ScenarioSetup, SyncSettings  # noqa: E402
+from comanip.simulation.policies import POLICIES  # noqa: E402
+from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE, compare_with_people, people_rows, people_table  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -84,20 +90,49 @@ def main(argv: list[str] | None = None) -> int:
     policies = list(next(iter(next(iter(results.values())).values())))
     rows = people_rows(results)
     _write_csv(rows, HERE / "people_comparison_sync.csv")
+    figure = _figure(rows, policies, HERE.parents[1] / "docs" / "figures" / "policy_comparison_people.png")
     goal_text = "; ".join(f"{label} {np.round(SyncSettings(goal=GOALS[label]).goal, 2).tolist()}" for label in goals)
     misses = [row for row in rows if not row.get("goal_error_below", True)]
     heavier = [row for row in rows if row.get("force_above")]
     block = (f"Measured by `PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py "
              f"--trials {trials} --seed {seed}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
-             f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; {wall / 60:.0f} min of simulation on "
-             f"the shared 2-core machine). Each cell: mean ± standard deviation over the trials; goal error averaged from "
+             f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; {wall / 60:.0f} min of simulation, "
+             f"summed over processes, on the shared 2-core machine). Each cell: mean ± standard deviation over the trials; goal error averaged from "
              f"t_o = 0.2 s to the movement time MT, force change from t_o on.\n\n"
              f"{people_table(rows, policies)}\n"
              f"`{CANDIDATE}` below `{GOAL_ERROR_BASELINE}` in mean goal error: {len(rows) - len(misses)} of {len(rows)} "
-             f"person–goal pairs; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}.\n")
+             f"person–goal pairs; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}.\n\n"
+             f"![policies with people who are not the model](../figures/{figure.name})")
     print(block)
     print("wrote", HERE / "people_comparison_sync.csv", file=sys.stderr)
     return 0
+
+
+def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
+    """Per person (columns): the continuous policy's and constant velocity's mean goal error per goal (top) and
+    every policy's RMS force change per goal (bottom), bars at the mean, error bars one standard deviation."""
+    people = list(dict.fromkeys(row["person"] for row in rows))
+    colors = dict(zip(policies, plt.cm.tab10(np.arange(len(policies)))))
+    fig, axes = plt.subplots(2, len(people), figsize=(3.6 * len(people), 6.4), squeeze=False, sharey="row")
+    for column, person in enumerate(people):
+        mine = [row for row in rows if row["person"] == person]
+        goals = np.arange(len(mine))
+        for ax, names, key, width in ((axes[0, column], (CANDIDATE, GOAL_ERROR_BASELINE), "goal_error_{}_mm", 0.38),
+                                      (axes[1, column], policies, "force_change_{}_N", 0.8 / len(policies))):
+            for k, name in enumerate(names):
+                mean, std = np.array([row.get(key.format(name), (np.nan, np.nan)) for row in mine]).T
+                ax.bar(goals + (k - (len(names) - 1) / 2) * width, mean, width, yerr=std, color=colors[name], label=name,
+                       error_kw={"lw": 0.8})
+            ax.set_xticks(goals, [row["goal"] for row in mine])
+        axes[0, column].set_title(person)
+    axes[0, 0].set_ylabel("goal error, mean t_o–MT (mm)")
+    axes[1, 0].set_ylabel("RMS force change (N)")
+    axes[0, 0].legend(fontsize=8)
+    axes[1, 0].legend(fontsize=7)
+    for ax in axes[1]:
+        ax.set_yscale("log")
+    fig.tight_layout()
+    return save_figure(fig, path)
 
 
 def _write_csv(rows: list[dict], path: Path) -> None:

@@ -96,7 +96,8 @@ def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> li
 
 
 def people_table(rows: list[dict], policies) -> str:
-    """:func:`people_rows` as a markdown table: cells 'mean ± std' over the trials, the verdicts last."""
+    """:func:`people_rows` as a markdown table: cells 'mean ± std' over the trials, the verdicts last (each
+    baseline with less force change followed by the candidate's excess over it)."""
     baselines = [name for name in policies if name != CANDIDATE]
     headings = (["person", "goal", "n", f"goal error t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)",
                  f"RMS force change, {CANDIDATE} (N)"] + [f"… {name} (N)" for name in baselines]
@@ -109,7 +110,9 @@ def people_table(rows: list[dict], policies) -> str:
         below = row.get("goal_error_below")
         cells.append("–" if below is None else "yes" if below else "**no**")
         above = row.get("force_above")
-        cells.append("–" if above is None else "none" if not above else "**" + ", ".join(above) + "**")
+        mine = (row.get(f"force_change_{CANDIDATE}_N") or (np.nan,))[0]
+        cells.append("–" if above is None else "none" if not above else "**" + ", ".join(
+            f"{name} ({mine - row[f'force_change_{name}_N'][0]:+.2f} N)" for name in above) + "**")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
