@@ -1,7 +1,7 @@
 """Print the people-comparison block of docs/results/policy_comparison.md: the robot policies on the sync scenario
 with simulated people who are not the model (``studies/regenerate_results.py policy-people`` puts it on its page).
 
-    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py [--trials 8] [--seed 0]
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py [--trials 10] [--seed 0]
 
 Needs the recordings (``pip install -e ".[data]"``). On a busy machine the people can run in separate processes
 and be merged afterwards:
@@ -40,7 +40,7 @@ from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE,
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from make_policy_comparison import GOALS  # noqa: E402  (a sibling script, not a package)
+from make_policy_comparison import GOALS, add_run_arguments  # noqa: E402  (a sibling script, not a package)
 
 #: label -> the simulated person: the model's own, the model 30 % faster and slower, a recorded person at the
 #: recording's timing, and the same recordings played 2.5 times slower (their median movement, 0.56 s, then
@@ -56,12 +56,8 @@ PEOPLE = {
 
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--trials", type=int, default=8, help="trials per person, goal and policy (default: %(default)s)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the first trial's person (default: %(default)s)")
-    parser.add_argument("--goals", default=",".join(GOALS), help="comma-separated labels of GOALS (default: all)")
+    add_run_arguments(parser, 10, "person, goal and policy")
     parser.add_argument("--people", default=",".join(PEOPLE), help="comma-separated labels of PEOPLE (default: all)")
-    parser.add_argument("--save", type=Path, help="only simulate, and pickle the results here (for --load)")
-    parser.add_argument("--load", type=Path, nargs="+", help="merge pickled results instead of simulating")
     args = parser.parse_args(argv)
     if args.load:
         runs = [pickle.loads(path.read_bytes()) for path in args.load]

@@ -63,14 +63,20 @@ def verdicts(rows: list[dict]) -> list[str]:
     return lines
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--trials", type=int, default=20, help="trials per goal and policy (default: %(default)s)")
+def add_run_arguments(parser: argparse.ArgumentParser, trials: int, per: str) -> None:
+    """The options of the sync comparison scripts: --trials (default ``trials`` per ``per``), --seed, --goals,
+    --save and --load."""
+    parser.add_argument("--trials", type=int, default=trials, help=f"trials per {per} (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial's person (default: %(default)s)")
     parser.add_argument("--goals", default=",".join(GOALS), help="comma-separated labels of GOALS (default: all)")
-    parser.add_argument("--policies", default=",".join(POLICIES), help="comma-separated policies (default: all)")
     parser.add_argument("--save", type=Path, help="only simulate, and pickle the results here (for --load)")
     parser.add_argument("--load", type=Path, nargs="+", help="merge pickled results instead of simulating")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    add_run_arguments(parser, 20, "goal and policy")
+    parser.add_argument("--policies", default=",".join(POLICIES), help="comma-separated policies (default: all)")
     args = parser.parse_args(argv)
     if args.load:
         runs = [pickle.loads(path.read_bytes()) for path in args.load]

@@ -6,8 +6,9 @@ control carrying an object with a simulated person whose hand follows the motor-
 >>> [trial.metrics["goal_error_m"] for trial in trials]
 
 Layers: :mod:`panda_model` (the MuJoCo model from the URDF), :mod:`kinematics` (MuJoCo as the controller's
-backend), :mod:`world` (plant + controller at 1 kHz), :mod:`person` (the simulated person), :mod:`scenario`
-(settings, workspace, the trial loop), :mod:`sync_scenario` and :mod:`handover_scenario` (paper VI-A, VI-B).
+backend), :mod:`world` (plant + controller at 1 kHz), :mod:`person` (the simulated person, at the model's pace or
+another) and :mod:`recorded_person` (one whose intended path is a recorded movement), :mod:`scenario` (settings,
+workspace, the trial loop), :mod:`sync_scenario` and :mod:`handover_scenario` (paper VI-A, VI-B).
 """
 
 from comanip.simulation.handover_scenario import HandoverRun, HandoverSettings, HandoverTrial, run_handover

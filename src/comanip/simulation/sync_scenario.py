@@ -7,6 +7,10 @@ motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. 
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
 baselines (prior goal only, constant velocity, minimum-jerk fit) and the passive robot.
 
+The person is the model's own by default; ``SyncSettings.person`` (:class:`comanip.simulation.person.PersonParameters`) makes them
+move at another pace (``pace``) or along a recorded movement (``hand_path="recorded"``), so that a robot is not
+rewarded only for assuming the person is the model.
+
 Per trial: the goal estimate, the error between the predicted trajectory and the handle over time
 normalised by the movement time (paper Fig. 7, per axis), the time each axis reaches the goal, the
 velocity profiles of the person's intention and of the robot's end effector, and the co-manipulation
