@@ -122,3 +122,13 @@ def test_the_sync_scenario_runs_with_people_who_are_not_the_model(person):
     assert trial.metrics["final_error_m"] < 0.01
     assert trial.metrics["goal_error_final_m"] < 0.02
     assert (trial.record.replans > 1) == (person.hand_path == "model")
+
+
+def test_a_slower_person_gets_their_horizon_on_their_own_clock():
+    from comanip.simulation import ScenarioSetup, SyncSettings
+
+    setup = ScenarioSetup(SyncSettings())
+    horizon = setup.model.H * setup.model.h
+    assert setup.trial_duration(PersonParameters(pace=1.3)) == pytest.approx(1.3 * horizon)
+    assert setup.trial_duration(PersonParameters(pace=0.7)) == pytest.approx(horizon)
+    assert ScenarioSetup(SyncSettings(duration=1.5)).trial_duration(PersonParameters(pace=2.0)) == 1.5

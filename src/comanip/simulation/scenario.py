@@ -89,7 +89,9 @@ class ScenarioSettings:
     seed: int = 0
     """Seed of the first trial's noise; trial k uses seed + k."""
     duration: float | None = None
-    """Simulated time per trial after the start (s); None: the person's planning horizon H·h."""
+    """Simulated time per trial after the start (s); None: the person's planning horizon H·h, on their own clock
+    (× ``person.pace``) when they are slower than the model
+    (:meth:`comanip.simulation.setup.ScenarioSetup.trial_duration`)."""
     robot_stiffness: float = 400.0
     """Translational stiffness along the axes the robot leads (N/m)."""
     object_mass: float = 1.5

@@ -54,6 +54,14 @@ class ScenarioSetup:
         """The robot's goal estimator (Cartesian preset)."""
         return GoalEstimator(self.model)
 
+    def trial_duration(self, person: PersonParameters) -> float:
+        """Simulated time per trial (s) with this person: the settings' duration when given, else the person's
+        planning horizon on their own clock, H·h × pace, but never less than H·h (a faster person's reach
+        ends sooner, the handle's settling does not)."""
+        if self.settings.duration is not None:
+            return self.duration
+        return self.duration * max(1.0, person.pace)
+
     def settled_start(self, stiffness) -> SettledStart:
         """The start with the object's sag settled, with the robot at translational stiffness (3,) N/m."""
         key = tuple(np.asarray(stiffness, dtype=float).tolist())

@@ -176,7 +176,7 @@ def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledS
     """What every policy knows before the reach, for the settings' prior goal (the prior plan is solved here)."""
     prior = np.asarray(settings.prior_goal)
     return PolicyContext(start=start.state, prior_goal=prior, width=setup.width, observation_time=settings.observation_time,
-                         dt=setup.world.timestep, duration=setup.duration, model=setup.model, estimator=setup.estimator,
+                         dt=setup.world.timestep, duration=setup.trial_duration(settings.person), model=setup.model, estimator=setup.estimator,
                          prior_plan=setup.person_first_plan(start, prior), update_interval=settings.update_interval)
 
 
@@ -194,7 +194,7 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
         person = setup.person(start, goal, settings.seed + k, first_plan, settings.person)
         policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials)))
         robot = PolicyRobot(setup.world.controller, policy, settings)
-        record = run_trial(setup.world, start, person, robot, setup.duration)
+        record = run_trial(setup.world, start, person, robot, context.duration)
         prediction = robot.prediction
         estimated = np.full((len(record.t), 3), np.nan) if prediction is None else np.array([prediction.rest(t)[0] for t in record.t])
         metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time)
