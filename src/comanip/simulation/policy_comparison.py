@@ -76,7 +76,10 @@ def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> li
     """One row per person and goal (results of :func:`compare_with_people`): the candidate's and the goal-error
     baseline's mean goal error from t_o to MT (mm) and every policy's RMS force change (N), each as mean and
     standard deviation over the trials, with the verdicts: ``goal_error_below`` (candidate's mean below the
-    baseline's) and ``force_above`` (the policies whose mean force change is below the candidate's)."""
+    baseline's) and ``force_above`` (the policies whose mean force change is below the candidate's); and, over
+    the trials paired by seed (the same person for every policy), the candidate's goal error minus the
+    baseline's (``goal_error_difference_mm``) and its force change minus each lighter policy's
+    (``force_excess_<policy>_N``), as mean and standard error."""
     rows = []
     for person, by_goal in results.items():
         for goal, by_policy in by_goal.items():
@@ -87,32 +90,37 @@ def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> li
             for name, trials in by_policy.items():
                 row[f"force_change_{name}_N"] = _mean_std(trials, "rms_force_change_N", 1.0)
             if CANDIDATE in by_policy:
+                mine = by_policy[CANDIDATE]
                 if GOAL_ERROR_BASELINE in by_policy:
                     row["goal_error_below"] = bool(row[f"goal_error_{CANDIDATE}_mm"][0] < row[f"goal_error_{GOAL_ERROR_BASELINE}_mm"][0])
-                mine = row[f"force_change_{CANDIDATE}_N"][0]
-                row["force_above"] = [name for name in by_policy if name != CANDIDATE and row[f"force_change_{name}_N"][0] < mine]
+                    row["goal_error_difference_mm"] = _paired(mine, by_policy[GOAL_ERROR_BASELINE], "goal_error_mean_m", 1e3)
+                row["force_above"] = [name for name in by_policy if name != CANDIDATE
+                                      and row[f"force_change_{name}_N"][0] < row[f"force_change_{CANDIDATE}_N"][0]]
+                for name in row["force_above"]:
+                    row[f"force_excess_{name}_N"] = _paired(mine, by_policy[name], "rms_force_change_N", 1.0)
             rows.append(row)
     return rows
 
 
 def people_table(rows: list[dict], policies) -> str:
-    """:func:`people_rows` as a markdown table: cells 'mean ± std' over the trials, the verdicts last (each
-    baseline with less force change followed by the candidate's excess over it)."""
+    """:func:`people_rows` as a markdown table: cells 'mean ± std' over the trials, paired differences 'mean ±
+    standard error', the verdicts last (each baseline with less force change followed by the candidate's paired
+    excess over it)."""
     baselines = [name for name in policies if name != CANDIDATE]
     headings = (["person", "goal", "n", f"goal error t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)",
-                 f"RMS force change, {CANDIDATE} (N)"] + [f"… {name} (N)" for name in baselines]
+                 "paired difference (mm)", f"RMS force change, {CANDIDATE} (N)"] + [f"… {name} (N)" for name in baselines]
                 + [f"{CANDIDATE} below {GOAL_ERROR_BASELINE}?", f"baselines with less force change than {CANDIDATE}"])
     lines = ["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)]
     for row in rows:
         cells = [row["person"], row["goal"], str(row["trials"])]
         cells += [_pm(row.get(f"goal_error_{name}_mm")) for name in (CANDIDATE, GOAL_ERROR_BASELINE)]
+        cells.append(_pm(row.get("goal_error_difference_mm"), signed=True))
         cells += [_pm(row.get(f"force_change_{name}_N")) for name in [CANDIDATE] + baselines]
         below = row.get("goal_error_below")
         cells.append("–" if below is None else "yes" if below else "**no**")
         above = row.get("force_above")
-        mine = (row.get(f"force_change_{CANDIDATE}_N") or (np.nan,))[0]
         cells.append("–" if above is None else "none" if not above else "**" + ", ".join(
-            f"{name} ({mine - row[f'force_change_{name}_N'][0]:+.2f} N)" for name in above) + "**")
+            f"{name} ({_pm(row[f'force_excess_{name}_N'], signed=True)} N)" for name in above) + "**")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -127,10 +135,20 @@ def _mean_std(trials: list[SyncTrial], key: str, scale: float) -> tuple[float, f
     return float(np.mean(values)), float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
 
 
-def _pm(value: tuple[float, float] | None) -> str:
+def _paired(trials: list[SyncTrial], others: list[SyncTrial], key: str, scale: float) -> tuple[float, float]:
+    """(mean, standard error) of a trial metric's difference trials[k] - others[k] over the trials paired by
+    index (the same person seed) where both are finite, in the shown unit; (NaN, NaN) when none are."""
+    difference = scale * (np.array([t.metrics[key] for t in trials], dtype=float) - np.array([t.metrics[key] for t in others], dtype=float))
+    difference = difference[np.isfinite(difference)]
+    if not len(difference):
+        return float("nan"), float("nan")
+    return float(np.mean(difference)), float(np.std(difference, ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else 0.0
+
+
+def _pm(value: tuple[float, float] | None, signed: bool = False) -> str:
     if value is None or not np.isfinite(value[0]):
         return "–"
-    return f"{_fmt(value[0])} ± {_fmt(value[1])}"
+    return f"{'+' if signed and value[0] >= 0 else ''}{_fmt(value[0])} ± {_fmt(value[1])}"
 
 
 def comparison_rows(results: dict[str, dict[str, list[SyncTrial]]], measures: dict = COMPARED) -> list[dict]:
