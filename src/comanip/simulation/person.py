@@ -29,7 +29,8 @@ velocity error twice (once in the plan, once in D_h) and the loop oscillates wit
 A person who is not the model's pace (``PersonParameters.pace`` = p ≠ 1) runs that whole internal model on
 their own clock s = t / p: the same plans, commands, noise and re-plans every ``replan_interval`` of s (so every
 p · replan_interval seconds), their intention x_d(t) = x_model(t / p) with velocity x_model'(t / p) / p; the
-efference copy stays in the model's units, so a plan from it is the model's plan. A person whose intended hand
+efference copy stays in the model's units, so a plan from it is the model's plan. Past their planning horizon
+(s > H·h) the reach is over and the person holds the intention where it ended. A person whose intended hand
 path is a recorded movement is :class:`comanip.simulation.recorded_person.RecordedPerson`.
 """
 
@@ -169,6 +170,11 @@ class SimulatedPerson:
         sets the intention (``intended_position``, ``intended_velocity``) to time t."""
         pace = self.parameters.pace
         s = (t - self._clock_start) / pace
+        if s > self.planner.model.duration + 1e-9:
+            # past their planning horizon the person's reach is over: they hold the intention where it ended
+            # (re-plans from a hand at rest on the goal long after the reach can leave it)
+            self.intended_velocity = np.zeros(3)
+            return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity)
         if s >= self._next_replan - 1e-9:
             self._replan(s, t, position)
         h = self.planner.model.h
