@@ -132,3 +132,19 @@ def test_a_slower_person_gets_their_horizon_on_their_own_clock():
     assert setup.trial_duration(PersonParameters(pace=1.3)) == pytest.approx(1.3 * horizon)
     assert setup.trial_duration(PersonParameters(pace=0.7)) == pytest.approx(horizon)
     assert ScenarioSetup(SyncSettings(duration=1.5)).trial_duration(PersonParameters(pace=2.0)) == 1.5
+
+
+def test_past_their_horizon_a_person_holds_their_intention(cartesian_planner):
+    horizon = cartesian_planner.model.duration
+    parameters = PersonParameters(pace=0.7, motor_noise=False, anticipates_inertia=False)
+    person = SimulatedPerson(cartesian_planner, parameters, GOAL, 0.05, np.random.default_rng(0))
+    person.start(np.zeros(3))
+    for t in np.arange(0.0, 0.7 * horizon, 0.02):
+        person.force(t, person.intended_position.copy(), person.intended_velocity.copy())
+    plans, held = len(person.plans), person.intended_position.copy()
+    for t in 0.7 * horizon + np.array([0.01, 0.3, 1.0]):
+        person.force(t, held, np.zeros(3))
+        np.testing.assert_array_equal(person.intended_position, held)
+        np.testing.assert_array_equal(person.intended_velocity, 0.0)
+    assert len(person.plans) == plans
+    assert np.linalg.norm(held - GOAL) < 0.02
