@@ -111,7 +111,7 @@ def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
     every policy's RMS force change per goal (bottom), bars at the mean, error bars one standard deviation."""
     people = list(dict.fromkeys(row["person"] for row in rows))
     colors = dict(zip(policies, plt.cm.tab10(np.arange(len(policies)))))
-    fig, axes = plt.subplots(2, len(people), figsize=(3.6 * len(people), 6.4), squeeze=False, sharey="row")
+    fig, axes = plt.subplots(2, len(people), figsize=(3.6 * len(people), 6.4), squeeze=False)
     for column, person in enumerate(people):
         mine = [row for row in rows if row["person"] == person]
         goals = np.arange(len(mine))
@@ -127,8 +127,6 @@ def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
     axes[1, 0].set_ylabel("RMS force change (N)")
     axes[0, 0].legend(fontsize=8)
     axes[1, 0].legend(fontsize=7)
-    for ax in axes[1]:
-        ax.set_yscale("log")
     fig.tight_layout()
     return save_figure(fig, path)
 
