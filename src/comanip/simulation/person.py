@@ -65,8 +65,9 @@ class PersonParameters:
     15 kg load at ratio 0.55, where arm-only values (10–50 N·s/m, Tsuji et al. 1995) would leave it ringing
     at ~1 Hz for seconds."""
     replan_interval: float = 0.22
-    """Time between re-plans (s), a whole number of the model's steps h (4 × 0.055 s): visual feedback
-    reaches the motor plan intermittently, about every 0.2–0.3 s (Loram et al. 2011)."""
+    """Time between re-plans (s) on the person's own clock (pace × this in the simulation's time), a whole
+    number of the model's steps h (4 × 0.055 s): visual feedback reaches the motor plan intermittently, about
+    every 0.2–0.3 s (Loram et al. 2011)."""
     iterations_per_replan: int = 4
     """Solver iterations per warm-started re-plan: the person refines the previous plan, not a fresh optimum."""
     motor_noise: bool = True

@@ -138,7 +138,8 @@ def _mean_std(trials: list[SyncTrial], key: str, scale: float) -> tuple[float, f
 def _paired(trials: list[SyncTrial], others: list[SyncTrial], key: str, scale: float) -> tuple[float, float]:
     """(mean, standard error) of a trial metric's difference trials[k] - others[k] over the trials paired by
     index (the same person seed) where both are finite, in the shown unit; (NaN, NaN) when none are."""
-    difference = scale * (np.array([t.metrics[key] for t in trials], dtype=float) - np.array([t.metrics[key] for t in others], dtype=float))
+    values = [np.array([trial.metrics[key] for trial in group], dtype=float) for group in (trials, others)]
+    difference = scale * (values[0] - values[1])
     difference = difference[np.isfinite(difference)]
     if not len(difference):
         return float("nan"), float("nan")

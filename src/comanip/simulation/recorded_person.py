@@ -54,7 +54,8 @@ def usable_for_reach(recording: Recording) -> bool:
     keep = recording.t >= recording.onset - 1e-9
     speed = np.linalg.norm(recording.velocity, axis=1)
     path = float(np.sum(np.linalg.norm(np.diff(recording.position[keep], axis=0), axis=1)))
-    return (recording.onset >= PLAYBACK_LEAD - 1e-9 and speed[keep][0] <= MAX_ONSET_SPEED * speed.max() and path <= MAX_PATH_RATIO * recording.distance
+    return (recording.onset >= PLAYBACK_LEAD - 1e-9 and speed[keep][0] <= MAX_ONSET_SPEED * speed.max()
+            and path <= MAX_PATH_RATIO * recording.distance
             and recording.distance >= MIN_DISTANCE and recording.movement_time <= MAX_MOVEMENT_TIME)
 
 
