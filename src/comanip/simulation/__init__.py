@@ -13,6 +13,7 @@ workspace, the trial loop), :mod:`sync_scenario` and :mod:`handover_scenario` (p
 
 from comanip.simulation.handover_scenario import HandoverRun, HandoverSettings, HandoverTrial, run_handover
 from comanip.simulation.person import PersonParameters, SimulatedPerson
+from comanip.simulation.recorded_person import RecordedPerson
 from comanip.simulation.scenario import NAMED_GOALS, ScenarioSettings, TrialRecord, resolve_goal
 from comanip.simulation.setup import ScenarioSetup
 from comanip.simulation.sync_scenario import SyncSettings, SyncTrial, run_sync
@@ -30,5 +31,5 @@ def scenario(name: str):
 
 
 __all__ = ["CoManipulationWorld", "HandoverRun", "HandoverSettings", "HandoverTrial", "NAMED_GOALS", "PersonParameters",
-           "SCENARIOS", "ScenarioSettings", "ScenarioSetup", "SimulatedPerson", "SyncSettings", "SyncTrial", "TrialRecord",
+           "RecordedPerson", "SCENARIOS", "ScenarioSettings", "ScenarioSetup", "SimulatedPerson", "SyncSettings", "SyncTrial", "TrialRecord",
            "resolve_goal", "run_handover", "run_sync", "scenario"]
