@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import csv
-import pickle
 import sys
 import time
 from pathlib import Path
@@ -40,7 +39,7 @@ from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE,
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from make_policy_comparison import GOALS, add_run_arguments  # noqa: E402  (a sibling script, not a package)
+from make_policy_comparison import GOALS, add_run_arguments, load_runs, save_run  # noqa: E402  (a sibling script, not a package)
 
 #: label -> the simulated person: the model's own, the model 30 % faster and slower, a recorded person at the
 #: recording's timing, and the same recordings played 2.5 times slower (their median movement, 0.56 s, then
@@ -60,12 +59,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--people", default=",".join(PEOPLE), help="comma-separated labels of PEOPLE (default: all)")
     args = parser.parse_args(argv)
     if args.load:
-        runs = [pickle.loads(path.read_bytes()) for path in args.load]
+        runs, wall, trials, seed = load_runs(args.load)
         results = {}
         for run in runs:
             results.update(run["results"])
         results = {label: results[label] for label in PEOPLE if label in results}
-        wall, trials, seed = sum(run["wall_s"] for run in runs), runs[0]["trials"], runs[0]["seed"]
         goals = list(next(iter(results.values())))
     else:
         goals = [label for label in args.goals.split(",") if label]
@@ -80,8 +78,7 @@ def main(argv: list[str] | None = None) -> int:
                                       ScenarioSetup(next(iter(settings.values()))), progress=True)
         wall = time.perf_counter() - began
         if args.save:
-            args.save.write_bytes(pickle.dumps({"results": results, "wall_s": wall, "trials": trials, "seed": seed}))
-            print(f"saved {args.save} ({wall / 60:.0f} min)")
+            save_run(args.save, results, wall, trials, seed)
             return 0
     policies = list(next(iter(next(iter(results.values())).values())))
     rows = people_rows(results)
