@@ -41,6 +41,8 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                                 ["benchmarks/goal_estimation_times.py", "--markdown", "--reaches", "20"]),
     "policy-comparison": ("robot policies compared on the sync scenario, 20 trials × 4 goals (about 10 min idle, an hour loaded)",
                           ["studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py", "--trials", "20"]),
+    "policy-people": ("robot policies on the sync scenario with people who are not the model: off-pace and recorded, 10 trials × 4 goals × 5 people (about 30 min in one process; --people, --save and --load split it)",
+                      ["studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py", "--trials", "10"]),
     "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
@@ -73,6 +75,7 @@ PAGES: dict[str, tuple[Path, ...]] = {
     "people-vs-presets": (RESULTS / "real_people.md",),
     "feedback-cost": (RESULTS / "calibration.md",),
     "policy-comparison": (RESULTS / "policy_comparison.md",),
+    "policy-people": (RESULTS / "policy_comparison.md",),
     "speed": (RESULTS / "speed.md", ROOT / "benchmarks" / "README.md"),
     "online-estimation-speed": (RESULTS / "speed.md",),
 }

@@ -63,23 +63,40 @@ def verdicts(rows: list[dict]) -> list[str]:
     return lines
 
 
-def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--trials", type=int, default=20, help="trials per goal and policy (default: %(default)s)")
+def add_run_arguments(parser: argparse.ArgumentParser, trials: int, per: str) -> None:
+    """The options of the sync comparison scripts: --trials (default ``trials`` per ``per``), --seed, --goals,
+    --save and --load."""
+    parser.add_argument("--trials", type=int, default=trials, help=f"trials per {per} (default: %(default)s)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial's person (default: %(default)s)")
     parser.add_argument("--goals", default=",".join(GOALS), help="comma-separated labels of GOALS (default: all)")
-    parser.add_argument("--policies", default=",".join(POLICIES), help="comma-separated policies (default: all)")
     parser.add_argument("--save", type=Path, help="only simulate, and pickle the results here (for --load)")
     parser.add_argument("--load", type=Path, nargs="+", help="merge pickled results instead of simulating")
+
+
+def load_runs(paths: list[Path]) -> tuple[list[dict], float, int, int]:
+    """The pickled runs of --save, their summed wall time (s), and the first run's trials and seed."""
+    runs = [pickle.loads(path.read_bytes()) for path in paths]
+    return runs, sum(run["wall_s"] for run in runs), runs[0]["trials"], runs[0]["seed"]
+
+
+def save_run(path: Path, results: dict, wall: float, trials: int, seed: int) -> None:
+    """Pickle a run's results with its wall time (s), trials and seed, for --load."""
+    path.write_bytes(pickle.dumps({"results": results, "wall_s": wall, "trials": trials, "seed": seed}))
+    print(f"saved {path} ({wall / 60:.0f} min)")
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    add_run_arguments(parser, 20, "goal and policy")
+    parser.add_argument("--policies", default=",".join(POLICIES), help="comma-separated policies (default: all)")
     args = parser.parse_args(argv)
     if args.load:
-        runs = [pickle.loads(path.read_bytes()) for path in args.load]
+        runs, wall, trials, seed = load_runs(args.load)
         results = {}
         for run in runs:
             for label, by_policy in run["results"].items():
                 results.setdefault(label, {}).update(by_policy)
         results = {label: {name: by_policy[name] for name in POLICIES if name in by_policy} for label, by_policy in results.items()}
-        wall, trials, seed = sum(run["wall_s"] for run in runs), runs[0]["trials"], runs[0]["seed"]
         settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in results}
     else:
         labels = [label for label in args.goals.split(",") if label]
@@ -93,8 +110,7 @@ def main(argv: list[str] | None = None) -> int:
         results = compare_sync_policies(settings, policies, ScenarioSetup(next(iter(settings.values()))), progress=True)
         wall = time.perf_counter() - began
         if args.save:
-            args.save.write_bytes(pickle.dumps({"results": results, "wall_s": wall, "trials": trials, "seed": seed}))
-            print(f"saved {args.save} ({wall / 60:.0f} min)")
+            save_run(args.save, results, wall, trials, seed)
             return 0
     rows = comparison_rows(results)
     files = write_comparison(rows, DOCS / "policy_comparison_sync")

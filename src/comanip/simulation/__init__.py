@@ -6,12 +6,14 @@ control carrying an object with a simulated person whose hand follows the motor-
 >>> [trial.metrics["goal_error_m"] for trial in trials]
 
 Layers: :mod:`panda_model` (the MuJoCo model from the URDF), :mod:`kinematics` (MuJoCo as the controller's
-backend), :mod:`world` (plant + controller at 1 kHz), :mod:`person` (the simulated person), :mod:`scenario`
-(settings, workspace, the trial loop), :mod:`sync_scenario` and :mod:`handover_scenario` (paper VI-A, VI-B).
+backend), :mod:`world` (plant + controller at 1 kHz), :mod:`person` (the simulated person, at the model's pace or
+another) and :mod:`recorded_person` (one whose intended path is a recorded movement), :mod:`scenario` (settings,
+workspace, the trial loop), :mod:`sync_scenario` and :mod:`handover_scenario` (paper VI-A, VI-B).
 """
 
 from comanip.simulation.handover_scenario import HandoverRun, HandoverSettings, HandoverTrial, run_handover
 from comanip.simulation.person import PersonParameters, SimulatedPerson
+from comanip.simulation.recorded_person import RecordedPerson
 from comanip.simulation.scenario import NAMED_GOALS, ScenarioSettings, TrialRecord, resolve_goal
 from comanip.simulation.setup import ScenarioSetup
 from comanip.simulation.sync_scenario import SyncSettings, SyncTrial, run_sync
@@ -29,5 +31,5 @@ def scenario(name: str):
 
 
 __all__ = ["CoManipulationWorld", "HandoverRun", "HandoverSettings", "HandoverTrial", "NAMED_GOALS", "PersonParameters",
-           "SCENARIOS", "ScenarioSettings", "ScenarioSetup", "SimulatedPerson", "SyncSettings", "SyncTrial", "TrialRecord",
+           "RecordedPerson", "SCENARIOS", "ScenarioSettings", "ScenarioSetup", "SimulatedPerson", "SyncSettings", "SyncTrial", "TrialRecord",
            "resolve_goal", "run_handover", "run_sync", "scenario"]

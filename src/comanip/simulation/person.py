@@ -25,11 +25,19 @@ distance to the goal, so x_d ends at the goal plus the current intention-hand of
 the impedance needs to hold the hand on the goal against a load (the object's weight) or a robot spring.
 Planning from the *measured* hand velocity instead, while the commands drive the intention, counts the
 velocity error twice (once in the plan, once in D_h) and the loop oscillates with growing amplitude.
+
+A person who is not the model's pace (``PersonParameters.pace`` = p ≠ 1) runs that whole internal model on
+their own clock s = t / p: the same plans, commands, noise and re-plans every ``replan_interval`` of s (so every
+p · replan_interval seconds), their intention x_d(t) = x_model(t / p) with velocity x_model'(t / p) / p; the
+efference copy stays in the model's units, so a plan from it is the model's plan. Past their planning horizon
+(s > H·h) the reach is over and the person holds the intention where it ended. A person whose intended hand
+path is a recorded movement is :class:`comanip.simulation.recorded_person.RecordedPerson`.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Literal
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -38,6 +46,10 @@ from comanip.arguments import as_count, as_matrix, as_positive, as_vector
 from comanip.belief.noise import sample_torque_error
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
+
+
+#: The sources of a simulated person's intended hand motion (:attr:`PersonParameters.hand_path`).
+HAND_PATHS = ("model", "recorded")
 
 
 @dataclass(frozen=True)
@@ -53,8 +65,9 @@ class PersonParameters:
     15 kg load at ratio 0.55, where arm-only values (10–50 N·s/m, Tsuji et al. 1995) would leave it ringing
     at ~1 Hz for seconds."""
     replan_interval: float = 0.22
-    """Time between re-plans (s), a whole number of the model's steps h (4 × 0.055 s): visual feedback
-    reaches the motor plan intermittently, about every 0.2–0.3 s (Loram et al. 2011)."""
+    """Time between re-plans (s) on the person's own clock (pace × this in the simulation's time), a whole
+    number of the model's steps h (4 × 0.055 s): visual feedback reaches the motor plan intermittently, about
+    every 0.2–0.3 s (Loram et al. 2011)."""
     iterations_per_replan: int = 4
     """Solver iterations per warm-started re-plan: the person refines the previous plan, not a fresh optimum."""
     motor_noise: bool = True
@@ -63,12 +76,24 @@ class PersonParameters:
     """Add the feedforward force M_load xddot_d that the handle's inertia needs to follow the intention: a
     practised person's internal model of the object they move (Flanagan & Wing 1997). Without it a heavy
     handle lags the intention by M_load xddot_d / K_h (about 40 % of the distance 0.2 s into a reach)."""
+    pace: float = 1.0
+    """The person's duration relative to their intended motion's (dimensionless): that motion played over pace
+    times its duration, positions unchanged, times × pace, velocities ÷ pace (module docstring). 1: the model's
+    own pace (or the recording's); 0.7: 30 % faster; 1.3: 30 % slower."""
+    hand_path: Literal["model", "recorded"] = "model"
+    """Where the intended hand motion comes from: ``"model"``, the reaching model's plan, re-planned every
+    ``replan_interval``; ``"recorded"``, a recorded person's movement (development split of the cursory
+    recordings, ``pip install -e ".[data]"``) scaled and turned onto the reach and played at its recorded timing
+    (:mod:`comanip.simulation.recorded_person`), with the same arm impedance and no re-planning."""
 
     def __post_init__(self):
         as_positive("stiffness", self.stiffness, "N/m")
         as_positive("damping", self.damping, "N·s/m")
         as_positive("replan_interval", self.replan_interval, "s")
         as_count("iterations_per_replan", self.iterations_per_replan)
+        as_positive("pace", self.pace, "dimensionless")
+        if self.hand_path not in HAND_PATHS:
+            raise ValueError(f"hand_path must be one of {HAND_PATHS}, got {self.hand_path!r}")
 
     def impedance_force(self, intended_position, intended_velocity, position, velocity) -> np.ndarray:
         """F = K_h (x_d - x) + D_h (xdot_d - xdot), (3,) N, from intended and actual hand states (3,) m, m/s."""
@@ -135,25 +160,36 @@ class SimulatedPerson:
         held the hand before the reach; the hand itself may sag below it under a load)."""
         self.intended_position = np.array(intended_position, dtype=float)
         self.intended_velocity = np.zeros(3)
-        self._model_velocity = np.zeros(3)    # the Euler model's velocity at the current step
-        self._next_replan = t
+        self._clock_start = t
+        self._model_velocity = np.zeros(3)    # the Euler model's velocity at the current step (model time)
+        self._model_rate = np.zeros(3)        # dx_d/ds, the intention's velocity on the person's clock s
+        self._next_replan = 0.0               # on the person's clock s (module docstring)
         self._plan = None
 
     def force(self, t: float, position, velocity) -> np.ndarray:
         """Force on the handle (3,), N, with the hand at position (3,) m, velocity (3,) m/s at time t (s);
         sets the intention (``intended_position``, ``intended_velocity``) to time t."""
-        if t >= self._next_replan - 1e-9:
-            self._replan(t, position)
+        pace = self.parameters.pace
+        s = (t - self._clock_start) / pace
+        if s > self.planner.model.duration + 1e-9:
+            # past their planning horizon the person's reach is over: they hold the intention where it ended
+            # (re-plans from a hand at rest on the goal long after the reach can leave it)
+            self.intended_velocity = np.zeros(3)
+            return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity)
+        if s >= self._next_replan - 1e-9:
+            self._replan(s, t, position)
         h = self.planner.model.h
-        j = min(int((t - self._plan_time) / h + 1e-9), len(self._spline) - 1)
-        tau = t - self._plan_time - j * h
-        # on step j, x = c3 tau³ + c2 tau² + c1 tau + c0: position, velocity, acceleration (3, 3) at once
-        self.intended_position, self.intended_velocity, acceleration = np.array(
+        j = min(int((s - self._plan_time) / h + 1e-9), len(self._spline) - 1)
+        tau = s - self._plan_time - j * h
+        # on step j, x = c3 tau³ + c2 tau² + c1 tau + c0: position, velocity, acceleration (3, 3) at once, per s
+        self.intended_position, self._model_rate, acceleration = np.array(
             [[tau**3, tau**2, tau, 1.0], [3 * tau**2, 2 * tau, 1.0, 0.0], [6 * tau, 2.0, 0.0, 0.0]]) @ self._spline[j]
+        self.intended_velocity = self._model_rate / pace
         return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
-            + self._load_inertia @ acceleration
+            + self._load_inertia @ acceleration / pace**2
 
-    def _replan(self, t: float, position) -> None:
+    def _replan(self, s: float, t: float, position) -> None:
+        """Re-plan at the person's clock s (s) = time t (s), from the hand's position (3,) m."""
         start = np.r_[position, self._model_velocity]
         if self._plan is None:
             self._plan = self.first_plan if self.first_plan is not None else solve_to_convergence(
@@ -174,8 +210,8 @@ class SimulatedPerson:
         for command in np.vstack([commands + noise, self._plan.torque[len(commands) : len(commands) + 2]]):
             x.append(x[-1] + model.h * v[-1])
             v.append(v[-1] + model.h * self._inverse_inertia @ (command - self._damping @ v[-1]))
-        spline = CubicSpline(model.h * np.arange(len(x)), np.array(x), bc_type=((1, self.intended_velocity), "not-a-knot"))
+        spline = CubicSpline(model.h * np.arange(len(x)), np.array(x), bc_type=((1, self._model_rate), "not-a-knot"))
         self._spline = spline.c[:, : len(commands)].transpose(1, 0, 2)  # (steps, 4, 3) coefficients per step
         self._model_velocity = v[len(commands)]
-        self._plan_time = t
-        self._next_replan = t + self.parameters.replan_interval
+        self._plan_time = s
+        self._next_replan = s + self.parameters.replan_interval

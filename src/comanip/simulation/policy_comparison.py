@@ -7,6 +7,11 @@ summarised per goal and policy by its median and interquartile range over the tr
 >>> results = compare_sync_policies({"near": SyncSettings(goal="near", trials=20)}, list(POLICIES))
 >>> rows = comparison_rows(results)
 >>> write_comparison(rows, Path("out/sync_policies"))      # .csv and .md
+
+The same policies also meet people who are not the model (:func:`compare_with_people`: a person at another
+pace, or one whose intended path is a recorded movement; :class:`comanip.simulation.person.PersonParameters`),
+summarised by :func:`people_rows` as the mean and standard deviation over the trials of the goal error and the
+person's force change, with the candidate policy's verdicts against the baselines.
 """
 
 from __future__ import annotations
@@ -15,6 +20,9 @@ import csv
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
+
+from comanip.simulation.person import PersonParameters
 from comanip.simulation.policies import POLICIES, check_policy
 from comanip.simulation.report import summarise
 from comanip.simulation.setup import ScenarioSetup
@@ -46,6 +54,102 @@ def compare_sync_policies(settings_by_goal: dict[str, SyncSettings], policies, s
     setup = setup or ScenarioSetup(next(iter(settings_by_goal.values())))
     return {label: {name: run_sync(replace(settings, policy=name), setup, progress) for name in policies}
             for label, settings in settings_by_goal.items()}
+
+
+def compare_with_people(settings_by_goal: dict[str, SyncSettings], people: dict[str, PersonParameters], policies,
+                        setup: ScenarioSetup | None = None, progress: bool = False) -> dict[str, dict[str, dict[str, list[SyncTrial]]]]:
+    """{person label: {goal label: {policy: trials}}}: :func:`compare_sync_policies` with each person's
+    parameters in place of the settings' person, all sharing one setup."""
+    if not people:
+        raise ValueError("people must name at least one person")
+    setup = setup or ScenarioSetup(next(iter(settings_by_goal.values())))
+    return {person: compare_sync_policies({label: replace(settings, person=parameters) for label, settings in settings_by_goal.items()},
+                                          policies, setup, progress)
+            for person, parameters in people.items()}
+
+
+#: The policy the people comparison's verdicts are about, and the one whose goal error it must beat.
+CANDIDATE, GOAL_ERROR_BASELINE = "continuous", "constant-velocity"
+
+
+def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> list[dict]:
+    """One row per person and goal (results of :func:`compare_with_people`): the candidate's and the goal-error
+    baseline's mean goal error from t_o to MT (mm) and every policy's RMS force change (N), each as mean and
+    standard deviation over the trials, with the verdicts: ``goal_error_below`` (candidate's mean below the
+    baseline's) and ``force_above`` (the policies whose mean force change is below the candidate's); and, over
+    the trials paired by seed (the same person for every policy), the candidate's goal error minus the
+    baseline's (``goal_error_difference_mm``) and its force change minus each lighter policy's
+    (``force_excess_<policy>_N``), as mean and standard error."""
+    rows = []
+    for person, by_goal in results.items():
+        for goal, by_policy in by_goal.items():
+            row = {"person": person, "goal": goal, "trials": len(next(iter(by_policy.values())))}
+            for name in (CANDIDATE, GOAL_ERROR_BASELINE):
+                if name in by_policy:
+                    row[f"goal_error_{name}_mm"] = _mean_std(by_policy[name], "goal_error_mean_m", 1e3)
+            for name, trials in by_policy.items():
+                row[f"force_change_{name}_N"] = _mean_std(trials, "rms_force_change_N", 1.0)
+            if CANDIDATE in by_policy:
+                mine = by_policy[CANDIDATE]
+                if GOAL_ERROR_BASELINE in by_policy:
+                    row["goal_error_below"] = bool(row[f"goal_error_{CANDIDATE}_mm"][0] < row[f"goal_error_{GOAL_ERROR_BASELINE}_mm"][0])
+                    row["goal_error_difference_mm"] = _paired(mine, by_policy[GOAL_ERROR_BASELINE], "goal_error_mean_m", 1e3)
+                row["force_above"] = [name for name in by_policy if name != CANDIDATE
+                                      and row[f"force_change_{name}_N"][0] < row[f"force_change_{CANDIDATE}_N"][0]]
+                for name in row["force_above"]:
+                    row[f"force_excess_{name}_N"] = _paired(mine, by_policy[name], "rms_force_change_N", 1.0)
+            rows.append(row)
+    return rows
+
+
+def people_table(rows: list[dict], policies) -> str:
+    """:func:`people_rows` as a markdown table: cells 'mean ± std' over the trials, paired differences 'mean ±
+    standard error', the verdicts last (each baseline with less force change followed by the candidate's paired
+    excess over it)."""
+    baselines = [name for name in policies if name != CANDIDATE]
+    headings = (["person", "goal", "n", f"goal error t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)",
+                 "paired difference (mm)", f"RMS force change, {CANDIDATE} (N)"] + [f"… {name} (N)" for name in baselines]
+                + [f"{CANDIDATE} below {GOAL_ERROR_BASELINE}?", f"baselines with less force change than {CANDIDATE}"])
+    lines = ["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)]
+    for row in rows:
+        cells = [row["person"], row["goal"], str(row["trials"])]
+        cells += [_pm(row.get(f"goal_error_{name}_mm")) for name in (CANDIDATE, GOAL_ERROR_BASELINE)]
+        cells.append(_pm(row.get("goal_error_difference_mm"), signed=True))
+        cells += [_pm(row.get(f"force_change_{name}_N")) for name in [CANDIDATE] + baselines]
+        below = row.get("goal_error_below")
+        cells.append("–" if below is None else "yes" if below else "**no**")
+        above = row.get("force_above")
+        cells.append("–" if above is None else "none" if not above else "**" + ", ".join(
+            f"{name} ({_pm(row[f'force_excess_{name}_N'], signed=True)} N)" for name in above) + "**")
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def _mean_std(trials: list[SyncTrial], key: str, scale: float) -> tuple[float, float]:
+    """(mean, standard deviation (ddof 1; 0 for one trial)) of a trial metric over the trials where it is
+    finite, in the shown unit; (NaN, NaN) when none is."""
+    values = np.array([trial.metrics[key] for trial in trials], dtype=float) * scale
+    values = values[np.isfinite(values)]
+    if not len(values):
+        return float("nan"), float("nan")
+    return float(np.mean(values)), float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
+
+
+def _paired(trials: list[SyncTrial], others: list[SyncTrial], key: str, scale: float) -> tuple[float, float]:
+    """(mean, standard error) of a trial metric's difference trials[k] - others[k] over the trials paired by
+    index (the same person seed) where both are finite, in the shown unit; (NaN, NaN) when none are."""
+    values = [np.array([trial.metrics[key] for trial in group], dtype=float) for group in (trials, others)]
+    difference = scale * (values[0] - values[1])
+    difference = difference[np.isfinite(difference)]
+    if not len(difference):
+        return float("nan"), float("nan")
+    return float(np.mean(difference)), float(np.std(difference, ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else 0.0
+
+
+def _pm(value: tuple[float, float] | None, signed: bool = False) -> str:
+    if value is None or not np.isfinite(value[0]):
+        return "–"
+    return f"{'+' if signed and value[0] >= 0 else ''}{_fmt(value[0])} ± {_fmt(value[1])}"
 
 
 def comparison_rows(results: dict[str, dict[str, list[SyncTrial]]], measures: dict = COMPARED) -> list[dict]:
@@ -95,4 +199,5 @@ def _fmt(value: float) -> str:
     return f"{value:.3g}" if magnitude < 10 else f"{value:.0f}" if magnitude >= 100 else f"{value:.1f}"
 
 
-__all__ = ["COMPARED", "POLICIES", "compare_sync_policies", "comparison_rows", "markdown_table", "write_comparison"]
+__all__ = ["CANDIDATE", "COMPARED", "GOAL_ERROR_BASELINE", "POLICIES", "compare_sync_policies", "compare_with_people",
+           "comparison_rows", "markdown_table", "people_rows", "people_table", "write_comparison"]

@@ -18,6 +18,7 @@ from comanip.arguments import as_count, as_positive, as_vector
 from comanip.control.impedance import ImpedanceGains, RobotState
 from comanip.simulation.panda_model import TABLE_HEIGHT
 from comanip.simulation.person import PersonParameters, SimulatedPerson
+from comanip.simulation.recorded_person import RecordedPerson
 from comanip.simulation.world import CoManipulationWorld
 
 #: Named goals (m, robot base frame) on a table whose placing height (z = 0.2 m) is fixed and known, as in
@@ -88,7 +89,9 @@ class ScenarioSettings:
     seed: int = 0
     """Seed of the first trial's noise; trial k uses seed + k."""
     duration: float | None = None
-    """Simulated time per trial after the start (s); None: the person's planning horizon H·h."""
+    """Simulated time per trial after the start (s); None: the person's planning horizon H·h, on their own clock
+    (× ``person.pace``) when they are slower than the model
+    (:meth:`comanip.simulation.setup.ScenarioSetup.trial_duration`)."""
     robot_stiffness: float = 400.0
     """Translational stiffness along the axes the robot leads (N/m)."""
     object_mass: float = 1.5
@@ -212,7 +215,7 @@ def settle(world: CoManipulationWorld, person: PersonParameters, stiffness, dura
     return SettledStart(qpos, qvel, state.position.copy(), state.velocity.copy(), hold)
 
 
-def run_trial(world: CoManipulationWorld, start: SettledStart, person: SimulatedPerson, robot: RobotBehaviour,
+def run_trial(world: CoManipulationWorld, start: SettledStart, person: SimulatedPerson | RecordedPerson, robot: RobotBehaviour,
               duration: float) -> TrialRecord:
     """Simulate one reach of ``duration`` seconds from the settled start, at the world's control rate."""
     begin = time.perf_counter()

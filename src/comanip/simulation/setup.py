@@ -1,5 +1,5 @@
 """What a scenario builds once and reuses for every trial: the world, the person's planner, the robot's
-planner or estimator, the settled start and the person's first plan.
+planner or estimator, the settled start, the person's first plan and, for recorded people, the recordings.
 
 Building the solvers takes seconds; a trial then takes a fraction of its simulated time. One
 :class:`ScenarioSetup` can serve several runs of the same scenario family (e.g. a near and a far goal):
@@ -17,7 +17,9 @@ from comanip.estimation import GoalEstimator
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner, SolverOptions
-from comanip.simulation.person import SimulatedPerson, solve_to_convergence
+from comanip.recordings.recording import Recording
+from comanip.simulation.person import PersonParameters, SimulatedPerson, solve_to_convergence
+from comanip.simulation.recorded_person import RECORDING_STRIDE, RecordedPerson, usable_for_reach
 from comanip.simulation.scenario import ScenarioSettings, SettledStart, settle
 from comanip.simulation.world import CoManipulationWorld
 
@@ -52,6 +54,14 @@ class ScenarioSetup:
         """The robot's goal estimator (Cartesian preset)."""
         return GoalEstimator(self.model)
 
+    def trial_duration(self, person: PersonParameters) -> float:
+        """Simulated time per trial (s) with this person: the settings' duration when given, else the person's
+        planning horizon on their own clock, H·h × pace, but never less than H·h (a faster person's reach
+        ends sooner, the handle's settling does not)."""
+        if self.settings.duration is not None:
+            return self.duration
+        return self.duration * max(1.0, person.pace)
+
     def settled_start(self, stiffness) -> SettledStart:
         """The start with the object's sag settled, with the robot at translational stiffness (3,) N/m."""
         key = tuple(np.asarray(stiffness, dtype=float).tolist())
@@ -66,10 +76,28 @@ class ScenarioSetup:
             self._first_plans[key] = solve_to_convergence(self.planner, start.state, goal, self.width)
         return self._first_plans[key]
 
-    def person(self, start: SettledStart, goal, seed: int, first_plan: Plan | None = None) -> SimulatedPerson:
-        """A person reaching from the settled start for goal (3,), m, with motor noise from seed; the
-        load they anticipate is the handle's apparent inertia at the start."""
+    @cached_property
+    def recordings(self) -> list[Recording]:
+        """The development split's recorded movements that play as a reach (:func:`usable_for_reach`), in file
+        order: the intended paths of recorded people (needs ``pip install -e ".[data]"``)."""
+        from comanip.recordings import load_cursory
+
+        return [recording for recording in load_cursory("development") if usable_for_reach(recording)]
+
+    def recording(self, seed: int) -> Recording:
+        """The recording a recorded person with this seed plays (:data:`RECORDING_STRIDE`)."""
+        return self.recordings[seed * RECORDING_STRIDE % len(self.recordings)]
+
+    def person(self, start: SettledStart, goal, seed: int, first_plan: Plan | None = None,
+               parameters: PersonParameters | None = None) -> SimulatedPerson | RecordedPerson:
+        """A person reaching from the settled start for goal (3,), m: the model's person with motor noise from
+        seed, or (``parameters.hand_path == "recorded"``) the recording of :meth:`recording` (seed); the load
+        they anticipate is the handle's apparent inertia at the start. parameters: None for the settings'."""
+        parameters = parameters or self.settings.person
         world = self.world
         world.reset(start.qpos, start.qvel)
-        return SimulatedPerson(self.planner, self.settings.person, goal, self.width, np.random.default_rng(seed),
-                               first_plan, load_inertia=world.handle_inertia(world.observe()))
+        load_inertia = world.handle_inertia(world.observe())
+        if parameters.hand_path == "recorded":
+            return RecordedPerson(self.recording(seed), parameters, start.position, goal, load_inertia=load_inertia)
+        return SimulatedPerson(self.planner, parameters, goal, self.width, np.random.default_rng(seed),
+                               first_plan, load_inertia=load_inertia)

@@ -7,6 +7,10 @@ motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. 
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
 baselines (prior goal only, constant velocity, minimum-jerk fit) and the passive robot.
 
+The person is the model's own by default; ``SyncSettings.person`` (:class:`comanip.simulation.person.PersonParameters`) makes them
+move at another pace (``pace``) or along a recorded movement (``hand_path="recorded"``), so that a robot is not
+rewarded only for assuming the person is the model.
+
 Per trial: the goal estimate, the error between the predicted trajectory and the handle over time
 normalised by the movement time (paper Fig. 7, per axis), the time each axis reaches the goal, the
 velocity profiles of the person's intention and of the robot's end effector, and the co-manipulation
@@ -172,7 +176,7 @@ def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledS
     """What every policy knows before the reach, for the settings' prior goal (the prior plan is solved here)."""
     prior = np.asarray(settings.prior_goal)
     return PolicyContext(start=start.state, prior_goal=prior, width=setup.width, observation_time=settings.observation_time,
-                         dt=setup.world.timestep, duration=setup.duration, model=setup.model, estimator=setup.estimator,
+                         dt=setup.world.timestep, duration=setup.trial_duration(settings.person), model=setup.model, estimator=setup.estimator,
                          prior_plan=setup.person_first_plan(start, prior), update_interval=settings.update_interval)
 
 
@@ -187,10 +191,10 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
     trials = []
     for k in progress_bar(f"sync {settings.policy} to {np.round(goal, 2).tolist()}", settings.trials, "trial", progress,
                            iterable=range(settings.trials)):
-        person = setup.person(start, goal, settings.seed + k, first_plan)
+        person = setup.person(start, goal, settings.seed + k, first_plan, settings.person)
         policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials)))
         robot = PolicyRobot(setup.world.controller, policy, settings)
-        record = run_trial(setup.world, start, person, robot, setup.duration)
+        record = run_trial(setup.world, start, person, robot, context.duration)
         prediction = robot.prediction
         estimated = np.full((len(record.t), 3), np.nan) if prediction is None else np.array([prediction.rest(t)[0] for t in record.t])
         metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time)

@@ -1,0 +1,142 @@
+"""A simulated person whose intended hand path is a recorded person's movement, not the model's plan.
+
+A recording (:class:`comanip.recordings.Recording`, d = 2: positions p(t) on a screen or table, m) is mapped
+onto the scenario's reach from the handle's start x_0 (3,) to the goal g (3,), both m:
+
+    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2),   0 ≤ t ≤ lead + MT_rec
+
+with u(t), w(t) the recorded displacement p(t_0 + t) - p(t_0) along and across the recorded chord
+p_end - p(t_0), D_rec its length, t_0 = onset - lead (:data:`PLAYBACK_LEAD`: the playback begins with the hand
+at rest shortly before the recorded onset, so the intention leaves from rest as a person's does);
+e_1 = (g - x_0) / D_reach the reach's direction (z included: the recording's progress carries the reach's
+height change), e_2 the horizontal unit vector across it, D_reach = ||g - x_0||. So the path starts at x_0,
+ends at g, keeps the recording's timing, speed profile and sideways deviations (scaled), and its x–y direction
+is the recording's turned onto the scenario's.
+
+The intention is that path added to where the person held the hand before the reach (the offset between
+intention and the sagging hand carries over, as for the model's person), interpolated by a quintic spline that
+leaves from rest and comes to rest (velocity and acceleration 0 at both ends: the holding force at t = 0 is
+the person's force at rest, the reference of the force-change measures), and held at its end afterwards. The force on the
+handle is the same arm impedance as :class:`comanip.simulation.person.SimulatedPerson`'s, with the same
+feedforward for the load's inertia; this person does not re-plan (the recording cannot), so it never
+corrects toward the goal beyond what the recording did.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.interpolate import make_interp_spline
+
+from comanip.arguments import as_matrix, as_vector
+from comanip.recordings.recording import Recording
+from comanip.simulation.person import PersonParameters
+
+PLAYBACK_LEAD = 0.05
+"""Time (s) before the recorded onset at which the playback (the trial's t = 0) starts: the hand is at rest there
+(the onset is where the speed last was below 2.5 % of its peak; a mouse sends no samples while still)."""
+MAX_ONSET_SPEED = 0.1
+"""A recording usable as a reach starts from rest: it has PLAYBACK_LEAD of samples before its onset, and its
+speed at the onset is at most this fraction of its peak."""
+MAX_PATH_RATIO = 1.5
+"""... its path is at most this multiple of its distance (longer ones wander, e.g. a mouse lifted and put back)."""
+MIN_DISTANCE = 0.1
+"""... it spans at least this distance (m), so that scaling it to a reach does not magnify its sampling noise."""
+MAX_MOVEMENT_TIME = 2.0
+"""... and it lasts at most this long (s)."""
+RECORDING_STRIDE = 37
+"""Trial seed k plays usable recording (k · stride) mod N of the development split, N usable recordings: a
+stride spreads consecutive seeds over the file (whose movements come in runs by person)."""
+
+
+def usable_for_reach(recording: Recording) -> bool:
+    """True if the recording starts from rest, goes fairly straight, is long enough and not too slow to play
+    as a reach (the thresholds above)."""
+    keep = recording.t >= recording.onset - 1e-9
+    speed = np.linalg.norm(recording.velocity, axis=1)
+    path = float(np.sum(np.linalg.norm(np.diff(recording.position[keep], axis=0), axis=1)))
+    return (recording.onset >= PLAYBACK_LEAD - 1e-9 and speed[keep][0] <= MAX_ONSET_SPEED * speed.max()
+            and path <= MAX_PATH_RATIO * recording.distance
+            and recording.distance >= MIN_DISTANCE and recording.movement_time <= MAX_MOVEMENT_TIME)
+
+
+def recorded_reach(recording: Recording, start, goal) -> tuple[np.ndarray, np.ndarray]:
+    """The recording mapped onto the reach from start (3,) m to goal (3,) m (module docstring).
+
+    Returns (t (K,) s from the playback's start, positions (K, 3) m): t[0] = 0 at start, t[-1] =
+    PLAYBACK_LEAD + MT_rec at goal (the recording's onset at PLAYBACK_LEAD, or at 0 when it has no samples
+    that early).
+    """
+    start, goal = as_vector("start", start, 3, "m"), as_vector("goal", goal, 3, "m")
+    if recording.position.shape[1] != 2:
+        raise ValueError(f"a recorded reach needs a planar recording (K, 2), got {recording.position.shape}")
+    reach = goal - start
+    distance = float(np.linalg.norm(reach))
+    if distance == 0:
+        raise ValueError("a recorded reach needs a start away from its goal")
+    first = max(recording.onset - PLAYBACK_LEAD, float(recording.t[0]))
+    keep = (recording.t >= first - 1e-9) & (recording.t <= recording.end_time + 1e-9)
+    t, recorded = recording.t[keep] - first, recording.position[keep]
+    chord = recorded[-1] - recorded[0]
+    length = float(np.linalg.norm(chord))
+    if length == 0:
+        raise ValueError(f"recording {recording.name!r} ends where it starts")
+    along = chord / length
+    across = np.array([-along[1], along[0]])
+    e1 = reach / distance
+    e2 = np.cross([0.0, 0.0, 1.0], e1)
+    e2 = e2 / np.linalg.norm(e2) if np.linalg.norm(e2) > 1e-9 else np.array([0.0, 1.0, 0.0])   # a vertical reach
+    displacement = recorded - recorded[0]
+    position = start + (distance / length) * (np.outer(displacement @ along, e1) + np.outer(displacement @ across, e2))
+    position[-1] = goal   # equal up to rounding
+    return t, position
+
+
+class RecordedPerson:
+    """One person reaching for the goal along a recorded movement's path, holding the handle (module docstring).
+
+    Args:
+        recording: a planar recording (:func:`usable_for_reach` says which play well).
+        parameters: arm impedance; ``pace`` scales the recording's times (1: as recorded).
+        start: where the handle starts (3,), m; goal: the person's goal (3,), m.
+        load_inertia: M_load (3, 3), kg, for the feedforward when ``parameters.anticipates_inertia``.
+    """
+
+    def __init__(self, recording: Recording, parameters: PersonParameters, start, goal, load_inertia=None):
+        self.recording, self.parameters = recording, parameters
+        self.goal = as_vector("goal", goal, 3, "m")
+        t, position = recorded_reach(recording, start, goal)
+        self.duration = float(t[-1] * parameters.pace)
+        """The path's duration (s): the playback's (lead and movement time) times the pace."""
+        rest = [(1, np.zeros(3)), (2, np.zeros(3))]
+        self._path = make_interp_spline(t * parameters.pace, position - position[0], k=5, bc_type=(rest, rest))
+        self._load_inertia = np.zeros((3, 3))
+        if parameters.anticipates_inertia:
+            if load_inertia is None:
+                raise ValueError("load_inertia (3, 3) kg is needed when the person anticipates the load's inertia")
+            self._load_inertia = as_matrix("load_inertia", load_inertia, (3, 3), "kg")
+        self.plans: list = []
+        """Always empty: this person does not plan (the scenario's records count re-plans from it)."""
+        self.replan_times: list[float] = []
+
+    def intended_motion(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The path's displacement from its start (3,) m, its velocity (3,) m/s and acceleration (3,) m/s² at
+        t (s) since the onset; at rest at the goal after the path's end."""
+        if t >= self.duration:
+            return self._path(self.duration), np.zeros(3), np.zeros(3)
+        t = max(t, 0.0)
+        return self._path(t), self._path(t, 1), self._path(t, 2)
+
+    def start(self, intended_position, t: float = 0.0) -> None:
+        """Begin the reach at time t (s), the intention at rest at intended_position (3,) m (where the person
+        held the hand before the reach)."""
+        self._hold = np.array(intended_position, dtype=float)
+        self._clock_start = t
+        self.intended_position, self.intended_velocity = self._hold.copy(), np.zeros(3)
+
+    def force(self, t: float, position, velocity) -> np.ndarray:
+        """Force on the handle (3,), N, with the hand at position (3,) m, velocity (3,) m/s at time t (s);
+        sets the intention (``intended_position``, ``intended_velocity``) to time t."""
+        displacement, self.intended_velocity, acceleration = self.intended_motion(t - self._clock_start)
+        self.intended_position = self._hold + displacement
+        return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
+            + self._load_inertia @ acceleration

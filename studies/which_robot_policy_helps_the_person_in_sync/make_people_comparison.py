@@ -1,0 +1,151 @@
+"""Print the people-comparison block of docs/results/policy_comparison.md: the robot policies on the sync scenario
+with simulated people who are not the model (``studies/regenerate_results.py policy-people`` puts it on its page).
+
+    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py [--trials 10] [--seed 0]
+
+Needs the recordings (``pip install -e ".[data]"``). On a busy machine the people can run in separate processes
+and be merged afterwards:
+
+    ... make_people_comparison.py --people model,x0.7,x1.3 --save /tmp/a.pkl
+    ... make_people_comparison.py --people recorded,recorded-x2.5 --save /tmp/b.pkl
+    ... make_people_comparison.py --load /tmp/a.pkl /tmp/b.pkl
+
+Every policy of :data:`comanip.simulation.policies.POLICIES` meets every person of PEOPLE at every goal of GOALS,
+``--trials`` trials each (trial k: person seed + k for every policy; a recorded person's seed picks its
+recording of the development split). Prints, per person and goal, the continuous policy's mean goal error from
+t_o to MT against constant velocity's and every policy's RMS force change (mean ± std over the trials), with the
+verdicts; writes the table's CSV beside this script and docs/figures/policy_comparison_people.png (progress on
+stderr).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from comanip.plots.figure_file import save_figure  # noqa: E402
+from comanip.simulation import PersonParameters, ScenarioSetup, SyncSettings  # noqa: E402
+from comanip.simulation.policies import POLICIES  # noqa: E402
+from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE, compare_with_people, people_rows, people_table  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from make_policy_comparison import GOALS, add_run_arguments, load_runs, save_run  # noqa: E402  (a sibling script, not a package)
+
+#: label -> the simulated person: the model's own, the model 30 % faster and slower, a recorded person at the
+#: recording's timing, and the same recordings played 2.5 times slower (their median movement, 0.56 s, then
+#: takes about the model person's time with the handle).
+PEOPLE = {
+    "model": PersonParameters(),
+    "x0.7": PersonParameters(pace=0.7),
+    "x1.3": PersonParameters(pace=1.3),
+    "recorded": PersonParameters(hand_path="recorded"),
+    "recorded-x2.5": PersonParameters(hand_path="recorded", pace=2.5),
+}
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    add_run_arguments(parser, 10, "person, goal and policy")
+    parser.add_argument("--people", default=",".join(PEOPLE), help="comma-separated labels of PEOPLE (default: all)")
+    args = parser.parse_args(argv)
+    if args.load:
+        runs, wall, trials, seed = load_runs(args.load)
+        results = {}
+        for run in runs:
+            results.update(run["results"])
+        results = {label: results[label] for label in PEOPLE if label in results}
+        goals = list(next(iter(results.values())))
+    else:
+        goals = [label for label in args.goals.split(",") if label]
+        people = [label for label in args.people.split(",") if label]
+        unknown = sorted(set(goals) - set(GOALS)) + sorted(set(people) - set(PEOPLE))
+        if unknown:
+            raise ValueError(f"--goals must name goals of {list(GOALS)} and --people people of {list(PEOPLE)}, got {unknown}")
+        trials, seed = args.trials, args.seed
+        settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in goals}
+        began = time.perf_counter()
+        results = compare_with_people(settings, {label: PEOPLE[label] for label in people}, list(POLICIES),
+                                      ScenarioSetup(next(iter(settings.values()))), progress=True)
+        wall = time.perf_counter() - began
+        if args.save:
+            save_run(args.save, results, wall, trials, seed)
+            return 0
+    policies = list(next(iter(next(iter(results.values())).values())))
+    rows = people_rows(results)
+    _write_csv(rows, HERE / "people_comparison_sync.csv")
+    figure = _figure(rows, policies, HERE.parents[1] / "docs" / "figures" / "policy_comparison_people.png")
+    goal_text = "; ".join(f"{label} {np.round(SyncSettings(goal=GOALS[label]).goal, 2).tolist()}" for label in goals)
+    misses = [row for row in rows if not row.get("goal_error_below", True)]
+    heavier = [row for row in rows if row.get("force_above")]
+    block = (f"Measured by `PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py "
+             f"--trials {trials} --seed {seed}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
+             f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; {wall / 60:.0f} min of simulation, "
+             f"summed over processes, on the shared 2-core machine). Each cell: mean ± standard deviation over the "
+             f"trials; goal error averaged from t_o = 0.2 s to the movement time MT, force change from t_o on. Paired "
+             f"differences (`{CANDIDATE}` minus the other policy, trial by trial: the same person meets every policy): "
+             f"mean ± standard error.\n\n"
+             f"{people_table(rows, policies)}\n"
+             f"`{CANDIDATE}` below `{GOAL_ERROR_BASELINE}` in mean goal error: {len(rows) - len(misses)} of {len(rows)} "
+             f"person–goal pairs; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}.\n\n"
+             f"![policies with people who are not the model](../figures/{figure.name})")
+    print(block)
+    print("wrote", HERE / "people_comparison_sync.csv", file=sys.stderr)
+    return 0
+
+
+def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
+    """Per person (columns): the continuous policy's and constant velocity's mean goal error per goal (top) and
+    every policy's RMS force change per goal (bottom), bars at the mean, error bars one standard deviation."""
+    people = list(dict.fromkeys(row["person"] for row in rows))
+    colors = dict(zip(policies, plt.cm.tab10(np.arange(len(policies)))))
+    fig, axes = plt.subplots(2, len(people), figsize=(3.6 * len(people), 6.4), squeeze=False)
+    for column, person in enumerate(people):
+        mine = [row for row in rows if row["person"] == person]
+        goals = np.arange(len(mine))
+        for ax, names, key, width in ((axes[0, column], (CANDIDATE, GOAL_ERROR_BASELINE), "goal_error_{}_mm", 0.38),
+                                      (axes[1, column], policies, "force_change_{}_N", 0.8 / len(policies))):
+            for k, name in enumerate(names):
+                mean, std = np.array([row.get(key.format(name), (np.nan, np.nan)) for row in mine]).T
+                ax.bar(goals + (k - (len(names) - 1) / 2) * width, mean, width, yerr=std, color=colors[name], label=name,
+                       error_kw={"lw": 0.8})
+            ax.set_xticks(goals, [row["goal"] for row in mine])
+        axes[0, column].set_title(person)
+    axes[0, 0].set_ylabel("goal error, mean t_o–MT (mm)")
+    axes[1, 0].set_ylabel("RMS force change (N)")
+    axes[0, 0].legend(fontsize=8)
+    axes[1, 0].legend(fontsize=7)
+    fig.tight_layout()
+    return save_figure(fig, path)
+
+
+def _write_csv(rows: list[dict], path: Path) -> None:
+    """One line per person and goal; (mean, std) pairs split into two columns, lists joined by spaces."""
+    flat = []
+    for row in rows:
+        out = {}
+        for key, value in row.items():
+            if isinstance(value, tuple):
+                out[f"{key}_mean"], out[f"{key}_std"] = value
+            elif isinstance(value, list):
+                out[key] = " ".join(value)
+            else:
+                out[key] = value
+        flat.append(out)
+    with path.open("w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(dict.fromkeys(key for row in flat for key in row)))
+        writer.writeheader()
+        writer.writerows(flat)
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
