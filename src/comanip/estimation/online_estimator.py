@@ -147,7 +147,7 @@ class OnlineOptions:
     people_model: PeopleModel | None = None
     """With ``timing="estimated"``: the model of people's movements (:class:`comanip.estimation.people_model.PeopleModel`,
     e.g. fitted to your own recordings); None: the one that ships with comanip."""
-    paced_threshold: float = 0.3
+    paced_threshold: float = 0.05
     """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
 

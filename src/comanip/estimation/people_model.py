@@ -6,8 +6,8 @@ them without units: time since the onset tau, path length since the onset L, the
 speed so far, the acceleration, time since the peak speed over tau, the path length at the peak over L, the
 straightness |x_K - x_0| / L, the angle between the velocity and the displacement, and v_peak tau / L.
 Two gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
-them how far beyond the hand the endpoint lies along the direction of motion u (the hand's displacement over
-the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
+them how far beyond the hand the endpoint lies along the direction of motion u (the velocity's while the hand
+moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
 endpoint is never behind the hand along u, and a hand that has stopped (speed below ``REST_FRACTION`` of its
 peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors).
@@ -39,8 +39,10 @@ FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak",
 """Names of :func:`movement_features`' numbers, in order."""
 SHIPPED = "people_endpoint_model.pkl"
 """File name of the fitted model in ``comanip/data``."""
+DIRECTION_SPEED = 0.1
+"""The direction of motion u is the velocity's while the speed is above this fraction of its peak so far..."""
 DIRECTION_WINDOW = 0.05
-"""The direction of motion u is that of the hand's displacement over the last this many seconds (s)."""
+"""... else that of the hand's displacement over the last this many seconds (s), else from the start."""
 QUANTILE = 0.3
 """The along regressor predicts this quantile of the distance still to go: below the median, since a goal
 predicted beyond where the hand stops costs a robot more than one predicted short of it."""
@@ -72,10 +74,10 @@ def movement_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray,
     displacement = math.sqrt(float(offset @ offset))
     recent = position[-1] - position[int(np.searchsorted(t, t[-1] - DIRECTION_WINDOW))]
     recent_length = math.sqrt(float(recent @ recent))
-    if recent_length > _MIN_RECENT:
-        u = recent / recent_length
-    elif speed[-1] > 1e-3:
+    if speed[-1] > DIRECTION_SPEED * speed[peak]:
         u = velocity[-1] / speed[-1]
+    elif recent_length > _MIN_RECENT:
+        u = recent / recent_length
     elif displacement > 0:
         u = offset / displacement
     else:
