@@ -203,7 +203,7 @@ def main(argv=None):
     parser.add_argument("--split", choices=("development", "held_out"), default="development",
                         help="cursory split; held_out only to report a claimed improvement")
     parser.add_argument("--limit", type=int, default=None, help="at most this many movements")
-    parser.add_argument("--models", default="planar,human", help="presets whose OnlineGoalEstimator is scored")
+    parser.add_argument("--models", default="planar,human,people", help="presets whose OnlineGoalEstimator is scored")
     parser.add_argument("--only", default=None, help="comma-separated predictor names to run (default: all)")
     parser.add_argument("--scale", type=float, default=None, help="cursory pixels to metres (m/px)")
     parser.add_argument("--count", type=int, default=100, help="simulated reaches")

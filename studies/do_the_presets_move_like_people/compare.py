@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-PRESETS = ("planar", "human", "cartesian", "human_cartesian")
+PRESETS = ("planar", "human", "people", "cartesian", "human_cartesian")
 BINS = ((0.1, 0.2), (0.2, 0.3), (0.3, 0.45), (0.45, 0.7))
 PHASE = np.linspace(0, 1, 101)
 
