@@ -32,7 +32,8 @@ its whitened misfit stays small and no settled fit of the model's reach at a fre
 model's reach at the person's own pace and onset (:mod:`comanip.estimation.paced_model`) where that explains
 the hand; else the model fitted to recorded people (:mod:`comanip.estimation.people_model`, status
 ``people_model``). Goals from the last two are combined with the prior and never lie behind a hand that has
-moved past them.
+moved past them, and their covariance is that of where the hand will stop (for the paced fit, its own plus
+the spread of the model's reach around its goal at the end).
 
 The plans come from a :class:`~comanip.estimation.reach_family.ReachFamily` of the model, built once per model
 and width: for a rotation-invariant point mass from rest, the plan to any goal is a 1-D reach turned onto its
@@ -224,7 +225,7 @@ DEFAULT_FAMILIES = FamilyCache()
 SETTLED_SPREAD = 0.1
 #: Observations since the onset a paced fit needs to pin the goal.
 SETTLED_OBSERVATIONS = 8
-#: |log pace| beyond which a settled paced fit contradicts the model's own pace.
+#: |log pace|, and |onset delay| / MT, beyond which a settled paced fit contradicts the model's own timing.
 PACE_TOLERANCE = 0.14
 #: Observed speed and displacement beyond this many noise standard deviations count as movement.
 _MOVEMENT_SIGMAS = 3.0
@@ -382,7 +383,9 @@ class OnlineGoalEstimator:
         else:
             paced = self._paced_fit(t, position, velocity, onset, None if previous is None else previous.goal)
         if paced.misfit <= self.options.paced_threshold and self._settled(paced):
-            goal, covariance = self._with_prior(self._not_behind(paced.goal, position[-1]), paced.covariance)
+            # where the hand stops spreads around the goal as the model's own reach to it does at its end
+            landing = self._prediction(paced.goal, order=0).cov[-1, :n, :n]
+            goal, covariance = self._with_prior(self._not_behind(paced.goal, position[-1]), paced.covariance + landing)
             return self._result(goal, covariance, Status.SOLVED, f"{self._off_model}; the model's reach at the person's "
                                 f"pace (×{paced.pace:.3g}, onset {paced.onset:.3g} s) does", 0, t_begin)
         people = (self.options.people_model or shipped_people_model()).predict(t, position, velocity, self.start_position)
@@ -410,15 +413,18 @@ class OnlineGoalEstimator:
     def _contradiction(self, estimate: GoalEstimate, paced: PacedFit) -> str | None:
         """Why the model at its own pace is contradicted by its reach at the person's pace, or None: that fit
         explains the hand (misfit at most ``paced_threshold``), pins the goal (:meth:`_settled`), finds a pace
-        off the model's by more than :data:`PACE_TOLERANCE` and a goal the model-pace estimate's 99.9 % region
-        (with the paced fit's) does not hold."""
-        if paced.misfit > self.options.paced_threshold or not self._settled(paced) or abs(math.log(paced.pace)) <= PACE_TOLERANCE:
+        off the model's by more than :data:`PACE_TOLERANCE` (as a log) or an onset off the model's by more
+        than that fraction of the movement time, and a goal the model-pace estimate's 99.9 % region (with the
+        paced fit's) does not hold."""
+        on_time = abs(math.log(paced.pace)) <= PACE_TOLERANCE and abs(paced.delay) <= PACE_TOLERANCE * paced.duration
+        if paced.misfit > self.options.paced_threshold or not self._settled(paced) or on_time:
             return None
         difference = paced.goal - estimate.goal
         distance2 = float(difference @ np.linalg.solve(paced.covariance + estimate.goal_covariance, difference))
         if distance2 <= chi2.ppf(0.999, len(difference)):
             return None
-        return (f"the model at its own pace is contradicted by its reach at the person's pace (×{paced.pace:.3g}), "
+        return (f"the model at its own pace is contradicted by its reach at the person's pace (×{paced.pace:.3g}, "
+                f"{paced.delay:+.3g} s late), "
                 f"whose goal lies {math.sqrt(distance2):.3g} standard deviations away")
 
     def _paced_fit(self, t, position, velocity, onset: float, goal) -> PacedFit:

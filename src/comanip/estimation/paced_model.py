@@ -54,7 +54,11 @@ class PacedFit:
     pace: float
     """Fitted duration over the model's: > 1 slower than the model, < 1 faster."""
     onset: float
-    """Fitted onset (s) of the shape (the model's own: tau_on)."""
+    """Fitted onset (s) of the shape."""
+    delay: float
+    """Fitted onset minus the model's own (tau_on, for a reach that starts at t = 0), s."""
+    duration: float
+    """Fitted movement time T (s)."""
     misfit: float
     """chi² per observed number of the fit (:mod:`comanip.estimation.profile_fit`)."""
     observations: int
@@ -110,7 +114,7 @@ class PacedModel:
         goal = start + scale * (fit.goal - start)
         floor = (GOAL_FLOOR * float(np.linalg.norm(goal - start))) ** 2 * np.eye(len(goal))
         return PacedFit(goal=goal, covariance=scale**2 * fit.covariance + floor, pace=fit.duration / shape.duration,
-                        onset=fit.onset, misfit=fit.misfit,
+                        onset=fit.onset, delay=fit.onset - shape.onset, duration=fit.duration, misfit=fit.misfit,
                         observations=int(np.count_nonzero(np.asarray(t) >= fit.onset)))
 
     def _key(self, distance: float) -> int:
