@@ -19,6 +19,7 @@ import numpy as np
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
+from comanip.estimation.observation import observation_step
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
@@ -93,7 +94,6 @@ def read_observations(path: Path, n: int, *, check_units: bool = True, joint_ang
 
 def run(args) -> int:
     model = load_model(args)
-    estimator = GoalEstimator(model)
     body, n = model.body, model.n
     at_rest = np.r_[body.home_position, np.zeros(n)]
     times = states = None
@@ -106,10 +106,12 @@ def run(args) -> int:
         start = args.start if args.start is not None else (states[0] if times[0] == 0 else at_rest)
     elif args.observed is not None:
         observed, t_obs = args.observed, args.t_obs
+        observation_step(model, t_obs)     # checked before the estimator is built (compiled on first use)
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
     out = output_dir(args.out, "estimate", args.force, create=False)
+    estimator = GoalEstimator(model)   # built (and compiled on first use) only once the observation is known
     # the estimator checks every input before its work: a mistake is a ValueError before the folder is made
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, prior_std=args.prior_std, method=args.method,
                                   max_wall_time=args.max_wall_time)
