@@ -29,6 +29,8 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
+from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
+
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 WORSE_MARGIN = 0.05
 
@@ -54,19 +56,16 @@ def predictors(model_names, library, exclude_self: bool, people_for):
     return made
 
 
-class _People:
+class _People(PrefixPredictor):
     """The people endpoint model alone, fed the whole prefix at every update."""
 
     def __init__(self, model, start):
-        from comanip.estimation.endpoint_baselines import CurrentPosition
-        self.model, self.start, self.history = model, start, CurrentPosition(start)
+        super().__init__(start)
+        self.model = model
 
-    def update(self, t, position, velocity):
-        now = self.history.update(t, position, velocity)
-        history = self.history
-        answer = self.model.predict(np.asarray(history._t), np.asarray(history._position), np.asarray(history._velocity),
-                                    self.start)
-        return (now.goal, None) if answer is None else (answer.goal, answer.covariance)
+    def predict(self, t, position, velocity):
+        answer = self.model.predict(t, position, velocity, self.start)
+        return EndpointPrediction(position[-1].copy()) if answer is None else answer
 
 
 class _Online:
@@ -77,7 +76,7 @@ class _Online:
 
     def update(self, t, position, velocity):
         estimate = self.estimator.update(t, position, velocity)
-        return estimate.goal, estimate.goal_covariance
+        return EndpointPrediction(estimate.goal, estimate.goal_covariance)
 
 
 def run_predictor(factory, recording):
@@ -89,7 +88,7 @@ def run_predictor(factory, recording):
         begin = time.perf_counter()
         answer = predictor.update(float(recording.t[k]), recording.position[k], recording.velocity[k])
         times.append(time.perf_counter() - begin)
-        latest = (answer.goal, answer.covariance) if hasattr(answer, "goal") else answer
+        latest = answer.goal, answer.covariance
         while len(results) < len(until) and until[len(results)] == k + 1:
             results.append(latest)
     while len(results) < len(until):
