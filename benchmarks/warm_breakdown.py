@@ -44,7 +44,7 @@ def best_ms(function, number: int = 20, repeat: int = 15) -> float:
 
 def measure(preset: str, compile: bool) -> dict:
     """The row's timings (ms) and the mean iterations of a warm solve, keyed by COLUMNS."""
-    from comanip.planning.newton import _symmetric_rank_one_update
+    from comanip.optim.hessian_models import symmetric_rank_one_update
 
     model = comanip.presets.load(preset)
     planner = comanip.Planner(model, SolverOptions(compile=compile))
@@ -73,7 +73,7 @@ def measure(preset: str, compile: bool) -> dict:
              "value only": best_ms(lambda: curvature.value(x, params)),
              "Hessian": best_ms(hessian),
              "Cholesky": best_ms(lambda: scipy.linalg.cho_factor(matrix, check_finite=False)),
-             "secant update": (best_ms(lambda: _symmetric_rank_one_update(correction, matrix, step, gradient))
+             "secant update": (best_ms(lambda: symmetric_rank_one_update(correction, matrix, step, gradient))
                                if not curvature.exact else float("nan")),
              "make_plan": best_ms(lambda: planner._make_plan(plan.torque, params, status="solved", success=True,
                                                              message="", solve_time=0.0, iterations=0)),

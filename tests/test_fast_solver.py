@@ -12,7 +12,7 @@ import comanip
 from comanip.planning import compiled as compiled_module
 from comanip.planning.compiled import BufferedFunction, compile_in_background, compiled
 from comanip.planning.curvature import ReachCurvature
-from comanip.planning.newton import newton_minimize
+from comanip.optim.active_set_newton import newton_minimize
 from comanip.planning.planner import Planner, SolverOptions
 from comanip.planning.reach_problem import ReachProblem
 
@@ -131,19 +131,19 @@ def test_hessian_refresh_is_checked(refresh, secant, word):
 def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
     """After the update in place, (H + C) s = y, C stays symmetric and C's change is rank one; a residual r
     orthogonal to s (no finite update meets the equation) leaves C alone."""
-    from comanip.planning.newton import _symmetric_rank_one_update
+    from comanip.optim.hessian_models import symmetric_rank_one_update
 
     size = 40
     H, C = (lambda M: M + M.T)(rng.normal(size=(size, size))), (lambda M: M + M.T)(rng.normal(size=(size, size)))
     s, y = rng.normal(size=size), rng.normal(size=size)
     before = C.copy()
-    _symmetric_rank_one_update(C, H, s, y)
+    symmetric_rank_one_update(C, H, s, y)
     np.testing.assert_allclose((H + C) @ s, y, atol=1e-10 * np.abs(y).max())
     np.testing.assert_array_equal(C, C.T)
     assert np.linalg.matrix_rank(C - before, tol=1e-8 * np.abs(C - before).max()) == 1
     unchanged = C.copy()
     w = rng.normal(size=size)
-    _symmetric_rank_one_update(C, H, s, (H + C) @ s + w - (w @ s) / (s @ s) * s)  # r ⟂ s: no finite update
+    symmetric_rank_one_update(C, H, s, (H + C) @ s + w - (w @ s) / (s @ s) * s)  # r ⟂ s: no finite update
     np.testing.assert_array_equal(C, unchanged)
 
 
@@ -152,12 +152,12 @@ def test_a_step_never_drives_a_row_past_its_limit_further_out():
     gives the step -g, which moves row 0 further out (a first-order rise of the merit's penalty: no step length
     is accepted, the Panda's 'failed' stalls along a joint limit). Row 0 must stay in the working set and the step
     still descend."""
-    from comanip.planning.newton import _constrained_step
+    from comanip.optim.active_set import constrained_step
 
     rows = np.array([[1.0, 0.0], [-1.0, 1.0]])
     g = np.array([-0.9, 1.0])  # multipliers with both rows working: (-0.1, -1.0)
     c = np.array([5e-7, 5e-7])
-    step, multipliers, working, _ = _constrained_step(lambda b: b, g, c, lambda indices: rows[indices],
+    step, multipliers, working, _ = constrained_step(lambda b: b, g, c, lambda indices: rows[indices],
                                                       margin=1e-3, tolerance=1e-6)
     assert np.all(rows @ step <= 1e-12), rows @ step
     assert g @ step < 0
@@ -168,12 +168,12 @@ def test_a_step_never_drives_a_row_past_its_limit_further_out():
 def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite_one(rng):
     """The Woodbury solve after secant updates equals a direct solve with F + Σ sign_j u_j u_jᵀ, and an update
     that makes the matrix indefinite (eigenvalues checked directly) gives None."""
-    from comanip.planning.newton import _UpdatedFactor
+    from comanip.optim.hessian_models import UpdatedFactor
 
     size = 30
     root = rng.normal(size=(size, size))
     F = root @ root.T + size * np.eye(size)
-    factor = _UpdatedFactor(scipy.linalg.cho_factor(F), 0.0)
+    factor = UpdatedFactor(scipy.linalg.cho_factor(F), 0.0)
     matrix = F.copy()
     for sign in (1.0, -1.0):
         u = rng.normal(size=size)
@@ -278,9 +278,9 @@ def test_shifted_cholesky_solves_the_shifted_system(rng):
 
 
 def test_chord_steps_reach_the_same_optimum_with_fewer_hessians(monkeypatch):
-    """Warm point-mass solves reusing a factorisation (module newton, Chord steps) against fresh Hessians at
+    """Warm point-mass solves reusing a factorisation (comanip.optim.hessian_models.ExactHessian, chord steps) against fresh Hessians at
     every iteration: the same plans (J to 1e-9 relative), fewer Hessians in all."""
-    import comanip.planning.newton as newton
+    import comanip.optim.hessian_models as newton
 
     model = comanip.presets.cartesian()
     planner = Planner(model)
@@ -291,8 +291,8 @@ def test_chord_steps_reach_the_same_optimum_with_fewer_hessians(monkeypatch):
     plan = planner.solve(start, goal, model.width)
     rng = np.random.default_rng(3)
     counts, objectives = {}, {}
-    for ratio in (newton._REUSE_RATIO, 0.0):
-        monkeypatch.setattr(newton, "_REUSE_RATIO", ratio)
+    for ratio in (newton.REUSE_RATIO, 0.0):
+        monkeypatch.setattr(newton, "REUSE_RATIO", ratio)
         hessians.clear()
         plans = [planner.solve(start, goal + rng.uniform(-0.05, 0.05, 3), model.width, warm_start=plan) for _ in range(8)]
         assert all(p.success for p in plans)

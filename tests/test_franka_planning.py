@@ -238,7 +238,7 @@ def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(f
 ROUNDING_SENSITIVE = pytest.mark.xfail(strict=False, reason=(
     "known: at 0.25 m two of the three starts stall along the joint limit with gradients of about 1.1e-4, just "
     "above the 1e-4 that makes a stalled point 'solved_acceptable'; since rows past their limits are no longer "
-    "dropped when the step would drive them further out (newton._constrained_step) the third converges "
+    "dropped when the step would drive them further out (comanip.optim.active_set.constrained_step) the third converges "
     "('solved'), before that all three could stall, depending on rounding (git log -- benchmarks/HISTORY.md)"))
 
 

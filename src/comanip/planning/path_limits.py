@@ -4,7 +4,7 @@ Constraints c(x) ≤ 0 on the mean state mu_i = [q_i; qdot_i] of steps i = 1..H:
 q_min ≤ q_i ≤ q_max and |qdot_i| ≤ qdot_max (the body's limits; infinite ones are -inf rows that never
 enter the working set). Torque limits are bounds on x itself. The rows of the constraints' Jacobian are
 rows of d mu_i / d tau, exact along the mean (the curvature object computes them from the step
-Jacobians). The Newton method (:func:`comanip.planning.newton.newton_minimize`) keeps the few binding
+Jacobians). The Newton method (:func:`comanip.optim.active_set_newton.newton_minimize`) keeps the few binding
 ones in its working set; most reaches bind none and pay nothing.
 
 An augmented Lagrangian (penalty rounds with multiplier updates) was measured first: 70–200 Newton

@@ -11,7 +11,7 @@ indefinite, docs/formulation.md §9). Start state, goal and width are parameters
 Two solvers (``SolverOptions.method``):
 
 - ``newton`` (default): a regularised Newton method with an active set for the limits
-  (:mod:`comanip.planning.newton`) on a Hessian assembled from per-step pieces: exact for point masses
+  (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from per-step pieces: exact for point masses
   (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
   (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
   Several times faster than IPOPT on the point masses, to the same optimum (benchmarks/README.md).
@@ -49,7 +49,7 @@ from comanip.optim import SolverResult, Status, cholesky_solve
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.compiled import BufferedFunction
 from comanip.planning.linearised_curvature import LinearisedCurvature
-from comanip.planning.newton import newton_minimize
+from comanip.optim.active_set_newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
 from comanip.planning.reach_library import ReachLibrary, is_symmetric
@@ -95,7 +95,7 @@ class SolverOptions:
     hessian_refresh: int = 3
     """Nonlinear bodies: the approximate Hessian is assembled every this many Newton iterations, and after any step
     the line search shortened or taken with a limit in the working set; in between it is kept with its secant
-    corrections updated (:func:`comanip.planning.newton.newton_minimize`). 1: every iteration. Point masses (exact
+    corrections updated (:func:`comanip.optim.active_set_newton.newton_minimize`). 1: every iteration. Point masses (exact
     Hessian) assemble theirs as before whatever this says. On the ``franka_rest`` problems above (tolerance 1e-8),
     3 took as many iterations as 1 (447 against 454), 62 % of the assemblies and ended at the same plans (J within
     1.6e-9); at tolerance 1e-6, 2 and 4 were slower than 3 (benchmarks/franka_solver_options.py)."""

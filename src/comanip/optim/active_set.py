@@ -1,0 +1,144 @@
+"""Constraints c(x) ≤ 0 for an active-set method: the iterate with its constraint values, the bounds and the
+caller's constraints as one set of rows, the Newton step under the working set's linearisation, and the
+restoration step onto violated constraints (:mod:`comanip.optim.active_set_newton` says how they are used)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+NO_ROWS, NO_MULTIPLIERS = np.zeros(0, dtype=int), np.zeros(0)
+"""An empty working set and its multipliers (read only)."""
+
+
+@dataclass(slots=True)
+class Iterate:
+    """A point x (N,) and what was evaluated there: f, its gradient (None after a value-only trial), the
+    evaluation's data, the constraints c (bounds first) and rows(indices) of their Jacobian."""
+
+    x: np.ndarray
+    f: float
+    g: np.ndarray | None
+    data: Any
+    c: np.ndarray
+    rows: Callable[[np.ndarray], np.ndarray]
+    largest: float = field(init=False)
+    """max c (-inf without constraints): the working set, the violation and the merit's penalty read it first."""
+
+    def __post_init__(self):
+        self.largest = float(self.c.max()) if len(self.c) else -math.inf
+
+    @property
+    def violation(self) -> float:
+        """max(0, c): the largest violation, bounds included."""
+        return max(0.0, self.largest)
+
+
+def finite(f: float, g: np.ndarray | None) -> bool:
+    """f and every entry of g finite (a sum of finite gradient entries is finite short of overflow, 1e308)."""
+    return math.isfinite(f) and (g is None or math.isfinite(g.sum()))
+
+
+class ConstraintSet:
+    """c(x) ≤ 0 and rows of its Jacobian on demand: the finite bounds lb ≤ x ≤ ub (rows of ±I), then the
+    caller's ``constraints`` ((x, data) -> (c (m,), rows(indices)), or None)."""
+
+    def __init__(self, lb: np.ndarray, ub: np.ndarray, constraints):
+        self.constraints = constraints
+        self.upper = np.flatnonzero(np.isfinite(ub))
+        self.lower = np.flatnonzero(np.isfinite(lb))
+        self.lb, self.ub, self.size = lb, ub, len(lb)
+        self.all_finite = len(self.upper) == len(self.lower) == self.size
+        self.unbounded = len(self.upper) == len(self.lower) == 0
+
+    def __call__(self, x, data):
+        """(c (bounds then the caller's), rows(indices) -> their Jacobian rows (len(indices), N)) at x."""
+        if self.unbounded:  # no finite bound (the point masses' torques): no rows at all
+            bounds = NO_MULTIPLIERS
+        elif self.all_finite:  # the usual bounded case (torque bounds): no index arrays to gather through
+            bounds = np.concatenate([x - self.ub, self.lb - x])
+        else:
+            bounds = np.concatenate([x[self.upper] - self.ub[self.upper], self.lb[self.lower] - x[self.lower]])
+        if self.constraints is None:
+            return bounds, self._bound_rows
+        c_user, user_rows = self.constraints(x, data)
+        n_bounds = len(bounds)
+
+        def rows(indices):
+            out = np.zeros((len(indices), self.size))
+            is_bound = indices < n_bounds
+            out[is_bound] = self._bound_rows(indices[is_bound])
+            if not is_bound.all():
+                out[~is_bound] = user_rows(indices[~is_bound] - n_bounds)
+            return out
+
+        return np.concatenate([bounds, c_user]), rows
+
+    def _bound_rows(self, indices):
+        out = np.zeros((len(indices), self.size))
+        n_upper = len(self.upper)
+        upper = indices < n_upper
+        out[np.flatnonzero(upper), self.upper[indices[upper]]] = 1.0
+        out[np.flatnonzero(~upper), self.lower[indices[~upper] - n_upper]] = -1.0
+        return out
+
+
+def constrained_step(solve, g, c, A, margin: float, tolerance: float):
+    """Newton step under the working set's linearised constraints; solve(b) applies the inverse of the regularised
+    hessian to b (N,) or (N, k).
+
+    A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row with a negative
+    multiplier is dropped and the step recomputed unless it is violated by more than ``tolerance`` (then
+    the step must restore it), or it is past its limit already and the step without it would move it further
+    (then it is kept). (Keeping a row met to within the tolerance, say at 3e-8 past a joint limit,
+    held the Panda's plans on the limit while the objective pulled them off it: the step vanished and
+    the solve stalled with a large Lagrangian gradient.) Returns (step,
+    multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
+    """
+    Hg = solve(g)
+    near = np.flatnonzero(c > -margin)
+    working, pinned = near, np.zeros(0, dtype=int)
+    while True:
+        if len(working):
+            rows = A(working)
+            HA = solve(rows.T)
+            schur = rows @ HA
+            multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
+            dropping = (multipliers < 0) & (c[working] <= tolerance) & ~np.isin(working, pinned)
+            if dropping.any():
+                working = working[~dropping]
+                continue
+            multipliers = np.maximum(multipliers, 0.0)
+            step = -(Hg + HA @ multipliers)
+        else:
+            multipliers, step = np.zeros(0), -Hg
+        # rows dropped together can push one another out: a dropped row already past its limit (within the
+        # tolerance) that the step would drive further out returns to the working set for good (on the Panda's
+        # reaches along a joint limit such rows made the merit rise at first order along every step, and the
+        # solve ended 'failed' at a gradient of 2e-4)
+        if len(working) == len(near):
+            break
+        dropped = np.setdiff1d(near, working, assume_unique=True)
+        dropped = dropped[c[dropped] > 0]
+        blocking = dropped[A(dropped) @ step > 0] if len(dropped) else dropped
+        if not len(blocking):
+            break
+        pinned = np.union1d(pinned, blocking)
+        working = np.union1d(working, blocking)
+    if not len(working):
+        return step, multipliers, working, None
+
+    def correct(c_working, HA=HA, schur=schur):
+        return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
+
+    return step, multipliers, working, correct
+
+
+def restoration_step(point: Iterate) -> np.ndarray:
+    """The least-norm move d with A_V d = -c_V onto the linearisation of the violated rows V at ``point``."""
+    violated = np.flatnonzero(point.c > 0)
+    rows = point.rows(violated)
+    return -rows.T @ np.linalg.lstsq(rows @ rows.T, point.c[violated], rcond=None)[0]

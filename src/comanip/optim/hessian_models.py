@@ -1,0 +1,180 @@
+"""How the active-set Newton method (:mod:`comanip.optim.active_set_newton`) gets the regularised Hessian it
+steps with: :class:`ExactHessian` assembles the caller's Hessian at every iteration and reuses its factor for
+chord steps; :class:`SecantHessian` corrects an approximate Hessian with symmetric rank-one (SR1) updates,
+assembles it lazily and carries the updates into the last factor by the Woodbury identity. Both regularise by
+IPOPT's growing shifts, more strongly after a failed line search."""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from comanip.optim.factorisation import cholesky_solve, growing_shifts, shifted_cholesky
+
+RECOVERY_SHIFT = 1e-3
+"""The least relative shift delta after the first failed line search (ten times more after each further one)."""
+REUSE_RATIO = 0.1
+"""An exact Hessian's factor is reused while each step cuts the gradient by at least this factor."""
+
+
+class _Regularised:
+    """The shifted Cholesky factorisation with IPOPT's shift schedule, remembering the last shift needed."""
+
+    shift_last = 0.0
+
+    def _factored(self, matrix: np.ndarray, recoveries: int) -> tuple[tuple | None, float]:
+        # after a failed line search, a stronger shift turns the step towards steepest descent
+        least = RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
+        factor, shift = shifted_cholesky(matrix, growing_shifts(self.shift_last, least))
+        if factor is not None and shift > 0:
+            self.shift_last = shift
+        return factor, shift
+
+
+class ExactHessian(_Regularised):
+    """An exact Hessian, assembled at every iteration. Chord steps: while no constraint is in the working set and
+    the last step cut max |∇f| at least tenfold (``REUSE_RATIO``), the next step reuses that step's factor
+    instead of a new Hessian (Kelley 2003, sec. 5.4)."""
+
+    def __init__(self, hessian: Callable):
+        self.hessian = hessian
+        self.kept = None
+        """The factor of the last free step and the optimality where it was taken, for chord steps."""
+
+    def chord_factor(self, optimality: float, recoveries: int) -> tuple | None:
+        """The kept factor when a chord step from a free point of this ``optimality`` may use it, else None."""
+        if recoveries == 0 and self.kept is not None and optimality <= REUSE_RATIO * self.kept[1]:
+            self.kept = (self.kept[0], optimality)
+            return self.kept[0]
+        return None
+
+    def factor(self, point, recoveries: int, model_held: bool) -> tuple[Callable, tuple] | str:
+        """(solve(b), factor) of the regularised Hessian at ``point``, or why there is none."""
+        self.kept = None
+        hessian = self.hessian(point.data)
+        if not np.isfinite(hessian).all():
+            return "Hessian not finite"
+        factor, _ = self._factored(hessian, recoveries)
+        if factor is None:
+            return "no positive definite regularised Hessian"
+        return (lambda b: cholesky_solve(factor, b)), factor
+
+    def stepped(self, factor: tuple, optimality: float, free: bool) -> None:
+        """A step was computed with ``factor`` at a point of this ``optimality``; a free one may be reused."""
+        if free:
+            self.kept = (factor, optimality)
+
+    def forget(self) -> None:
+        """After a failed line search: no chord step from the factor that failed."""
+        self.kept = None
+
+
+class SecantHessian(_Regularised):
+    """An approximate Hessian with secant corrections, assembled every ``refresh`` iterations (module docstring
+    of :mod:`comanip.optim.active_set_newton`)."""
+
+    def __init__(self, hessian: Callable, refresh: int):
+        self.hessian, self.refresh = hessian, refresh
+        self.correction = None
+        self.previous = None
+        """(x, g) before the last step."""
+        self.assembled, self.age = None, 0
+        """The last assembled hessian, and the iterations it has served."""
+        self.updated: UpdatedFactor | None = None
+        """The last factored matrix with the secant updates since."""
+
+    def chord_factor(self, optimality: float, recoveries: int) -> None:
+        """Never: the secant corrections change the matrix at every step."""
+        return None
+
+    def factor(self, point, recoveries: int, model_held: bool) -> tuple[Callable, tuple | None] | str:
+        """(solve(b), factor or None when the matrix had updates since it was factored), or why there is none.
+        ``model_held``: the last step was a full one with no constraint in the working set."""
+        reused = self.assembled is not None and self.age < self.refresh and model_held
+        if not reused:
+            self.assembled, self.age = self.hessian(point.data), 0
+            if not np.isfinite(self.assembled).all():
+                return "Hessian not finite"
+        self.age += 1
+        self.correction = np.zeros_like(self.assembled) if self.correction is None else self.correction
+        update = None
+        if self.previous is not None:
+            update = symmetric_rank_one_update(self.correction, self.assembled, point.x - self.previous[0],
+                                               point.g - self.previous[1])
+        self.previous = (point.x, point.g)
+        # between assemblies the last factor takes the secant updates (Woodbury), unless it was shifted or
+        # an update leaves the matrix indefinite: then the matrix is factored anew, with the shifts
+        reusable = reused and not recoveries and self.updated.shift == 0
+        self.updated = self.updated.updated(update) if reusable else None
+        if self.updated is None:
+            factor, shift = self._factored(self.assembled + self.correction, recoveries)
+            if factor is None:
+                return "no positive definite regularised Hessian"
+            self.updated = UpdatedFactor(factor, shift)
+        return self.updated.solve, self.updated.factor
+
+    def stepped(self, factor, optimality: float, free: bool) -> None:
+        """Nothing to remember: the corrections were updated in :meth:`factor`."""
+
+    def forget(self) -> None:
+        """After a failed line search: drop the corrections (they may have learnt curvature from far away) and
+        assemble anew."""
+        self.correction, self.previous, self.assembled = None, None, None
+
+
+def symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float] | None:
+    """correction += r rᵀ / (rᵀ s), r = y - (H + correction) s, in place; skipped when rᵀ s is tiny
+    (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|). correction and H (N, N), s and y (N,).
+
+    Returns the update as (u (N,), sign ±1), correction's change being sign·u uᵀ; None when skipped."""
+    r = y - H @ s - correction @ s
+    denominator = r @ s
+    if abs(denominator) > 1e-8 * np.linalg.norm(r) * np.linalg.norm(s):
+        u = r / np.sqrt(abs(denominator))  # u_i u_j = u_j u_i: the correction stays exactly symmetric
+        sign = float(np.sign(denominator))
+        correction += np.outer(u, sign * u)
+        return u, sign
+    return None
+
+
+class UpdatedFactor:
+    """Solves with a regularised hessian M = F + U S Uᵀ: F's Cholesky factor (from
+    :func:`~comanip.optim.shifted_cholesky`, with its relative ``shift``), and the secant updates made since it was
+    factored, U = [u_1 ... u_m] (N, m) with signs S = diag(±1), by the Woodbury identity
+    M⁻¹ b = F⁻¹ b - F⁻¹U C⁻¹ Uᵀ F⁻¹ b, C = S⁻¹ + Uᵀ F⁻¹ U (m, m): two triangular solves per update (about
+    0.1 ms for the Panda's 350 unknowns) instead of a factorisation (1.1 ms)."""
+
+    def __init__(self, cholesky: tuple, shift: float, vectors: np.ndarray | None = None, signs: np.ndarray | None = None):
+        self.cholesky, self.shift = cholesky, shift
+        self.vectors = np.zeros((len(cholesky[0]), 0)) if vectors is None else vectors
+        self.signs = np.zeros(0) if signs is None else signs
+        if len(self.signs):
+            self._solved = cholesky_solve(cholesky, self.vectors)  # F⁻¹ U
+            self._capacitance = np.diag(self.signs) + self.vectors.T @ self._solved  # S⁻¹ = S for signs ±1
+
+    @property
+    def factor(self) -> tuple | None:
+        """M's Cholesky factor when no update was made since it was factored (M = F), else None."""
+        return None if len(self.signs) else self.cholesky
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """M⁻¹ b for b (N,) or (N, k)."""
+        x = cholesky_solve(self.cholesky, b)
+        if not len(self.signs):
+            return x
+        return x - self._solved @ np.linalg.solve(self._capacitance, self._solved.T @ b)
+
+    def updated(self, update: tuple[np.ndarray, float] | None) -> "UpdatedFactor | None":
+        """The factor of M + sign·u uᵀ (``update`` as :func:`symmetric_rank_one_update` returns it; None: M
+        itself), or None when that matrix is not safely positive definite. By Haynsworth's inertia additivity
+        M + U S Uᵀ is positive definite exactly when C has as many negative eigenvalues as S has negative signs;
+        C nearly singular counts as not."""
+        if update is None:
+            return self
+        u, sign = update
+        factor = UpdatedFactor(self.cholesky, self.shift, np.column_stack([self.vectors, u]), np.append(self.signs, sign))
+        eigenvalues = np.linalg.eigvalsh(factor._capacitance)
+        if np.sum(eigenvalues < 0) != np.sum(factor.signs < 0) or np.min(np.abs(eigenvalues)) <= 1e-8 * np.max(np.abs(eigenvalues)):
+            return None
+        return factor

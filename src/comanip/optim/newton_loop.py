@@ -1,0 +1,87 @@
+"""The one Newton iteration every solver in comanip runs: the planner's active-set SQP
+(:mod:`comanip.optim.active_set_newton`), the goal estimate's root finding on the regret's first-order conditions
+(:mod:`comanip.estimation.regret_newton`) and the online estimator's MAP goal (:mod:`comanip.estimation.map_newton`).
+
+One pass of :func:`newton_iterate`:
+
+1. stop with ``max_iterations`` when the budget is spent, with ``max_wall_time`` when ``expired()``;
+2. ``method.begin(state)``: count the iteration (a method that counts something else, such as linearisations, does
+   nothing here);
+3. ``method.converged(state)``: a :class:`Stop` when the iterate is a solution (the test that needs no step);
+4. ``method.direction(state)``: the Newton direction at the iterate, or a :class:`Stop` found while computing it
+   (a converged constrained point, a Hessian that cannot be factored);
+5. ``method.globalise(state, direction)``: a line search or a trust region; True when the iterate moved;
+6. otherwise ``method.recover(state, direction)``: None to try again from the same iterate (a stronger
+   regularisation, a fresh Hessian), or the :class:`Stop` that ends the solve.
+
+``method.result(state, stop)`` turns the state into the :class:`~comanip.optim.SolverResult`. What differs between the
+solvers (the working set of constraints, secant corrections, trust regions, the goal's projection onto a
+range) lives in their methods, never in this loop.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable, Protocol, TypeVar
+
+from comanip.optim.result import SolverResult
+from comanip.optim.status import Status
+
+S = TypeVar("S")
+D = TypeVar("D")
+
+
+@dataclass(frozen=True)
+class Stop:
+    """Why a solve ends: its status and the status in words."""
+
+    status: Status
+    message: str
+
+
+class NewtonMethod(Protocol[S, D]):
+    """What :func:`newton_iterate` asks of a solver, for its state S (the iterate and what the method
+    remembers between iterations) and its directions D."""
+
+    def iterations(self, state: S) -> int:
+        """The iterations spent so far (what ``max_iterations`` bounds)."""
+
+    def begin(self, state: S) -> None:
+        """Called once per pass, after the budget checks."""
+
+    def converged(self, state: S) -> Stop | None:
+        """A stop when the iterate is a solution, before any direction is computed."""
+
+    def direction(self, state: S) -> D | Stop:
+        """The step to try from the iterate, or why the solve ends."""
+
+    def globalise(self, state: S, direction: D) -> bool:
+        """Move the iterate along ``direction`` (line search or trust region); False when it did not move."""
+
+    def recover(self, state: S, direction: D) -> Stop | None:
+        """After ``direction`` failed: None to try again from the iterate, or why the solve ends."""
+
+    def result(self, state: S, stop: Stop) -> SolverResult:
+        """The solve's result at the iterate."""
+
+
+def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
+                   expired: Callable[[], bool] = lambda: False) -> SolverResult:
+    """Run ``method`` from ``state`` until it stops (module docstring); never raises for an unconverged solve."""
+    while True:
+        if method.iterations(state) >= max_iterations:
+            return method.result(state, Stop(Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations"))
+        if expired():
+            return method.result(state, Stop(Status.MAX_WALL_TIME, "the wall-time budget ran out"))
+        method.begin(state)
+        stop = method.converged(state)
+        if stop is None:
+            direction = method.direction(state)
+            if isinstance(direction, Stop):
+                stop = direction
+            elif method.globalise(state, direction):
+                continue
+            else:
+                stop = method.recover(state, direction)
+        if stop is not None:
+            return method.result(state, stop)
