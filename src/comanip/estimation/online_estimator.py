@@ -56,7 +56,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import lapack
 from scipy.stats import chi2
 from threadpoolctl import ThreadpoolController
 
@@ -66,6 +65,7 @@ from comanip.estimation.corrected_deviation import (CORRECTION_TIME, DEVIATION_T
                                                    correction_factor)
 from comanip.estimation.estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
+from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
@@ -227,19 +227,8 @@ SETTLED_SPREAD = 0.1
 SETTLED_OBSERVATIONS = 8
 #: |log pace|, and |onset delay| / MT, beyond which a settled paced fit contradicts the model's own timing.
 PACE_TOLERANCE = 0.14
-#: Observed speed and displacement beyond this many noise standard deviations count as movement.
-_MOVEMENT_SIGMAS = 3.0
 #: Whitenings rebuilt per update at most (each at the goal the previous round ended at).
 _COVARIANCE_ROUNDS = 3
-#: Relative std along the reach above which the goal's variance there comes from a quadrature, and its points.
-_SKEWED = 0.05
-_QUADRATURE_POINTS = 80
-#: Halvings of a Newton step before the iteration gives up.
-_BACKTRACKS = 12
-#: Newton decrement (the decrease of -log p the step predicts, nats) below which an update has converged.
-_DECREMENT = 1e-6
-#: ... and, relative to -log p, below which a step that no line search can lower counts as converged (rounding).
-_ACCEPTABLE_DECREMENT = 1e-6
 
 
 class OnlineGoalEstimator:
@@ -460,11 +449,13 @@ class OnlineGoalEstimator:
         counts = self._counts[steps]
         observed = self._sums[steps] / counts[:, None]
         weights = self._weights[steps] / counts[:, None]
-        problem = _Problem(self, steps, observed, weights)
+        problem = MapProblem(self.family, lambda goal: self._prediction(goal, order=2, covariance=False), self.start_position,
+                             self.prior_mean, self._prior_precision, steps, observed, weights)
         previous = self.latest
         try:
             if previous is None or previous.status in (Status.UNINFORMATIVE, Status.FAILED):
-                goal = problem.cold_goal()
+                goal = problem.cold_goal(self._last_observation, self.options.observation_std,
+                                         self._R[None] / counts[:, None, None])
                 if goal is None:
                     return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE,
                                         "no observation shows movement: the estimate is the prior", 0, t_begin), None
@@ -473,8 +464,10 @@ class OnlineGoalEstimator:
             iterations = 0
             for _ in range(_COVARIANCE_ROUNDS):
                 whitening = self._whitening_at(goal)
-                goal, covariance, status, message, used = problem.newton(goal, whitening)
-                iterations += used
+                solved = MapNewton(problem, whitening, self.options.tolerance, self.options.step_fraction,
+                                   self.width).solve(goal, self.options.max_iterations)
+                goal, covariance, status, message = solved.x, solved.local_model.covariance(), solved.status, solved.message
+                iterations += solved.nit
                 if not self._stale(goal):
                     break
             covariance = self.options.covariance_scale * problem.distance_spread(goal, covariance, whitening)
@@ -562,209 +555,9 @@ class OnlineGoalEstimator:
         return self.family.prediction(self.start_position, goal, order=order, covariance=covariance)
 
 
-class _Problem:
-    """One update's MAP problem: the averaged observations at ``steps`` (S,) (observed (S, 2n), interpolation
-    ``weights`` (S, H+1) of the grid means), Newton's method and the cold start."""
-
-    def __init__(self, estimator: OnlineGoalEstimator, steps, observed, weights):
-        self.e, self.steps, self.observed, self.weights = estimator, steps, observed, weights
-        self.m = observed.shape[1]
-        self._predicted: tuple[bytes, ReachPrediction] | None = None    # the last goal's prediction (rounds share it)
-
-    def _prediction(self, goal: np.ndarray) -> ReachPrediction:
-        key = goal.tobytes()
-        if self._predicted is None or self._predicted[0] != key:
-            self._predicted = key, self.e._prediction(goal, order=2, covariance=False)
-        return self._predicted[1]
-
-    def _terms(self, whitening: ObservationWhitening, goal):
-        """(objective, Hessian (d, d), Gauss–Newton matrix (d, d), minus the gradient (d,)) at ``goal``."""
-        e, m = self.e, self.m
-        d = len(goal)
-        prediction = self._prediction(goal)
-        H1, nx = prediction.mean.shape
-        grid = np.concatenate([prediction.mean[:, :m, None], prediction.mean_jacobian[:, :m]], axis=2)
-        columns = (self.weights @ grid.reshape(H1, -1)).reshape(len(self.steps), m, 1 + d)
-        columns[:, :, 0] = self.observed - columns[:, :, 0]
-        flat = whitening.apply(columns).reshape(-1, 1 + d)
-        residual, G = flat[:, 0], flat[:, 1:]
-        offset = goal - e.prior_mean
-        objective = 0.5 * float(residual @ residual + offset @ e._prior_precision @ offset)
-        gauss_newton = G.T @ G + e._prior_precision
-        # Newton's Hessian adds -sum_j e_j (L^-1 d²mu/dg²)_j, the residuals pulled back onto the grid's means
-        z = np.zeros((H1, nx))
-        z[:, :m] = self.weights.T @ whitening.transpose_apply(residual)
-        newton = gauss_newton - prediction.hessian_contraction(z)
-        return objective, 0.5 * (newton + newton.T), gauss_newton, G.T @ residual - e._prior_precision @ offset
-
-    def misfit(self, whitening: ObservationWhitening, goal: np.ndarray) -> float:
-        """Mean squared whitened residual of the observations at ``goal``, per observed number: about 1 where
-        the model at its own pace explains them."""
-        predicted = self.weights @ self._prediction(goal).mean[:, :self.m]
-        residual = whitening.apply((self.observed - predicted)[:, :, None]).ravel()
-        return float(residual @ residual) / residual.size
-
-    def _projected(self, goal: np.ndarray) -> np.ndarray:
-        """The goal moved into the family's range of distances from the start."""
-        e = self.e
-        offset = goal - e.start_position
-        D = math.sqrt(float(offset @ offset))
-        low, high = e.family.distances[0], e.family.distances[-1]
-        if D == 0:
-            return e.start_position + low * np.eye(len(goal))[0]
-        if low <= D <= high:
-            return goal
-        return e.start_position + offset * (min(max(D, low), high) / D)
-
-    def distance_spread(self, goal: np.ndarray, covariance: np.ndarray, whitening: ObservationWhitening) -> np.ndarray:
-        """The covariance with its variance along the reach replaced by the posterior's along the line through
-        the start and ``goal`` (1-D quadrature on a grid of distances), and the spread across it scaled by the
-        root mean square distance over D_hat, where the Laplace approximation's relative std along the reach
-        exceeds :data:`_SKEWED`: early in a reach the distance's posterior has a long tail towards far goals
-        that the curvature at the mode does not see."""
-        e = self.e
-        offset = goal - e.start_position
-        D = float(np.linalg.norm(offset))
-        u = offset / D
-        variance = float(u @ covariance @ u)
-        spread = math.sqrt(variance) / D
-        if spread < _SKEWED:
-            return covariance
-        family = e.family
-        low = max(math.log(D) - 6 * spread, math.log(family.distances[0]))
-        high = min(math.log(D) + 6 * spread, math.log(family.distances[-1]))
-        if high - low < 1e-6:
-            return covariance
-        distances = np.exp(np.linspace(low, high, _QUADRATURE_POINTS))
-        n, m, M = e.model.n, self.m, len(distances)
-        along = self.weights @ family.along(distances)[:, :, :m // n]               # (M, S, 2): position, velocity
-        means = (along[:, :, :, None] * u).reshape(M, len(self.steps), m)
-        means[:, :, :n] += e.start_position
-        whitened = whitening.matrix @ (self.observed[None] - means).reshape(M, -1).T
-        goals = e.start_position + distances[:, None] * u
-        offsets = goals - e.prior_mean
-        energy = 0.5 * (np.sum(whitened**2, axis=0) + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
-        weights = np.exp(-(energy - energy.min())) * np.gradient(distances)
-        weights /= weights.sum()
-        along = float(weights @ (distances - D) ** 2)
-        # across the reach the direction's uncertainty spreads the goal in proportion to its distance
-        across = np.eye(len(u)) - np.outer(u, u)
-        stretch = math.sqrt(max(1.0, float(weights @ distances**2) / D**2))
-        scale = across * stretch + np.outer(u, u)
-        return scale @ covariance @ scale + max(0.0, along - variance) * np.outer(u, u)
-
-    def _at_range_end(self, goal: np.ndarray) -> bool:
-        return bool(np.linalg.norm(goal - self.e.start_position) >= self.e.family.distances[-1] * (1 - 1e-9))
-
-    def _range_message(self) -> str:
-        return (f"the estimate sits at the largest distance the reach family covers ({self.e.family.distances[-1]:g} m): "
-                "the observations point farther than the model's plans reach")
-
-    def newton(self, goal: np.ndarray, whitening: ObservationWhitening):
-        """Newton's method from ``goal`` under a fixed ``whitening`` (the Gauss–Newton matrix where the Hessian
-        is not positive definite), a backtracking line search on the objective: (goal, covariance (d, d) m²,
-        status, message, iterations). The covariance is the inverse Hessian at the result (Laplace)."""
-        e, options = self.e, self.e.options
-        goal = self._projected(np.asarray(goal, dtype=float))
-        terms = self._terms(whitening, goal)
-        for iteration in range(1, options.max_iterations + 1):
-            objective, newton, gauss_newton, descent = terms
-            step = _solve_positive(newton, gauss_newton, descent)
-            if 0.5 * float(step @ descent) <= _DECREMENT or math.sqrt(float(step @ step)) <= options.tolerance:
-                # the Newton step would lower -log p by less than _DECREMENT: take it and stop
-                goal = self._projected(goal + step)
-                if self._at_range_end(goal):
-                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
-                return goal, _covariance(terms), Status.SOLVED, f"converged in {iteration} Newton iterations", iteration
-            limit = options.step_fraction * max(math.sqrt(float((goal - e.start_position) @ (goal - e.start_position))), e.width)
-            length = math.sqrt(float(step @ step))
-            if length > limit:
-                step *= limit / length
-            for _ in range(_BACKTRACKS):
-                trial = self._projected(goal + step)
-                trial_terms = self._terms(whitening, trial)
-                if trial_terms[0] <= objective + 1e-12 * abs(objective):
-                    break
-                step *= 0.5
-            else:
-                if self._at_range_end(goal):
-                    return goal, _covariance(terms), Status.MAX_ITERATIONS, self._range_message(), iteration
-                decrement = 0.5 * float(_solve_positive(newton, gauss_newton, descent) @ descent)
-                if decrement <= _ACCEPTABLE_DECREMENT * max(1.0, abs(objective)):
-                    return goal, _covariance(terms), Status.SOLVED_ACCEPTABLE, (
-                        f"no Newton step lowers the objective any more (decrement {decrement:.2g})"), iteration
-                return goal, _covariance(terms), Status.FAILED, (
-                    f"no Newton step lowers the objective, though it predicts a decrease of {decrement:.2g}"), iteration
-            goal, terms = trial, trial_terms
-        return goal, _covariance(terms), Status.MAX_ITERATIONS, f"no convergence in {options.max_iterations} Newton iterations", options.max_iterations
-
-    def cold_goal(self) -> np.ndarray | None:
-        """The best member of the family along the observed directions (latest velocity, latest displacement
-        from the start, and the prior's direction), scored by the observations' likelihood with each step's
-        error taken independently, plus the prior; None when no observation shows movement beyond its noise."""
-        e = self.e
-        n = e.model.n
-        sigma_q, sigma_v = e.options.observation_std
-        latest = e._last_observation
-        directions = []
-        if np.linalg.norm(latest[n:]) > _MOVEMENT_SIGMAS * sigma_v:
-            directions.append(latest[n:] / np.linalg.norm(latest[n:]))
-        displacement = latest[:n] - e.start_position
-        if np.linalg.norm(displacement) > _MOVEMENT_SIGMAS * sigma_q:
-            directions.append(displacement / np.linalg.norm(displacement))
-        if not directions:
-            return None
-        prior_offset = e.prior_mean - e.start_position
-        if np.linalg.norm(prior_offset) > 0:
-            directions.append(prior_offset / np.linalg.norm(prior_offset))
-        family, m = e.family, self.m
-        noise = e._R[None] / e._counts[self.steps][:, None, None]
-        best, best_score = None, math.inf
-        for u in directions:
-            goals = e.start_position + family.distances[:, None] * u
-            K = len(goals)
-            means = (family.member_along[:, :, :, None] * u).reshape(K, e.model.H + 1, -1)[:, :, :m]
-            means[:, :, :n] += e.start_position
-            r = self.observed - np.einsum("sj,kjm->ksm", self.weights, means)
-            T = family.frame(u)[:m, :m]
-            S = T @ family.member_cov[:, self.steps, :m, :m] @ T.T + noise
-            solved = np.linalg.solve(S, r[..., None])[..., 0]
-            _, log_det = np.linalg.slogdet(S)
-            offsets = goals - e.prior_mean
-            scores = 0.5 * (np.sum(r * solved, axis=(1, 2)) + log_det.sum(axis=1)
-                            + np.einsum("ki,ij,kj->k", offsets, e._prior_precision, offsets))
-            k = int(np.argmin(scores))
-            if scores[k] < best_score:
-                best, best_score = goals[k], scores[k]
-        return best
-
-
 def _grid_position(time_s: float, h: float, H: int) -> tuple[int, float]:
     """Where time_s (s, ≥ 0) falls on the grid of step h (s): the step i ≤ H at or before it and the fraction
     of a step (in [0, 1]) it lies after t_i; times at or after the horizon H·h read as (H, 0)."""
     grid = time_s / h
     before = min(H, int(math.floor(grid * (1 + 1e-9))))
     return before, (0.0 if before == H else min(max(grid - before, 0.0), 1.0))
-
-
-def _factor(newton: np.ndarray, gauss_newton: np.ndarray) -> np.ndarray:
-    """Cholesky factor of the Hessian when it is positive definite, else of the Gauss–Newton matrix (positive
-    definite by construction). LAPACK directly: numpy's wrappers cost more than these d×d solves."""
-    factor, info = lapack.dpotrf(newton, lower=1)
-    if info != 0:
-        factor, info = lapack.dpotrf(gauss_newton, lower=1)
-        if info != 0:
-            raise np.linalg.LinAlgError("the Gauss–Newton matrix is not positive definite")
-    return factor
-
-
-def _solve_positive(newton: np.ndarray, gauss_newton: np.ndarray, rhs: np.ndarray) -> np.ndarray:
-    """The Newton step: (Hessian or Gauss–Newton matrix)^-1 rhs (:func:`_factor`)."""
-    return lapack.dpotrs(_factor(newton, gauss_newton), rhs, lower=1)[0]
-
-
-def _covariance(terms) -> np.ndarray:
-    """The Laplace covariance: the inverse of the Hessian at the estimate (:func:`_factor`)."""
-    _, newton, gauss_newton, _ = terms
-    inverse, _ = lapack.dpotri(_factor(newton, gauss_newton), lower=1)
-    return np.tril(inverse) + np.tril(inverse, -1).T
