@@ -5,8 +5,8 @@
 Each block between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` has one page and one script below that
 measures it and prints the block's markdown on stdout; this runs the scripts of the blocks named (default: all,
 in order; the slow ones take minutes) and replaces each block's text in its page with the output.
-``tests/test_docs.py`` checks that every table of numbers on a results page sits in such a block and that every
-block has its script here.
+``tests/project/test_docs.py`` checks that every table of numbers on a results page sits in such a block and that
+every block has its script here.
 """
 
 from __future__ import annotations

@@ -45,11 +45,11 @@ def activation_planner():
 
 
 def pytest_terminal_summary(terminalreporter):
-    """Report the Hypothesis profile and how many generated inputs the fuzz suite (tests/test_fuzz.py) tried,
-    when it ran."""
+    """Report the Hypothesis profile and how many generated inputs the fuzz suite (tests/project/test_fuzz.py)
+    tried, when it ran."""
     import sys
 
-    fuzz = sys.modules.get("test_fuzz") or sys.modules.get("tests.test_fuzz")
+    fuzz = sys.modules.get("tests.project.test_fuzz")
     if fuzz is not None and fuzz.FUZZ_COUNT["inputs"]:
         terminalreporter.write_line(f"fuzz: {fuzz.FUZZ_COUNT['inputs']} generated inputs tried "
                                     f"(hypothesis profile {settings.get_current_profile_name()!r})")

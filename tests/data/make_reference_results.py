@@ -5,7 +5,7 @@ Run on the code whose behaviour is the reference (it writes ``reference_results.
 
     PYTHONPATH=src python tests/data/make_reference_results.py
 
-``tests/test_reference_results.py`` recomputes every entry with :func:`reference_results` and compares.
+``tests/project/test_reference_results.py`` recomputes every entry with :func:`reference_results` and compares.
 Entries are named ``<case>/<quantity>``: a plan stores its objective J, torques (H, n), status and
 iterations; an estimate its goal (d,), torques, normalised regret, status and iterations; a posterior its
 probabilities (K, C) and log-likelihoods (K, C).
@@ -113,7 +113,7 @@ def reference_results() -> dict[str, np.ndarray]:
     """Every point-mass entry, computed by the code as it is (seconds).
 
     Cold solves run every initial guess (``cold_search="all"``, the search the entries were made with); the
-    default ranked search reaches the same objectives (tests/test_planner.py) in fewer iterations."""
+    default ranked search reaches the same objectives (tests/planning/test_reach_library.py) in fewer iterations."""
     options = SolverOptions(cold_search="all")
     planners = {name: comanip.Planner(getattr(comanip.presets, name)(), options) for name in ("planar", "cartesian", "human")}
     return {**_plans(planners), **_estimates(planners), **_posteriors(planners)}

@@ -44,7 +44,7 @@ def test_the_command_reports_a_bad_parameter_file_in_one_line(tmp_path, capsys):
 
 
 def test_the_ros_guides_franka_parameters_are_valid(tmp_path):
-    readme = (Path(__file__).resolve().parents[1] / "docs" / "guide" / "ros.md").read_text()
+    readme = (Path(__file__).resolve().parents[2] / "docs" / "guide" / "ros.md").read_text()
     block = readme.split("```yaml\ncomanip_goal:", 1)[1].split("```", 1)[0]
     params = tmp_path / "franka.yaml"
     params.write_text("comanip_goal:" + block)
@@ -53,5 +53,5 @@ def test_the_ros_guides_franka_parameters_are_valid(tmp_path):
 
 
 def test_the_example_node_config_is_valid():
-    settings = NodeSettings.from_yaml(Path(__file__).resolve().parents[1] / "examples" / "data" / "node.yaml")
+    settings = NodeSettings.from_yaml(Path(__file__).resolve().parents[2] / "examples" / "data" / "node.yaml")
     assert settings.preset == "cartesian" and settings.prior_goal == (0.4, 0.1, 0.1)

@@ -40,8 +40,10 @@ def test_plans_from_varied_starts_reach_the_goal(planar_planner, start):
     assert plan.success, plan.message
     assert plan.final_error < 0.02
     assert plan.ee_speed[-1] < 0.05 * plan.ee_speed.max()
-    # the plan beats doing nothing
-    assert plan.objective < planar_planner.solve(start, goal, 0.02, warm_start=np.zeros((30, 2))).objective or plan.final_error < 0.02
+    # the plan beats doing nothing: J of zero torques from the same start (a warm start from zero torques is no
+    # such check: zero torques are a stationary point of J that the solver may stay at)
+    nothing = planar_planner.problem.objective_value(np.zeros_like(plan.torque), np.asarray(start, float), goal, 0.02)
+    assert plan.objective < nothing
 
 
 def test_cartesian_plan_reaches_goal_and_warm_start_agrees(cartesian_planner):

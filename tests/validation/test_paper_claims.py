@@ -94,7 +94,7 @@ def test_closed_loop_execution_brings_the_peak_earlier_than_the_open_loop_plan(p
 @pytest.mark.slow
 def test_validate_quick_writes_figures_and_a_complete_report(tmp_path, grid):
     out = tmp_path / "validate"
-    # the Franka section has its own tests (test_validation_franka.py); here the flag must skip it
+    # the Franka section has its own tests (test_franka_section.py); here the flag must skip it
     assert main(["validate", "--quick", "--no-franka", "--out", str(out)]) == 0
     assert not list(out.glob("franka*"))
     for name in ("report.json", "report.md", "velocity_profiles.png", "fitts.png", "dispersion.png", "phase.png",

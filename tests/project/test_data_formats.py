@@ -38,9 +38,9 @@ from comanip.objectives.discounting import DISCOUNT_FORMS
 from comanip.objectives.reward import GOAL_COVARIANCE_FORMS, REWARD_FORMS
 from comanip.planning.plan import Plan
 from comanip.simulation.scenario import TrialRecord
-from test_docs import subcommand_tree
+from tests.project.test_docs import subcommand_tree
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "data_formats.md"
+DOC = Path(__file__).resolve().parents[2] / "docs" / "data_formats.md"
 
 
 def section(heading: str) -> list[str]:
