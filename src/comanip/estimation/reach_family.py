@@ -7,7 +7,7 @@ block of the state (q, qdot, and the activation stages, each (n,)) has a mean u 
 Q Sigma_i(D) Q^T, Q an orthogonal map with Q e_1 = u; the torque is u · tau_i(D). So the plans to the goals
 along one axis, at distances D_1 < ... < D_K (m, geometric), give the plan to any goal: the member at
 |g - x_0| (a cubic spline in log D between members), turned onto u. The spline's error against a real plan
-is measured by tests/test_online_estimation.py (about 1e-5 m in the mean on the Cartesian preset).
+is measured by tests/estimation/test_online_estimator.py (about 1e-5 m in the mean on the Cartesian preset).
 
 The derivative of the mean with respect to the goal, which the online estimator needs for its Gauss–Newton
 steps, follows from the same form: d(u a)/dg = a'(D) u u^T + (a(D) / D) (I - u u^T).

@@ -23,7 +23,7 @@ F(t) = E[exp(-t u)] = det(I + t Sigma_x / s²)^-1/2 exp(-t e^T (s² I + t Sigma_
 
 the derivatives of F taken symbolically (CasADi). With m = 4 it is the probability of a hit up to the soft
 edge: 0.98 (kernel) against 0.996 (ball) for a centred hand with sigma = 0.3 w in 2-D, 0.81 against 0.85
-at sigma = 0.4 w, 0.5 w off centre (tests/test_reward.py checks the closed form against Monte Carlo of the
+at sigma = 0.4 w, 0.5 w off centre (tests/objectives/test_reward.py checks the closed form against Monte Carlo of the
 kernel). It is dimensionless, at most 1, and saturates once the hand is surely inside the goal: unlike the
 Gaussian overlap, precision beyond the goal's size earns nothing.
 """
