@@ -69,6 +69,7 @@ import numpy as np
 from comanip.estimation.goal_prior import GoalPrior
 from comanip.estimation.regret_system import Linearisation, RegretPoint, RegretSystem
 from comanip.optim import SolverResult, Status, backtrack
+from comanip.optim.newton_loop import Stop, newton_iterate
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 
 
@@ -95,89 +96,30 @@ def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o:
         A :class:`~comanip.optim.SolverResult`: x the point, fun the normalised regret J(tau_c) - J(tau_s)
         (without the regulariser), optimality max |F| (normalised gradient units; m, m/s or rad, rad/s for F2).
     """
-    problem = _Problem(system, start, observed, n_o, observed_rows, prior, width)
-    linearise, moved = problem.linearise, problem.moved
-    excluded_c = system.limits_at_step(n_o) if system.path_limits.active else np.zeros(0, dtype=int)
-
-    def ceiling_at(at: RegretPoint) -> float:
-        return step_fraction * max(np.linalg.norm(at.goal - observed_position), width)
-
-    linearisation = linearise(point)
-    # the limits binding at the start (within 1e-4) are held from the first step on
-    updated = _updated_active_sets(point, linearisation, excluded_c, threshold=-_INITIAL_MARGIN)
-    if updated is not None:
-        point, linearisation = updated, linearise(updated)
-    radius = ceiling_at(point)
-    status, message = Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations"
-    active_set_rounds = 0
-    while True:
-        residual = linearisation.residual
-        if not np.isfinite(residual):
-            return SolverResult(point, np.nan, Status.FAILED, "J is not finite at the starting point", problem.count, residual)
-        try:
-            converged = Status.SOLVED if residual <= tolerance else None
-            if converged is None and not system.exact and _acceptable_without_exact_jacobian(linearisation, point, width, radius):
-                converged = Status.SOLVED_ACCEPTABLE
-            if converged is not None:
-                updated = _updated_active_sets(point, linearisation, excluded_c, threshold=LIMIT_TOLERANCE)
-                if updated is not None and active_set_rounds < _ACTIVE_SET_ROUNDS and problem.count < max_iterations:
-                    active_set_rounds += 1
-                    point, linearisation = updated, linearise(updated)
-                    radius = ceiling_at(point)
-                    continue
-                return _converged_result(converged, point, linearisation, system.exact, problem.count)
-            if problem.count >= max_iterations:
-                break
-            if expired():
-                status, message = Status.MAX_WALL_TIME, "the wall-time budget ran out"
-                break
-            # with an approximate Jacobian, once no goal step longer than the acceptable one lowers the
-            # regret, the goal has settled as far as the approximation can tell: only the plans move on
-            settled = not system.exact and radius <= _ACCEPTABLE_GOAL_STEP * width
-            if not settled:
-                accepted, point, linearisation, radius = _goal_step(problem, point, linearisation, radius, ceiling_at(point))
-                if accepted:
-                    continue
-                if radius < _SHORTEST_GOAL_STEP * max(width, 1e-3):
-                    status, message = Status.FAILED, "the Newton iteration stalled (no goal step lowers the regret)"
-                    break
-            inner_step = linearisation.step(0.0, point)
-            scale = 1.0 if system.exact else problem.inner_step_length(point, inner_step, linearisation)
-            inner, inner_linearisation = moved(point, inner_step, scale)
-        except np.linalg.LinAlgError:
-            status, message = Status.FAILED, "a Newton system was singular (the observation does not pin the torques down)"
-            break
-        if np.isfinite(inner_linearisation.residual):
-            point, linearisation = inner, inner_linearisation
-    return SolverResult(point, linearisation.J_c - linearisation.J_s, status, message, problem.count, linearisation.residual)
-
-
-def _goal_step(problem: "_Problem", point: RegretPoint, linearisation: Linearisation, radius: float,
-               ceiling: float) -> tuple[bool, RegretPoint, Linearisation, float]:
-    """One trust-region step on the goal, of length at most min(radius, ceiling) (m): (True, the new point, its
-    linearisation, the radius doubled if the step was that long) when the trial is acceptable; (False, the
-    point, its linearisation, a quarter of the tried goal step) otherwise."""
-    step = linearisation.step(min(radius, ceiling), point)
-    trial, trial_linearisation = problem.moved(point, step)
-    if _acceptable(linearisation, trial_linearisation):
-        grown = min(2 * radius, ceiling) if np.linalg.norm(step.goal) >= 0.99 * min(radius, ceiling) else radius
-        return True, trial, trial_linearisation, grown
-    return False, point, linearisation, 0.25 * np.linalg.norm(step.goal)
-
-
-def _converged_result(converged: Status, point: RegretPoint, linearisation: Linearisation, exact: bool,
-                      count: int) -> SolverResult[RegretPoint]:
-    """The result at a point that meets the convergence test ``converged``, after the second-order check."""
-    is_minimum, why = linearisation.is_strict_minimum(exact)
-    message = "converged" if converged == Status.SOLVED else \
-        "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
-    status, message = (converged, message) if is_minimum else (Status.NOT_A_MINIMUM, why)
-    return SolverResult(point, linearisation.J_c - linearisation.J_s, status, message, count, linearisation.residual)
+    method = RegretNewton(system, start, observed, n_o, observed_rows, prior, width, observed_position=observed_position,
+                          tolerance=tolerance, max_iterations=max_iterations, step_fraction=step_fraction)
+    state = method.first_state(point)
+    try:
+        return newton_iterate(method, state, max_iterations=max_iterations, expired=expired)
+    except np.linalg.LinAlgError:
+        return method.result(state, Stop(Status.FAILED, "a Newton system was singular (the observation does not pin the torques down)"))
 
 
 @dataclass
-class _Problem:
-    """One estimate's fixed data (start, observation, prior, width) and the linearisations made so far."""
+class RegretState:
+    """The iterate, its linearisation, and the trust region's radius on the goal step (m)."""
+
+    point: RegretPoint
+    linearisation: Linearisation
+    radius: float
+    active_set_rounds: int = 0
+    """Updates of the plans' active sets after convergence."""
+
+
+@dataclass
+class RegretNewton:
+    """One estimate's fixed data (start, observation, prior, width), the linearisations made so far, and the
+    hooks of :func:`~comanip.optim.newton_loop.newton_iterate` (:func:`newton_solve`)."""
 
     system: RegretSystem
     start: np.ndarray
@@ -186,8 +128,92 @@ class _Problem:
     observed_rows: np.ndarray
     prior: GoalPrior | None
     width: float
+    observed_position: np.ndarray
+    tolerance: float
+    max_iterations: int
+    step_fraction: float
     count: int = 0
     """Linearisations at moved points (the iterations reported)."""
+
+    def __post_init__(self):
+        path_limits = self.system.path_limits
+        self.excluded_c = self.system.limits_at_step(self.n_o) if path_limits.active else np.zeros(0, dtype=int)
+
+    def first_state(self, point: RegretPoint) -> RegretState:
+        """The state at ``point``, with the limits binding there (within 1e-4) held from the first step on."""
+        linearisation = self.linearise(point)
+        updated = _updated_active_sets(point, linearisation, self.excluded_c, threshold=-_INITIAL_MARGIN)
+        if updated is not None:
+            point, linearisation = updated, self.linearise(updated)
+        return RegretState(point, linearisation, self.ceiling_at(point))
+
+    def ceiling_at(self, at: RegretPoint) -> float:
+        return self.step_fraction * max(np.linalg.norm(at.goal - self.observed_position), self.width)
+
+    def iterations(self, state: RegretState) -> int:
+        return self.count
+
+    def begin(self, state: RegretState) -> None:
+        """Iterations are linearisations, counted where they are made."""
+
+    def converged(self, state: RegretState) -> Stop | None:
+        """Converged (max |F| ≤ tolerance, or the approximate Jacobian's test), after at most
+        ``_ACTIVE_SET_ROUNDS`` updates of the plans' active sets, and checked to be a strict minimum."""
+        while True:
+            linearisation, point = state.linearisation, state.point
+            if not np.isfinite(linearisation.residual):
+                return Stop(Status.FAILED, "J is not finite at the starting point")
+            converged = Status.SOLVED if linearisation.residual <= self.tolerance else None
+            if converged is None and not self.system.exact and \
+                    _acceptable_without_exact_jacobian(linearisation, point, self.width, state.radius):
+                converged = Status.SOLVED_ACCEPTABLE
+            if converged is None:
+                return None
+            updated = _updated_active_sets(point, linearisation, self.excluded_c, threshold=LIMIT_TOLERANCE)
+            if updated is None or state.active_set_rounds >= _ACTIVE_SET_ROUNDS or self.count >= self.max_iterations:
+                return _converged_stop(converged, linearisation, self.system.exact)
+            state.active_set_rounds += 1
+            state.point, state.linearisation = updated, self.linearise(updated)
+            state.radius = self.ceiling_at(updated)
+
+    def direction(self, state: RegretState) -> RegretPoint | None:
+        """The trust-region step on the goal, or None when the goal has settled: with an approximate Jacobian,
+        once no goal step longer than the acceptable one lowers the regret, only the plans move on."""
+        if not self.system.exact and state.radius <= _ACCEPTABLE_GOAL_STEP * self.width:
+            return None
+        return state.linearisation.step(min(state.radius, self.ceiling_at(state.point)), state.point)
+
+    def globalise(self, state: RegretState, step: RegretPoint | None) -> bool:
+        """Take the goal step when the trial is acceptable (the radius doubles if the step was that long); else
+        shrink the radius to a quarter of the step tried."""
+        if step is None:
+            return False
+        trial, trial_linearisation = self.moved(state.point, step)
+        length, ceiling = np.linalg.norm(step.goal), min(state.radius, self.ceiling_at(state.point))
+        if not _acceptable(state.linearisation, trial_linearisation):
+            state.radius = 0.25 * length
+            return False
+        if length >= 0.99 * ceiling:
+            state.radius = min(2 * state.radius, self.ceiling_at(state.point))
+        state.point, state.linearisation = trial, trial_linearisation
+        return True
+
+    def recover(self, state: RegretState, step: RegretPoint | None) -> Stop | None:
+        """After a rejected (or no) goal step: the inner problems' Newton step at the current goal, unless the
+        trust region has collapsed (stalled)."""
+        if step is not None and state.radius < _SHORTEST_GOAL_STEP * max(self.width, 1e-3):
+            return Stop(Status.FAILED, "the Newton iteration stalled (no goal step lowers the regret)")
+        inner_step = state.linearisation.step(0.0, state.point)
+        scale = 1.0 if self.system.exact else self.inner_step_length(state.point, inner_step, state.linearisation)
+        inner, inner_linearisation = self.moved(state.point, inner_step, scale)
+        if np.isfinite(inner_linearisation.residual):
+            state.point, state.linearisation = inner, inner_linearisation
+        return None
+
+    def result(self, state: RegretState, stop: Stop) -> SolverResult[RegretPoint]:
+        linearisation = state.linearisation
+        return SolverResult(state.point, linearisation.J_c - linearisation.J_s, stop.status, stop.message, self.count,
+                            linearisation.residual)
 
     def linearise(self, at: RegretPoint) -> Linearisation:
         return self.system.linearise(at, self.start, self.observed, self.n_o, self.observed_rows, self.prior, self.width)
@@ -215,6 +241,14 @@ class _Problem:
             return True if np.isfinite(trial) and trial <= bound else None
 
         return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS)[0]
+
+
+def _converged_stop(converged: Status, linearisation: Linearisation, exact: bool) -> Stop:
+    """The stop at a point that meets the convergence test ``converged``, after the second-order check."""
+    is_minimum, why = linearisation.is_strict_minimum(exact)
+    message = "converged" if converged == Status.SOLVED else \
+        "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
+    return Stop(converged, message) if is_minimum else Stop(Status.NOT_A_MINIMUM, why)
 
 
 def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
