@@ -154,22 +154,11 @@ class GoalEstimator:
         """
         t_begin = time.perf_counter()
         model = self.model
-        start, _, width = self.planner.check_inputs(start, np.zeros(model.d), width)
-        observed = observed_state(model, observed)
-        n_o = observation_step(model, t_obs)
-        prior_cov = prior_covariance(prior_std, model, width)
-        prior = None if prior_goal is None else GoalPrior(as_vector("prior_goal", prior_goal, model.d, "task-space position, m"), prior_cov)
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-        if method == "paper" and not model.body.is_linear:
-            raise ValueError(f"method 'paper' (IPOPT with CasADi's exact Hessian of the expanded problem) is for point "
-                             f"masses; the {model.body.name!r} body needs method 'regret'")
-        max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
-        rows = observed_rows(model, n_o)
+        checked = self._checked_request(start, observed, t_obs, prior_goal, width, prior_std, method, max_wall_time)
+        start, observed, n_o, prior, width, rows = (checked.start, checked.observed, checked.n_o, checked.prior,
+                                                    checked.width, checked.rows)
+        max_wall_time = checked.max_wall_time
         if n_o == 0:
-            if prior is None:
-                raise ValueError(f"t_obs = {float(t_obs):g} s falls on step 0 (before h = {model.h:g} s): the observed state is the "
-                                 "start itself and says nothing about the goal; give prior_goal (the estimate is then the plan to it)")
             return self._uninformative(start, observed, float(t_obs), prior, width, method, warm_start, max_wall_time, t_begin)
         point, plan_needed = self._warm_point(warm_start, len(rows)) if warm_start is not None else (None, False)
 
@@ -198,6 +187,25 @@ class GoalEstimator:
         return GoalEstimate.of(plan, t_obs=float(t_obs), observed_step=n_o, observed_state=observed,
                                observation_residual=plan.mean[n_o] - observed, prior_goal=None if prior is None else prior.mean,
                                method=method, multipliers=point.lam.copy(), goal_covariance=covariance, **details)
+
+    def _checked_request(self, start, observed, t_obs, prior_goal, width, prior_std, method, max_wall_time) -> "_Request":
+        """:meth:`estimate`'s arguments checked (one-line errors before any work) and converted."""
+        model = self.model
+        start, _, width = self.planner.check_inputs(start, np.zeros(model.d), width)
+        observed = observed_state(model, observed)
+        n_o = observation_step(model, t_obs)
+        prior_cov = prior_covariance(prior_std, model, width)
+        prior = None if prior_goal is None else GoalPrior(as_vector("prior_goal", prior_goal, model.d, "task-space position, m"), prior_cov)
+        if method not in METHODS:
+            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+        if method == "paper" and not model.body.is_linear:
+            raise ValueError(f"method 'paper' (IPOPT with CasADi's exact Hessian of the expanded problem) is for point "
+                             f"masses; the {model.body.name!r} body needs method 'regret'")
+        max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
+        if n_o == 0 and prior is None:
+            raise ValueError(f"t_obs = {float(t_obs):g} s falls on step 0 (before h = {model.h:g} s): the observed state is the "
+                             "start itself and says nothing about the goal; give prior_goal (the estimate is then the plan to it)")
+        return _Request(start, observed, n_o, prior, width, observed_rows(model, n_o), max_wall_time)
 
     def _goal_covariance(self, point: RegretPoint, plan: Plan, start, observed, n_o, rows, prior: GoalPrior | None, width) -> np.ndarray:
         """The Laplace covariance (d, d) m² of the estimate (module docstring); the prior's (or the weak default
@@ -370,3 +378,17 @@ def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observe
     """
     estimator = (cache or DEFAULT_CACHE).estimator(model)
     return estimator.estimate(start, observed, t_obs, prior_goal, width, **options)
+
+
+@dataclass(frozen=True)
+class _Request:
+    """An estimate's checked arguments: start s_0 (2n,), observed s_o (2n,), the observed step n_o, the prior
+    (or None), the width w (m), the observed entries of s_o, and the wall-time budget (s, or None)."""
+
+    start: np.ndarray
+    observed: np.ndarray
+    n_o: int
+    prior: GoalPrior | None
+    width: float
+    rows: np.ndarray
+    max_wall_time: float | None
