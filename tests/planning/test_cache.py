@@ -1,7 +1,9 @@
-"""The one model-keyed cache (comanip.planning.cache) that planners and estimators are kept in."""
+"""The one model-keyed cache (comanip.caching.model_cache) that planners and estimators are kept in."""
 
 import comanip
-from comanip.planning.cache import ModelCache, PlannerCache, model_key
+from comanip.caching.model_cache import ModelCache
+from comanip.model import model_key
+from comanip.planning.planner_cache import PlannerCache
 from comanip.planning.planner import Planner
 
 

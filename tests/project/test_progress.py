@@ -4,7 +4,7 @@ import time
 
 import casadi as ca
 
-from comanip.planning.compiled import compiled
+from comanip.caching.compiled import compiled
 from comanip.progress import LOG_INTERVAL, elapsed, progress_bar
 
 

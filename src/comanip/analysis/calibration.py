@@ -33,7 +33,7 @@ from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, open_loo
 from comanip.arguments import as_count
 from comanip.model import ReachingModel
 from comanip.objectives.reward import goal_covariance
-from comanip.planning.cache import PlannerCache
+from comanip.planning.planner_cache import PlannerCache
 from comanip.progress import progress_bar
 
 #: Fitts' law holds when the better of the two fits has at least this R².

@@ -60,7 +60,7 @@ from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
 from comanip.optim import CONVERGED, Status
-from comanip.planning.cache import ModelCache
+from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.planner import Planner
@@ -343,9 +343,9 @@ class GoalEstimator:
 class EstimatorCache(ModelCache[GoalEstimator]):
     """Goal estimators kept between calls of :func:`estimate_goal` and :func:`comanip.goal_posterior`.
 
-    A :class:`~comanip.planning.cache.ModelCache` with one addition to its key: a Planner is its own key
+    A :class:`~comanip.caching.model_cache.ModelCache` with one addition to its key: a Planner is its own key
     (its options are part of what it solves) and gets an estimator using it; a ReachingModel is keyed by
-    its parameters (:func:`~comanip.planning.cache.model_key`, so two loads of a preset share an
+    its parameters (:func:`~comanip.caching.model_cache.model_key`, so two loads of a preset share an
     estimator) and gets an estimator with its own planner. At most ``size`` estimators are kept, the least
     recently used dropped first. Safe to share between threads; an estimator itself is not (give each
     thread its own cache or planner).

@@ -77,7 +77,7 @@ from comanip.estimation.shared import checked_model, estimation_planner
 from comanip.model import ReachingModel
 from comanip.optim import CONVERGED, Status
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
-from comanip.planning.cache import ModelCache
+from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 

@@ -27,7 +27,7 @@ import scipy.linalg
 
 from comanip.estimation.goal_prior import GoalPrior
 from comanip.optim import decade_shifts, shifted_cholesky
-from comanip.planning.compiled import BufferedFunction
+from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
 from comanip.planning.planner import Planner

@@ -1,5 +1,5 @@
 """The planner an estimator builds for a model (the key that says two models are the same is
-:func:`comanip.planning.cache.model_key`)."""
+:func:`comanip.caching.model_cache.model_key`)."""
 
 from __future__ import annotations
 

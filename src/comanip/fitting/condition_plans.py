@@ -2,7 +2,7 @@
 
 Tasks carry the model as its config (plain data), never a Planner: planners are kept by their model's
 parameters in a cache that the ConditionPlanner owns (planning here) or that each Dask worker owns (a
-:class:`~comanip.planning.worker_cache.WorkerCache` registered on the cluster), so a process builds a
+:class:`~comanip.caching.worker_cache.WorkerCache` registered on the cluster), so a process builds a
 Planner once per configuration and reuses it for every condition.
 
 Every solve is cold (the planner's multi-start from minimum-jerk guesses), not warm-started from the
@@ -21,7 +21,7 @@ import threading
 import numpy as np
 
 from comanip.model import ReachingModel
-from comanip.planning.cache import ModelCache
+from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 
@@ -50,7 +50,7 @@ def plan_condition(planners: ModelCache, model_config: dict, start: np.ndarray, 
 
 def _plan_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, width: float) -> Plan:
     """:func:`plan_condition` on a Dask worker, with the worker's planners."""
-    from comanip.planning.worker_cache import worker_cache
+    from comanip.caching.worker_cache import worker_cache
 
     return plan_condition(worker_cache(_PLANNERS), model_config, start, goal, width)
 
@@ -70,7 +70,7 @@ class ConditionPlanner:
         self._client, self._owned = _client(scheduler)
         self._planners = ModelCache(locked_planner, _CACHE_SIZE)
         if self._client is not None:
-            from comanip.planning.worker_cache import WorkerCache
+            from comanip.caching.worker_cache import WorkerCache
 
             self._client.register_plugin(WorkerCache(_PLANNERS, locked_planner, _CACHE_SIZE))
 

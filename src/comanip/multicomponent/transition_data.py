@@ -164,7 +164,7 @@ def _run_on_local_cluster(tasks: list[tuple], workers: int, bar: tqdm) -> list[d
     """Run condition tasks on a Dask LocalCluster of single-threaded worker processes; rows in task order."""
     from dask.distributed import Client, LocalCluster, as_completed
 
-    from comanip.planning.worker_cache import WorkerCache
+    from comanip.caching.worker_cache import WorkerCache
 
     # processes, not threads: CasADi/IPOPT solves hold the GIL; no dashboard (no web server in a batch job)
     with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
@@ -186,7 +186,7 @@ _PLANNERS = "comanip-transition-planners"
 def _condition_task(model_config: dict, distance_over_arm_length: float, width: float, n_trials: int,
                     arm_length: float, steps: int, seed: np.random.SeedSequence) -> dict:
     """One condition on a Dask worker, with the worker's planner for the model (built on its first condition)."""
-    from comanip.planning.worker_cache import worker_cache
+    from comanip.caching.worker_cache import worker_cache
 
     return _simulate_seeded(worker_cache(_PLANNERS).get(model_config), distance_over_arm_length, width, n_trials,
                             arm_length, steps, seed)

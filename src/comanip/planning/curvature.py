@@ -33,7 +33,8 @@ from comanip.belief.noise import noise_covariance
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.model import model_key
-from comanip.planning.compiled import BufferedFunction, cached_compiled, compile_in_background, compiled_or_cached
+from comanip.caching.buffered_function import BufferedFunction
+from comanip.caching.compiled import cached_compiled, compile_in_background, compiled_or_cached
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ReachTerms
 
@@ -46,7 +47,7 @@ class ReachCurvature:
 
     Args:
         problem: the model's :class:`ReachProblem`.
-        compile: True: build the per-solve functions as C (:mod:`comanip.planning.compiled`): about a third
+        compile: True: build the per-solve functions as C (:mod:`comanip.caching.compiled`): about a third
             faster per solve, at a few seconds' build per new model. None: load them if an earlier build for
             this model is in the disk cache, else run CasADi's virtual machine until
             :meth:`compile_in_background` has built them. False: the virtual machine.

@@ -13,7 +13,7 @@ import casadi as ca
 import numpy as np
 
 from comanip.bodies.body import Body
-from comanip.planning.compiled import BufferedFunction
+from comanip.caching.buffered_function import BufferedFunction
 
 
 def minimum_jerk(x0, v0, x1, duration, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

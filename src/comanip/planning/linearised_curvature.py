@@ -23,7 +23,7 @@ The objective and gradient come from one CasADi function, the per-step pieces of
 evaluated on the first one's rollout only when a Hessian is assembled (with ``hessian_refresh`` about one
 iteration in three on the Panda, where the gradient takes 1.9 ms and the pieces 1.2 ms). Both are
 MX graphs over per-step SX functions (belief step, reward, kinematics), compiled to C on first use
-(:mod:`comanip.planning.compiled`); generating C for the expanded problem instead gives hundreds of megabytes
+(:mod:`comanip.caching.compiled`); generating C for the expanded problem instead gives hundreds of megabytes
 that do not compile in minutes.
 """
 
@@ -36,7 +36,8 @@ from comanip.belief.propagation import belief_step_function, linearised_step_fun
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.model import model_key
-from comanip.planning.compiled import BufferedFunction, compiled_or_cached
+from comanip.caching.buffered_function import BufferedFunction
+from comanip.caching.compiled import compiled_or_cached
 from comanip.planning.curvature import _noise_second_derivatives, _reward_derivatives_function
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ArmPieces, ArmTerms, Rollout

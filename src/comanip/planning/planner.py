@@ -47,7 +47,7 @@ from comanip.planning.initial_guess import (brake_durations, braked_torques, gue
                                           minimum_jerk_torques, retargeted_torques)
 from comanip.optim import SolverResult, Status, cholesky_solve
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
-from comanip.planning.compiled import BufferedFunction
+from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
@@ -125,7 +125,7 @@ class SolverOptions:
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
-    """Compile the Newton method's per-solve function to C (cached on disk, see comanip.planning.compiled).
+    """Compile the Newton method's per-solve function to C (cached on disk, see comanip.caching.compiled).
     True: when the planner is built. False: never. None: when built for nonlinear bodies, where CasADi's
     virtual machine is ten times slower (a first build takes about a minute for the Panda); for a point mass,
     in a background thread once the planner has spent ``compile_after`` seconds solving, its solves going on

@@ -16,7 +16,7 @@ from comanip.model import ReachingModel
 from comanip.objectives.discounting import discount_weights
 from comanip.objectives.reach_objective import reach_objective, velocity_cost
 from comanip.objectives.reward import GoalReward
-from comanip.planning.compiled import BufferedFunction
+from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.plan import Plan
 
 

@@ -3,7 +3,7 @@ around it, their numbers (:mod:`comanip.analysis.arm_reaches`) and CSV files, an
 :mod:`comanip.plots.validation_figures`).
 
 Building the Panda's planner compiles its per-solve functions to C the first time (about a minute, then
-cached on disk; :mod:`comanip.planning.compiled`), so the build gets its own progress line.
+cached on disk; :mod:`comanip.caching.compiled`), so the build gets its own progress line.
 """
 
 from __future__ import annotations
@@ -16,7 +16,7 @@ import numpy as np
 
 from comanip.analysis.arm_reaches import arm_reaches, summarise_reaches
 from comanip.model import ReachingModel
-from comanip.planning.compiled import cache_dir
+from comanip.caching.compiled import cache_dir
 from comanip.planning.planner import Planner
 from comanip.progress import elapsed, progress_bar
 from comanip.validation.figure_data import ArmFigureData

@@ -1,4 +1,4 @@
-"""A :class:`~comanip.planning.cache.ModelCache` owned by each Dask worker: Dask's counterpart of a process
+"""A :class:`~comanip.caching.model_cache.ModelCache` owned by each Dask worker: Dask's counterpart of a process
 pool's initializer. Imported only where Dask is used (it imports ``distributed``)."""
 
 from __future__ import annotations
@@ -7,7 +7,7 @@ from typing import Callable
 
 from distributed import WorkerPlugin, get_worker
 
-from comanip.planning.cache import ModelCache
+from comanip.caching.model_cache import ModelCache
 
 
 class WorkerCache(WorkerPlugin):

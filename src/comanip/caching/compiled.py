@@ -38,7 +38,6 @@ from pathlib import Path
 from typing import Callable
 
 import casadi as ca
-import numpy as np
 
 from comanip.progress import elapsed
 
@@ -149,34 +148,52 @@ def _compiler() -> list[str]:
     return shlex.split(os.environ.get("CC", "gcc"))
 
 
-_BACKGROUND = threading.Lock()
-"""Held by the background build in progress: they run one at a time (each compiler takes a core)."""
-_RUNNING: dict[subprocess.Popen, str] = {}
-"""Compiler processes in progress and their scratch folders, stopped and removed at exit."""
+class Compilers:
+    """The compiler processes of this Python process: background builds run one at a time (each compiler takes a
+    core), and compilers still running at exit are stopped and their scratch folders removed (a background
+    build's daemon thread dies with Python and would leave them behind)."""
+
+    def __init__(self):
+        self.turn = threading.Lock()
+        """Held by the background build in progress."""
+        self.running: dict[subprocess.Popen, str] = {}
+        """Compiler processes in progress and their scratch folders."""
+
+    def in_background(self, owner: object, functions_of: Callable[[object], list[ca.Function]],
+                      tag: str | None = None) -> Future:
+        """Start compiling ``functions_of(owner)`` in a daemon thread; the future's result is the list of compiled
+        functions (:func:`compiled` of each, in order, filed under ``tag``).
+
+        Only a weak reference to ``owner`` is kept: if it is garbage-collected before its turn comes (builds run
+        one at a time), the build is skipped and the future holds None. A failed build (no compiler) gives the
+        uncompiled function with a warning, as :func:`compiled` does.
+        """
+        future: Future = Future()
+        reference = weakref.ref(owner)
+
+        def build():
+            with self.turn:
+                try:
+                    owner = reference()
+                    future.set_result(None if owner is None else [compiled(f, tag) for f in functions_of(owner)])
+                except BaseException as error:  # handed to the caller through the future
+                    future.set_exception(error)
+
+        threading.Thread(target=build, name="comanip-compile", daemon=True).start()
+        return future
+
+    def stop_running(self) -> None:
+        """Stop the compilers still running and remove their scratch folders."""
+        for process, scratch in list(self.running.items()):
+            process.kill()
+            process.wait()
+            shutil.rmtree(scratch, ignore_errors=True)
 
 
-def compile_in_background(owner: object, functions_of: Callable[[object], list[ca.Function]],
-                          tag: str | None = None) -> Future:
-    """Start compiling ``functions_of(owner)`` in a daemon thread; the future's result is the list of compiled
-    functions (:func:`compiled` of each, in order, filed under ``tag``).
-
-    Only a weak reference to ``owner`` is kept: if it is garbage-collected before its turn comes (builds run
-    one at a time), the build is skipped and the future holds None. A failed build (no compiler) gives the
-    uncompiled function with a warning, as :func:`compiled` does.
-    """
-    future: Future = Future()
-    reference = weakref.ref(owner)
-
-    def build():
-        with _BACKGROUND:
-            try:
-                owner = reference()
-                future.set_result(None if owner is None else [compiled(f, tag) for f in functions_of(owner)])
-            except BaseException as error:  # handed to the caller through the future
-                future.set_exception(error)
-
-    threading.Thread(target=build, name="comanip-compile", daemon=True).start()
-    return future
+COMPILERS = Compilers()
+"""This process's compilers (stopped at exit)."""
+atexit.register(COMPILERS.stop_running)
+compile_in_background = COMPILERS.in_background
 
 
 def _build(source: str, compiler: list[str], library: Path) -> None:
@@ -188,80 +205,11 @@ def _build(source: str, compiler: list[str], library: Path) -> None:
         built = Path(scratch) / library.name
         process = subprocess.Popen([*compiler, *COMPILE_FLAGS, str(c_file), "-o", str(built), "-lm"],
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        _RUNNING[process] = scratch
+        COMPILERS.running[process] = scratch
         try:
             output, errors = process.communicate()
         finally:
-            _RUNNING.pop(process, None)
+            COMPILERS.running.pop(process, None)
         if process.returncode != 0:
             raise subprocess.CalledProcessError(process.returncode, process.args, output, errors)
         os.replace(built, library)
-
-
-@atexit.register
-def _stop_running_builds() -> None:
-    """Stop compilers still running at exit (a background build's daemon thread dies with Python and would
-    leave its compiler and scratch folder behind)."""
-    for process, scratch in list(_RUNNING.items()):
-        process.kill()
-        process.wait()
-        shutil.rmtree(scratch, ignore_errors=True)
-
-
-class BufferedFunction:
-    """Calls a CasADi function on NumPy arrays through CasADi's zero-copy ``Function.buffer()`` interface.
-
-    A plain call converts every input and output between NumPy and CasADi's DM (about 0.3 ms for the
-    planner's Cartesian terms, four times the evaluation itself); the buffer reads and writes preallocated
-    arrays in place. Inputs must be dense and are copied into the buffer; outputs are returned as fresh
-    dense arrays of each output's shape (structural zeros filled in).
-    """
-
-    def __init__(self, function: ca.Function):
-        self.function = function
-        for i in range(function.n_in()):
-            if not function.sparsity_in(i).is_dense():
-                raise ValueError(f"BufferedFunction needs dense inputs; input {function.name_in(i)!r} is sparse")
-        self._inputs = [np.zeros(function.nnz_in(i)) for i in range(function.n_in())]
-        self._outputs = [np.zeros(function.nnz_out(i)) for i in range(function.n_out())]
-        self._shapes = [function.size_out(i) for i in range(function.n_out())]
-        self._entries = []  # (rows, columns) of each sparse output's nonzeros; None when dense
-        for i in range(function.n_out()):
-            sparsity = function.sparsity_out(i)
-            self._entries.append(None if sparsity.is_dense() else tuple(np.array(v) for v in sparsity.get_triplet()))
-        # a dense output with one row or column needs no reordering: copied as it is, then given its shape
-        self._vectors = [entries is None and min(shape) == 1 for entries, shape in zip(self._entries, self._shapes)]
-        self._buffer, self._evaluate = function.buffer()
-        for i, array in enumerate(self._inputs):
-            self._buffer.set_arg(i, memoryview(array))
-        for i, array in enumerate(self._outputs):
-            self._buffer.set_res(i, memoryview(array))
-
-    def vector(self, *args) -> np.ndarray:
-        """The first output's entries in column-major order (a fresh array; dense outputs only): a call without the
-        list of outputs and their reshaping, for a function whose first output is a vector."""
-        for array, value in zip(self._inputs, args):
-            array[:] = value.ravel(order="F") if getattr(value, "ndim", 0) > 1 else value
-        self._evaluate()
-        if self._buffer.ret() != 0:
-            raise RuntimeError(f"evaluating {self.function.name()} failed")
-        return self._outputs[0].copy()
-
-    def __call__(self, *args) -> list[np.ndarray]:
-        for array, value in zip(self._inputs, args):
-            # vectors and scalars as they are (np.ravel costs more than the copy); matrices column by column
-            array[:] = value.ravel(order="F") if getattr(value, "ndim", 0) > 1 else value
-        self._evaluate()
-        if self._buffer.ret() != 0:
-            raise RuntimeError(f"evaluating {self.function.name()} failed")
-        results = []
-        for values, shape, entries, vector in zip(self._outputs, self._shapes, self._entries, self._vectors):
-            if vector:
-                results.append(values.copy().reshape(shape))
-            elif entries is None:
-                results.append(values.reshape(shape, order="F").copy())
-            else:
-                dense = np.zeros(shape)
-                dense[entries] = values
-                results.append(dense)
-        return results

@@ -12,8 +12,7 @@ import threading
 from collections import OrderedDict
 from typing import Callable, Generic, Hashable, TypeVar
 
-from comanip.model import ReachingModel, config_key, model_key  # noqa: F401  (model_key: this module's key, re-exported)
-from comanip.planning.planner import Planner, SolverOptions
+from comanip.model import ReachingModel, config_key, model_key
 
 T = TypeVar("T")
 
@@ -52,14 +51,3 @@ class ModelCache(Generic[T]):
 
     def __len__(self) -> int:
         return len(self._items)
-
-
-class PlannerCache(ModelCache[Planner]):
-    """Planners kept by their model's parameters, all built with the same ``options``."""
-
-    def __init__(self, size: int = 4, options: SolverOptions | None = None):
-        super().__init__(lambda model: Planner(model, options), size)
-
-    def planner(self, model) -> Planner:
-        """The planner for ``model`` (a ReachingModel or its config dict), built on first use."""
-        return self.get(model)
