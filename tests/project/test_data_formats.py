@@ -25,7 +25,7 @@ from comanip.bodies import BODY_TYPES, body_from_config
 from comanip.cli.estimate_command import read_observations
 from comanip.cli.outputs import write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
-from comanip.estimation.estimate import GoalEstimate
+from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.fitting.movement_times import MT_COLUMNS
 from comanip.fitting.recordings import load_recordings
 from comanip.planning.arm_reach_library import bundled_library

@@ -21,7 +21,7 @@ from comanip.cli.options import add_model_arguments, add_reach_arguments, add_un
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 from comanip.estimation.observation import observation_step
 from comanip.estimation import GoalEstimator, goal_posterior
-from comanip.estimation.goal_estimate import METHODS
+from comanip.estimation.goal_estimator import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
 from comanip.plausibility import human_plausibility
 from comanip.units import check_angles_rad, check_positions_m, check_times_s

@@ -1,7 +1,7 @@
 """Estimation from observed reaching: the goal of a reach in progress, and a posterior over candidate goals."""
 
-from comanip.estimation.estimate import GoalEstimate
-from comanip.estimation.goal_estimate import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
+from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.goal_estimator import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
 from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
 from comanip.estimation.online_estimator import OnlineGoalEstimator, OnlineOptions
 

@@ -63,7 +63,7 @@ from comanip.arguments import as_count, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.corrected_deviation import (CORRECTION_TIME, DEVIATION_TIME, corrected_covariance, corrected_powers,
                                                    correction_factor)
-from comanip.estimation.estimate import GoalEstimate
+from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
@@ -73,7 +73,7 @@ from comanip.estimation.paced_model import PacedFit, PacedModel
 from comanip.estimation.people_model import PeopleModel, shipped_people_model
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
-from comanip.estimation.shared import checked_model, estimation_planner
+from comanip.estimation.estimation_planner import checked_model, estimation_planner
 from comanip.model import ReachingModel
 from comanip.optim import CONVERGED, Status
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S

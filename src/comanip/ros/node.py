@@ -51,7 +51,7 @@ from std_msgs.msg import Empty, Float64MultiArray
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator
 from comanip.estimation.online_estimator import CORRECTING_PERSON, FamilyCache
-from comanip.estimation.shared import estimation_planner
+from comanip.estimation.estimation_planner import estimation_planner
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.planner import Planner
