@@ -29,7 +29,7 @@ from comanip.estimation.estimate import GoalEstimate
 from comanip.fitting.movement_times import MT_COLUMNS
 from comanip.fitting.recordings import load_recordings
 from comanip.planning.arm_reach_library import bundled_library
-from comanip.fitting.result import FIT_STATUSES, FitResult
+from comanip.fitting.fit_result import FIT_STATUSES, FitResult
 from comanip.model import ReachingModel
 from comanip.multicomponent import transition_csv
 from comanip.multicomponent.handover import HandoverSchedule

@@ -51,7 +51,7 @@ def test_the_example_inputs_read_in_their_documented_formats():
     import comanip
     from comanip.cli.estimate_command import read_observations
     from comanip.fitting import load_recordings
-    from comanip.ros.settings import NodeSettings
+    from comanip.ros.node_settings import NodeSettings
 
     data = EXAMPLES / "data"
     times, states = read_observations(data / "observations.csv", 2)

@@ -31,7 +31,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from comanip.ros.settings import NodeSettings
+    from comanip.ros.node_settings import NodeSettings
 
     settings = NodeSettings.from_yaml(args.params) if args.params is not None else NodeSettings()
     speed = None if args.speed is None else as_positive("--speed", args.speed, "times real time")

@@ -75,7 +75,7 @@ def run(args) -> int:
 
     files, goals_out, strips = [], {}, {}
     if by_policy:
-        from comanip.plots.policy_comparison import plot_policy_comparison
+        from comanip.plots.policy_comparison_figure import plot_policy_comparison
         from comanip.simulation.policy_comparison import comparison_rows, write_comparison
 
         rows = comparison_rows(by_policy)
