@@ -136,7 +136,7 @@ def test_read_observations_reads_unusual_units_when_told():
     import tempfile
     from pathlib import Path
 
-    from comanip.cli.estimate_command import read_observations
+    from comanip.recordings.observation_files import read_observations
 
     with tempfile.TemporaryDirectory() as folder:
         path = _observations(Path(folder) / "observed.csv", 1000.0)

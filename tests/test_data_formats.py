@@ -22,7 +22,7 @@ import comanip
 from comanip import presets
 from comanip.belief.noise import NOISE_FORMS
 from comanip.bodies import BODY_TYPES, body_from_config
-from comanip.cli.estimate_command import read_observations
+from comanip.recordings.observation_files import read_observations
 from comanip.cli.outputs import write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.estimate import GoalEstimate

@@ -10,9 +10,7 @@ to the horizon feeds the posterior.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
-from pathlib import Path
 
 import numpy as np
 
@@ -24,7 +22,7 @@ from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
 from comanip.estimation.goal_prior import PAPER_PRIOR
 from comanip.plausibility import human_plausibility
-from comanip.units import check_angles_rad, check_positions_m, check_times_s
+from comanip.recordings.observation_files import read_observations
 
 
 def add_parser(subparsers) -> None:
@@ -61,44 +59,14 @@ def candidate_list(text: str) -> np.ndarray:
     return np.array(rows)
 
 
-def read_observations(path: Path, n: int, *, check_units: bool = True, joint_angles: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Times (K,) s and states (K, 2n) from a CSV with columns t_s, q0..q{n-1}, qdot0..qdot{n-1}, sorted by time.
-
-    ``check_units`` refuses times that look like ms and positions q that look like mm, or like degrees when
-    ``joint_angles`` (an arm's q in rad), with a one-line ValueError (:mod:`comanip.units`)."""
-    columns = ["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        missing = [c for c in columns if c not in (reader.fieldnames or [])]
-        if missing:
-            raise ValueError(f"--observations needs the columns {columns}; {str(path)!r} lacks {missing}")
-        try:
-            rows = np.array([[float(row[c]) for c in columns] for row in reader])
-        except (TypeError, ValueError) as error:
-            raise ValueError(f"--observations: a value in {str(path)!r} is missing or not a number ({error})") from None
-    if rows.size == 0:
-        raise ValueError(f"--observations file {str(path)!r} has no rows")
-    if not np.all(np.isfinite(rows)):
-        raise ValueError(f"--observations file {str(path)!r} holds NaN or inf; every value must be a finite number")
-    rows = rows[np.argsort(rows[:, 0], kind="stable")]
-    if check_units:
-        where = f"--observations file {str(path)!r}"
-        check_times_s(rows[:, 0], f"{where}, column 't_s'")
-        positions = rows[:, 1: n + 1]
-        if joint_angles:
-            check_angles_rad(positions, f"{where}, columns q0..q{n - 1}")
-        else:
-            check_positions_m(positions, f"{where}, columns q0..q{n - 1}")
-    return rows[:, 0], rows[:, 1:]
-
-
 def run(args) -> int:
     model = load_model(args)
     body, n = model.body, model.n
     at_rest = np.r_[body.home_position, np.zeros(n)]
     times = states = None
     if args.observations is not None:
-        times, states = read_observations(args.observations, n, check_units=args.check_units, joint_angles=not body.is_linear)
+        times, states = read_observations(args.observations, n, check_units=args.check_units,
+                                          joint_angles=not body.is_linear, name="--observations")
         before = np.flatnonzero((times > 0) & (times <= args.t_obs))
         if before.size == 0:
             raise ValueError(f"--observations has no row with 0 < t_s ≤ --t-obs = {args.t_obs:g} s")
