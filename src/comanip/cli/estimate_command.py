@@ -14,13 +14,15 @@ import json
 
 import numpy as np
 
+from comanip.arguments import as_optional_positive, as_vector
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
-from comanip.estimation.observation import observation_step
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import METHODS
-from comanip.estimation.goal_prior import PAPER_PRIOR
+from comanip.estimation.goal_prior import PAPER_PRIOR, prior_covariance
+from comanip.estimation.observation import observation_step, observed_state
+from comanip.planning.planner import reach_inputs
 from comanip.plausibility import human_plausibility
 from comanip.recordings.observation_files import read_observations
 
@@ -59,6 +61,21 @@ def candidate_list(text: str) -> np.ndarray:
     return np.array(rows)
 
 
+def check_inputs(args, model, start, observed, t_obs) -> None:
+    """Every input of the estimate and of the posterior, checked as the estimator checks them (a one-line
+    ValueError naming the argument) before it is built."""
+    width = reach_inputs(model, start, np.zeros(model.d), args.width)[2]     # the start and the width
+    observed_state(model, observed)
+    observation_step(model, t_obs)
+    prior_covariance(args.prior_std, model, width)
+    if args.prior is not None:
+        as_vector("prior_goal", args.prior, model.d, "task-space position, m")
+    as_optional_positive("max_wall_time", args.max_wall_time, "s")
+    if args.candidates is not None and args.candidates.shape[1] != model.d:
+        raise ValueError(f"--candidates must be goals of {model.d} coordinates (m) for the {model.name!r} model, "
+                         f"got {args.candidates.shape[1]}")
+
+
 def run(args) -> int:
     model = load_model(args)
     body, n = model.body, model.n
@@ -74,13 +91,12 @@ def run(args) -> int:
         start = args.start if args.start is not None else (states[0] if times[0] == 0 else at_rest)
     elif args.observed is not None:
         observed, t_obs = args.observed, args.t_obs
-        observation_step(model, t_obs)     # checked before the estimator is built (compiled on first use)
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+    check_inputs(args, model, start, observed, t_obs)
     out = output_dir(args.out, "estimate", args.force, create=False)
-    estimator = GoalEstimator(model)   # built (and compiled on first use) only once the observation is known
-    # the estimator checks every input before its work: a mistake is a ValueError before the folder is made
+    estimator = GoalEstimator(model)   # built (and compiled on first use) only once every input is checked
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, prior_std=args.prior_std, method=args.method,
                                   max_wall_time=args.max_wall_time)
     out.mkdir(parents=True, exist_ok=True)
