@@ -259,3 +259,15 @@ def test_transition_fit_and_plot_check_the_output_before_the_model_is_fitted(tmp
     monkeypatch.setattr(transition_model, "TransitionModel", _refuse_to_build)
     (tmp_path / "file").write_text("not a folder")
     assert_one_line_error(*run_cli(["transition", action, "--out", out.format(file=tmp_path / "file")], capsys), "is a file")
+
+
+def test_ros_replay_reads_its_csv_before_the_node_is_built(tmp_path, capsys, monkeypatch):
+    pytest.importorskip("rclpy")
+    from comanip.ros import replay
+
+    monkeypatch.setattr(replay, "Replay", _refuse_to_build)
+    hand = tmp_path / "hand.csv"
+    hand.write_text("t_s,q0,q1,q2\n0,0,0,0\n")
+    assert_one_line_error(*run_cli(["ros", "--replay", str(hand), "--out", str(tmp_path / "out")], capsys),
+                          "needs the columns", "qdot0")
+    assert not (tmp_path / "out").exists()

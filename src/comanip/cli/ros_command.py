@@ -44,7 +44,7 @@ def run(args) -> int:
     if args.replay is not None:
         from comanip.ros.replay import replay_csv
 
-        out = output_dir(args.out, "ros", args.force)
+        out = output_dir(args.out, "ros", args.force, create=False)     # made once the replay CSV is read
         recording, written = replay_csv(settings, args.replay, out, speed, check_units=args.check_units)
         write_manifest(out, "ros", written)
         last = recording.statuses[-1][3] if recording.statuses else {}
