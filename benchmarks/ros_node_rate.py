@@ -40,7 +40,7 @@ import numpy as np
 from comanip.estimation.estimation_planner import estimation_planner
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.ros.replay import Replay, private_domain
-from comanip.ros.settings import NodeSettings
+from comanip.ros.node_settings import NodeSettings
 
 GOAL = np.array([0.4, 0.25, -0.1])
 

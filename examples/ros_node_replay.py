@@ -15,7 +15,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from comanip.ros.replay import BASE_STAMP, replay_csv
-from comanip.ros.settings import NodeSettings
+from comanip.ros.node_settings import NodeSettings
 from _common import DATA, figure_path
 
 settings = NodeSettings.from_yaml(DATA / "node.yaml")

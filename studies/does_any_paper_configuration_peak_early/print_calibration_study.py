@@ -15,7 +15,7 @@ import time
 
 from comanip import presets
 from comanip.analysis.calibration import run_calibration, study_configurations
-from comanip.validation.settings import ValidationSettings
+from comanip.validation.run_settings import ValidationSettings
 
 
 LABELS = ("Labels: W=std reads W = w²I, W=cov W = wI; iso, chan, rank1: isotropic, per-channel, rank-one noise; "

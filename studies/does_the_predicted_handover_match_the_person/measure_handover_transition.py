@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.multicomponent.dispersion import perpendicular_dispersion_profile
+from comanip.multicomponent.perpendicular_dispersion import perpendicular_dispersion_profile
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.simulation import HandoverSettings, ScenarioSetup, SyncSettings, run_handover, run_sync
 

@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.plots.policy_comparison import plot_policy_comparison
+from comanip.plots.policy_comparison_figure import plot_policy_comparison
 from comanip.simulation import ScenarioSetup, SyncSettings
 from comanip.simulation.policies import POLICIES
 from comanip.simulation.policy_comparison import compare_sync_policies, comparison_rows, markdown_table, write_comparison

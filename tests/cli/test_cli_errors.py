@@ -136,7 +136,7 @@ def test_read_observations_reads_unusual_units_when_told():
     import tempfile
     from pathlib import Path
 
-    from comanip.cli.estimate_command import read_observations
+    from comanip.recordings.observation_files import read_observations
 
     with tempfile.TemporaryDirectory() as folder:
         path = _observations(Path(folder) / "observed.csv", 1000.0)
@@ -205,3 +205,69 @@ def test_an_observation_in_mm_gives_an_estimate_with_a_warning(tmp_path, capsys)
     main(["estimate", "--observed", "10,0,300,0", "--t-obs", "0.1", "--out", str(tmp_path)])
     err = capsys.readouterr().err
     assert "comanip estimate: warning: the goal is" in err and "peak hand speed" in err and "Traceback" not in err
+
+
+class Built(BaseException):
+    """Raised where a command would build a model, planner or estimator (BaseException, so the CLI's handler of
+    user errors does not catch it): a test that sees it found an input checked too late."""
+
+
+def _refuse_to_build(*args, **kwargs):
+    raise Built
+
+
+@pytest.mark.parametrize("extra, fragment", [
+    (["--width", "-1"], "width"),
+    (["--start", "0,0,0"], "start"),
+    (["--prior", "0.3"], "prior_goal"),
+    (["--prior-std", "-1"], "prior_std"),
+    (["--max-wall-time", "0"], "max_wall_time"),
+    (["--candidates", "0.3,0,0;0.2,0.2,0"], "--candidates"),
+])
+def test_estimate_checks_every_input_before_the_estimator_is_built(tmp_path, capsys, monkeypatch, extra, fragment):
+    from comanip.cli import estimate_command
+
+    monkeypatch.setattr(estimate_command, "GoalEstimator", _refuse_to_build)
+    argv = ["estimate", "--observed", "0.01,0,0.3,0", "--t-obs", "0.1", *extra, "--out", str(tmp_path / "out")]
+    assert_one_line_error(*run_cli(argv, capsys), fragment)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("extra, fragment", [
+    (["--width", "-1"], "width"),
+    (["--max-wall-time", "0"], "max_wall_time"),
+    (["--goal", "0.3,0"], "goal"),
+    (["--out", "{file}"], "is a file"),
+])
+def test_handover_checks_every_input_before_the_transition_model_or_planner_is_built(tmp_path, capsys, monkeypatch,
+                                                                                     extra, fragment):
+    from comanip.multicomponent import transition_model
+    from comanip.planning import planner
+
+    monkeypatch.setattr(transition_model, "TransitionModel", _refuse_to_build)
+    monkeypatch.setattr(planner, "Planner", _refuse_to_build)
+    (tmp_path / "file").write_text("not a folder")
+    argv = ["handover", "--out", str(tmp_path / "out"), *[word.format(file=tmp_path / "file") for word in extra]]
+    assert_one_line_error(*run_cli(argv, capsys), fragment)
+    assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("action, out", [("fit", "{file}"), ("plot", "{file}/transition.png")])
+def test_transition_fit_and_plot_check_the_output_before_the_model_is_fitted(tmp_path, capsys, monkeypatch, action, out):
+    from comanip.multicomponent import transition_model
+
+    monkeypatch.setattr(transition_model, "TransitionModel", _refuse_to_build)
+    (tmp_path / "file").write_text("not a folder")
+    assert_one_line_error(*run_cli(["transition", action, "--out", out.format(file=tmp_path / "file")], capsys), "is a file")
+
+
+def test_ros_replay_reads_its_csv_before_the_node_is_built(tmp_path, capsys, monkeypatch):
+    pytest.importorskip("rclpy")
+    from comanip.ros import replay
+
+    monkeypatch.setattr(replay, "Replay", _refuse_to_build)
+    hand = tmp_path / "hand.csv"
+    hand.write_text("t_s,q0,q1,q2\n0,0,0,0\n")
+    assert_one_line_error(*run_cli(["ros", "--replay", str(hand), "--out", str(tmp_path / "out")], capsys),
+                          "needs the columns", "qdot0")
+    assert not (tmp_path / "out").exists()

@@ -324,7 +324,7 @@ def test_a_fit_that_scores_no_sample_is_not_converged(tmp_path):
 
 
 def test_identification_names_parameters_left_at_their_start_without_an_error():
-    from comanip.fitting.result import identification
+    from comanip.fitting.fit_result import identification
 
     assert identification({"kappa": 0.01}, {"kappa": 0.01}, {"kappa": 0.002}, 30) is None
     assert identification({"kappa": 0.02}, {"kappa": 0.01}, {"kappa": np.nan}, 30) is None

@@ -8,7 +8,7 @@ import pytest
 
 import comanip
 from comanip.cli.main import main
-from comanip.multicomponent.dispersion import perpendicular_dispersion_profile
+from comanip.multicomponent.perpendicular_dispersion import perpendicular_dispersion_profile
 from comanip.multicomponent.transition_csv import (
     REQUIRED_COLUMNS,
     read_transition_csv,

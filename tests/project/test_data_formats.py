@@ -22,14 +22,14 @@ import comanip
 from comanip import presets
 from comanip.belief.noise import NOISE_FORMS
 from comanip.bodies import BODY_TYPES, body_from_config
-from comanip.cli.estimate_command import read_observations
+from comanip.recordings.observation_files import read_observations
 from comanip.cli.outputs import write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.fitting.movement_times import MT_COLUMNS
 from comanip.fitting.recordings import load_recordings
 from comanip.planning.arm_reach_library import bundled_library
-from comanip.fitting.result import FIT_STATUSES, FitResult
+from comanip.fitting.fit_result import FIT_STATUSES, FitResult
 from comanip.model import ReachingModel
 from comanip.multicomponent import transition_csv
 from comanip.multicomponent.handover import HandoverSchedule

@@ -49,9 +49,9 @@ def test_every_example_says_what_it_shows_and_how_to_run_it():
 
 def test_the_example_inputs_read_in_their_documented_formats():
     import comanip
-    from comanip.cli.estimate_command import read_observations
+    from comanip.recordings.observation_files import read_observations
     from comanip.fitting import load_recordings
-    from comanip.ros.settings import NodeSettings
+    from comanip.ros.node_settings import NodeSettings
 
     data = EXAMPLES / "data"
     times, states = read_observations(data / "observations.csv", 2)

@@ -177,7 +177,7 @@ VECTORS = ["0.3,0.1", "0.3,0,0.2", "0.45,0.15,0.2", "0,0,0,0", "0,0,0,0,0,0", "0
 LONG_COMMANDS = {
     "simulate": (["simulate"], {"--trials": SCALARS, "--goal": ["near", "far", *VECTORS], "--width": SCALARS,
                                 "--kappa": SCALARS, "--seed": SCALARS, "--duration": SCALARS},
-                 ("comanip.simulation", "ScenarioSetup")),
+                 ("comanip.simulation.scenario_runs", "ScenarioSetup")),
     "handover": (["handover"], {"--start": VECTORS, "--goal": VECTORS, "--width": SCALARS, "--ramp-time": SCALARS,
                                 "--stiffness": SCALARS, "--rate": SCALARS, "--arm-length": SCALARS,
                                 "--max-wall-time": SCALARS, "--preset": ["planar", "cartesian", "human", "nope"]},

@@ -15,7 +15,7 @@ from comanip.multicomponent.handover import plan_handover  # noqa: E402
 from comanip.multicomponent.transition_model import TransitionModel  # noqa: E402
 from comanip.ros.node import reach_estimator  # noqa: E402
 from comanip.ros.replay import BASE_STAMP, Replay, replay_csv  # noqa: E402
-from comanip.ros.settings import NodeSettings  # noqa: E402
+from comanip.ros.node_settings import NodeSettings  # noqa: E402
 
 GOAL = np.array([0.4, 0.25, -0.1])
 

@@ -5,7 +5,7 @@ from pathlib import Path
 import pytest
 
 from comanip.cli.main import main
-from comanip.ros.settings import NodeSettings
+from comanip.ros.node_settings import NodeSettings
 
 
 @pytest.mark.parametrize("values, message", [

@@ -15,7 +15,7 @@ from comanip.cli.main import main
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 from comanip.validation import ValidationSettings, run_validation
 from comanip.plots.validation_figures import ARM_FIGURES
-from comanip.validation.settings import FRANKA_GOAL_OFFSETS
+from comanip.validation.run_settings import FRANKA_GOAL_OFFSETS
 
 pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
 

@@ -19,7 +19,7 @@ from comanip.analysis.calibration import (
     run_calibration,
     study_configurations,
 )
-from comanip.analysis.dispersion import EndpointDispersion, endpoint_dispersion
+from comanip.analysis.open_loop_dispersion import EndpointDispersion, endpoint_dispersion
 from comanip.analysis.closed_loop_targets import measure_closed_loop_targets
 from comanip.analysis.fitts import FITTS_FORMS, FittsFit, fit_fitts, index_of_difficulty, trend_fraction
 from comanip.analysis.human_targets import (

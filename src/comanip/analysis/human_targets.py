@@ -24,7 +24,7 @@ import numpy as np
 from scipy.stats import linregress
 
 from comanip.analysis.ball_probability import ball_probability
-from comanip.analysis.dispersion import endpoint_dispersion
+from comanip.analysis.open_loop_dispersion import endpoint_dispersion
 from comanip.analysis.fitts import FittsFit, fit_fitts, index_of_difficulty
 from comanip.analysis.minimum_jerk_baseline import minimum_jerk_speed_fraction
 from comanip.analysis.profile_shape import profile_shape

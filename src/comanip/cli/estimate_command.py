@@ -10,21 +10,21 @@ to the horizon feeds the posterior.
 from __future__ import annotations
 
 import argparse
-import csv
 import json
-from pathlib import Path
 
 import numpy as np
 
+from comanip.arguments import as_optional_positive, as_vector
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
-from comanip.estimation.observation import observation_step
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimator import METHODS
-from comanip.estimation.goal_prior import PAPER_PRIOR
+from comanip.estimation.goal_prior import PAPER_PRIOR, prior_covariance
+from comanip.estimation.observation import observation_step, observed_state
+from comanip.planning.planner import reach_inputs
 from comanip.plausibility import human_plausibility
-from comanip.units import check_angles_rad, check_positions_m, check_times_s
+from comanip.recordings.observation_files import read_observations
 
 
 def add_parser(subparsers) -> None:
@@ -61,35 +61,19 @@ def candidate_list(text: str) -> np.ndarray:
     return np.array(rows)
 
 
-def read_observations(path: Path, n: int, *, check_units: bool = True, joint_angles: bool = False) -> tuple[np.ndarray, np.ndarray]:
-    """Times (K,) s and states (K, 2n) from a CSV with columns t_s, q0..q{n-1}, qdot0..qdot{n-1}, sorted by time.
-
-    ``check_units`` refuses times that look like ms and positions q that look like mm, or like degrees when
-    ``joint_angles`` (an arm's q in rad), with a one-line ValueError (:mod:`comanip.units`)."""
-    columns = ["t_s"] + [f"q{k}" for k in range(n)] + [f"qdot{k}" for k in range(n)]
-    with open(path, newline="") as f:
-        reader = csv.DictReader(f)
-        missing = [c for c in columns if c not in (reader.fieldnames or [])]
-        if missing:
-            raise ValueError(f"--observations needs the columns {columns}; {str(path)!r} lacks {missing}")
-        try:
-            rows = np.array([[float(row[c]) for c in columns] for row in reader])
-        except (TypeError, ValueError) as error:
-            raise ValueError(f"--observations: a value in {str(path)!r} is missing or not a number ({error})") from None
-    if rows.size == 0:
-        raise ValueError(f"--observations file {str(path)!r} has no rows")
-    if not np.all(np.isfinite(rows)):
-        raise ValueError(f"--observations file {str(path)!r} holds NaN or inf; every value must be a finite number")
-    rows = rows[np.argsort(rows[:, 0], kind="stable")]
-    if check_units:
-        where = f"--observations file {str(path)!r}"
-        check_times_s(rows[:, 0], f"{where}, column 't_s'")
-        positions = rows[:, 1: n + 1]
-        if joint_angles:
-            check_angles_rad(positions, f"{where}, columns q0..q{n - 1}")
-        else:
-            check_positions_m(positions, f"{where}, columns q0..q{n - 1}")
-    return rows[:, 0], rows[:, 1:]
+def check_inputs(args, model, start, observed, t_obs) -> None:
+    """Every input of the estimate and of the posterior, checked as the estimator checks them (a one-line
+    ValueError naming the argument) before it is built."""
+    width = reach_inputs(model, start, np.zeros(model.d), args.width)[2]     # the start and the width
+    observed_state(model, observed)
+    observation_step(model, t_obs)
+    prior_covariance(args.prior_std, model, width)
+    if args.prior is not None:
+        as_vector("prior_goal", args.prior, model.d, "task-space position, m")
+    as_optional_positive("max_wall_time", args.max_wall_time, "s")
+    if args.candidates is not None and args.candidates.shape[1] != model.d:
+        raise ValueError(f"--candidates must be goals of {model.d} coordinates (m) for the {model.name!r} model, "
+                         f"got {args.candidates.shape[1]}")
 
 
 def run(args) -> int:
@@ -98,7 +82,8 @@ def run(args) -> int:
     at_rest = np.r_[body.home_position, np.zeros(n)]
     times = states = None
     if args.observations is not None:
-        times, states = read_observations(args.observations, n, check_units=args.check_units, joint_angles=not body.is_linear)
+        times, states = read_observations(args.observations, n, check_units=args.check_units,
+                                          joint_angles=not body.is_linear, name="--observations")
         before = np.flatnonzero((times > 0) & (times <= args.t_obs))
         if before.size == 0:
             raise ValueError(f"--observations has no row with 0 < t_s ≤ --t-obs = {args.t_obs:g} s")
@@ -106,13 +91,12 @@ def run(args) -> int:
         start = args.start if args.start is not None else (states[0] if times[0] == 0 else at_rest)
     elif args.observed is not None:
         observed, t_obs = args.observed, args.t_obs
-        observation_step(model, t_obs)     # checked before the estimator is built (compiled on first use)
         start = args.start if args.start is not None else at_rest
     else:
         raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+    check_inputs(args, model, start, observed, t_obs)
     out = output_dir(args.out, "estimate", args.force, create=False)
-    estimator = GoalEstimator(model)   # built (and compiled on first use) only once the observation is known
-    # the estimator checks every input before its work: a mistake is a ValueError before the folder is made
+    estimator = GoalEstimator(model)   # built (and compiled on first use) only once every input is checked
     estimate = estimator.estimate(start, observed, t_obs, args.prior, args.width, prior_std=args.prior_std, method=args.method,
                                   max_wall_time=args.max_wall_time)
     out.mkdir(parents=True, exist_ok=True)

@@ -53,16 +53,17 @@ def run(args) -> int:
     check_schedule_arguments(args.ramp_time, args.stiffness, args.rate)
     arm_length = None if args.arm_length is None else as_positive("arm_length", args.arm_length, "m")
     model = load_model(args)
-    transition = TransitionModel.load(args.transition_model) if args.transition_model else TransitionModel()
-    if arm_length is not None:
-        transition.arm_length = arm_length
     start = np.zeros(2 * model.n) if args.start is None else args.start
     goals = args.goal or [vector(g) for g in DEFAULT_GOALS]
     as_optional_positive("max_wall_time", args.max_wall_time, "s")
-    for goal in goals:  # every input checked before a planner is built or the output folder made
+    for goal in goals:  # every input checked before the transition model is fitted, a planner built or the folder made
         reach_inputs(model, start, goal, args.width)
+    out = output_dir(args.out, "handover", args.force, create=False)
+    transition = TransitionModel.load(args.transition_model) if args.transition_model else TransitionModel()
+    if arm_length is not None:
+        transition.arm_length = arm_length
     planner = Planner(model)
-    out = output_dir(args.out, "handover", args.force)
+    out.mkdir(parents=True, exist_ok=True)
     plans, schedules, results, written, lines = [], [], [], [], []
     for k, goal in enumerate(goals):
         plan = planner.solve(start, goal, args.width, max_wall_time=args.max_wall_time)

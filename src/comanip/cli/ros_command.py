@@ -31,7 +31,7 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from comanip.ros.settings import NodeSettings
+    from comanip.ros.node_settings import NodeSettings
 
     settings = NodeSettings.from_yaml(args.params) if args.params is not None else NodeSettings()
     speed = None if args.speed is None else as_positive("--speed", args.speed, "times real time")
@@ -44,7 +44,7 @@ def run(args) -> int:
     if args.replay is not None:
         from comanip.ros.replay import replay_csv
 
-        out = output_dir(args.out, "ros", args.force)
+        out = output_dir(args.out, "ros", args.force, create=False)     # made once the replay CSV is read
         recording, written = replay_csv(settings, args.replay, out, speed, check_units=args.check_units)
         write_manifest(out, "ros", written)
         last = recording.statuses[-1][3] if recording.statuses else {}

@@ -7,7 +7,7 @@ over trials) and a figure comparing the policies over the same trials and person
 from __future__ import annotations
 
 import json
-import time
+from pathlib import Path
 
 from comanip.cli.commands import command_help
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
@@ -35,12 +35,35 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from comanip.simulation import SCENARIOS, ScenarioSetup, resolve_goal, scenario
+    from comanip.simulation.report import write_summary
+    from comanip.simulation.scenario_runs import run_scenario
 
+    settings_by_goal, policies = scenario_settings(args)    # every setting checked before any solver or model is built
+    out = output_dir(args.out, "simulate", args.force)
+    result = run_scenario(args.scenario, settings_by_goal, policies)
+    files, strips = write_outputs(result, out, frames=not args.no_frames)
+    summary = result.summary()
+    summary_path = out / f"{args.scenario}_summary.json"
+    files.append(summary_path)
+    write_summary(summary_path, summary | {"frame_strips": strips, "files": [str(p) for p in files]})
+    if args.viewer:
+        from comanip.simulation.rendering import replay_in_viewer
+
+        record = next(iter(result.goals.values())).trials[0].record
+        print(replay_in_viewer(result.setup.world.model, record.t, record.qpos))
+    write_manifest(out, "simulate", files)
+    lines, full = _report_text(result, summary, out)
+    report(args, lines, full, out, files)
+    return 0
+
+
+def scenario_settings(args) -> tuple[dict, list[str] | None]:
+    """Each goal's settings {label: settings} and the compared policies (None: the settings' own only), every
+    argument checked (one-line ValueError)."""
+    from comanip.simulation import resolve_goal, scenario
     from comanip.simulation.policies import POLICIES, check_policy
 
-    settings_class, runner = scenario(args.scenario)
-    goals = args.goal or ["near", "far"]
+    settings_class, _ = scenario(args.scenario)
     common = {"trials": args.trials, "width": args.width, "kappa": args.kappa, "seed": args.seed, "duration": args.duration}
     policies = None
     if args.policy is not None:
@@ -52,95 +75,78 @@ def run(args) -> int:
         if args.scenario != "handover":
             raise ValueError(f"--trigger applies to the handover scenario only, got scenario {args.scenario!r}")
         common["release_trigger"] = args.trigger
-    # every setting is checked here, before any solver or model is built
-    all_settings = {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in goals}
-    setup = ScenarioSetup(next(iter(all_settings.values())))
-    out = output_dir(args.out, "simulate", args.force)
+    return {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in args.goal or ["near", "far"]}, policies
 
-    results, timing, by_policy = {}, {}, {}
-    for label, settings in all_settings.items():
-        begin = time.perf_counter()
-        if policies is None:
-            results[label] = runner(settings, setup)
-        else:
-            from comanip.simulation.policy_comparison import compare_sync_policies
 
-            by_policy[label] = compare_sync_policies({label: settings}, policies, setup, progress=True)[label]
-            results[label] = by_policy[label][settings.policy]
-        wall = time.perf_counter() - begin
-        simulated = settings.trials * setup.duration * (1 if policies is None else len(policies))
-        timing[label] = {"wall_s": wall, "simulated_s": simulated, "real_time_factor": simulated / wall}
+def write_outputs(result, out: Path, frames: bool) -> tuple[list[Path], dict]:
+    """Write the policy comparison (table and figure, the other policies' trials), one CSV per trial, a frame
+    strip per goal (when ``frames``) and the scenario's figure; the files written and {goal label: strip path
+    or why there is none}."""
+    from comanip.simulation.report import write_trials
 
-    from comanip.simulation.report import settings_dict, summarise, write_summary, write_trials
-
-    files, goals_out, strips = [], {}, {}
-    if by_policy:
-        from comanip.plots.policy_comparison import plot_policy_comparison
-        from comanip.simulation.policy_comparison import comparison_rows, write_comparison
-
-        rows = comparison_rows(by_policy)
-        files += write_comparison(rows, out / "sync_policies")
-        files.append(plot_policy_comparison(by_policy, out / "sync_policies.png"))
-        for label, runs in by_policy.items():
-            for name, trials in runs.items():
-                if name != all_settings[label].policy:
-                    files += write_trials([trial.record for trial in trials], out, f"sync_{label}_{name}")
-    for label, result in results.items():
-        trials = result if args.scenario == "sync" else result.trials
-        stem = f"{args.scenario}_{label}"
-        files += write_trials([trial.record for trial in trials], out, stem)
-        metrics = [trial.metrics for trial in trials]
-        goals_out[label] = {"goal_m": list(all_settings[label].goal), "trials": metrics, "summary": summarise(metrics),
-                            "timing": timing[label]}
-        if args.scenario == "handover":
-            goals_out[label]["schedule"] = result.schedule.summary()
-            if result.dispersion is not None:
-                # the lead at 400 N/m holds the spread down until the release, so this peak lies inside T by
-                # construction; the person's own transition is measured with a passive robot
-                # (studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py)
-                goals_out[label]["transition"] = {
-                    "predicted_distance_m": result.schedule.transition_distance,
-                    "handover_spread_peak_distance_m": result.dispersion.transition_distance}
-        if label in by_policy:
-            goals_out[label]["policies"] = {name: summarise([trial.metrics for trial in trials])
-                                            for name, trials in by_policy[label].items()}
-        if not args.no_frames:
+    files, strips = _write_policy_comparison(result, out), {}
+    for label, goal in result.goals.items():
+        stem = f"{result.scenario}_{label}"
+        files += write_trials([trial.record for trial in goal.trials], out, stem)
+        if frames:
             from comanip.simulation.rendering import frame_strip
 
-            path, reason = frame_strip(setup.settings.object_mass, trials[0].record.qpos, out / f"{stem}_frames.png",
-                                       markers=[trials[0].record.goal])
+            record = goal.trials[0].record
+            path, reason = frame_strip(result.setup.settings.object_mass, record.qpos, out / f"{stem}_frames.png",
+                                       markers=[record.goal])
             strips[label] = str(path) if path else reason
             files += [path] if path else []
-    if args.scenario == "sync":
-        from comanip.plots.simulation_sync import plot_sync
+    return files + FIGURES[result.scenario](result, out), strips
 
-        files.append(plot_sync(results, next(iter(all_settings.values())).observation_time, out / "sync.png"))
-    elif any(run.dispersion is not None for run in results.values()):     # the profiles need ≥ 2 trials
-        from comanip.plots.simulation_handover import plot_handover
 
-        files.append(plot_handover({k: r for k, r in results.items() if r.dispersion is not None}, out / "handover.png"))
-    summary_path = out / f"{args.scenario}_summary.json"
-    files.append(summary_path)
-    write_summary(summary_path, {"scenario": args.scenario, "scenarios_available": sorted(SCENARIOS),
-                                 "settings": settings_dict(next(iter(all_settings.values()))), "goals": goals_out,
-                                 "frame_strips": strips,
-                                 "files": [str(p) for p in files]})
-    if args.viewer:
-        from comanip.simulation.rendering import replay_in_viewer
+def _write_policy_comparison(result, out: Path) -> list[Path]:
+    """The comparison table (CSV and markdown), its figure and the trials of the policies other than the
+    settings' own; nothing when no policies were compared."""
+    if not result.policies:
+        return []
+    from comanip.plots.policy_comparison_figure import plot_policy_comparison
+    from comanip.simulation.policy_comparison import write_comparison
+    from comanip.simulation.report import write_trials
 
-        first = next(iter(results.values()))
-        record = (first if args.scenario == "sync" else first.trials)[0].record
-        print(replay_in_viewer(setup.world.model, record.t, record.qpos))
-    write_manifest(out, "simulate", files)
-    full = {label: {"summary": _headline(goals_out[label]["summary"]), "timing": timing[label]} for label in goals_out}
-    lines = [f"simulate {args.scenario}, goal {label}: {all_settings[label].trials} trials"
-             f"{'' if policies is None else f' x {len(policies)} policies'} in {timing[label]['wall_s']:.1f} s "
-             f"({timing[label]['real_time_factor']:.1f}x real time)" for label in goals_out]
-    if by_policy:
+    files = write_comparison(result.policy_rows(), out / "sync_policies")
+    files.append(plot_policy_comparison(result.policy_trials(), out / "sync_policies.png"))
+    for label, goal in result.goals.items():
+        files += [path for name, trials in goal.policies.items() if name != goal.settings.policy
+                  for path in write_trials([trial.record for trial in trials], out, f"sync_{label}_{name}")]
+    return files
+
+
+def _sync_figure(result, out: Path) -> list[Path]:
+    from comanip.plots.simulation_sync import plot_sync
+
+    runs = {label: goal.trials for label, goal in result.goals.items()}
+    return [plot_sync(runs, result.settings.observation_time, out / "sync.png")]
+
+
+def _handover_figure(result, out: Path) -> list[Path]:
+    """The handover figure of the goals with profiles (≥ 2 trials); none without any."""
+    from comanip.plots.simulation_handover import plot_handover
+
+    runs = {label: goal.profiles for label, goal in result.goals.items() if goal.profiles is not None}
+    return [plot_handover(runs, out / "handover.png")] if runs else []
+
+
+#: scenario name -> its figure
+FIGURES = {"sync": _sync_figure, "handover": _handover_figure}
+
+
+def _report_text(result, summary: dict, out: Path) -> tuple[list[str], object]:
+    """The terminal lines and what --verbose prints (the comparison table first, when policies were compared)."""
+    goals = summary["goals"]
+    full = {label: {"summary": _headline(goals[label]["summary"]), "timing": goals[label]["timing"]} for label in goals}
+    compared = "" if result.policies is None else f" x {len(result.policies)} policies"
+    lines = [f"simulate {result.scenario}, goal {label}: {goal.settings.trials} trials{compared} in "
+             f"{goal.timing['wall_s']:.1f} s ({goal.timing['real_time_factor']:.1f}x real time)"
+             for label, goal in result.goals.items()]
+    if result.policies:
         lines.append(f"policy comparison (median [q25, q75]) in {out / 'sync_policies.md'}")
         full = (out / "sync_policies.md").read_text() + "\n" + json.dumps(full, indent=1, default=float)
-    report(args, lines, full, out, files)
-    return 0
+    return lines, full
 
 
 def _label(goal: str) -> str:

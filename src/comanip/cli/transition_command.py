@@ -93,8 +93,9 @@ def run_fit(args) -> int:
     from comanip.multicomponent.trends import trend_report
 
     data = args.data or shipped_dataset_path()
+    out = output_dir(args.out, "transition", args.force, create=False)   # checked before the model is fitted
     model = TransitionModel(data, arm_length=args.arm_length)
-    out = output_dir(args.out, "transition", args.force)
+    out.mkdir(parents=True, exist_ok=True)
     model.save(out / "model.json")
     trends = trend_report(model)
     (out / "trends.json").write_text(json.dumps(trends, indent=1))
@@ -113,8 +114,9 @@ def run_plot(args) -> int:
     from comanip.multicomponent.transition_model import TransitionModel
     from comanip.plots.transition_figure import plot_transition_model
 
+    folder = output_dir(Path(args.out).parent, "transition", args.force, create=False)   # checked before the model is fitted
     model = TransitionModel.load(args.model) if args.model else TransitionModel(args.data or shipped_dataset_path())
-    folder = output_dir(Path(args.out).parent, "transition", args.force)
+    folder.mkdir(parents=True, exist_ok=True)
     figure = plot_transition_model(model, args.out)
     write_manifest(folder, "transition", [figure], action="plot")
     report(args, ["transition plot: predicted transition distance over (D/L, w)"], {"figure": str(figure)}, folder, [figure])

@@ -2,7 +2,7 @@
 latter from the actual state or from a Kalman estimate made from noisy, delayed feedback."""
 
 from comanip.execution.kalman_filter import DelayedKalmanFilter
-from comanip.execution.observation import Observation
+from comanip.execution.delayed_observation import Observation
 from comanip.execution.receding_horizon import Execution, execute_receding_horizon
 
 __all__ = ["DelayedKalmanFilter", "Execution", "Observation", "execute_receding_horizon"]

@@ -4,7 +4,7 @@ Notation (as comanip.belief.propagation): s_k (nx,) the state, u_k (n,) the comm
 s_{k+1} = f(s_k, (I + E_k) u_k) with A_k = df/ds, B_k = df/du at the estimate, and process noise
 B_k N(u_k) B_k^T (comanip.belief.noise: the motor noise of the known command). The measurement received
 after step k is y_{k+1} = C s_{k+1-d} + v, C = [I_2n 0] (it sees [q; qdot], not the activation stages),
-v ~ N(0, R) (:class:`comanip.execution.observation.Observation`), d the delay in steps.
+v ~ N(0, R) (:class:`comanip.execution.delayed_observation.Observation`), d the delay in steps.
 
 The filter keeps the estimate of the delayed state s_{k+1-d} (mean m, covariance P), corrects it with each
 measurement (Joseph form, so P stays symmetric positive semi-definite; a pseudo-inverse of the innovation
@@ -23,7 +23,7 @@ import numpy as np
 
 from comanip.belief.noise import noise_covariance
 from comanip.belief.propagation import linearised_step_function
-from comanip.execution.observation import Observation
+from comanip.execution.delayed_observation import Observation
 from comanip.model import ReachingModel
 
 

@@ -4,7 +4,7 @@ At step k the planner solves the full H-step problem from the state s_k (warm-st
 plan shifted by one step); the first torque tau_0 is executed with signal-dependent noise,
 s_{k+1} = f(s_k, (I + E_k) tau_0), E_k drawn as the model's noise form says. The receding window keeps its
 length H, so the person always looks H·h seconds ahead. By default the replan starts from the actual state;
-with an :class:`~comanip.execution.observation.Observation` it starts from the person's estimate of it,
+with an :class:`~comanip.execution.delayed_observation.Observation` it starts from the person's estimate of it,
 made from noisy, delayed measurements by :class:`~comanip.execution.kalman_filter.DelayedKalmanFilter`.
 """
 
@@ -17,7 +17,7 @@ import numpy as np
 
 from comanip.belief.noise import sample_torque_error
 from comanip.execution.kalman_filter import DelayedKalmanFilter
-from comanip.execution.observation import Observation
+from comanip.execution.delayed_observation import Observation
 from comanip.planning.planner import Planner
 
 

@@ -8,7 +8,7 @@ from importlib import import_module
 _EXPORTS = {"fit_model": "comanip.fitting.fit", "recordings_nll": "comanip.fitting.fit",
             "fit_movement_times": "comanip.fitting.movement_times", "MovementTimeTable": "comanip.fitting.movement_times",
             "Trial": "comanip.fitting.recordings", "load_recordings": "comanip.fitting.recordings",
-            "FitResult": "comanip.fitting.result"}
+            "FitResult": "comanip.fitting.fit_result"}
 
 __all__ = ["fit_model", "recordings_nll", "fit_movement_times", "MovementTimeTable", "Trial", "load_recordings", "FitResult"]
 

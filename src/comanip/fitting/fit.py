@@ -24,8 +24,8 @@ from comanip.fitting.objective import RecordingsObjective
 from comanip.fitting.parameters import DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.recordings import Trial, load_recordings
 from comanip.fitting.residuals import condition_curves, condition_residuals, trial_residuals
-from comanip.fitting.progress import ProgressBar
-from comanip.fitting.result import FitResult, failed_result, fitted_model, identification, outcome_message
+from comanip.fitting.evaluation_progress import ProgressBar
+from comanip.fitting.fit_result import FitResult, failed_result, fitted_model, identification, outcome_message
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
 

@@ -24,9 +24,9 @@ from comanip.arguments import as_count, as_positive, as_positive_array
 from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.csv_table import read_table
 from comanip.fitting.parameters import MT_DEFAULT_PARAMETERS, ParameterSpace
-from comanip.fitting.progress import ProgressBar
+from comanip.fitting.evaluation_progress import ProgressBar
 from comanip.fitting.residuals import movement_time
-from comanip.fitting.result import FitResult, failed_result, fitted_model, identification, outcome_message
+from comanip.fitting.fit_result import FitResult, failed_result, fitted_model, identification, outcome_message
 from comanip.model import ReachingModel
 
 MT_COLUMNS = ("distance_m", "width_m", "mt_s")

@@ -25,7 +25,7 @@ from comanip import presets
 from comanip.arguments import as_count, as_positive, as_positive_array
 from comanip.execution import execute_receding_horizon
 from comanip.model import ReachingModel
-from comanip.multicomponent.dispersion import bootstrap_transition_std, first_passage_deviations, profile_from_deviations
+from comanip.multicomponent.perpendicular_dispersion import bootstrap_transition_std, first_passage_deviations, profile_from_deviations
 from comanip.planning.planner import Planner
 from comanip.progress import progress_bar
 

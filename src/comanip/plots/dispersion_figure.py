@@ -10,7 +10,7 @@ import numpy as np
 from matplotlib.patches import Circle
 from scipy.stats import norm
 
-from comanip.analysis.dispersion import EndpointDispersion
+from comanip.analysis.open_loop_dispersion import EndpointDispersion
 from comanip.plots.figure_file import save_figure
 
 

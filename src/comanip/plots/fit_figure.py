@@ -9,7 +9,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from comanip.analysis.fitts import index_of_difficulty
-from comanip.fitting.result import FitResult
+from comanip.fitting.fit_result import FitResult
 from comanip.plots.figure_file import save_figure
 
 #: At most this many conditions get a column of their own.

@@ -3,5 +3,5 @@ arrive, and publishes the estimate, the predicted hand path and the handover's i
 (:mod:`comanip.ros.node`); a replay of recorded hand states through it (:mod:`comanip.ros.replay`).
 
 Needs the optional extra: ``pip install -e ".[ros]"`` (ROS 2's rclpy and message packages as wheels; no ROS
-installation). :mod:`comanip.ros.settings` needs neither.
+installation). :mod:`comanip.ros.node_settings` needs neither.
 """

@@ -1,6 +1,6 @@
 """The ROS 2 goal node: online goal estimation, prediction and the handover's impedance schedule, in a robot's loop.
 
-Inputs (topic names are parameters, :class:`~comanip.ros.settings.NodeSettings`): the hand's pose and twist,
+Inputs (topic names are parameters, :class:`~comanip.ros.node_settings.NodeSettings`): the hand's pose and twist,
 a prior goal, a reset. A reach starts at the first hand pose (after startup, a reset, or a gap in the input
 longer than ``input_timeout``): that pose and the twist paired with it are the start s_0 = [x; xdot], and its
 stamp is t = 0. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
@@ -57,7 +57,7 @@ from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.planner import Planner
 from comanip.ros.messages import (RejectedMessage, Sample, goal_message, path_message, pose_of, read_vector, schedule_message,
                                   stamp_of, status_message)
-from comanip.ros.settings import NodeSettings
+from comanip.ros.node_settings import NodeSettings
 
 QUEUE_DEPTH = 50
 """Depth of every subscription and publisher queue (messages)."""

@@ -34,10 +34,10 @@ from rclpy.node import Node
 from rosgraph_msgs.msg import Clock
 from std_msgs.msg import Float64MultiArray
 
-from comanip.cli.estimate_command import read_observations
+from comanip.recordings.observation_files import read_observations
 from comanip.ros.messages import SCHEDULE_COLUMNS, read_schedule, seconds, stamp_of, status_text, status_values
 from comanip.ros.node import GoalNode
-from comanip.ros.settings import NodeSettings
+from comanip.ros.node_settings import NodeSettings
 
 BASE_STAMP = 1000.0
 """ROS time (s) of the recording's t = 0."""

@@ -24,7 +24,7 @@ from comanip.arguments import as_positive
 from comanip.control.impedance import CartesianImpedanceController, RobotState
 from comanip.estimation import OnlineGoalEstimator
 from comanip.estimation.online_estimator import CORRECTING_PERSON
-from comanip.multicomponent.dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
+from comanip.multicomponent.perpendicular_dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan

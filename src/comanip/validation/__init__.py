@@ -7,6 +7,6 @@ matplotlib).
 
 from comanip.validation.figure_data import ValidationFigureData
 from comanip.validation.run import run_validation
-from comanip.validation.settings import ValidationSettings
+from comanip.validation.run_settings import ValidationSettings
 
 __all__ = ["run_validation", "ValidationFigureData", "ValidationSettings"]

@@ -20,7 +20,7 @@ from comanip.caching.compiled import cache_dir
 from comanip.planning.planner import Planner
 from comanip.progress import elapsed, progress_bar
 from comanip.validation.figure_data import ArmFigureData
-from comanip.validation.settings import ValidationSettings
+from comanip.validation.run_settings import ValidationSettings
 
 def run_arm_section(model: ReachingModel, out: Path, settings: ValidationSettings,
                     progress: bool = True) -> tuple[dict, ArmFigureData]:

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from comanip.analysis.arm_reaches import ArmReach
-from comanip.analysis.dispersion import EndpointDispersion
+from comanip.analysis.open_loop_dispersion import EndpointDispersion
 from comanip.analysis.fitts import FittsFit
 from comanip.analysis.human_targets import HumanTargetsResult
 from comanip.analysis.phase import PhaseCurve

@@ -18,7 +18,7 @@ from comanip.analysis.reach_grid import ReachOutcome
 from comanip.analysis.target_verdicts import HumanTargets
 from comanip.model import ReachingModel
 from comanip.progress import progress_bar
-from comanip.validation.settings import ValidationSettings
+from comanip.validation.run_settings import ValidationSettings
 
 #: The one definition of w and ID the section states.
 DEFINITION = "w is the goal radius: a reach hits when ‖x − g‖ ≤ w at MT (2w is the full width), and ID = log2(2D/w) bits"

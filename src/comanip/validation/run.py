@@ -42,7 +42,7 @@ from comanip.validation.arm_section import run_arm_section
 from comanip.validation.figure_data import PointMassFigureData, ValidationFigureData
 from comanip.validation.human_section import run_human_section
 from comanip.validation.markdown import report_markdown
-from comanip.validation.settings import ValidationSettings
+from comanip.validation.run_settings import ValidationSettings
 
 
 def run_validation(model: ReachingModel, out: str | Path, settings: ValidationSettings | None = None,
