@@ -22,7 +22,7 @@ import numpy as np
 
 import comanip
 from comanip.optim import Status
-from comanip.planning.arm_reach_library import CANDIDATE_ENTRIES
+from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES
 from comanip.planning.planner import SolverOptions, _rank
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -43,10 +43,10 @@ def main(argv=None) -> None:
     winners = np.zeros(3, dtype=int)
     for k, (start, goal, width) in enumerate(problems(model, args.problems)):
         params = np.concatenate([start, goal, [width]])
-        guesses = planner._cold_guesses(start, goal, planner.options.n_starts)
-        library_start = planner._lowest_objective(guesses + planner._library_candidates(start, goal, CANDIDATE_ENTRIES),
+        guesses = planner.starts.cold_guesses(start, goal, planner.options.n_starts)
+        library_start = planner.starts.lowest_objective(guesses + planner.starts.library_candidates(start, goal, CANDIDATE_ENTRIES),
                                                   start, goal, width)
-        best_ranked = int(np.argmin([planner._objective(g, params) for g in guesses]))
+        best_ranked = int(np.argmin([planner.starts.objective(g, params) for g in guesses]))
         library, *solved = (planner._run_solver(s, params, np.inf) for s in [library_start] + guesses)
         converged = library.status == Status.SOLVED and planner._ends_at_goal(library.x, params)
         winner = min(range(3), key=lambda j: _rank(solved[j]))

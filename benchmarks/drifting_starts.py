@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 import comanip
-from comanip.planning.initial_guess import guess_durations, minimum_jerk_torques
+from comanip.planning.starts.initial_guess import guess_durations, minimum_jerk_torques
 from comanip.planning.planner import SolverOptions
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -38,16 +38,16 @@ def main(argv=None) -> None:
     iterations = {"all guesses": 0, "best guess + best library": 0}
     count = 0
     for k, (start, goal, width) in enumerate(problems(model, args.problems)):
-        if not start[n:].any() or planner._drift(start, goal, width) <= np.linalg.norm(goal - start[:n]):
+        if not start[n:].any() or planner.starts.drift(start, goal, width) <= np.linalg.norm(goal - start[:n]):
             continue
         count += 1
         params = np.concatenate([start, goal, [width]])
         motion = start.copy()
         motion[:n] = 0.0
-        turned = planner._library.guess(start, goal, width)
-        starts = planner._cold_guesses(start, goal, 3) + list(
-            turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(n), durations, planner._linear_dynamics))
-        ranks = np.array([planner._objective(s, params) for s in starts])
+        turned = planner.starts.library.guess(start, goal, width)
+        starts = planner.starts.cold_guesses(start, goal, 3) + list(
+            turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(n), durations, planner.starts.linear_dynamics))
+        ranks = np.array([planner.starts.objective(s, params) for s in starts])
         results = [planner._run_solver(s, params, np.inf) for s in starts]
         J = np.array([r.fun for r in results])
         its = [r.nit for r in results]

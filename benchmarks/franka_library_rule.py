@@ -34,14 +34,23 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import comanip  # noqa: E402
 from cold_quality import arm_problems  # noqa: E402
 from comanip.planning.planner import Planner, SolverOptions  # noqa: E402
+from comanip.planning.starts import StartPolicy  # noqa: E402
+
+
+class LibraryAndGuessStarts(StartPolicy):
+    """The ``library+guess`` strategy: the library's start and the best minimum-jerk guess."""
+
+    def arm_library_starts(self, start, goal, width, goal_q=None):
+        best, *guesses = super().arm_library_starts(start, goal, width, goal_q)
+        return [best, self.lowest_objective(guesses, start, goal, width)]
 
 
 class LibraryAndGuess(Planner):
-    """The planner with the ``library+guess`` strategy: the library's start and the best minimum-jerk guess."""
+    """The planner with the ``library+guess`` strategy, running every start it is given."""
 
-    def _arm_library_starts(self, start, goal, width, goal_q=None):
-        best, *guesses = super()._arm_library_starts(start, goal, width, goal_q)
-        return [best, self._lowest_objective(guesses, start, goal, width)]
+    def _build(self):
+        super()._build()
+        self.starts.__class__ = LibraryAndGuessStarts
 
     def _solve_from(self, guesses, start, goal, width, t_begin, max_wall_time, until_converged=False):
         return super()._solve_from(guesses, start, goal, width, t_begin, max_wall_time, until_converged=False)

@@ -79,7 +79,7 @@ def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4)
     """Cold solves (no warm start) from the home position to goals ``distances`` (m; 0.1–0.4 m) away in
     uniformly drawn directions, a new goal each time (a user's first plan for a goal), at the model's width;
     from rest, or (``moving``) with start velocities uniform in ±0.3 m/s per axis (rad/s per joint for an arm). The planner is fresh: its
-    first solves also fill its reach library (comanip.planning.reach_library)."""
+    first solves also fill its reach library (comanip.planning.starts.reach_library)."""
 
     def make() -> Case:
         model = comanip.presets.load(preset)

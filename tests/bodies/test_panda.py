@@ -11,7 +11,7 @@ from comanip.belief.propagation import linearised_step_function
 from comanip.bodies import body_from_config
 from comanip.bodies.panda import Panda
 from comanip.bodies.panda_urdf import panda_urdf_path
-from comanip.planning.initial_guess import minimum_jerk_torques
+from comanip.planning.starts.initial_guess import minimum_jerk_torques
 
 pytestmark = pytest.mark.slow  # the Panda's dynamics and Monte Carlo of its nonlinear step
 

@@ -6,9 +6,9 @@ import pytest
 
 import comanip
 from comanip.cli.main import main as comanip_main
-from comanip.planning.arm_reach_library import (GRID_SPACING, SHELL, ArmReachLibrary, build_library, bundled_library,
+from comanip.planning.starts.arm_reach_library import (GRID_SPACING, SHELL, ArmReachLibrary, build_library, bundled_library,
                                                 grid_goals)
-from comanip.planning.initial_guess import minimum_jerk, minimum_jerk_torques
+from comanip.planning.starts.initial_guess import minimum_jerk, minimum_jerk_torques
 from comanip.planning.planner import SolverOptions
 
 RELATIVE = 1e-6
@@ -76,7 +76,7 @@ def test_a_braked_plan_from_a_moving_start_follows_the_plan_from_rest(preset):
     rest once the braking has ended (the move is continuous-time, the step forward Euler; for the Panda also
     first order in the nonlinearity): the end state is ten times closer to the plan's than without braking."""
     from comanip.belief.propagation import propagate_belief
-    from comanip.planning.initial_guess import braked_torques
+    from comanip.planning.starts.initial_guess import braked_torques
 
     model = comanip.presets.load(preset)
     body, n = model.body, model.n
@@ -141,7 +141,7 @@ def test_a_warm_solve_from_the_ready_pose_also_starts_from_the_library():
     start = np.r_[model.body.home_position, np.zeros(model.n)]
     hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     with_library, without = comanip.Planner(model), comanip.Planner(model, SolverOptions(cold_search="all"))
-    assert with_library._arm_library is not None and without._arm_library is None
+    assert with_library.starts.arm_library is not None and without.starts.arm_library is None
     previous = without.solve(start, hand + [0.15, 0.1, -0.1])
     goal = previous.goal + [0.04, -0.03, 0.045]
     plan, reference = with_library.solve(start, goal, warm_start=previous), without.solve(start, goal, warm_start=previous)

@@ -1,6 +1,7 @@
 """The fast solver layer: structured Hessian, compiled functions and their cache, the Newton method, and
 its optimum against IPOPT with CasADi's exact Hessian (the reference)."""
 
+import pickle
 import warnings
 
 import casadi as ca
@@ -225,15 +226,15 @@ def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(t
 
 
 def test_goal_sensitivity_of_a_plan_matches_finite_differences_of_solved_plans():
-    """d tau*/d goal that a point-mass planner keeps after a solve (implicit function theorem with its last
+    """d tau*/d goal that a point-mass plan carries (implicit function theorem with its solve's last
     factorisation) against central differences of plans solved to goals 0.1 mm away; a wrong sign or a
     missing term is off by the whole column."""
     model = comanip.presets.planar()
     planner = Planner(model, SolverOptions(tolerance=1e-11))
     start, goal, width = np.zeros(4), np.array([0.25, 0.04]), 0.02
     plan = planner.solve(start, goal, width)
-    torque, sensitivity = planner._goal_sensitivity
-    assert torque is plan.torque and sensitivity.shape == (model.H * model.n, model.d)
+    sensitivity = plan.goal_sensitivity.matrix()
+    assert sensitivity.shape == (model.H * model.n, model.d)
     step = 1e-4
     for k in range(model.d):
         shift = step * np.eye(model.d)[k]
@@ -244,19 +245,24 @@ def test_goal_sensitivity_of_a_plan_matches_finite_differences_of_solved_plans()
         np.testing.assert_allclose(sensitivity[:, k], difference, rtol=0, atol=2e-2 * np.abs(difference).max())
 
 
-def test_the_goal_predictor_applies_only_to_the_planners_last_plan_at_its_start_and_width():
+def test_the_goal_predictor_applies_only_to_the_planners_own_plans_at_their_start_and_width():
+    """A plan carries its goal sensitivity: a warm start from it is predicted by the planner that solved it
+    (whatever it solved since: a solve depends only on its arguments), from the same start and width; not by
+    another planner, and not once the plan has been sent to another process (pickled)."""
     model = comanip.presets.planar()
     planner, other = Planner(model), Planner(model)
     start, goal, width = np.zeros(4), np.array([0.3, 0.0]), 0.02
     plan = planner.solve(start, goal, width)
     moved = goal + np.array([0.02, -0.01])
-    predicted = planner._predicted(plan, start, moved, width)
-    np.testing.assert_allclose(predicted, plan.torque + (planner._goal_sensitivity[1] @ (moved - goal)).reshape(plan.torque.shape))
-    assert planner._predicted(other.solve(start, goal, width), start, moved, width) is None  # another planner's plan
-    assert planner._predicted(plan, start, moved, 0.01) is None  # another width
-    assert planner._predicted(plan, np.array([0.0, 0.0, 0.1, 0.0]), moved, width) is None  # another start
+    predicted = planner.starts.predicted(plan, start, moved, width)
+    np.testing.assert_allclose(predicted, plan.torque + (plan.goal_sensitivity.matrix() @ (moved - goal)).reshape(plan.torque.shape))
+    assert planner.starts.predicted(other.solve(start, goal, width), start, moved, width) is None  # another planner's plan
+    assert planner.starts.predicted(plan, start, moved, 0.01) is None  # another width
+    assert planner.starts.predicted(plan, np.array([0.0, 0.0, 0.1, 0.0]), moved, width) is None  # another start
     planner.solve(start, moved, width)
-    assert planner._predicted(plan, start, moved, width) is None  # no longer the last plan
+    np.testing.assert_allclose(planner.starts.predicted(plan, start, moved, width), predicted)  # not only the last plan
+    assert pickle.loads(pickle.dumps(plan)).goal_sensitivity is None
+    assert "goal_sensitivity" not in plan.to_dict()
 
 
 def test_shifted_cholesky_solves_the_shifted_system(rng):

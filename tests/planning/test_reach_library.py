@@ -6,7 +6,7 @@ import pytest
 
 import comanip
 from comanip.planning.planner import SolverOptions
-from comanip.planning.reach_library import is_symmetric, reflection_onto
+from comanip.planning.starts.reach_library import is_symmetric, reflection_onto
 
 RELATIVE = 1e-6
 """Objectives of the ranked and the full search agree to this (relative)."""
@@ -29,7 +29,7 @@ def _problems(model, count: int, seed: int):
 def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
     model = comanip.presets.load(preset)
     ranked, full = comanip.Planner(model), comanip.Planner(model, SolverOptions(cold_search="all"))
-    assert ranked._library is not None
+    assert ranked.starts.library is not None
     for start, goal, width in _problems(model, 4, seed):
         fast, reference = ranked.solve(start, goal, width), full.solve(start, goal, width)
         assert fast.success and reference.success
@@ -78,7 +78,7 @@ def test_only_symmetric_models_get_a_library(change):
     model = comanip.presets.cartesian().replace(**change)
     planner = comanip.Planner(model)
     symmetric = change.get("noise") != "per_channel"
-    assert (planner._library is not None) == symmetric
+    assert (planner.starts.library is not None) == symmetric
     assert is_symmetric(planner.problem) == symmetric
     plan = planner.solve(np.zeros(6), [0.2, 0.1, 0.0], 0.02)
     assert plan.success
@@ -91,9 +91,9 @@ def test_a_budgeted_cold_solve_does_not_solve_a_new_library_reach():
     planner = comanip.Planner(model)
     start, goal = np.zeros(6), np.array([0.1, 0.2, 0.0])
     budgeted = planner.solve(start, goal, 0.02, max_wall_time=60.0)
-    assert budgeted.success and not planner._library._entries
+    assert budgeted.success and not planner.starts.library._entries
     plan = planner.solve(start, goal, 0.02)
-    assert plan.success and len(planner._library._entries) == 1
+    assert plan.success and len(planner.starts.library._entries) == 1
     np.testing.assert_allclose(budgeted.objective, plan.objective, rtol=RELATIVE)
 
 
@@ -102,7 +102,7 @@ def test_a_retargeted_plan_moves_its_mean_path_by_the_shift(preset):
     """A point mass's mean is affine in the torques: a plan retargeted by a move of ≥ 12 steps ends moved by
     the joint shift to within 4 % (the move's acceleration is sampled once per step), for a bare point mass;
     retargeting for several durations at once equals retargeting for each alone."""
-    from comanip.planning.initial_guess import retargeted_torques
+    from comanip.planning.starts.initial_guess import retargeted_torques
 
     model = comanip.presets.load(preset)
     planner = comanip.Planner(model)
@@ -122,7 +122,7 @@ def test_a_retargeted_plan_moves_its_mean_path_by_the_shift(preset):
 
 
 def test_minimum_jerk_profiles_meet_their_boundary_conditions_one_duration_or_several():
-    from comanip.planning.initial_guess import minimum_jerk
+    from comanip.planning.starts.initial_guess import minimum_jerk
 
     x0, v0, x1 = np.array([0.1, -0.2]), np.array([0.3, 0.05]), np.array([0.4, 0.2])
     durations = np.array([0.2, 0.37, 0.5])

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from comanip.planning.initial_guess import minimum_jerk
+from comanip.planning.starts.initial_guess import minimum_jerk
 from comanip.simulation import ScenarioSetup, SyncSettings, TrialRecord
 from comanip.simulation.measures import progress_toward, trial_measures
 from comanip.simulation.policies import POLICIES

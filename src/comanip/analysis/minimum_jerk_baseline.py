@@ -12,7 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from comanip.analysis.speed_profile import SETTLING_FRACTION
-from comanip.planning.initial_guess import minimum_jerk
+from comanip.planning.starts.initial_guess import minimum_jerk
 
 
 def minimum_jerk_settling_fraction(settling_fraction: float = SETTLING_FRACTION) -> float:

@@ -1,6 +1,6 @@
 """``comanip library``: solve an arm's reach library (plans from its ready pose to a grid of goals) and save it.
 
-Cold solves from the ready pose then start from the nearest entries (``comanip.planning.arm_reach_library``).
+Cold solves from the ready pose then start from the nearest entries (``comanip.planning.starts.arm_reach_library``).
 The ``franka_rest`` preset's library ships with the package; this makes one for another model (e.g. ``franka``,
 or a YAML of your own; pass the file as ``SolverOptions(arm_library=...)``) or remakes the shipped one:
 
@@ -17,7 +17,7 @@ import numpy as np
 
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, load_model
-from comanip.planning.arm_reach_library import FILE_PREFIX, GRID_SPACING, SHELL, build_library, grid_goals
+from comanip.planning.starts.arm_reach_library import FILE_PREFIX, GRID_SPACING, SHELL, build_library, grid_goals
 from comanip.planning.planner import Planner, SolverOptions
 from comanip.progress import progress_bar
 

@@ -29,7 +29,7 @@ from scipy.interpolate import CubicSpline
 
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
-from comanip.planning.reach_library import reflection_onto
+from comanip.planning.starts.reach_library import reflection_onto
 
 #: Largest difference (m, m/s, ...) between an oblique plan and the turned member for the model to count as
 #: rotation-invariant: well above the planner's convergence noise, far below any model asymmetry.

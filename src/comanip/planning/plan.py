@@ -62,6 +62,10 @@ class Plan:
     model_name: str = ""
     extras: dict = field(default_factory=dict)
     """Application-specific results (e.g. an estimated goal)."""
+    goal_sensitivity: "GoalSensitivity | None" = field(default=None, repr=False, compare=False)
+    """How the torques move with the goal, for a converged point-mass plan of the planner that solved it
+    (:class:`~comanip.planning.goal_sensitivity.GoalSensitivity`; None otherwise, and in another process): a warm
+    solve from this plan to a moved goal starts from its first-order prediction."""
 
     @property
     def ee_speed(self) -> np.ndarray:
@@ -92,6 +96,8 @@ class Plan:
         """JSON-ready dictionary (arrays as nested lists)."""
         out = {}
         for name in self.__dataclass_fields__:
+            if name == "goal_sensitivity":  # the solver's state, not a result
+                continue
             value = getattr(self, name)
             out[name] = value.tolist() if isinstance(value, np.ndarray) else value
         out["extras"] = {k: (v.tolist() if isinstance(v, np.ndarray) else v) for k, v in self.extras.items()}

@@ -37,23 +37,19 @@ import numpy as np
 
 from threadpoolctl import ThreadpoolController
 
-from comanip.arguments import (as_bounded_vector, as_count, as_goal_width, as_matrix, as_optional_positive, as_position,
-                               as_positive)
+from comanip.arguments import as_bounded_vector, as_count, as_goal_width, as_optional_positive, as_position, as_positive
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
-from comanip.planning.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
 from comanip.planning.curvature import ReachCurvature
-from comanip.planning.initial_guess import (brake_durations, braked_torques, guess_durations, linear_dynamics_of,
-                                          minimum_jerk_torques, retargeted_torques)
-from comanip.optim import SolverResult, Status, cholesky_solve
+from comanip.optim import SolverResult, Status
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
-from comanip.caching.buffered_function import BufferedFunction
+from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
-from comanip.planning.reach_library import ReachLibrary, is_symmetric
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.starts import StartPolicy
 from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
@@ -121,7 +117,7 @@ class SolverOptions:
     arm_library: str | None = None
     """An arm's reach library for 'ranked' cold solves from its ready pose, at rest or moving (its nearest plan
     also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:
-    the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.arm_reach_library`)."""
+    the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.starts.arm_reach_library`)."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
@@ -181,46 +177,17 @@ class Planner:
         self._curvature = self._newton_terms() if self.options.method == "newton" else None
         body, H = self.model.body, self.model.H
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
-        self._torque_box = tuple(bound.reshape(H, body.n) for bound in self._torque_bounds)  # the same, (H, n)
-        self._unbounded = not np.isfinite(body.tau_max).any()
         self._limits = PathLimits.of(self.model)
-        self._linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
-        # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
-        self._task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
-            if body.is_linear else None
         self._blas = _SingleThreadBlas()
         self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
-        self._library = self._reach_library()
-        ranked_arm = self.options.cold_search == "ranked" and not body.is_linear
-        self._arm_library = self._arm_reach_library() if ranked_arm else None
+        self.starts = StartPolicy(self.model, self.options, problem, self._curvature, self._limits, self._solve_reach)
+        """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`)."""
         self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
-        self._last_solution: _LastSolution | None = None  # the last point-mass plan's, for _predicted
-        self._kinematics = BufferedFunction(body.kinematics_function)
 
-    def _arm_reach_library(self) -> ArmReachLibrary | None:
-        """The arm's reach library: ``options.arm_library`` (it must be this model's) or the shipped one."""
-        if self.options.arm_library is None:
-            return bundled_library(self.model)
-        library = ArmReachLibrary.load(self.options.arm_library)
-        if not library.is_for(self.model):
-            raise ValueError(f"arm_library {self.options.arm_library!r} was solved for another model; a library applies "
-                             f"to the model it was made for (comanip library --preset <this model's YAML>)")
-        return library
-
-    def _reach_library(self) -> ReachLibrary | None:
-        """Solved reaches to start 'ranked' cold solves from (:mod:`comanip.planning.reach_library`), for a
-        point mass whose objective is unchanged by turning and shifting the problem; None otherwise."""
-        model = self.model
-        if self.options.cold_search != "ranked" or not model.body.is_linear or model.d != model.n or model.state_size % model.n:
-            return None
-        if not is_symmetric(self.problem):
-            return None
-
-        def solve(start, goal, width):
-            guesses = self._searched_guesses(start, goal, width)
-            return self._solve_from(guesses, start, goal, width, time.perf_counter(), None).torque
-
-        return ReachLibrary(solve, model.n, model.state_size, model.width)
+    def _solve_reach(self, start, goal, width) -> np.ndarray:
+        """The torques (H, n) of a cold solve from the minimum-jerk guesses (a point-mass reach library's entry)."""
+        guesses = self.starts.searched_guesses(start, goal, width)
+        return self._solve_from(guesses, start, goal, width, time.perf_counter(), None).torque
 
     @property
     def curvature(self) -> Curvature | None:
@@ -275,13 +242,13 @@ class Planner:
             width: goal width w (m) > 0; the model's default when None.
             warm_start: a previous :class:`Plan` or torques (H, n) to start from; cold multi-start when None. A
                 plan for another goal starts the solve from the best of itself and itself moved onto the goal:
-                for a point mass's plan this planner solved last, from the same start at the same width, by
-                the optimum's first-order sensitivity to the goal (:meth:`_predicted`); otherwise by joint-space
+                for a point-mass plan this planner solved, from the same start at the same width, by the optimum's
+                first-order sensitivity to the goal (``plan.goal_sensitivity``); otherwise by joint-space
                 minimum-jerk corrections. From an arm reach library's ready pose the library's nearest plan, moved
                 onto the goal (and braked, from a moving start), competes too.
             max_wall_time: wall-time budget (s) for the whole solve; the best plan so far is returned with
                 status 'max_wall_time' when it runs out. A budgeted cold solve starts only from reach-library
-                entries solved before (:meth:`_cold_start`): a new one would be a whole solve outside the budget.
+                entries solved before (:meth:`StartPolicy.cold_starts <comanip.planning.starts.StartPolicy.cold_starts>`): a new one would be a whole solve outside the budget.
 
         Returns:
             A :class:`Plan`; never raises on a failed solve (check ``plan.success``: converged and reaching). For a
@@ -296,9 +263,9 @@ class Planner:
         if unreachable is not None:
             return unreachable
         with self._blas:  # the starts' small products too: one BLAS switch per solve
-            guesses = self._initial_guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
-                                            goal_q=goal_q if warm_start is None else None)
-            from_library = warm_start is None and self._arm_library is not None and self._arm_library.serves(start)
+            guesses = self.starts.guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
+                                          goal_q=goal_q if warm_start is None else None)
+            from_library = warm_start is None and self.starts.from_arm_library(start)
             plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
                                                      until_converged=from_library))
         self._count_solving_time(plan.solve_time)
@@ -346,200 +313,15 @@ class Planner:
         return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
-    def _initial_guesses(self, start, goal, width, warm_start, budgeted: bool = False,
-                         goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """The starts of a solve; ``goal_q`` (n,): the goal's inverse kinematics from the start, if known."""
-        model = self.model
-        if warm_start is None:
-            return self._cold_start(start, goal, width, budgeted, goal_q)
-        torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
-        torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
-        if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
-                and warm_start.mean.shape[0] == model.H + 1 and not np.array_equal(warm_start.goal, goal)):
-            return [torque]
-        # a plan for another goal: also try it moved onto the new goal (by the tangential predictor if this
-        # planner solved it last: it gave the best start in 398 of 400 warm point-mass solves, against the
-        # minimum-jerk retargeting's 1), and start from the best
-        predicted = self._predicted(warm_start, start, goal, width)
-        candidates = [torque, predicted] if predicted is not None else \
-            self._retargeted(torque, warm_start.mean, warm_start.goal, goal)
-        if self._arm_library is not None and self._arm_library.serves(start):
-            # the solved reach nearest to the goal competes too: on 50 chained warm franka_rest solves to goals
-            # moved by up to 5 cm per axis it was the best start 48 times (15 → 10 Newton iterations, J within 3e-9)
-            candidates += self._library_candidates(start, goal, WARM_CANDIDATE_ENTRIES)
-        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
-            # far beyond the goal's reward (it underflows there): fresh reaches compete too
-            candidates += self._cold_guesses(start, goal, self.options.n_starts)
-        return [self._lowest_objective(candidates, start, goal, width)]
-
-    def _predicted(self, warm_start: Plan, start, goal, width) -> np.ndarray | None:
-        """The first-order prediction of the optimal torques (H, n) for ``goal`` from a point-mass plan this
-        planner solved last (same start and width, another goal): tau* + (d tau*/d goal) (goal - its goal), the
-        tangential predictor of parametric optimisation; None for any other warm start. On warm planar solves
-        to goals moved by up to 5 cm its gradient is about a tenth of the retargeted plan's, and the solves
-        take 4.7 instead of 5.9 Newton iterations (benchmarks/README.md)."""
-        remembered = self._goal_sensitivity
-        if remembered is None or remembered[0] is not warm_start.torque or warm_start.width != width \
-                or not np.array_equal(warm_start.start, start):
-            return None
-        model = self.model
-        return warm_start.torque + (remembered[1] @ (goal - warm_start.goal)).reshape(model.H, model.n)
-
-    @property
-    def _goal_sensitivity(self) -> tuple[np.ndarray, np.ndarray] | None:
-        """(torques (H, n) of the planner's last plan, their d tau*/d goal (H·n, d)) if that was a converged
-        point-mass solve (:class:`_LastSolution`), else None; the sensitivity is computed on the first request."""
-        last = self._last_solution
-        if last is None:
-            return None
-        if last.sensitivity is None:
-            with self._blas:
-                last.sensitivity = -cholesky_solve(last.factor, self._curvature.goal_cross_derivative(last.data))
-        return last.torque, last.sensitivity
-
-    def _solution_of(self, result: SolverResult, torque: np.ndarray) -> _LastSolution | None:
-        """What :meth:`_goal_sensitivity` needs of a converged point-mass solve (the Newton method's last
-        factorisation and the evaluation at the plan), kept for the planner's last plan; None otherwise."""
+    def _sensitivity_of(self, result: SolverResult) -> GoalSensitivity | None:
+        """The goal sensitivity of a converged point-mass solve (from the Newton method's last factorisation and
+        the evaluation at the plan); None otherwise."""
         curvature = self._curvature
         if curvature is None or not curvature.exact or not result.success or result.local_model is None \
                 or result.local_model[0] is None:
             return None
         factor, data = result.local_model
-        return _LastSolution(torque, factor, data)
-
-    def _retargeted(self, torque: np.ndarray, mean: np.ndarray, planned_goal: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
-        """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
-        minimum-jerk corrections of four durations (:func:`retargeted_torques`, along its mean (H+1, nx))."""
-        model, body = self.model, self.model.body
-        if self._linear_dynamics is not None:  # x_ee linear in q: one constant pseudo-inverse
-            shift_q = self._task_to_joint_shift @ (goal - planned_goal)
-        else:
-            J = np.asarray(body.kinematics_function(mean[-1, : model.n])[1])
-            shift_q = np.linalg.lstsq(J, goal - planned_goal, rcond=None)[0]
-        return [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q, guess_durations(model.duration, 4),
-                                             mean, self._linear_dynamics)
-
-    def _lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
-        """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
-        path keeps the joint limits (all candidates if none does)."""
-        params = np.concatenate([start, goal, [width]])
-        low, high = self._torque_box
-        if self._unbounded:  # no torque bound (the point masses): clipping would only copy
-            return min(candidates, key=lambda c: self._start_rank(c, params))
-        return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._start_rank(c, params))
-
-    def _start_rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
-        """(mean path beyond a joint limit, objective) of a start (H, n): its order among candidates. A start
-        beyond the limits can have the lowest objective and still be the worst: the solver must first bring it
-        back (on the Panda, starts retargeted far ended 'constraints_violated')."""
-        curvature = self._curvature
-        if curvature is None or not curvature.carries_belief or not self._limits.active:
-            return False, self._objective(torque, params)
-        f, data = curvature.value_and_data(np.ravel(torque), params)
-        return self._limits.violation(curvature.mean_path(data)) > LIMIT_TOLERANCE, f
-
-    def _cold_start(self, start, goal, width, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """The guesses a cold solve runs (``SolverOptions.cold_search``).
-
-        An arm at the ready pose of its reach library: :meth:`_arm_library_starts`. 'all', or another nonlinear
-        body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
-        candidate of lowest objective (evaluating one costs about a hundredth of solving from it) among the
-        minimum-jerk guesses and the nearest solved reach of the planner's :class:`ReachLibrary` (from a moving
-        start with minimum-jerk moves that bring the start's motion to rest superposed: the mean is affine in
-        the torques and the start). Where several local optima compete the lowest-objective start can end on
-        a worse one, so the plan is compared with others: a goal farther than ``narrow_ratio`` widths also runs
-        the best minimum-jerk guess, and a start whose motion alone would carry the hand farther than the goal
-        within the horizon runs every minimum-jerk guess instead, as 'all' does (the plan can brake or ride the
-        motion: the Cartesian preset's moving starts ended up to 0.1 % worse in 4 of 100 otherwise,
-        benchmarks/cold_quality.py). A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
-        before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
-        """
-        if self._arm_library is not None and self._arm_library.serves(start):
-            return self._arm_library_starts(start, goal, width, goal_q)
-        if self._library is None:
-            return self._searched_guesses(start, goal, width, goal_q)
-        model = self.model
-        motion = start.copy()
-        motion[: model.n] = 0.0
-        moving = bool(np.any(motion))
-        guesses = self._cold_guesses(start, goal, self.options.n_starts)
-        if moving and self._drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
-            return guesses
-        params = np.concatenate([start, goal, [width]])
-        objectives = [self._objective(guess, params) for guess in guesses]
-        first_best = min(range(len(guesses)), key=objectives.__getitem__)
-        best_guess = guesses[first_best]
-        turned = self._library.guess(start, goal, width, solve_missing=not budgeted)
-        if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
-            return guesses if self._narrow(start, goal, width) else [best_guess]
-        candidates = [turned]
-        if moving:
-            candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
-                                                            guess_durations(model.duration, self.options.n_starts),
-                                                            self._linear_dynamics))
-        scored = [(self._objective(candidate, params), candidate) for candidate in candidates] + \
-            [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
-        best = min(scored, key=lambda pair: pair[0])[1]
-        return [best, best_guess] if self._narrow(start, goal, width) and best is not best_guess else [best]
-
-    def _arm_library_starts(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """An arm's cold starts from its ready pose (:mod:`comanip.planning.arm_reach_library`): first the
-        lowest-objective torques (H, n) among the minimum-jerk guesses and the plans of the nearest library
-        entries, each as solved and moved onto the goal; then the minimum-jerk guesses, which
-        :meth:`_solve_from` runs only if no start before them converged."""
-        guesses = self._cold_guesses(start, goal, self.options.n_starts, goal_q)
-        candidates = guesses + self._library_candidates(start, goal, CANDIDATE_ENTRIES)
-        return [self._lowest_objective(candidates, start, goal, width)] + guesses
-
-    def _library_candidates(self, start, goal, entries: int) -> list[np.ndarray]:
-        """The plans (H, n) of the arm reach library's ``entries`` entries nearest to ``goal`` (d,), each as solved
-        and moved onto the goal (:meth:`_retargeted`); ``start`` (2n,) has the library's joint positions, and if it
-        moves, each candidate gets the braking moves of :func:`braked_torques` instead."""
-        library, model, candidates = self._arm_library, self.model, []
-        velocity = start[model.n:2 * model.n]
-        for entry_goal, torque in library.nearest(goal, entries):
-            entry_params = np.concatenate([library.start, entry_goal, [library.width]])
-            mean = self._curvature.mean_path(self._curvature.value_and_data(np.ravel(torque), entry_params)[1])
-            moved = self._retargeted(torque, mean, entry_goal, goal)
-            if np.any(velocity):
-                moved = [braked for candidate in moved for braked in
-                         braked_torques(model.body, model.h, model.H, candidate, velocity, brake_durations(model.duration), mean)]
-            candidates += moved
-        return candidates
-
-    def _drift(self, start, goal, width) -> float:
-        """How far (m) the start's motion alone (zero commands) carries the hand within the horizon."""
-        free = self.problem.trajectory(tau=np.zeros(self.model.H * self.model.n), s0=start, goal=goal, width=width)
-        return float(np.max(np.linalg.norm(np.asarray(free["ee_mean"]).T - free["ee_mean"][:, 0].full().T, axis=1)))
-
-    def _searched_guesses(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
-        or a goal beyond ``narrow_ratio`` widths; otherwise the one of lowest objective."""
-        guesses = self._cold_guesses(start, goal, self.options.n_starts, goal_q)
-        if self.options.cold_search == "all" or not self.model.body.is_linear or self._narrow(start, goal, width):
-            return guesses
-        params = np.concatenate([start, goal, [width]])
-        return [min(guesses, key=lambda guess: self._objective(guess, params))]
-
-    def _narrow(self, start, goal, width) -> bool:
-        """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
-        position = self._kinematics(start[: self.model.n])[0].ravel()
-        return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
-
-    def _cold_guesses(self, start, goal, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """Minimum-jerk reaches to ``goal_q`` (n,), the inverse-kinematics solution from the start (computed
-        when None), ``count`` durations."""
-        model = self.model
-        goal_q = model.body.inverse_kinematics(goal, start[: model.n]) if goal_q is None else goal_q
-        return list(minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, guess_durations(model.duration, count),
-                                         self._linear_dynamics))
-
-    def _objective(self, torque: np.ndarray, params: np.ndarray) -> float:
-        """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
-        if self._curvature is not None:
-            return self._curvature.value(np.ravel(torque), params)
-        n2, d = self.model.state_size, self.model.d
-        return self.problem.objective_value(torque, params[:n2], params[n2:n2 + d], params[-1])
+        return GoalSensitivity(curvature, factor, data, self._blas)
 
     def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
@@ -575,7 +357,7 @@ class Planner:
         evaluation = None if best.local_model is None else (best.fun, best.local_model[1])
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
-        self._last_solution = self._solution_of(best, plan.torque)
+        plan.goal_sensitivity = self._sensitivity_of(best)
         return plan
 
     def _ends_at_goal(self, torque: np.ndarray, params: np.ndarray) -> bool:
@@ -624,19 +406,6 @@ class Planner:
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
-
-
-@dataclass(eq=False)
-class _LastSolution:
-    """A converged point-mass plan's torques (H, n), the Cholesky factor of its solve's last Newton step and the
-    evaluation at the plan: d tau*/d goal = -∇²f⁻¹ ∂²f/∂tau∂goal by the implicit function theorem (about 0.05 ms),
-    computed when a warm start from the plan asks for it (:meth:`Planner._predicted`), not after every solve."""
-
-    torque: np.ndarray
-    factor: tuple
-    data: object
-    sensitivity: np.ndarray | None = None
-    """d tau*/d goal (H·n, d) once computed."""
 
 
 class _SingleThreadBlas:

@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import minimize_scalar
 
 from comanip.arguments import as_positive
-from comanip.planning.initial_guess import minimum_jerk
+from comanip.planning.starts.initial_guess import minimum_jerk
 from comanip.simulation.policies.protocol import PolicyContext, Prediction
 
 

@@ -1,6 +1,6 @@
 """Solved reaches of an arm from its ready pose, shipped with the package, as starts for cold solves.
 
-A nonlinear arm has no symmetry to turn one reach into another (:mod:`comanip.planning.reach_library` does
+A nonlinear arm has no symmetry to turn one reach into another (:mod:`comanip.planning.starts.reach_library` does
 that for point masses), but most of its reaches start from one pose: the body's ``home_position`` at rest (the
 Panda's ready pose). :class:`ArmReachLibrary` keeps plans from there to goals on a cubic grid around the
 hand (spacing 7 cm, between 0.12 and 0.33 m from it), so every goal 0.15–0.3 m away has an entry within about

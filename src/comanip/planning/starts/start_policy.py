@@ -1,0 +1,253 @@
+"""Where a solve starts: the planner's start-point policy (:class:`StartPolicy`).
+
+A warm solve starts from the plan or torques it is given, and for a plan to another goal from the best of it
+and it moved onto the new goal: by the optimum's first-order sensitivity to the goal when the plan carries one
+(:class:`~comanip.planning.goal_sensitivity.GoalSensitivity`), otherwise by joint-space minimum-jerk corrections;
+from an arm reach library's ready pose its nearest plans compete. A cold solve starts from minimum-jerk reaches,
+ranked by their objective, and from the solved reaches of a point mass's :class:`ReachLibrary` (turned and scaled
+to the goal) or an arm's :class:`ArmReachLibrary` (moved onto the goal), as ``SolverOptions.cold_search`` says.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from comanip.arguments import as_matrix
+from comanip.caching.buffered_function import BufferedFunction
+from comanip.model import ReachingModel
+from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
+from comanip.planning.plan import Plan
+from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
+from comanip.planning.starts.initial_guess import (brake_durations, braked_torques, guess_durations, linear_dynamics_of,
+                                                   minimum_jerk_torques, retargeted_torques)
+from comanip.planning.starts.reach_library import ReachLibrary, is_symmetric
+from comanip.planning.terms import Curvature
+
+
+class StartPolicy:
+    """The starts of a planner's solves (module docstring); built by the :class:`~comanip.planning.planner.Planner`.
+
+    Args:
+        model: the model planned for.
+        options: the planner's ``SolverOptions`` (``cold_search``, ``n_starts``, ``narrow_ratio``,
+            ``far_warm_start``, ``arm_library``).
+        problem: the reach problem; curvature: the Newton method's terms (None for IPOPT); limits: the joint
+            limits on the mean path.
+        solve_reach: (start, goal, width) -> the torques (H, n) of a cold solve from :meth:`searched_guesses`,
+            with which a point mass's reach library solves its entries.
+    """
+
+    def __init__(self, model: ReachingModel, options, problem: ReachProblem, curvature: Curvature | None,
+                 limits: PathLimits, solve_reach: Callable[[np.ndarray, np.ndarray, float], np.ndarray]):
+        self.model, self.options, self.problem, self.curvature, self.limits = model, options, problem, curvature, limits
+        body, H = model.body, model.H
+        self.torque_box = (np.tile(-body.tau_max, (H, 1)), np.tile(body.tau_max, (H, 1)))
+        self.unbounded = not np.isfinite(body.tau_max).any()
+        self.linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
+        # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
+        self.task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
+            if body.is_linear else None
+        self.kinematics = BufferedFunction(body.kinematics_function)
+        self.library = self._reach_library(solve_reach)
+        ranked_arm = options.cold_search == "ranked" and not body.is_linear
+        self.arm_library = self._arm_reach_library() if ranked_arm else None
+
+    def _arm_reach_library(self) -> ArmReachLibrary | None:
+        """The arm's reach library: ``options.arm_library`` (it must be this model's) or the shipped one."""
+        if self.options.arm_library is None:
+            return bundled_library(self.model)
+        library = ArmReachLibrary.load(self.options.arm_library)
+        if not library.is_for(self.model):
+            raise ValueError(f"arm_library {self.options.arm_library!r} was solved for another model; a library applies "
+                             f"to the model it was made for (comanip library --preset <this model's YAML>)")
+        return library
+
+    def _reach_library(self, solve_reach) -> ReachLibrary | None:
+        """Solved reaches to start 'ranked' cold solves from (:mod:`comanip.planning.starts.reach_library`), for a
+        point mass whose objective is unchanged by turning and shifting the problem; None otherwise."""
+        model = self.model
+        if self.options.cold_search != "ranked" or not model.body.is_linear or model.d != model.n or model.state_size % model.n:
+            return None
+        if not is_symmetric(self.problem):
+            return None
+        return ReachLibrary(solve_reach, model.n, model.state_size, model.width)
+
+    def from_arm_library(self, start) -> bool:
+        """Whether a cold solve from ``start`` (nx,) starts from the arm reach library (its ready pose)."""
+        return self.arm_library is not None and self.arm_library.serves(start)
+
+    def guesses(self, start, goal, width, warm_start, budgeted: bool = False,
+                goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """The starts (H, n) of a solve; ``goal_q`` (n,): the goal's inverse kinematics from the start, if known."""
+        model = self.model
+        if warm_start is None:
+            return self.cold_starts(start, goal, width, budgeted, goal_q)
+        torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
+        torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
+        if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
+                and warm_start.mean.shape[0] == model.H + 1 and not np.array_equal(warm_start.goal, goal)):
+            return [torque]
+        # a plan for another goal: also try it moved onto the new goal (by the tangential predictor if the plan
+        # carries its sensitivity: it gave the best start in 398 of 400 warm point-mass solves, against the
+        # minimum-jerk retargeting's 1), and start from the best
+        predicted = self.predicted(warm_start, start, goal, width)
+        candidates = [torque, predicted] if predicted is not None else \
+            self.retargeted(torque, warm_start.mean, warm_start.goal, goal)
+        if self.from_arm_library(start):
+            # the solved reach nearest to the goal competes too: on 50 chained warm franka_rest solves to goals
+            # moved by up to 5 cm per axis it was the best start 48 times (15 → 10 Newton iterations, J within 3e-9)
+            candidates += self.library_candidates(start, goal, WARM_CANDIDATE_ENTRIES)
+        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
+            # far beyond the goal's reward (it underflows there): fresh reaches compete too
+            candidates += self.cold_guesses(start, goal, self.options.n_starts)
+        return [self.lowest_objective(candidates, start, goal, width)]
+
+    def predicted(self, warm_start: Plan, start, goal, width) -> np.ndarray | None:
+        """The first-order prediction of the optimal torques (H, n) for ``goal`` from a plan that carries its
+        goal sensitivity for this planner's problem (same start and width, another goal): tau* + (d tau*/d goal)
+        (goal - its goal), the tangential predictor of parametric optimisation; None for any other warm start.
+        On warm planar solves to goals moved by up to 5 cm its gradient is about a tenth of the retargeted
+        plan's, and the solves take 4.7 instead of 5.9 Newton iterations (benchmarks/README.md)."""
+        sensitivity = warm_start.goal_sensitivity
+        if sensitivity is None or not sensitivity.is_for(self.curvature) or warm_start.width != width \
+                or not np.array_equal(warm_start.start, start):
+            return None
+        model = self.model
+        return warm_start.torque + (sensitivity.matrix() @ (goal - warm_start.goal)).reshape(model.H, model.n)
+
+    def retargeted(self, torque: np.ndarray, mean: np.ndarray, planned_goal: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
+        """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
+        minimum-jerk corrections of four durations (:func:`retargeted_torques`, along its mean (H+1, nx))."""
+        model, body = self.model, self.model.body
+        if self.linear_dynamics is not None:  # x_ee linear in q: one constant pseudo-inverse
+            shift_q = self.task_to_joint_shift @ (goal - planned_goal)
+        else:
+            J = np.asarray(body.kinematics_function(mean[-1, : model.n])[1])
+            shift_q = np.linalg.lstsq(J, goal - planned_goal, rcond=None)[0]
+        return [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q, guess_durations(model.duration, 4),
+                                             mean, self.linear_dynamics)
+
+    def lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
+        """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
+        path keeps the joint limits (all candidates if none does)."""
+        params = np.concatenate([start, goal, [width]])
+        low, high = self.torque_box
+        if self.unbounded:  # no torque bound (the point masses): clipping would only copy
+            return min(candidates, key=lambda c: self._rank(c, params))
+        return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._rank(c, params))
+
+    def _rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
+        """(mean path beyond a joint limit, objective) of a start (H, n): its order among candidates. A start
+        beyond the limits can have the lowest objective and still be the worst: the solver must first bring it
+        back (on the Panda, starts retargeted far ended 'constraints_violated')."""
+        curvature = self.curvature
+        if curvature is None or not curvature.carries_belief or not self.limits.active:
+            return False, self.objective(torque, params)
+        f, data = curvature.value_and_data(np.ravel(torque), params)
+        return self.limits.violation(curvature.mean_path(data)) > LIMIT_TOLERANCE, f
+
+    def cold_starts(self, start, goal, width, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """The guesses a cold solve runs (``SolverOptions.cold_search``).
+
+        An arm at the ready pose of its reach library: :meth:`arm_library_starts`. 'all', or another nonlinear
+        body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
+        candidate of lowest objective (evaluating one costs about a hundredth of solving from it) among the
+        minimum-jerk guesses and the nearest solved reach of the :class:`ReachLibrary` (from a moving
+        start with minimum-jerk moves that bring the start's motion to rest superposed: the mean is affine in
+        the torques and the start). Where several local optima compete the lowest-objective start can end on
+        a worse one, so the plan is compared with others: a goal farther than ``narrow_ratio`` widths also runs
+        the best minimum-jerk guess, and a start whose motion alone would carry the hand farther than the goal
+        within the horizon runs every minimum-jerk guess instead, as 'all' does (the plan can brake or ride the
+        motion: the Cartesian preset's moving starts ended up to 0.1 % worse in 4 of 100 otherwise,
+        benchmarks/cold_quality.py). A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
+        before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
+        """
+        if self.from_arm_library(start):
+            return self.arm_library_starts(start, goal, width, goal_q)
+        if self.library is None:
+            return self.searched_guesses(start, goal, width, goal_q)
+        model = self.model
+        motion = start.copy()
+        motion[: model.n] = 0.0
+        moving = bool(np.any(motion))
+        guesses = self.cold_guesses(start, goal, self.options.n_starts)
+        if moving and self.drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
+            return guesses
+        params = np.concatenate([start, goal, [width]])
+        objectives = [self.objective(guess, params) for guess in guesses]
+        first_best = min(range(len(guesses)), key=objectives.__getitem__)
+        best_guess = guesses[first_best]
+        turned = self.library.guess(start, goal, width, solve_missing=not budgeted)
+        if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
+            return guesses if self.narrow(start, goal, width) else [best_guess]
+        candidates = [turned]
+        if moving:
+            candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
+                                                            guess_durations(model.duration, self.options.n_starts),
+                                                            self.linear_dynamics))
+        scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
+            [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
+        best = min(scored, key=lambda pair: pair[0])[1]
+        return [best, best_guess] if self.narrow(start, goal, width) and best is not best_guess else [best]
+
+    def arm_library_starts(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """An arm's cold starts from its ready pose (:mod:`comanip.planning.starts.arm_reach_library`): first the
+        lowest-objective torques (H, n) among the minimum-jerk guesses and the plans of the nearest library
+        entries, each as solved and moved onto the goal; then the minimum-jerk guesses, which the planner runs
+        only if no start before them converged."""
+        guesses = self.cold_guesses(start, goal, self.options.n_starts, goal_q)
+        candidates = guesses + self.library_candidates(start, goal, CANDIDATE_ENTRIES)
+        return [self.lowest_objective(candidates, start, goal, width)] + guesses
+
+    def library_candidates(self, start, goal, entries: int) -> list[np.ndarray]:
+        """The plans (H, n) of the arm reach library's ``entries`` entries nearest to ``goal`` (d,), each as solved
+        and moved onto the goal (:meth:`retargeted`); ``start`` (2n,) has the library's joint positions, and if it
+        moves, each candidate gets the braking moves of :func:`braked_torques` instead."""
+        library, model, candidates = self.arm_library, self.model, []
+        velocity = start[model.n:2 * model.n]
+        for entry_goal, torque in library.nearest(goal, entries):
+            entry_params = np.concatenate([library.start, entry_goal, [library.width]])
+            mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params)[1])
+            moved = self.retargeted(torque, mean, entry_goal, goal)
+            if np.any(velocity):
+                moved = [braked for candidate in moved for braked in
+                         braked_torques(model.body, model.h, model.H, candidate, velocity, brake_durations(model.duration), mean)]
+            candidates += moved
+        return candidates
+
+    def drift(self, start, goal, width) -> float:
+        """How far (m) the start's motion alone (zero commands) carries the hand within the horizon."""
+        free = self.problem.trajectory(tau=np.zeros(self.model.H * self.model.n), s0=start, goal=goal, width=width)
+        return float(np.max(np.linalg.norm(np.asarray(free["ee_mean"]).T - free["ee_mean"][:, 0].full().T, axis=1)))
+
+    def searched_guesses(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
+        or a goal beyond ``narrow_ratio`` widths; otherwise the one of lowest objective."""
+        guesses = self.cold_guesses(start, goal, self.options.n_starts, goal_q)
+        if self.options.cold_search == "all" or not self.model.body.is_linear or self.narrow(start, goal, width):
+            return guesses
+        params = np.concatenate([start, goal, [width]])
+        return [min(guesses, key=lambda guess: self.objective(guess, params))]
+
+    def narrow(self, start, goal, width) -> bool:
+        """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
+        position = self.kinematics(start[: self.model.n])[0].ravel()
+        return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
+
+    def cold_guesses(self, start, goal, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """Minimum-jerk reaches to ``goal_q`` (n,), the inverse-kinematics solution from the start (computed
+        when None), ``count`` durations."""
+        model = self.model
+        goal_q = model.body.inverse_kinematics(goal, start[: model.n]) if goal_q is None else goal_q
+        return list(minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, guess_durations(model.duration, count),
+                                         self.linear_dynamics))
+
+    def objective(self, torque: np.ndarray, params: np.ndarray) -> float:
+        """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
+        if self.curvature is not None:
+            return self.curvature.value(np.ravel(torque), params)
+        n2, d = self.model.state_size, self.model.d
+        return self.problem.objective_value(torque, params[:n2], params[n2:n2 + d], params[-1])
