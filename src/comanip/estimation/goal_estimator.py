@@ -155,9 +155,7 @@ class GoalEstimator:
         t_begin = time.perf_counter()
         model = self.model
         checked = self._checked_request(start, observed, t_obs, prior_goal, width, prior_std, method, max_wall_time)
-        start, observed, n_o, prior, width, rows = (checked.start, checked.observed, checked.n_o, checked.prior,
-                                                    checked.width, checked.rows)
-        max_wall_time = checked.max_wall_time
+        start, observed, n_o, prior, width, rows, max_wall_time = checked.fields()
         if n_o == 0:
             return self._uninformative(start, observed, float(t_obs), prior, width, method, warm_start, max_wall_time, t_begin)
         point, plan_needed = self._warm_point(warm_start, len(rows)) if warm_start is not None else (None, False)
@@ -183,8 +181,14 @@ class GoalEstimator:
         plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
                                       success=status in CONVERGED, message=message,
                                       solve_time=time.perf_counter() - t_begin, iterations=iterations)
-        covariance = self._goal_covariance(point, plan, start, observed, n_o, rows, prior, width)
-        return GoalEstimate.of(plan, t_obs=float(t_obs), observed_step=n_o, observed_state=observed,
+        return self._estimate_of(plan, point, checked, float(t_obs), method, details)
+
+    def _estimate_of(self, plan: Plan, point: RegretPoint, checked: "_Request", t_obs: float, method: str,
+                     details: dict) -> GoalEstimate:
+        """The :class:`GoalEstimate` of a solved ``plan`` through the observation, with the goal's covariance."""
+        n_o, observed, prior = checked.n_o, checked.observed, checked.prior
+        covariance = self._goal_covariance(point, plan, checked.start, observed, n_o, checked.rows, prior, checked.width)
+        return GoalEstimate.of(plan, t_obs=t_obs, observed_step=n_o, observed_state=observed,
                                observation_residual=plan.mean[n_o] - observed, prior_goal=None if prior is None else prior.mean,
                                method=method, multipliers=point.lam.copy(), goal_covariance=covariance, **details)
 
@@ -392,3 +396,7 @@ class _Request:
     width: float
     rows: np.ndarray
     max_wall_time: float | None
+
+    def fields(self) -> tuple:
+        """(start, observed, n_o, prior, width, rows, max_wall_time), in that order."""
+        return self.start, self.observed, self.n_o, self.prior, self.width, self.rows, self.max_wall_time
