@@ -24,6 +24,7 @@ import comanip
 from comanip.optim import Status
 from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES
 from comanip.planning.planner import SolverOptions, _rank
+from comanip.planning.reach_parameters import ReachParameters
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cold_quality import RELATIVE, problems  # noqa: E402
@@ -42,7 +43,7 @@ def main(argv=None) -> None:
                   "library + guess 0": [], "library + guess 1": [], "library + guess 2": []}
     winners = np.zeros(3, dtype=int)
     for k, (start, goal, width) in enumerate(problems(model, args.problems)):
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         guesses = planner.starts.cold_guesses(start, goal, planner.options.n_starts)
         library_start = planner.starts.lowest_objective(guesses + planner.starts.library_candidates(start, goal, CANDIDATE_ENTRIES),
                                                   start, goal, width)

@@ -21,6 +21,7 @@ import numpy as np
 import comanip
 from comanip.planning.starts.initial_guess import guess_durations, minimum_jerk_torques
 from comanip.planning.planner import SolverOptions
+from comanip.planning.reach_parameters import ReachParameters
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from cold_quality import problems  # noqa: E402
@@ -41,7 +42,7 @@ def main(argv=None) -> None:
         if not start[n:].any() or planner.starts.drift(start, goal, width) <= np.linalg.norm(goal - start[:n]):
             continue
         count += 1
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         motion = start.copy()
         motion[:n] = 0.0
         turned = planner.starts.library.guess(start, goal, width)

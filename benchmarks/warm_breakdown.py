@@ -33,6 +33,7 @@ from threadpoolctl import threadpool_limits
 
 import comanip
 from comanip.planning.planner import SolverOptions
+from comanip.planning.reach_parameters import ReachParameters
 
 COLUMNS = ("terms evaluation", "value only", "Hessian", "Cholesky", "secant update", "make_plan", "warm solve",
            "iterations", "warm solve / iteration")
@@ -53,7 +54,7 @@ def measure(preset: str, compile: bool) -> dict:
     reach = (0.3, 0.0, 0.0) if model.body.is_linear else (0.15, 0.1, -0.1)
     goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + np.asarray(reach)[:model.d]
     plan = planner.solve(start, goal, model.width)
-    x, params = plan.torque.ravel(), np.concatenate([start, goal, [model.width]])
+    x, params = plan.torque.ravel(), ReachParameters(start, goal, model.width)
     _, gradient, data = curvature.evaluate(x, params)
 
     def hessian():

@@ -13,6 +13,7 @@ from comanip.bodies import MuscleActuatedBody
 from comanip.objectives.reward import HIT_KERNEL_ORDER, GoalReward, goal_covariance
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.reach_parameters import ReachParameters
 
 FILTERED = dict(activation=(0.04, 0.03))
 
@@ -97,9 +98,9 @@ def test_structured_hessian_is_exact_with_the_extensions(changes, rng):
     nx = model.state_size
     for _ in range(2):
         tau = rng.normal(scale=3.0, size=x.numel())
-        p = np.r_[model.full_state(rng.normal(scale=0.1, size=4)), rng.uniform(0.05, 0.15, 2), 0.03]
+        p = ReachParameters(model.full_state(rng.normal(scale=0.1, size=4)), rng.uniform(0.05, 0.15, 2), 0.03)
         value, _, data = curvature.evaluate(tau, p)
-        H_exact, f_exact = (np.asarray(v) for v in exact(tau, p[:nx], p[nx:-1], p[-1]))
+        H_exact, f_exact = (np.asarray(v) for v in exact(tau, p.start, p.goal, p.width))
         assert value == pytest.approx(f_exact.item(), rel=1e-12)
         np.testing.assert_allclose(curvature.hessian(data), H_exact, rtol=1e-8, atol=1e-10 * np.abs(H_exact).max())
 

@@ -17,6 +17,7 @@ from comanip.planning.curvature import ReachCurvature
 from comanip.optim.active_set_newton import newton_minimize
 from comanip.planning.planner import Planner, SolverOptions
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.reach_parameters import ReachParameters
 
 
 @pytest.fixture(scope="module")
@@ -36,9 +37,9 @@ def test_structured_hessian_equals_casadi_exact_hessian(preset, noise, rng):
     exact = ca.Function("exact", [x, problem.s0, problem.goal, problem.width], [ca.hessian(f, x)[0], ca.gradient(f, x), f])
     for _ in range(3):
         tau = rng.normal(scale=3.0, size=x.numel())
-        p = np.r_[rng.normal(scale=0.1, size=2 * model.n), rng.uniform(0.1, 0.3, model.d), rng.uniform(0.01, 0.05)]
+        p = ReachParameters(rng.normal(scale=0.1, size=2 * model.n), rng.uniform(0.1, 0.3, model.d), rng.uniform(0.01, 0.05))
         value, gradient, data = curvature.evaluate(tau, p)
-        H_exact, g_exact, f_exact = (np.asarray(v) for v in exact(tau, p[: 2 * model.n], p[2 * model.n:-1], p[-1]))
+        H_exact, g_exact, f_exact = (np.asarray(v) for v in exact(tau, p.start, p.goal, p.width))
         assert value == pytest.approx(f_exact.item(), rel=1e-12)
         np.testing.assert_allclose(gradient, g_exact.ravel(), rtol=1e-10, atol=1e-12 * np.abs(g_exact).max())
         np.testing.assert_allclose(curvature.hessian(data), H_exact, rtol=1e-9, atol=1e-11 * np.abs(H_exact).max())

@@ -11,6 +11,7 @@ import comanip
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.reach_parameters import ReachParameters
 
 pytestmark = pytest.mark.slow  # the Panda: compiled terms, minutes on a first run
 
@@ -37,7 +38,7 @@ def _point(model, rng):
     start = np.r_[model.body.home_position + rng.normal(scale=0.1, size=7), rng.normal(scale=0.2, size=7)]
     tau = rng.normal(scale=2.0, size=7 * model.H)
     goal = np.asarray(model.body.kinematics_function(start[:7])[0]).ravel() + rng.uniform(-0.1, 0.1, 3)
-    return tau, np.r_[start, goal, 0.05]
+    return tau, ReachParameters(start, goal, 0.05)
 
 
 def test_gradient_and_mean_sensitivities_are_exact(short_franka, rng):
@@ -46,14 +47,14 @@ def test_gradient_and_mean_sensitivities_are_exact(short_franka, rng):
     model, problem, curvature = short_franka
     tau, p = _point(model, rng)
     f, g, data = curvature.evaluate(tau, p)
-    J = lambda x: problem.objective_value(x, p[:14], p[14:17], p[17]) / curvature.normaliser(p[17])  # noqa: E731
+    J = lambda x: problem.objective_value(x, p.start, p.goal, p.width) / curvature.normaliser(p.width)  # noqa: E731
     assert f == pytest.approx(J(tau), rel=1e-12)
     eps = 1e-6
     fd = np.array([(J(tau + eps * e) - J(tau - eps * e)) / (2 * eps) for e in np.eye(tau.size)])
     np.testing.assert_allclose(g, fd, rtol=1e-5, atol=1e-7 * np.abs(g).max())
     means = ca.Function("means", [ca.vec(problem.tau), problem.s0], [ca.horzcat(*problem.means)])
     exact = np.asarray(ca.Function("dmu", [ca.vec(problem.tau), problem.s0],
-                                   [ca.jacobian(ca.vec(means(ca.vec(problem.tau), problem.s0)), ca.vec(problem.tau))])(tau, p[:14]))
+                                   [ca.jacobian(ca.vec(means(ca.vec(problem.tau), problem.s0)), ca.vec(problem.tau))])(tau, p.start))
     T = curvature.mean_sensitivities(data)  # (H+1, 2n, H, n): rows (i, state entry), columns (k, joint)
     np.testing.assert_allclose(T.reshape(-1, tau.size), exact, atol=1e-10 * np.abs(exact).max())
 
@@ -67,7 +68,7 @@ def test_structured_hessian_is_close_to_the_exact_one(short_franka, rng):
     exact = ca.Function("H", [x, problem.s0, problem.goal, problem.width], [ca.hessian(f, x)[0]])
     for _ in range(2):
         tau, p = _point(model, rng)
-        H_exact = np.asarray(exact(tau, p[:14], p[14:17], p[17]))
+        H_exact = np.asarray(exact(tau, p.start, p.goal, p.width))
         H = curvature.hessian(curvature.evaluate(tau, p)[2])
         assert np.linalg.norm(H - H_exact, 2) < 0.1 * np.linalg.norm(H_exact, 2)
 
@@ -110,7 +111,7 @@ def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
             for j in range(n):
                 for m in range(n):
                     expected[k * n + j, k * n + m] += np.sum(Lambda * (G_k @ second[j][m] @ G_k.T))
-    expected += 2 * model.nu / curvature.normaliser(p[-1]) * np.eye(H * n)
+    expected += 2 * model.nu / curvature.normaliser(p.width) * np.eye(H * n)
     np.testing.assert_allclose(curvature.hessian(data), expected, rtol=0, atol=1e-12 * np.abs(expected).max())
 
 
@@ -136,9 +137,9 @@ def test_speed_cost_value_and_gradient_are_exact(short_franka_rest, rng):
     model, problem, curvature, bare = short_franka_rest
     tau, p = _point(model, rng)
     f, g, _ = curvature.evaluate(tau, p)
-    J = lambda x: problem.objective_value(x, p[:14], p[14:17], p[17]) / curvature.normaliser(p[17])  # noqa: E731
+    J = lambda x: problem.objective_value(x, p.start, p.goal, p.width) / curvature.normaliser(p.width)  # noqa: E731
     assert f == pytest.approx(J(tau), rel=1e-12)
-    mean, cov = propagate_belief(model.body, model.h, model.kappa, p[:14], tau.reshape(model.H, 7), model.noise)
+    mean, cov = propagate_belief(model.body, model.h, model.kappa, p.start, tau.reshape(model.H, 7), model.noise)
     energies = np.sum(mean[1:, 7:] ** 2, axis=1) + np.trace(cov[1:, 7:, 7:], axis1=1, axis2=2)
     expected = SPEED_COST["stop_weight"] * energies[-1] + SPEED_COST["joint_velocity_weight"] * energies.mean()
     assert f - bare.value(tau, p) == pytest.approx(expected, rel=1e-9)
@@ -176,7 +177,7 @@ def test_speed_cost_hessian_is_the_gauss_newton_term_and_close_to_the_exact_one(
             S_k = sum(c[i] * Tv[i][:, k * n:(k + 1) * n].T @ Tv[i][:, k * n:(k + 1) * n] for i in range(H + 1))
             expected[k * n:(k + 1) * n, k * n:(k + 1) * n] += [[np.sum(S_k * second[j][m]) for m in range(n)] for j in range(n)]
         np.testing.assert_allclose(share, expected, rtol=0, atol=1e-12 * np.abs(expected).max())
-        H_exact = np.asarray(exact(tau, p[:14]))
+        H_exact = np.asarray(exact(tau, p.start))
         assert np.linalg.norm(share - H_exact, 2) < 0.1 * np.linalg.norm(H_exact, 2)
 
 

@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 
 import comanip
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.reach_problem import ReachProblem
@@ -22,10 +23,10 @@ def test_point_mass_goal_derivatives_match_finite_differences(request, preset, g
     tau = planner.solve(start, goal + 0.02).torque.ravel()
 
     def terms(g):
-        f, grad, data = curvature.evaluate(tau, np.r_[start, g, model.width])
+        f, grad, data = curvature.evaluate(tau, ReachParameters(start, g, model.width))
         return f, grad, curvature.goal_derivatives(data)[0]
 
-    _, _, data = curvature.evaluate(tau, np.r_[start, goal, model.width])
+    _, _, data = curvature.evaluate(tau, ReachParameters(start, goal, model.width))
     grad_g, cross, hess_gg = curvature.goal_derivatives(data)
     eps = 1e-6
     differences = [[(a - b) / (2 * eps) for a, b in zip(terms(goal + eps * e), terms(goal - eps * e))] for e in np.eye(model.d)]
@@ -47,7 +48,7 @@ def test_panda_goal_derivatives_against_casadi(rng):
     start = np.r_[model.body.home_position + rng.normal(scale=0.1, size=7), rng.normal(scale=0.2, size=7)]
     tau = rng.normal(scale=2.0, size=7 * model.H)
     goal = np.asarray(model.body.kinematics_function(start[:7])[0]).ravel() + rng.uniform(-0.03, 0.03, 3)
-    _, _, data = curvature.evaluate(tau, np.r_[start, goal, model.width])
+    _, _, data = curvature.evaluate(tau, ReachParameters(start, goal, model.width))
     grad_g, cross, hess_gg = curvature.goal_derivatives(data)
 
     x = ca.vertcat(ca.vec(problem.tau), problem.goal)

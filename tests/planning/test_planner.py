@@ -8,15 +8,16 @@ import pytest
 import comanip
 from comanip.belief import end_effector_belief, propagate_belief
 from comanip.objectives import GoalReward, discount_weights, reach_objective
+from comanip.planning.reach_parameters import ReachParameters
 
 
 def test_objective_gradient_matches_finite_differences(planar_planner, rng):
     """The gradient the planner's solver uses (compiled C) against central differences of the SPEC §4 J."""
     problem, curvature = planar_planner.problem, planar_planner.curvature
-    p = np.r_[np.zeros(4), 0.3, 0.0, 0.02]
+    p = ReachParameters(np.zeros(4), [0.3, 0.0], 0.02)
     x = planar_planner.solve(np.zeros(4), [0.3, 0.0], 0.02).torque.ravel() + rng.normal(scale=0.5, size=60)
     _, g, _ = curvature.evaluate(x, p)
-    J = lambda v: problem.objective_value(v, p[:4], p[4:6], p[6]) / curvature.normaliser(p[6])  # noqa: E731
+    J = lambda v: problem.objective_value(v, p.start, p.goal, p.width) / curvature.normaliser(p.width)  # noqa: E731
     eps = 1e-6
     fd = np.array([(J(x + eps * e) - J(x - eps * e)) / (2 * eps) for e in np.eye(60)])
     np.testing.assert_allclose(g, fd, rtol=1e-5, atol=1e-7 * np.abs(g).max())

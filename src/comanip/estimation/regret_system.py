@@ -31,6 +31,7 @@ from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
 from comanip.planning.planner import Planner
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.terms import ReachTerms
 
 _NO_INDICES = np.zeros(0, dtype=int)
@@ -107,7 +108,7 @@ class RegretSystem:
     def derivatives(self, tau: np.ndarray, goal: np.ndarray, start: np.ndarray, width: float) -> Derivatives:
         """Normalised J and its first and second derivatives in (tau, g) at torques tau (H·n,) and goal g (d,)."""
         curvature = self.curvature
-        f, grad, data = curvature.evaluate(np.asarray(tau, dtype=float), np.r_[start, goal, width])
+        f, grad, data = curvature.evaluate(np.asarray(tau, dtype=float), ReachParameters(start, goal, width))
         grad_g, cross, hess_gg = curvature.goal_derivatives(data)
         return Derivatives(f, grad, grad_g, curvature.hessian(data), cross, hess_gg, data)
 
@@ -137,7 +138,7 @@ class RegretSystem:
         """l1 merit of the two plans at the point's goal: J(tau_c) + mu_c |c_c|_1 + J(tau_s) + mu_s |c_s|_1,
         (mu_c, mu_s) = ``weights``, c the constraints each holds (observed rows and active limits)."""
         total = 0.0
-        params = np.r_[start, point.goal, width]
+        params = ReachParameters(start, point.goal, width)
         for tau, active, mu, observe in ((point.tau_c, point.active_c, weights[0], True),
                                          (point.tau_s, point.active_s, weights[1], False)):
             f, data = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)

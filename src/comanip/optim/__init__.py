@@ -10,7 +10,7 @@ them. Names of solver quantities follow ``docs/notation.md`` (``hessian``, ``shi
 
 from comanip.optim.factorisation import cholesky_solve, decade_shifts, growing_shifts, shifted_cholesky
 from comanip.optim.line_search import ARMIJO, backtrack
-from comanip.optim.result import SolverResult
+from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import CONVERGED, Status
 
-__all__ = ["ARMIJO", "CONVERGED", "SolverResult", "Status", "backtrack", "cholesky_solve", "decade_shifts", "growing_shifts", "shifted_cholesky"]
+__all__ = ["ARMIJO", "CONVERGED", "LocalModel", "SolverResult", "Status", "backtrack", "cholesky_solve", "decade_shifts", "growing_shifts", "shifted_cholesky"]

@@ -72,7 +72,7 @@ from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Ite
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import backtrack
 from comanip.optim.newton_loop import Stop, newton_iterate
-from comanip.optim.result import SolverResult
+from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import Status
 
 _BACKTRACKS = 30
@@ -118,9 +118,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     Returns:
         A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
         optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included, local_model
-        (factor, data): the Cholesky factor of the (regularised, corrected) Hessian of the last step taken (None if
-        no step was taken or its matrix had secant updates since it was factored) and the evaluation's ``data``
-        at x.
+        a :class:`~comanip.optim.LocalModel`: the factor of the last step's matrix and the evaluation's ``data`` at x.
     """
     if type(hessian_refresh) is not int or hessian_refresh != 1:
         hessian_refresh = as_count("hessian_refresh", hessian_refresh, unit="iterations")
@@ -267,7 +265,7 @@ class ActiveSetNewton:
         point = state.point
         optimality = np.inf if stop.status in _BUDGET else state.optimality
         return SolverResult(point.x, point.f, stop.status, stop.message, state.iterations, optimality, point.violation,
-                            (state.stepped_with, point.data))
+                            LocalModel(state.stepped_with, point.data))
 
     def _converged(self, state: SQPState) -> Stop | None:
         """A stop when the point is a solution (module docstring, Convergence), else None."""

@@ -10,6 +10,17 @@ from comanip.optim.status import CONVERGED, Status
 X = TypeVar("X")
 
 
+@dataclass(frozen=True)
+class LocalModel:
+    """What the active-set Newton method knows of the objective at its result: the Cholesky factor of the
+    (regularised, corrected) Hessian of the last step taken (as :func:`~comanip.optim.shifted_cholesky` gives it;
+    None if no step was taken or its matrix had secant updates since it was factored) and the evaluation's data
+    at the result."""
+
+    factor: tuple | None
+    data: Any
+
+
 @dataclass
 class SolverResult(Generic[X]):
     """Where a solver stopped and why; never an exception for an unconverged solve."""
@@ -28,8 +39,8 @@ class SolverResult(Generic[X]):
     violation: float = 0.0
     """Largest constraint violation at x (units of the constraints)."""
     local_model: Any = None
-    """What the solver knows of the objective at and around x, for callers that build on it (the Newton method:
-    its last factorisation, or None, and the evaluation's data at x); None when it has nothing."""
+    """What the solver knows of the objective at and around x, for callers that build on it (the active-set Newton
+    method: a :class:`LocalModel`; the online estimator's MAP: its terms); None when it has nothing."""
 
     @property
     def success(self) -> bool:

@@ -35,6 +35,7 @@ from comanip.objectives.reward import GoalReward
 from comanip.model import model_key
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.caching.compiled import cached_compiled, compile_in_background, compiled_or_cached
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ReachTerms
 
@@ -169,21 +170,21 @@ class ReachCurvature:
         """|J_best(w)|: the objective is divided by it."""
         return self.problem.normaliser(width)
 
-    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ReachTerms]:
+    def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ReachTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
-        out = self._terms.vector(x, params)
+        out = self._terms.vector(x, params.vector)
         ends, nz, steps = self._term_ends, self._nz, self.model.H + 1
         # the per-step pieces as views, column by column (as the compiled function wrote them)
-        return float(out[0]), out[1:ends[0]], ReachTerms(x, params[-1], out[ends[0]:ends[1]].reshape((nz, nz * steps), order="F"),
+        return float(out[0]), out[1:ends[0]], ReachTerms(x, params.width, out[ends[0]:ends[1]].reshape((nz, nz * steps), order="F"),
                                                          out[ends[1]:ends[2]].reshape((nz, steps), order="F"))
 
-    def value(self, x: np.ndarray, params: np.ndarray) -> float:
+    def value(self, x: np.ndarray, params: ReachParameters) -> float:
         """f at torques x (H·n,) alone."""
-        return float(self._value.vector(x, params)[0])
+        return float(self._value.vector(x, params.vector)[0])
 
-    def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, None]:
+    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> tuple[float, None]:
         """(f, None) at torques x: a point mass has no path limits, so a line-search trial needs no data."""
         return self.value(x, params), None
 

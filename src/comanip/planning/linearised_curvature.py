@@ -39,6 +39,7 @@ from comanip.model import model_key
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.caching.compiled import compiled_or_cached
 from comanip.planning.curvature import _noise_second_derivatives, _reward_derivatives_function
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.terms import ArmPieces, ArmTerms, Rollout
 
@@ -125,12 +126,11 @@ class LinearisedCurvature:
         """|J_best(w)|: the objective is divided by it."""
         return self.problem.normaliser(width)
 
-    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ArmTerms]:
+    def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ArmTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""
-        n2, d = 2 * self.model.n, self.model.d
-        goal = params[n2:n2 + d]
-        f, grad, mean, cov = self._gradient(x, params[:n2], goal, params[-1], *self._speed_weights)
-        return float(f.item()), grad.ravel(), ArmTerms(np.array(x, dtype=float), goal.copy(), params[-1], mean, cov)
+        goal = params.goal
+        f, grad, mean, cov = self._gradient(x, params.start, goal, params.width, *self._speed_weights)
+        return float(f.item()), grad.ravel(), ArmTerms(np.array(x, dtype=float), goal.copy(), params.width, mean, cov)
 
     def pieces(self, data: ArmTerms) -> ArmPieces:
         """The Hessian's per-step pieces at the evaluation ``data``, computed on first request and kept in
@@ -139,14 +139,13 @@ class LinearisedCurvature:
             data.pieces = ArmPieces(*self._pieces(data.x, data.goal, data.width, data.mean, data.cov))
         return data.pieces
 
-    def value(self, x: np.ndarray, params: np.ndarray) -> float:
+    def value(self, x: np.ndarray, params: ReachParameters) -> float:
         return self.value_and_data(x, params)[0]
 
-    def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, Rollout]:
+    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> tuple[float, Rollout]:
         """(f, data for :meth:`mean_path`) at torques x: the forward rollout alone, without derivatives."""
-        n2, d = 2 * self.model.n, self.model.d
-        f, means = self._value(x, params[:n2], params[n2:n2 + d], params[-1], *self._speed_weights)
-        return float(f.item()), Rollout(np.array(x, dtype=float), params[-1], means)
+        f, means = self._value(x, params.start, params.goal, params.width, *self._speed_weights)
+        return float(f.item()), Rollout(np.array(x, dtype=float), params.width, means)
 
     @staticmethod
     def mean_path(data: ArmTerms | Rollout) -> np.ndarray:

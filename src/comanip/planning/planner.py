@@ -48,6 +48,7 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_minimize
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.starts import StartPolicy
 from comanip.planning.terms import Curvature
@@ -309,7 +310,7 @@ class Planner:
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
@@ -318,10 +319,9 @@ class Planner:
         the evaluation at the plan); None otherwise."""
         curvature = self._curvature
         if curvature is None or not curvature.exact or not result.success or result.local_model is None \
-                or result.local_model[0] is None:
+                or result.local_model.factor is None:
             return None
-        factor, data = result.local_model
-        return GoalSensitivity(curvature, factor, data, self._blas)
+        return GoalSensitivity(curvature, result.local_model.factor, result.local_model.data, self._blas)
 
     def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
@@ -331,7 +331,7 @@ class Planner:
         stop the search: on 200 cold franka_rest problems 5 library starts did, one of them 6.4e-6 above the plan
         of the full search (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         best = None
         iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
@@ -354,26 +354,24 @@ class Planner:
                     best = candidate
                 if until_converged and best.status == Status.SOLVED and self._ends_at_goal(best.x, params):
                     break
-        evaluation = None if best.local_model is None else (best.fun, best.local_model[1])
+        evaluation = None if best.local_model is None else (best.fun, best.local_model.data)
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=iterations)
         plan.goal_sensitivity = self._sensitivity_of(best)
         return plan
 
-    def _ends_at_goal(self, torque: np.ndarray, params: np.ndarray) -> bool:
+    def _ends_at_goal(self, torque: np.ndarray, params: ReachParameters) -> bool:
         """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
         plan can rest on the zero-reward plateau instead)."""
         model, curvature = self.model, self._curvature
-        n2, d = model.state_size, model.d
         q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params)[1])[-1, : model.n]
         end = np.asarray(model.body.kinematics_function(q_end)[0]).ravel()
-        return bool(np.linalg.norm(end - params[n2:n2 + d]) <= params[-1])
+        return bool(np.linalg.norm(end - params.goal) <= params.width)
 
-    def _make_plan(self, torque, params, evaluation: tuple | None = None, **fields) -> Plan:
+    def _make_plan(self, torque, params: ReachParameters, evaluation: tuple | None = None, **fields) -> Plan:
         """The Plan of torques (H, n); ``evaluation`` = (f, data): the Newton method's own evaluation at them, from
         which an arm's belief is taken without evaluating again (about 4 ms of a Panda solve)."""
-        n2, d = self.model.state_size, self.model.d
-        start, goal, width = params[:n2], params[n2:n2 + d], params[-1]
+        start, goal, width = params.start, params.goal, params.width
         curvature = self._curvature
         if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
             return self.problem.make_plan(torque, start, goal, width, **fields)
@@ -381,7 +379,7 @@ class Planner:
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
+    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
         fun the normalised objective."""
         if self._curvature is None:
@@ -398,10 +396,10 @@ class Planner:
         result.x = result.x.reshape(self.model.H, self.model.n)
         return result
 
-    def _run_ipopt(self, guess: np.ndarray, params: np.ndarray, deadline: float) -> SolverResult[np.ndarray]:
+    def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
         solver = self._ipopt
         self._deadline.time = deadline
-        result = solver(x0=np.ravel(guess), p=params)
+        result = solver(x0=np.ravel(guess), p=params.vector)
         stats = solver.stats()
         status = ipopt_status(stats, self._deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)

@@ -18,6 +18,8 @@ from typing import Protocol
 
 import numpy as np
 
+from comanip.planning.reach_parameters import ReachParameters
+
 
 @dataclass(eq=False)
 class ReachTerms:
@@ -109,13 +111,13 @@ class Curvature(Protocol):
     def normaliser(self, width: float) -> float:
         """|J_best(w)| for width w (m)."""
 
-    def evaluate(self, x: np.ndarray, params: np.ndarray) -> tuple[float, np.ndarray, ReachTerms]:
+    def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ReachTerms]:
         """(f, ∇f (H·n,), data) at torques x (H·n,) and parameters p."""
 
-    def value(self, x: np.ndarray, params: np.ndarray) -> float:
+    def value(self, x: np.ndarray, params: ReachParameters) -> float:
         """f at torques x."""
 
-    def value_and_data(self, x: np.ndarray, params: np.ndarray) -> tuple[float, ReachTerms | Rollout]:
+    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> tuple[float, ReachTerms | Rollout]:
         """(f, data enough for the path limits) at torques x, as cheaply as the curvature can."""
 
     def hessian(self, data: ReachTerms) -> np.ndarray:

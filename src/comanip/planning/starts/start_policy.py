@@ -19,6 +19,7 @@ from comanip.caching.buffered_function import BufferedFunction
 from comanip.model import ReachingModel
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
 from comanip.planning.starts.initial_guess import (brake_durations, braked_torques, guess_durations, linear_dynamics_of,
@@ -133,13 +134,13 @@ class StartPolicy:
     def lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
         """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
         path keeps the joint limits (all candidates if none does)."""
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         low, high = self.torque_box
         if self.unbounded:  # no torque bound (the point masses): clipping would only copy
             return min(candidates, key=lambda c: self._rank(c, params))
         return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._rank(c, params))
 
-    def _rank(self, torque: np.ndarray, params: np.ndarray) -> tuple[bool, float]:
+    def _rank(self, torque: np.ndarray, params: ReachParameters) -> tuple[bool, float]:
         """(mean path beyond a joint limit, objective) of a start (H, n): its order among candidates. A start
         beyond the limits can have the lowest objective and still be the worst: the solver must first bring it
         back (on the Panda, starts retargeted far ended 'constraints_violated')."""
@@ -176,7 +177,7 @@ class StartPolicy:
         guesses = self.cold_guesses(start, goal, self.options.n_starts)
         if moving and self.drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
             return guesses
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         objectives = [self.objective(guess, params) for guess in guesses]
         first_best = min(range(len(guesses)), key=objectives.__getitem__)
         best_guess = guesses[first_best]
@@ -209,7 +210,7 @@ class StartPolicy:
         library, model, candidates = self.arm_library, self.model, []
         velocity = start[model.n:2 * model.n]
         for entry_goal, torque in library.nearest(goal, entries):
-            entry_params = np.concatenate([library.start, entry_goal, [library.width]])
+            entry_params = ReachParameters(library.start, entry_goal, library.width)
             mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params)[1])
             moved = self.retargeted(torque, mean, entry_goal, goal)
             if np.any(velocity):
@@ -229,7 +230,7 @@ class StartPolicy:
         guesses = self.cold_guesses(start, goal, self.options.n_starts, goal_q)
         if self.options.cold_search == "all" or not self.model.body.is_linear or self.narrow(start, goal, width):
             return guesses
-        params = np.concatenate([start, goal, [width]])
+        params = ReachParameters(start, goal, width)
         return [min(guesses, key=lambda guess: self.objective(guess, params))]
 
     def narrow(self, start, goal, width) -> bool:
@@ -245,9 +246,8 @@ class StartPolicy:
         return list(minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, guess_durations(model.duration, count),
                                          self.linear_dynamics))
 
-    def objective(self, torque: np.ndarray, params: np.ndarray) -> float:
+    def objective(self, torque: np.ndarray, params: ReachParameters) -> float:
         """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
         if self.curvature is not None:
             return self.curvature.value(np.ravel(torque), params)
-        n2, d = self.model.state_size, self.model.d
-        return self.problem.objective_value(torque, params[:n2], params[n2:n2 + d], params[-1])
+        return self.problem.objective_value(torque, params.start, params.goal, params.width)
