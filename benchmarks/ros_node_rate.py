@@ -10,7 +10,7 @@ steps), replayed through the node for the whole 2.75 s reach:
   node to finish with it (:mod:`comanip.ros.replay`), so this is the node's throughput, estimates per second of
   wall time;
 - real time, two processes, as on a robot, at each of ``--rates`` (estimation_rate, Hz): the node started by
-  ``python -m comanip.ros`` in its own process, this script publishing the poses (stamped with the wall clock) and
+  ``python -m comanip ros`` in its own process, this script publishing the poses (stamped with the wall clock) and
   receiving the estimates over DDS.
 
 For the real-time rows: the delivered estimation rate, (N - 1) / (last - first) over the input stamps of the N
@@ -67,7 +67,7 @@ def replay_once(settings: NodeSettings, transition: TransitionModel, times, stat
 
 
 def two_processes(rate: float, times, states, src: Path | None = None) -> dict:
-    """Real time with the node in its own process (``python -m comanip.ros``) at ``estimation_rate`` rate; ``src``:
+    """Real time with the node in its own process (``python -m comanip ros``) at ``estimation_rate`` rate; ``src``:
     the checkout's source folder the node imports (None: this environment's)."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
@@ -83,7 +83,7 @@ def two_processes(rate: float, times, states, src: Path | None = None) -> dict:
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain)}
     if src is not None:
         env["PYTHONPATH"] = str(src)
-    node = subprocess.Popen([sys.executable, "-m", "comanip.ros", "--params", str(params)], stderr=subprocess.DEVNULL, env=env)
+    node = subprocess.Popen([sys.executable, "-m", "comanip", "ros", "--params", str(params)], stderr=subprocess.DEVNULL, env=env)
     rclpy.init(domain_id=domain)
     player = Node("comanip_rate_benchmark")
     goals, statuses = {}, []

@@ -271,3 +271,15 @@ def test_ros_replay_reads_its_csv_before_the_node_is_built(tmp_path, capsys, mon
     assert_one_line_error(*run_cli(["ros", "--replay", str(hand), "--out", str(tmp_path / "out")], capsys),
                           "needs the columns", "qdot0")
     assert not (tmp_path / "out").exists()
+
+
+def test_python_dash_m_comanip_runs_the_command_and_reports_a_mistake_in_one_line():
+    """``python -m comanip`` is the ``comanip`` command (how the ROS node runs in its own process): a mistake
+    exits with status 2 and one line on stderr."""
+    import subprocess
+    import sys
+
+    done = subprocess.run([sys.executable, "-m", "comanip", "plan", "--preset", "no_such_preset"], capture_output=True,
+                          text=True, timeout=120)
+    assert done.returncode == 2, done.stderr
+    assert len(done.stderr.strip().splitlines()) == 1 and "no_such_preset" in done.stderr
