@@ -233,6 +233,18 @@ def test_estimate_checks_every_input_before_the_estimator_is_built(tmp_path, cap
     assert not (tmp_path / "out").exists()
 
 
+def test_estimate_refuses_the_paper_method_for_an_arm_before_the_estimator_is_built(tmp_path, capsys, monkeypatch):
+    from comanip.cli import estimate_command
+
+    monkeypatch.setattr(estimate_command, "GoalEstimator", _refuse_to_build)
+    home = presets.franka().body.home_position
+    observed = ",".join(str(v) for v in [*home, *[0.0] * 7])
+    argv = ["estimate", "--preset", "franka", "--method", "paper", "--observed", observed, "--t-obs", "0.1",
+            "--out", str(tmp_path / "out")]
+    assert_one_line_error(*run_cli(argv, capsys), "method 'paper'")
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("extra, fragment", [
     (["--width", "-1"], "width"),
     (["--max-wall-time", "0"], "max_wall_time"),

@@ -19,7 +19,7 @@ from comanip.cli.commands import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, add_unit_check_argument, input_file, load_model, vector
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
-from comanip.estimation.goal_estimator import METHODS
+from comanip.estimation.goal_estimator import METHODS, check_method
 from comanip.estimation.goal_prior import PAPER_PRIOR, prior_covariance
 from comanip.estimation.observation import observation_step, observed_state
 from comanip.planning.planner import reach_inputs
@@ -71,6 +71,7 @@ def check_inputs(args, model, start, observed, t_obs) -> None:
     if args.prior is not None:
         as_vector("prior_goal", args.prior, model.d, "task-space position, m")
     as_optional_positive("max_wall_time", args.max_wall_time, "s")
+    check_method(model, args.method)
     if args.candidates is not None and args.candidates.shape[1] != model.d:
         raise ValueError(f"--candidates must be goals of {model.d} coordinates (m) for the {model.name!r} model, "
                          f"got {args.candidates.shape[1]}")

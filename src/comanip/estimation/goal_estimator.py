@@ -200,11 +200,7 @@ class GoalEstimator:
         n_o = observation_step(model, t_obs)
         prior_cov = prior_covariance(prior_std, model, width)
         prior = None if prior_goal is None else GoalPrior(as_vector("prior_goal", prior_goal, model.d, "task-space position, m"), prior_cov)
-        if method not in METHODS:
-            raise ValueError(f"method must be one of {METHODS}, got {method!r}")
-        if method == "paper" and not model.body.is_linear:
-            raise ValueError(f"method 'paper' (IPOPT with CasADi's exact Hessian of the expanded problem) is for point "
-                             f"masses; the {model.body.name!r} body needs method 'regret'")
+        check_method(model, method)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         if n_o == 0 and prior is None:
             raise ValueError(f"t_obs = {float(t_obs):g} s falls on step 0 (before h = {model.h:g} s): the observed state is the "
@@ -382,6 +378,16 @@ def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observe
     """
     estimator = (cache or DEFAULT_CACHE).estimator(model)
     return estimator.estimate(start, observed, t_obs, prior_goal, width, **options)
+
+
+def check_method(model: ReachingModel, method: str) -> str:
+    """``method`` if :meth:`GoalEstimator.estimate` can use it for ``model``; a one-line ValueError otherwise."""
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    if method == "paper" and not model.body.is_linear:
+        raise ValueError(f"method 'paper' (IPOPT with CasADi's exact Hessian of the expanded problem) is for point "
+                         f"masses; the {model.body.name!r} body needs method 'regret'")
+    return method
 
 
 @dataclass(frozen=True)
