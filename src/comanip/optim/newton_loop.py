@@ -4,7 +4,8 @@
 
 One pass of :func:`newton_iterate`:
 
-1. stop with ``max_iterations`` when the budget is spent, with ``max_wall_time`` when ``expired()``;
+1. when the budget is spent (``max_iterations``) or ``expired()``: stop, as a solution if ``method.converged``
+   finds the iterate is one, else with status ``max_iterations`` or ``max_wall_time``;
 2. ``method.begin(state)``: count the iteration (a method that counts something else, such as linearisations, does
    nothing here);
 3. ``method.converged(state)``: a :class:`Stop` when the iterate is a solution (the test that needs no step);
@@ -69,10 +70,13 @@ def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
                    expired: Callable[[], bool] = lambda: False) -> SolverResult:
     """Run ``method`` from ``state`` until it stops (module docstring); never raises for an unconverged solve."""
     while True:
-        if method.iterations(state) >= max_iterations:
-            return method.result(state, Stop(Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations"))
-        if expired():
-            return method.result(state, Stop(Status.MAX_WALL_TIME, "the wall-time budget ran out"))
+        spent = method.iterations(state) >= max_iterations
+        if spent or expired():
+            # the iterate the budget ends on may be a solution: then it is reported as one
+            stop = method.converged(state) or (
+                Stop(Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations") if spent else
+                Stop(Status.MAX_WALL_TIME, "the wall-time budget ran out"))
+            return method.result(state, stop)
         method.begin(state)
         stop = method.converged(state)
         if stop is None:
