@@ -44,9 +44,9 @@ def main(argv=None) -> None:
     winners = np.zeros(3, dtype=int)
     for k, (start, goal, width) in enumerate(problems(model, args.problems)):
         params = ReachParameters(start, goal, width)
-        guesses = planner.starts.cold_guesses(start, goal, planner.options.n_starts)
-        library_start = planner.starts.lowest_objective(guesses + planner.starts.library_candidates(start, goal, CANDIDATE_ENTRIES),
-                                                  start, goal, width)
+        guesses = planner.starts.cold_guesses(params, planner.options.n_starts)
+        library_start = planner.starts.lowest_objective(guesses + planner.starts.library_candidates(params, CANDIDATE_ENTRIES),
+                                                        params)
         best_ranked = int(np.argmin([planner.starts.objective(g, params) for g in guesses]))
         library, *solved = (planner._run_solver(s, params, np.inf) for s in [library_start] + guesses)
         converged = library.status == Status.SOLVED and planner._ends_at_goal(library.x, params)

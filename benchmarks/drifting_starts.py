@@ -39,14 +39,14 @@ def main(argv=None) -> None:
     iterations = {"all guesses": 0, "best guess + best library": 0}
     count = 0
     for k, (start, goal, width) in enumerate(problems(model, args.problems)):
-        if not start[n:].any() or planner.starts.drift(start, goal, width) <= np.linalg.norm(goal - start[:n]):
+        params = ReachParameters(start, goal, width)
+        if not start[n:].any() or planner.starts.drift(params) <= np.linalg.norm(goal - start[:n]):
             continue
         count += 1
-        params = ReachParameters(start, goal, width)
         motion = start.copy()
         motion[:n] = 0.0
         turned = planner.starts.library.guess(start, goal, width)
-        starts = planner.starts.cold_guesses(start, goal, 3) + list(
+        starts = planner.starts.cold_guesses(params, 3) + list(
             turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(n), durations, planner.starts.linear_dynamics))
         ranks = np.array([planner.starts.objective(s, params) for s in starts])
         results = [planner._run_solver(s, params, np.inf) for s in starts]

@@ -40,9 +40,9 @@ from comanip.planning.starts import StartPolicy  # noqa: E402
 class LibraryAndGuessStarts(StartPolicy):
     """The ``library+guess`` strategy: the library's start and the best minimum-jerk guess."""
 
-    def arm_library_starts(self, start, goal, width, goal_q=None):
-        best, *guesses = super().arm_library_starts(start, goal, width, goal_q)
-        return [best, self.lowest_objective(guesses, start, goal, width)]
+    def arm_library_starts(self, params, goal_q=None):
+        best, *guesses = super().arm_library_starts(params, goal_q)
+        return [best, self.lowest_objective(guesses, params)]
 
 
 class LibraryAndGuess(Planner):
@@ -52,8 +52,8 @@ class LibraryAndGuess(Planner):
         super()._build()
         self.starts.__class__ = LibraryAndGuessStarts
 
-    def _solve_from(self, guesses, start, goal, width, t_begin, max_wall_time, until_converged=False):
-        return super()._solve_from(guesses, start, goal, width, t_begin, max_wall_time, until_converged=False)
+    def _solve_from(self, guesses, params, t_begin, max_wall_time, until_converged=False):
+        return super()._solve_from(guesses, params, t_begin, max_wall_time, until_converged=False)
 
 
 def main(argv=None) -> None:

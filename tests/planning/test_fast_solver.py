@@ -255,13 +255,13 @@ def test_the_goal_predictor_applies_only_to_the_planners_own_plans_at_their_star
     start, goal, width = np.zeros(4), np.array([0.3, 0.0]), 0.02
     plan = planner.solve(start, goal, width)
     moved = goal + np.array([0.02, -0.01])
-    predicted = planner.starts.predicted(plan, start, moved, width)
+    predicted = planner.starts.predicted(plan, ReachParameters(start, moved, width))
     np.testing.assert_allclose(predicted, plan.torque + (plan.goal_sensitivity.matrix() @ (moved - goal)).reshape(plan.torque.shape))
-    assert planner.starts.predicted(other.solve(start, goal, width), start, moved, width) is None  # another planner's plan
-    assert planner.starts.predicted(plan, start, moved, 0.01) is None  # another width
-    assert planner.starts.predicted(plan, np.array([0.0, 0.0, 0.1, 0.0]), moved, width) is None  # another start
+    assert planner.starts.predicted(other.solve(start, goal, width), ReachParameters(start, moved, width)) is None  # another planner's plan
+    assert planner.starts.predicted(plan, ReachParameters(start, moved, 0.01)) is None  # another width
+    assert planner.starts.predicted(plan, ReachParameters(np.array([0.0, 0.0, 0.1, 0.0]), moved, width)) is None  # another start
     planner.solve(start, moved, width)
-    np.testing.assert_allclose(planner.starts.predicted(plan, start, moved, width), predicted)  # not only the last plan
+    np.testing.assert_allclose(planner.starts.predicted(plan, ReachParameters(start, moved, width)), predicted)  # not only the last plan
     assert pickle.loads(pickle.dumps(plan)).goal_sensitivity is None
     assert "goal_sensitivity" not in plan.to_dict()
 

@@ -136,7 +136,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     return newton_iterate(method, SQPState(point, history=[point.f]), max_iterations=max_iterations, expired=expired)
 
 
-@dataclass
+@dataclass(slots=True)
 class SQPState:
     """The iterate and what the method remembers between iterations."""
 
@@ -161,7 +161,7 @@ class SQPState:
     """The pass retries the iteration (a chord step failed): it is not counted again."""
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class SQPDirection:
     """A step from the iterate, with the working set and multipliers it was computed under."""
 

@@ -187,8 +187,8 @@ class Planner:
 
     def _solve_reach(self, start, goal, width) -> np.ndarray:
         """The torques (H, n) of a cold solve from the minimum-jerk guesses (a point-mass reach library's entry)."""
-        guesses = self.starts.searched_guesses(start, goal, width)
-        return self._solve_from(guesses, start, goal, width, time.perf_counter(), None).torque
+        params = ReachParameters(start, goal, width)
+        return self._solve_from(self.starts.searched_guesses(params), params, time.perf_counter(), None).torque
 
     @property
     def curvature(self) -> Curvature | None:
@@ -259,16 +259,16 @@ class Planner:
         start, goal, width = self.check_inputs(start, goal, width)
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
+        params = ReachParameters(start, goal, width)
         goal_q = None if self.model.body.is_linear else self._goal_joints(start, goal, width, warm_start)
-        unreachable = self._unreachable_plan(start, goal, width, goal_q, t_begin)
+        unreachable = self._unreachable_plan(params, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
         with self._blas:  # the starts' small products too: one BLAS switch per solve
-            guesses = self.starts.guesses(start, goal, width, warm_start, budgeted=max_wall_time is not None,
+            guesses = self.starts.guesses(params, warm_start, budgeted=max_wall_time is not None,
                                           goal_q=goal_q if warm_start is None else None)
             from_library = warm_start is None and self.starts.from_arm_library(start)
-            plan = with_reach_check(self._solve_from(guesses, start, goal, width, t_begin, max_wall_time,
-                                                     until_converged=from_library))
+            plan = with_reach_check(self._solve_from(guesses, params, t_begin, max_wall_time, until_converged=from_library))
         self._count_solving_time(plan.solve_time)
         return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
 
@@ -296,12 +296,12 @@ class Planner:
         near = body.clip_to_limits(body.least_squares_inverse_kinematics(goal, final, WITNESS_STEPS))
         return near if _distance(body, near, goal) <= width else body.inverse_kinematics(goal, final)
 
-    def _unreachable_plan(self, start, goal, width, goal_q: np.ndarray | None, t_begin: float) -> Plan | None:
+    def _unreachable_plan(self, params: ReachParameters, goal_q: np.ndarray | None, t_begin: float) -> Plan | None:
         """A plan with status 'unreachable' when no joint position within the limits puts the end effector
         within the goal width of the goal (the residual of ``goal_q`` (n,), :meth:`_goal_joints`, > w); None
         otherwise, and for point masses (``goal_q`` None: they reach everywhere). An arm is checked before any
         solver work."""
-        model, body = self.model, self.model.body
+        model, body, goal, width = self.model, self.model.body, params.goal, params.width
         if goal_q is None:
             return None
         residual = _distance(body, goal_q, goal)
@@ -310,7 +310,6 @@ class Planner:
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
-        params = ReachParameters(start, goal, width)
         return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
@@ -323,7 +322,7 @@ class Planner:
             return None
         return GoalSensitivity(curvature, result.local_model.factor, result.local_model.data, self._blas)
 
-    def _solve_from(self, guesses, start, goal, width, t_begin: float, max_wall_time: float | None,
+    def _solve_from(self, guesses, params: ReachParameters, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
         """The best plan from the guesses (each (H, n)), solved in turn; ``until_converged``: stop at the
         first whose solve converges ('solved') within the limits and ends at the goal (later guesses are
@@ -331,7 +330,6 @@ class Planner:
         stop the search: on 200 cold franka_rest problems 5 library starts did, one of them 6.4e-6 above the plan
         of the full search (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
-        params = ReachParameters(start, goal, width)
         best = None
         iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
@@ -343,8 +341,8 @@ class Planner:
                 candidate = self._run_solver(guess, params, deadline)
                 iterations += candidate.nit
                 if not np.isfinite(candidate.x).all() or not np.isfinite(candidate.fun):
-                    candidate = SolverResult(guess, self.problem.objective_value(guess, start, goal, width)
-                                             / self.problem.normaliser(width),
+                    candidate = SolverResult(guess, self.problem.objective_value(guess, params.start, params.goal, params.width)
+                                             / self.problem.normaliser(params.width),
                                              Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
                                              candidate.nit, np.inf)
                 # The plan within the limits with the lowest objective wins, whatever its status: a start that

@@ -80,12 +80,12 @@ class StartPolicy:
         """Whether a cold solve from ``start`` (nx,) starts from the arm reach library (its ready pose)."""
         return self.arm_library is not None and self.arm_library.serves(start)
 
-    def guesses(self, start, goal, width, warm_start, budgeted: bool = False,
+    def guesses(self, params: ReachParameters, warm_start, budgeted: bool = False,
                 goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The starts (H, n) of a solve; ``goal_q`` (n,): the goal's inverse kinematics from the start, if known."""
-        model = self.model
+        model, start, goal, width = self.model, params.start, params.goal, params.width
         if warm_start is None:
-            return self.cold_starts(start, goal, width, budgeted, goal_q)
+            return self.cold_starts(params, budgeted, goal_q)
         torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
         torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
         if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
@@ -94,30 +94,30 @@ class StartPolicy:
         # a plan for another goal: also try it moved onto the new goal (by the tangential predictor if the plan
         # carries its sensitivity: it gave the best start in 398 of 400 warm point-mass solves, against the
         # minimum-jerk retargeting's 1), and start from the best
-        predicted = self.predicted(warm_start, start, goal, width)
+        predicted = self.predicted(warm_start, params)
         candidates = [torque, predicted] if predicted is not None else \
             self.retargeted(torque, warm_start.mean, warm_start.goal, goal)
         if self.from_arm_library(start):
             # the solved reach nearest to the goal competes too: on 50 chained warm franka_rest solves to goals
             # moved by up to 5 cm per axis it was the best start 48 times (15 → 10 Newton iterations, J within 3e-9)
-            candidates += self.library_candidates(start, goal, WARM_CANDIDATE_ENTRIES)
+            candidates += self.library_candidates(params, WARM_CANDIDATE_ENTRIES)
         if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
             # far beyond the goal's reward (it underflows there): fresh reaches compete too
-            candidates += self.cold_guesses(start, goal, self.options.n_starts)
-        return [self.lowest_objective(candidates, start, goal, width)]
+            candidates += self.cold_guesses(params, self.options.n_starts)
+        return [self.lowest_objective(candidates, params)]
 
-    def predicted(self, warm_start: Plan, start, goal, width) -> np.ndarray | None:
+    def predicted(self, warm_start: Plan, params: ReachParameters) -> np.ndarray | None:
         """The first-order prediction of the optimal torques (H, n) for ``goal`` from a plan that carries its
         goal sensitivity for this planner's problem (same start and width, another goal): tau* + (d tau*/d goal)
         (goal - its goal), the tangential predictor of parametric optimisation; None for any other warm start.
         On warm planar solves to goals moved by up to 5 cm its gradient is about a tenth of the retargeted
         plan's, and the solves take 4.7 instead of 5.9 Newton iterations (benchmarks/README.md)."""
         sensitivity = warm_start.goal_sensitivity
-        if sensitivity is None or not sensitivity.is_for(self.curvature) or warm_start.width != width \
-                or not np.array_equal(warm_start.start, start):
+        if sensitivity is None or not sensitivity.is_for(self.curvature) or warm_start.width != params.width \
+                or not np.array_equal(warm_start.start, params.start):
             return None
         model = self.model
-        return warm_start.torque + (sensitivity.matrix() @ (goal - warm_start.goal)).reshape(model.H, model.n)
+        return warm_start.torque + (sensitivity.matrix() @ (params.goal - warm_start.goal)).reshape(model.H, model.n)
 
     def retargeted(self, torque: np.ndarray, mean: np.ndarray, planned_goal: np.ndarray, goal: np.ndarray) -> list[np.ndarray]:
         """A plan's torques (H, n) for ``planned_goal`` (d,) and the same moved onto ``goal`` (d,) by joint-space
@@ -131,10 +131,9 @@ class StartPolicy:
         return [torque] + retargeted_torques(body, model.h, model.H, torque, shift_q, guess_durations(model.duration, 4),
                                              mean, self.linear_dynamics)
 
-    def lowest_objective(self, candidates: list[np.ndarray], start, goal, width) -> np.ndarray:
+    def lowest_objective(self, candidates: list[np.ndarray], params: ReachParameters) -> np.ndarray:
         """The candidate torques (H, n), clipped to the torque bounds, of lowest objective among those whose mean
         path keeps the joint limits (all candidates if none does)."""
-        params = ReachParameters(start, goal, width)
         low, high = self.torque_box
         if self.unbounded:  # no torque bound (the point masses): clipping would only copy
             return min(candidates, key=lambda c: self._rank(c, params))
@@ -150,7 +149,7 @@ class StartPolicy:
         f, data = curvature.value_and_data(np.ravel(torque), params)
         return self.limits.violation(curvature.mean_path(data)) > LIMIT_TOLERANCE, f
 
-    def cold_starts(self, start, goal, width, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
         An arm at the ready pose of its reach library: :meth:`arm_library_starts`. 'all', or another nonlinear
@@ -166,24 +165,24 @@ class StartPolicy:
         benchmarks/cold_quality.py). A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
         before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
         """
+        start, goal, width = params.start, params.goal, params.width
         if self.from_arm_library(start):
-            return self.arm_library_starts(start, goal, width, goal_q)
+            return self.arm_library_starts(params, goal_q)
         if self.library is None:
-            return self.searched_guesses(start, goal, width, goal_q)
+            return self.searched_guesses(params, goal_q)
         model = self.model
         motion = start.copy()
         motion[: model.n] = 0.0
         moving = bool(np.any(motion))
-        guesses = self.cold_guesses(start, goal, self.options.n_starts)
-        if moving and self.drift(start, goal, width) > np.linalg.norm(goal - start[: model.n]):
+        guesses = self.cold_guesses(params, self.options.n_starts)
+        if moving and self.drift(params) > np.linalg.norm(goal - start[: model.n]):
             return guesses
-        params = ReachParameters(start, goal, width)
         objectives = [self.objective(guess, params) for guess in guesses]
         first_best = min(range(len(guesses)), key=objectives.__getitem__)
         best_guess = guesses[first_best]
         turned = self.library.guess(start, goal, width, solve_missing=not budgeted)
         if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
-            return guesses if self.narrow(start, goal, width) else [best_guess]
+            return guesses if self.narrow(params) else [best_guess]
         candidates = [turned]
         if moving:
             candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
@@ -192,23 +191,23 @@ class StartPolicy:
         scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
             [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
         best = min(scored, key=lambda pair: pair[0])[1]
-        return [best, best_guess] if self.narrow(start, goal, width) and best is not best_guess else [best]
+        return [best, best_guess] if self.narrow(params) and best is not best_guess else [best]
 
-    def arm_library_starts(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def arm_library_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """An arm's cold starts from its ready pose (:mod:`comanip.planning.starts.arm_reach_library`): first the
         lowest-objective torques (H, n) among the minimum-jerk guesses and the plans of the nearest library
         entries, each as solved and moved onto the goal; then the minimum-jerk guesses, which the planner runs
         only if no start before them converged."""
-        guesses = self.cold_guesses(start, goal, self.options.n_starts, goal_q)
-        candidates = guesses + self.library_candidates(start, goal, CANDIDATE_ENTRIES)
-        return [self.lowest_objective(candidates, start, goal, width)] + guesses
+        guesses = self.cold_guesses(params, self.options.n_starts, goal_q)
+        candidates = guesses + self.library_candidates(params, CANDIDATE_ENTRIES)
+        return [self.lowest_objective(candidates, params)] + guesses
 
-    def library_candidates(self, start, goal, entries: int) -> list[np.ndarray]:
+    def library_candidates(self, params: ReachParameters, entries: int) -> list[np.ndarray]:
         """The plans (H, n) of the arm reach library's ``entries`` entries nearest to ``goal`` (d,), each as solved
-        and moved onto the goal (:meth:`retargeted`); ``start`` (2n,) has the library's joint positions, and if it
+        and moved onto the goal (:meth:`retargeted`); the start has the library's joint positions, and if it
         moves, each candidate gets the braking moves of :func:`braked_torques` instead."""
-        library, model, candidates = self.arm_library, self.model, []
-        velocity = start[model.n:2 * model.n]
+        library, model, candidates, goal = self.arm_library, self.model, [], params.goal
+        velocity = params.start[model.n:2 * model.n]
         for entry_goal, torque in library.nearest(goal, entries):
             entry_params = ReachParameters(library.start, entry_goal, library.width)
             mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params)[1])
@@ -219,30 +218,30 @@ class StartPolicy:
             candidates += moved
         return candidates
 
-    def drift(self, start, goal, width) -> float:
+    def drift(self, params: ReachParameters) -> float:
         """How far (m) the start's motion alone (zero commands) carries the hand within the horizon."""
-        free = self.problem.trajectory(tau=np.zeros(self.model.H * self.model.n), s0=start, goal=goal, width=width)
+        free = self.problem.trajectory(tau=np.zeros(self.model.H * self.model.n), s0=params.start, goal=params.goal,
+                                       width=params.width)
         return float(np.max(np.linalg.norm(np.asarray(free["ee_mean"]).T - free["ee_mean"][:, 0].full().T, axis=1)))
 
-    def searched_guesses(self, start, goal, width, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def searched_guesses(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
         or a goal beyond ``narrow_ratio`` widths; otherwise the one of lowest objective."""
-        guesses = self.cold_guesses(start, goal, self.options.n_starts, goal_q)
-        if self.options.cold_search == "all" or not self.model.body.is_linear or self.narrow(start, goal, width):
+        guesses = self.cold_guesses(params, self.options.n_starts, goal_q)
+        if self.options.cold_search == "all" or not self.model.body.is_linear or self.narrow(params):
             return guesses
-        params = ReachParameters(start, goal, width)
         return [min(guesses, key=lambda guess: self.objective(guess, params))]
 
-    def narrow(self, start, goal, width) -> bool:
+    def narrow(self, params: ReachParameters) -> bool:
         """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
-        position = self.kinematics(start[: self.model.n])[0].ravel()
-        return bool(np.linalg.norm(goal - position) > self.options.narrow_ratio * width)
+        position = self.kinematics(params.start[: self.model.n])[0].ravel()
+        return bool(np.linalg.norm(params.goal - position) > self.options.narrow_ratio * params.width)
 
-    def cold_guesses(self, start, goal, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def cold_guesses(self, params: ReachParameters, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """Minimum-jerk reaches to ``goal_q`` (n,), the inverse-kinematics solution from the start (computed
         when None), ``count`` durations."""
-        model = self.model
-        goal_q = model.body.inverse_kinematics(goal, start[: model.n]) if goal_q is None else goal_q
+        model, start = self.model, params.start
+        goal_q = model.body.inverse_kinematics(params.goal, start[: model.n]) if goal_q is None else goal_q
         return list(minimum_jerk_torques(model.body, model.h, model.H, start, goal_q, guess_durations(model.duration, count),
                                          self.linear_dynamics))
 
