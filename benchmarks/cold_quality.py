@@ -14,7 +14,8 @@ or, without it, this code with ``SolverOptions(cold_search="all")`` (every minim
 convergence, the best kept). Each side runs in its own process, the presets alternating between them.
 
 Prints per preset and kind of start (rest, moving, all): objectives of the current code worse / better /
-equal (relative 1e-6) than the reference, successes, median and p90 solve times, median iterations; writes
+equal (relative 1e-6) than the reference, successes, median and p90 solve times, median iterations, and whether
+the cold-search rule is met (:data:`RULE_CLOSE`, :data:`RULE_SHARE`, :data:`RULE_WORST`); writes
 every problem's row to benchmarks/results/cold_quality.csv (``--summarise CSV`` prints a CSV's table again).
 """
 
@@ -33,6 +34,9 @@ import numpy as np
 PRESETS = ("planar", "cartesian", "human", "human_cartesian")
 RELATIVE = 1e-6
 """Objectives within this relative difference count as equal."""
+RULE_CLOSE, RULE_SHARE, RULE_WORST = 1e-4, 0.98, 1e-3
+"""The cold-search rule: a cold result within RULE_CLOSE relative of the reference's (the full search) in at
+least RULE_SHARE of the problems, never more than RULE_WORST worse, and no fewer successes."""
 
 
 def problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray, float]]:
@@ -69,7 +73,7 @@ def arm_problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.
     return out
 
 
-def worker(preset: str, count: int, cold_search: str | None) -> None:
+def worker(preset: str, count: int, cold_search: str | None, seed: int = 0) -> None:
     """Solve the preset's problems with the comanip on sys.path; one JSON line per problem on stdout."""
     import comanip
     from comanip.planning.planner import SolverOptions
@@ -80,17 +84,17 @@ def worker(preset: str, count: int, cold_search: str | None) -> None:
     rest = np.r_[model.body.home_position, np.zeros(model.n)]
     hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     planner.solve(rest, hand + 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
-    for start, goal, width in problems(model, count):
+    for start, goal, width in problems(model, count, seed):
         plan = planner.solve(start, goal, width)
         print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
                           "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal - hand) / width),
                           "moving": bool(np.any(start[model.n:]))}), flush=True)
 
 
-def run_side(src: Path, cold_search: str | None, preset: str, count: int) -> list[dict]:
+def run_side(src: Path, cold_search: str | None, preset: str, count: int, seed: int = 0) -> list[dict]:
     """The worker's rows for one preset, run in a fresh process importing comanip from ``src``."""
     env = {**os.environ, "PYTHONPATH": str(src)}
-    command = [sys.executable, __file__, "--worker", preset, "--problems", str(count)]
+    command = [sys.executable, __file__, "--worker", preset, "--problems", str(count), "--seed", str(seed)]
     if cold_search:
         command += ["--cold-search", cold_search]
     done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
@@ -118,6 +122,22 @@ def summary(rows: list[dict]) -> list[str]:
     return lines
 
 
+def rule_verdicts(rows: list[dict]) -> list[str]:
+    """Per preset, the cold-search rule (:data:`RULE_CLOSE`, :data:`RULE_SHARE`, :data:`RULE_WORST`) against the
+    reference: the share within RULE_CLOSE, the largest relative excess, the successes, and whether it is met."""
+    lines = [f"rule: within {RULE_CLOSE:g} relative in ≥ {RULE_SHARE:.0%}, never more than {RULE_WORST:g} worse, "
+             "successes not fewer"]
+    for preset in dict.fromkeys(row["preset"] for row in rows):
+        part = [r for r in rows if r["preset"] == preset]
+        relative = np.array([float(r["relative"]) for r in part])
+        close, worst = float(np.mean(relative <= RULE_CLOSE)), float(relative.max())
+        ok_new, ok_ref = (sum(r[key] for r in part) for key in ("new_success", "ref_success"))
+        met = close >= RULE_SHARE and worst <= RULE_WORST and ok_new >= ok_ref
+        lines.append(f"{preset:<16} within {RULE_CLOSE:g}: {close:.1%} ({len(part)} problems), largest excess {worst:.2e}, "
+                     f"successes {ok_new}/{ok_ref}: {'met' if met else 'NOT met'}")
+    return lines
+
+
 def read_rows(path: Path) -> list[dict]:
     """The rows of a CSV this script wrote, typed back."""
     with open(path) as file:
@@ -132,6 +152,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--problems", type=int, default=200)
     parser.add_argument("--presets", default=",".join(PRESETS))
+    parser.add_argument("--seed", type=int, default=0, help="seed of the random problems (default: %(default)s)")
     parser.add_argument("--compare", type=Path, default=None, help="checkout of the reference code (its src/ is used)")
     parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results" / "cold_quality.csv",
                         help="the CSV of every problem's row (default: %(default)s)")
@@ -140,10 +161,11 @@ def main(argv=None) -> None:
     parser.add_argument("--cold-search", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
-        worker(args.worker, args.problems, args.cold_search)
+        worker(args.worker, args.problems, args.cold_search, args.seed)
         return
     if args.summarise:
-        print("\n".join(summary(read_rows(args.summarise))))
+        rows = read_rows(args.summarise)
+        print("\n".join(summary(rows) + rule_verdicts(rows)))
         return
     here = Path(__file__).resolve().parents[1] / "src"
     reference = (args.compare.resolve() / "src", None) if args.compare else (here, "all")
@@ -151,8 +173,8 @@ def main(argv=None) -> None:
     print(f"reference: {label}; {args.problems} problems per preset; equal = within {RELATIVE:g} relative", flush=True)
     rows = []
     for preset in args.presets.split(","):
-        new = run_side(here, None, preset, args.problems)
-        ref = run_side(*reference, preset, args.problems)
+        new = run_side(here, None, preset, args.problems, args.seed)
+        ref = run_side(*reference, preset, args.problems, args.seed)
         for k, (a, b) in enumerate(zip(new, ref)):
             relative = (a["objective"] - b["objective"]) / abs(b["objective"])
             verdict = "worse" if relative > RELATIVE else "better" if relative < -RELATIVE else "equal"
@@ -164,7 +186,7 @@ def main(argv=None) -> None:
             if verdict == "worse":
                 print(f"  {preset} worse: problem {k}, D/w {a['distance_over_width']:.1f}, moving {a['moving']}, "
                       f"relative {relative:.2e}", flush=True)
-    print("\n".join(summary(rows)))
+    print("\n".join(summary(rows) + rule_verdicts(rows)))
     out = args.out
     out.parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="") as file:

@@ -33,9 +33,9 @@ def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
     for start, goal, width in _problems(model, 4, seed):
         fast, reference = ranked.solve(start, goal, width), full.solve(start, goal, width)
         assert fast.success and reference.success
+        # as good as the full search (the cold-search rule allows 1e-4 in 2 % of problems; these four are closer)
         assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
-        if not np.any(start[model.n:]):  # from rest: one solve from a near-optimal start (moving: every guess too)
-            assert fast.iterations < reference.iterations
+        assert fast.iterations < reference.iterations  # one or two solves from near-optimal starts, not every guess
 
 
 def test_library_entries_do_not_depend_on_the_order_of_the_solves():
