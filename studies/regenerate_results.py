@@ -46,8 +46,8 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
     "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
-               "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,"
-               "franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
+               "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,planar_cold_moving,"
+               "cartesian_cold_moving,franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
     "real-people-development": ("goal prediction on recorded people, development split, 400 movements (about 20 min)",
                                 ["benchmarks/real_people.py", "--markdown", "--limit", "400", "--figure",
                                  "docs/figures/real_people_development.png"]),
