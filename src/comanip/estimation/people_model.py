@@ -33,6 +33,7 @@ from sklearn.ensemble import HistGradientBoostingRegressor
 from threadpoolctl import ThreadpoolController
 
 from comanip.estimation.endpoint_baselines import MOVING_SPEED, EndpointPrediction
+from comanip.estimation.profile_fit import onset_index
 
 FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak", "acceleration_scaled",
             "since_peak_over_tau", "path_at_peak_over_path", "straightness", "direction_cosine", "peak_speed_tau_over_path")
@@ -62,10 +63,9 @@ def movement_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray,
         t: times (K,), s; position: (K, d) m; velocity: (K, d) m/s; start: rest position x_0 (d,), m.
     """
     speed = np.sqrt((velocity * velocity).sum(axis=1))
-    moving = np.flatnonzero(speed > MOVING_SPEED)
-    if moving.size == 0:
+    first = onset_index(speed, MOVING_SPEED)
+    if first is None:
         return None
-    first = int(moving[0])
     covered = np.r_[0.0, np.cumsum(0.5 * (speed[1:] + speed[:-1]) * np.diff(t))]
     path = covered[-1] - covered[first] + _MIN_PATH
     tau = t[-1] - t[first] + 1e-3

@@ -67,10 +67,16 @@ class ProfileFit:
     """Covariance of ``goal`` (d, d), m² (module docstring)."""
 
 
+def onset_index(speed: np.ndarray, threshold: float) -> int | None:
+    """The index of the first speed (K,) above ``threshold`` (m/s), or None."""
+    moving = np.flatnonzero(speed > threshold)
+    return None if moving.size == 0 else int(moving[0])
+
+
 def detected_onset(t: np.ndarray, speed: np.ndarray, threshold: float) -> float | None:
     """The first time (s) of ``t`` (K,) at which the speed (K,) exceeds ``threshold`` (m/s), or None."""
-    moving = np.flatnonzero(speed > threshold)
-    return None if moving.size == 0 else float(t[moving[0]])
+    first = onset_index(speed, threshold)
+    return None if first is None else float(t[first])
 
 
 def fit_profile(t, position, velocity, start, profile: ReachProfile, onset: float,
