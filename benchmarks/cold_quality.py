@@ -187,13 +187,17 @@ def main(argv=None) -> None:
                 print(f"  {preset} worse: problem {k}, D/w {a['distance_over_width']:.1f}, moving {a['moving']}, "
                       f"relative {relative:.2e}", flush=True)
     print("\n".join(summary(rows) + rule_verdicts(rows)))
-    out = args.out
-    out.parent.mkdir(parents=True, exist_ok=True)
-    with open(out, "w", newline="") as file:
+    write_rows(args.out, rows)
+
+
+def write_rows(path: Path, rows: list[dict]) -> None:
+    """Every problem's row (dicts with the same keys) to a CSV at ``path`` (its folder made if missing)."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    with open(path, "w", newline="") as file:
         writer = csv.DictWriter(file, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
-    print(f"wrote {out}")
+    print(f"wrote {path}")
 
 
 if __name__ == "__main__":

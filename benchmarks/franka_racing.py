@@ -16,7 +16,6 @@ search's. Writes every problem's row to benchmarks/results/franka_racing.csv.
 from __future__ import annotations
 
 import argparse
-import csv
 import sys
 import time
 from pathlib import Path
@@ -26,7 +25,7 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 import comanip  # noqa: E402
-from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems  # noqa: E402
+from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
 from comanip.optim import Status  # noqa: E402
 from comanip.planning.planner import SolverOptions  # noqa: E402
 from comanip.planning.reach_parameters import ReachParameters  # noqa: E402
@@ -77,12 +76,7 @@ def main(argv=None) -> None:
         print(f"{k:>7} {close:>13.1%} {worst:>15.2e} {ok:>4}/{full_ok:<5} "
               f"{np.median([r[f'race{k}_iterations'] for r in rows]):>9.0f} of {np.median([r['full_iterations'] for r in rows]):<8.0f}"
               f" {'met' if met else 'NOT met':>8}")
-    args.out.parent.mkdir(parents=True, exist_ok=True)
-    with open(args.out, "w", newline="") as file:
-        writer = csv.DictWriter(file, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    print(f"wrote {args.out}")
+    write_rows(args.out, rows)
 
 
 if __name__ == "__main__":
