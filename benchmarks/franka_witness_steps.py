@@ -39,7 +39,7 @@ def main(argv=None) -> None:
                                                for steps in (1, 2, 3)])
         previous = planner.solve(start, goal, warm_start=previous)
     rows = np.array(rows)
-    print(f"| | start | 1 step | 2 steps | 3 steps |\n|---|---|---|---|---|")
+    print("| | start | 1 step | 2 steps | 3 steps |\n|---|---|---|---|---|")
     for name, reduce in (("median mm", np.median), ("largest mm", np.max)):
         print(f"| {name} | " + " | ".join(f"{reduce(rows[:, k]):.4g}" for k in range(4)) + " |")
 

@@ -22,7 +22,7 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 
-from result_blocks import block_names, block_spans, replace_block  # noqa: E402  (a sibling script, not a package)
+from result_blocks import block_names, replace_block  # noqa: E402  (a sibling script, not a package)
 
 #: block name: (what it shows, the command that prints it, run from the repository root)
 BLOCKS: dict[str, tuple[str, list[str]]] = {

@@ -98,7 +98,7 @@ def main() -> None:
     results = compare_sync_policies(settings, ["constant-velocity", "continuous"], setup)
     model = setup.model
     planner = OnlineGoalEstimator(model, np.zeros(model.state_size)).planner
-    out = [f"# Why the continuous goal estimate lags mid-reach\n",
+    out = ["# Why the continuous goal estimate lags mid-reach\n",
            f"Measured by `PYTHONPATH=src python studies/why_does_the_online_estimate_lag_mid_reach/measure_online_lag.py --trials {args.trials} --seed {args.seed}` "
            f"(sync scenario, person seeds {args.seed}–{args.seed + args.trials - 1}, medians over the trials; "
            "{wall} s).\n"]

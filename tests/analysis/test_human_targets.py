@@ -1,9 +1,7 @@
-"""The human-likeness targets (issue 11, item 2): the closed-form hit rate, the profile-shape metrics on
+"""The human-likeness targets: the closed-form hit rate, the profile-shape metrics on
 synthetic profiles, the verdict on the planar preset, and their place in ``comanip validate``."""
 
-import importlib.util
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest

@@ -81,7 +81,7 @@ def _estimates(planners: dict) -> dict:
             observed = plan.mean[n_o]
             prior = goal + 0.05 * _direction(90, 0, model.d)
             out.update(_estimate_entries(f"estimate/{preset}/{k}/cold", estimator.estimate(plan.start, observed, T_OBS)))
-            # the stored estimates weigh the prior with W from the width, the default before issue 12
+            # the stored estimates weigh the prior with W from the width (prior_std="width")
             out.update(_estimate_entries(f"estimate/{preset}/{k}/prior",
                                          estimator.estimate(plan.start, observed, T_OBS, prior, prior_std=PAPER_PRIOR)))
             prior_plan = estimator.planner.solve(plan.start, prior)

@@ -1,4 +1,4 @@
-"""Continuous goal estimation and the goal's uncertainty (issue 12): the reach family against real plans, the
+"""Continuous goal estimation and the goal's uncertainty: the reach family against real plans, the
 whitening against the joint covariance, exact observations, the prior's std, the calibration of the goal
 covariance over reaches sampled from the model's own noisy dynamics, updates at any time, and bad input."""
 
@@ -102,7 +102,7 @@ def test_whitening_matches_the_joint_covariance(cartesian_planner):
 
 
 def issue_cases(rng, count=5):
-    """Cartesian reaches 0.2–0.45 m with a prior 0.2–0.45 m off the goal (issue 12)."""
+    """Cartesian reaches 0.2–0.45 m with a prior 0.2–0.45 m off the goal."""
     for _ in range(count):
         goal = random_goal(rng, 0.2, 0.45)
         offset = rng.normal(size=3)

@@ -95,7 +95,6 @@ def test_structured_hessian_is_exact_with_the_extensions(changes, rng):
     x = ca.vec(problem.tau)
     f = problem.objective / -problem.best_objective
     exact = ca.Function("exact", [x, problem.s0, problem.goal, problem.width], [ca.hessian(f, x)[0], f])
-    nx = model.state_size
     for _ in range(2):
         tau = rng.normal(scale=3.0, size=x.numel())
         p = ReachParameters(model.full_state(rng.normal(scale=0.1, size=4)), rng.uniform(0.05, 0.15, 2), 0.03)

@@ -1,4 +1,4 @@
-"""Robot policies on the synchronisation scenario and the co-manipulation measures (issue 12)."""
+"""Robot policies on the synchronisation scenario and the co-manipulation measures."""
 
 import numpy as np
 import pytest

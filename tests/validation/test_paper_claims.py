@@ -1,6 +1,6 @@
 """The paper's validation claims (Section IV-D) on the planar preset, and the ``comanip validate`` command.
 
-Grid: D ∈ {0.15, 0.3, 0.45} m × w ∈ {0.005, 0.01, 0.02, 0.04} m, open-loop plans from rest (issue 2).
+Grid: D ∈ {0.15, 0.3, 0.45} m × w ∈ {0.005, 0.01, 0.02, 0.04} m, open-loop plans from rest.
 """
 
 import json

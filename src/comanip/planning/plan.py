@@ -6,10 +6,14 @@ import csv
 import json
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from comanip.optim import CONVERGED, Status
+
+if TYPE_CHECKING:  # the planner makes it; a plan only carries it
+    from comanip.planning.goal_sensitivity import GoalSensitivity
 
 
 #: statuses of a solver that converged (to its tolerance, or to an acceptable level)
@@ -62,7 +66,7 @@ class Plan:
     model_name: str = ""
     extras: dict = field(default_factory=dict)
     """Application-specific results (e.g. an estimated goal)."""
-    goal_sensitivity: "GoalSensitivity | None" = field(default=None, repr=False, compare=False)
+    goal_sensitivity: GoalSensitivity | None = field(default=None, repr=False, compare=False)
     """How the torques move with the goal, for a converged point-mass plan of the planner that solved it
     (:class:`~comanip.planning.goal_sensitivity.GoalSensitivity`; None otherwise, and in another process): a warm
     solve from this plan to a moved goal starts from its first-order prediction."""
