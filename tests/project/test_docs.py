@@ -269,6 +269,7 @@ def test_every_table_of_measured_numbers_is_a_marked_block_with_its_script():
     <!-- NAME:begin/end --> markers that studies/regenerate_results.py knows (and rewrites by running the script
     it names). Every block has a script that exists and sits on the page the script says."""
     script = _load(ROOT / "studies" / "regenerate_results.py", "regenerate_results")
+    blocks = _load(ROOT / "studies" / "result_blocks.py", "result_blocks")
     assert sorted(script.PAGES) == sorted(script.BLOCKS)
     for name, (_, command) in script.BLOCKS.items():
         for word in command:
@@ -278,7 +279,7 @@ def test_every_table_of_measured_numbers_is_a_marked_block_with_its_script():
         text = page.read_text(encoding="utf-8")
         names = script.block_names(text)
         assert all(page in script.PAGES[name] for name in names), f"{page.name}: a block its script puts elsewhere"
-        spans = script.block_spans(text)
+        spans = blocks.block_spans(text)
         for first, lines in markdown_tables(text):
             if lines[0] in DEFINITION_TABLES or not any(ch.isdigit() for line in lines[2:] for ch in line):
                 continue
