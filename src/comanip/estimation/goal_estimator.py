@@ -155,15 +155,15 @@ class GoalEstimator:
         t_begin = time.perf_counter()
         model = self.model
         checked = self._checked_request(start, observed, t_obs, prior_goal, width, prior_std, method, max_wall_time)
-        start, observed, n_o, prior, width, rows, max_wall_time = checked.fields()
+        start, observed, n_o, prior, width, rows = checked.start, checked.observed, checked.n_o, checked.prior, checked.width, checked.rows
         if n_o == 0:
-            return self._uninformative(start, observed, float(t_obs), prior, width, method, warm_start, max_wall_time, t_begin)
+            return self._uninformative(start, observed, float(t_obs), prior, width, method, warm_start, checked.max_wall_time, t_begin)
         point, plan_needed = self._warm_point(warm_start, len(rows)) if warm_start is not None else (None, False)
 
-        deadline = math.inf if max_wall_time is None else t_begin + max_wall_time
+        deadline = math.inf if checked.max_wall_time is None else t_begin + checked.max_wall_time
 
         def remaining_time() -> float | None:
-            return None if max_wall_time is None else max(deadline - time.perf_counter(), 1e-6)
+            return None if checked.max_wall_time is None else max(deadline - time.perf_counter(), 1e-6)
 
         if plan_needed:
             point.tau_s = self.planner.solve(start, point.goal, width, max_wall_time=remaining_time()).torque.ravel()
@@ -402,7 +402,3 @@ class _Request:
     width: float
     rows: np.ndarray
     max_wall_time: float | None
-
-    def fields(self) -> tuple:
-        """(start, observed, n_o, prior, width, rows, max_wall_time), in that order."""
-        return self.start, self.observed, self.n_o, self.prior, self.width, self.rows, self.max_wall_time
