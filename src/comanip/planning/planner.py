@@ -103,10 +103,10 @@ class SolverOptions:
     """How a cold solve starts. 'all': from each of the ``n_starts`` minimum-jerk guesses, keeping the best
     converged plan. 'ranked': from the lowest-objective start among those guesses and, for a point mass, a solved
     reach turned to the goal, for an arm at its ready pose, the nearest plans of its reach library
-    (:meth:`Planner._cold_start`), about as fast as a warm solve, with second solves where local optima compete
-    (point masses) or the guesses as fallbacks (arms). An arm without a library, or away from its ready pose,
-    runs every guess as 'all' does. Against 'all' on 200 random cold problems per point-mass preset: 0 worse,
-    11 better, 789 equal (1e-6 relative; benchmarks/cold_quality.py)."""
+    (:meth:`StartPolicy.cold_starts <comanip.planning.starts.StartPolicy.cold_starts>`), about as fast as a warm
+    solve, with second solves where local optima compete (point masses) or the guesses as fallbacks (arms). An arm
+    without a library, or away from its ready pose, runs every guess as 'all' does. benchmarks/cold_quality.py
+    compares 'ranked' with 'all' under the cold-search rule (docs/results/speed.md)."""
     narrow_ratio: float = 20.0
     """Reach distance over goal width beyond which a 'ranked' cold solve also solves from the best minimum-jerk
     guess (without a reach library: from every guess): far, narrow goals of the planar preset have several

@@ -159,9 +159,9 @@ class StartPolicy:
         start with minimum-jerk moves that bring the start's motion to rest superposed: the mean is affine in
         the torques and the start). Where several local optima compete the lowest-objective start can end on
         a worse one, so the plan is compared with another: a goal farther than ``narrow_ratio`` widths also runs
-        the best minimum-jerk guess. This meets the cold-search rule (within 1e-4 of the full search's objective
-        in at least 98 % of random problems, never 1e-3 worse, as many successes; benchmarks/cold_quality.py) on
-        every point-mass preset, with half of the starts moving; the full search stays ``cold_search="all"``.
+        the best minimum-jerk guess. The full search stays ``cold_search="all"``; benchmarks/cold_quality.py checks
+        the ranked starts against it under the cold-search rule (within 1e-4 of its objective in at least 98 % of
+        random problems, never 1e-3 worse, as many successes).
         A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
         before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
         """
