@@ -212,6 +212,27 @@ def test_paper_franka_plan_ends_moving(franka_planner):
     assert plan.success and motion.final_joint_speed > 1.0 and motion.time_at_velocity_limit > 0.1
 
 
+def test_starts_solved_side_by_side_give_the_plan_solved_one_after_another(franka_planner, monkeypatch):
+    """The paper preset's cold solve runs its three starts on threads; each thread evaluates with its own buffers,
+    so the plan, its objective and its iterations are those of the starts solved in turn, bit for bit."""
+    from comanip.planning.planner import SolverOptions
+    from comanip.planning.start_threads import StartThreads
+
+    model = franka_planner.model
+    start = np.r_[model.body.home_position, np.zeros(7)]
+    goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.1, -0.15, 0.1]
+    threads_used = []
+    map_on_threads = StartThreads.map
+    monkeypatch.setattr(StartThreads, "map", lambda self, solve, starts: threads_used.append(self.threads)
+                        or map_on_threads(self, solve, starts))
+    side_by_side = comanip.Planner(model, SolverOptions(threads=3)).solve(start, goal)
+    in_turn = comanip.Planner(model, SolverOptions(threads=1)).solve(start, goal)
+    assert threads_used == [3]
+    np.testing.assert_array_equal(side_by_side.torque, in_turn.torque)
+    assert (side_by_side.objective, side_by_side.iterations, side_by_side.status) == \
+        (in_turn.objective, in_turn.iterations, in_turn.status)
+
+
 def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(franka_planner):
     """Ten goals around the ready pose (up to 0.2 m along each axis), visited in a tour and each
     warm-started from the plan to the one before, as a robot tracking a person would."""

@@ -29,6 +29,8 @@ that do not compile in minutes.
 
 from __future__ import annotations
 
+import copy
+
 import casadi as ca
 import numpy as np
 
@@ -125,6 +127,14 @@ class LinearisedCurvature:
     def normaliser(self, width: float) -> float:
         """|J_best(w)|: the objective is divided by it."""
         return self.problem.normaliser(width)
+
+    def for_another_thread(self) -> "LinearisedCurvature":
+        """These terms with evaluation buffers of their own, for a thread evaluating beside this one (the compiled
+        functions and constants are shared; only the buffers the functions read and write are not)."""
+        twin = copy.copy(self)
+        twin._gradient, twin._pieces, twin._value = (BufferedFunction(buffered.function)
+                                                     for buffered in (self._gradient, self._pieces, self._value))
+        return twin
 
     def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ArmTerms]:
         """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""

@@ -50,6 +50,7 @@ from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.start_threads import StartThreads, usable_cores
 from comanip.planning.starts import StartPolicy
 from comanip.planning.terms import Curvature
 
@@ -119,6 +120,13 @@ class SolverOptions:
     """An arm's reach library for 'ranked' cold solves from its ready pose, at rest or moving (its nearest plan
     also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:
     the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.starts.arm_reach_library`)."""
+    threads: int | None = None
+    """Threads that solve a nonlinear body's cold starts side by side when every start runs to convergence (an arm
+    without a reach library, or ``cold_search="all"``): a Newton iteration on an arm spends most of its time in
+    compiled code and LAPACK, which run outside Python's interpreter lock (:mod:`comanip.planning.start_threads`).
+    None: one thread per start, at most one per processor the process may use; 1: one start after another (e.g.
+    for sweeps that already run a process per core). The plan is the same whatever this says: each start is solved
+    alone and the best is kept by the same rule."""
     ipopt: dict = field(default_factory=dict)
     """Extra IPOPT options, passed through (e.g. {"hessian_approximation": "limited-memory"})."""
     compile: bool | None = None
@@ -138,6 +146,7 @@ class SolverOptions:
         if self.method not in SOLVER_METHODS:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
         as_count("max_iterations", self.max_iterations, optional=True)
+        as_count("threads", self.threads, optional=True)
         for name in ("n_starts", "point_mass_iterations", "arm_iterations", "hessian_refresh"):
             as_count(name, getattr(self, name))
         as_positive("far_warm_start", self.far_warm_start, "goal widths")
@@ -184,6 +193,9 @@ class Planner:
         self.starts = StartPolicy(self.model, self.options, problem, self._curvature, self._limits, self._solve_reach)
         """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`)."""
         self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
+        threads = min(self.options.n_starts, usable_cores()) if self.options.threads is None else self.options.threads
+        self._start_threads = StartThreads(self._curvature, threads) \
+            if threads > 1 and isinstance(self._curvature, LinearisedCurvature) else None
 
     def _solve_reach(self, start, goal, width) -> np.ndarray:
         """The torques (H, n) of a cold solve from the minimum-jerk guesses (a point-mass reach library's entry)."""
@@ -324,7 +336,8 @@ class Planner:
 
     def _solve_from(self, guesses, params: ReachParameters, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
-        """The best plan from the guesses (each (H, n)), solved in turn; ``until_converged``: stop at the
+        """The best plan from the guesses (each (H, n)), solved in turn, or side by side on the start threads when
+        every guess is solved (:attr:`SolverOptions.threads`); ``until_converged``: stop at the
         first whose solve converges ('solved') within the limits and ends at the goal (later guesses are
         fallbacks). A solve that stalled ('solved_acceptable', along a redundant arm's flat directions) does not
         stop the search: on 200 cold franka_rest problems 5 library starts did, one of them 6.4e-6 above the plan
@@ -335,10 +348,13 @@ class Planner:
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
         # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
         with self._blas:
-            for guess in guesses:
-                if time.perf_counter() > deadline and best is not None:
+            solved = None
+            if self._start_threads is not None and not until_converged and len(guesses) > 1:
+                solved = self._start_threads.map(lambda guess, terms: self._run_solver(guess, params, deadline, terms), guesses)
+            for index, guess in enumerate(guesses):
+                if solved is None and time.perf_counter() > deadline and best is not None:
                     break
-                candidate = self._run_solver(guess, params, deadline)
+                candidate = self._run_solver(guess, params, deadline) if solved is None else solved[index]
                 iterations += candidate.nit
                 if not np.isfinite(candidate.x).all() or not np.isfinite(candidate.fun):
                     candidate = SolverResult(guess, self.problem.objective_value(guess, params.start, params.goal, params.width)
@@ -377,12 +393,14 @@ class Planner:
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
+    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float,
+                    curvature: Curvature | None = None) -> SolverResult[np.ndarray]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
-        fun the normalised objective."""
+        fun the normalised objective. ``curvature``: the terms to evaluate with (a start thread's own copy);
+        None: the planner's."""
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
-        curvature = self._curvature
+        curvature = curvature or self._curvature
         value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
         result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                                  *self._torque_bounds, tolerance=self._tolerance,
