@@ -266,6 +266,36 @@ def test_the_goal_predictor_applies_only_to_the_planners_own_plans_at_their_star
     assert "goal_sensitivity" not in plan.to_dict()
 
 
+def test_final_position_change_is_the_change_of_the_rolled_out_end(rng):
+    """For a point mass the mean is affine in the torques: the end's change the curvature predicts from its constant
+    sensitivities equals the difference of two expanded rollouts (an independent construction)."""
+    model = comanip.presets.cartesian()
+    planner = Planner(model)
+    start, goal = np.r_[np.zeros(3), rng.normal(scale=0.2, size=3)], np.array([0.3, 0.1, 0.0])
+    torque, change = rng.normal(scale=2.0, size=(model.H, 3)), rng.normal(scale=0.5, size=(model.H, 3))
+    end = lambda tau: np.asarray(planner.problem.trajectory(tau=np.ravel(tau), s0=start, goal=goal, width=model.width)["ee_mean"])[:, -1]  # noqa: E731
+    np.testing.assert_allclose(planner.curvature.final_position_change(change), end(torque + change) - end(torque), atol=1e-12)
+
+
+def test_fresh_reaches_compete_with_a_warm_start_only_where_its_prediction_ends_far_from_the_goal(monkeypatch):
+    """A plan to a goal 10 widths away ends far from the new goal, but its goal predictor moves it onto the new goal:
+    no fresh reach competes. A plan without its sensitivity (torques only, or another planner's) ends as far as it
+    was planned, and the minimum-jerk reaches compete."""
+    model = comanip.presets.planar()
+    planner = Planner(model)
+    start, goal, width = np.zeros(4), np.array([0.25, 0.0]), 0.02
+    plan = planner.solve(start, goal, width)
+    moved = goal + np.array([0.0, 10 * width])
+    fresh = []
+    cold_guesses = planner.starts.cold_guesses
+    monkeypatch.setattr(planner.starts, "cold_guesses", lambda *args: fresh.append(1) or cold_guesses(*args))
+    predicted = planner.solve(start, moved, width, warm_start=plan)
+    assert predicted.success and not fresh
+    from_torques = planner.solve(start, moved, width, warm_start=Planner(model).solve(start, goal, width))
+    assert from_torques.success and len(fresh) == 1
+    assert predicted.objective == pytest.approx(from_torques.objective, rel=1e-9)
+
+
 def test_shifted_cholesky_solves_the_shifted_system(rng):
     """The factor of an indefinite matrix comes with the shift that made it definite, and solves that system."""
     from comanip.optim import cholesky_solve, growing_shifts, shifted_cholesky

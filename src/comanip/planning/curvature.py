@@ -188,6 +188,11 @@ class ReachCurvature:
         """(f, None) at torques x: a point mass has no path limits, so a line-search trial needs no data."""
         return self.value(x, params), None
 
+    def final_position_change(self, torque_change: np.ndarray) -> np.ndarray:
+        """How far (d,) m the mean end-effector position at step H moves for a change of the torques (H, n) (exact:
+        for a linear body the mean is affine in the torques)."""
+        return np.einsum("kan,kn->a", self._G[-1], torque_change)
+
     def hessian(self, data: ReachTerms) -> np.ndarray:
         """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
         phi_hess, phi_grad = self._pieces(data)

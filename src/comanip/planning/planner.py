@@ -115,7 +115,8 @@ class SolverOptions:
     none below 20 widths on any point-mass preset)."""
     far_warm_start: float = 3.0
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
-    from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it."""
+    from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it. For
+    a plan that carries its goal sensitivity the position is where the predicted start ends."""
     arm_library: str | None = None
     """An arm's reach library for 'ranked' cold solves from its ready pose, at rest or moving (its nearest plan
     also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:

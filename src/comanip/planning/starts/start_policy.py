@@ -101,7 +101,10 @@ class StartPolicy:
             # the solved reach nearest to the goal competes too: on 50 chained warm franka_rest solves to goals
             # moved by up to 5 cm per axis it was the best start 48 times (15 → 10 Newton iterations, J within 3e-9)
             candidates += self.library_candidates(params, WARM_CANDIDATE_ENTRIES)
-        if np.linalg.norm(warm_start.ee_mean[-1] - goal) > self.options.far_warm_start * width:
+        end = warm_start.ee_mean[-1]
+        if predicted is not None:  # where the predicted start ends (the mean is affine in the torques)
+            end = end + self.curvature.final_position_change(predicted - torque)
+        if np.linalg.norm(end - goal) > self.options.far_warm_start * width:
             # far beyond the goal's reward (it underflows there): fresh reaches compete too
             candidates += self.cold_guesses(params, self.options.n_starts)
         return [self.lowest_objective(candidates, params)]
