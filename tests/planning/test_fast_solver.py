@@ -266,6 +266,31 @@ def test_the_goal_predictor_applies_only_to_the_planners_own_plans_at_their_star
     assert "goal_sensitivity" not in plan.to_dict()
 
 
+@pytest.mark.parametrize("secant", [False, True])
+def test_a_solve_paused_and_resumed_takes_the_iterates_of_one_run(secant):
+    """newton_solve's stages: advancing to 7 iterations, then to the end, ends on the point, objective and status of
+    one run to the end (bounded Rosenbrock, exact Hessian or secant corrections: the method's memory survives the
+    pause); the pause itself reports 'max_iterations' at iteration 7."""
+    from comanip.optim import Status, newton_solve
+
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    hessian = (lambda x: 0.5 * (scipy.optimize.rosen_hess(x) + np.diag(np.diag(scipy.optimize.rosen_hess(x))))) if secant \
+        else scipy.optimize.rosen_hess
+    arguments = (evaluate, hessian, np.full(6, -1.2), np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5])
+    options = dict(tolerance=1e-10, secant=secant, hessian_refresh=3 if secant else 1)
+    whole = newton_solve(*arguments, **options).advance(500)
+    staged = newton_solve(*arguments, **options)
+    paused = staged.advance(7)
+    assert paused.status == Status.MAX_ITERATIONS and paused.nit == 7 and not staged.finished
+    resumed = staged.advance(500)
+    assert staged.finished and resumed.status == whole.status and resumed.success
+    np.testing.assert_array_equal(resumed.x, whole.x)
+    assert resumed.fun == whole.fun and abs(resumed.nit - whole.nit) <= 1
+    assert staged.advance(1000) is resumed  # a finished solve only reports
+
+
 def test_final_position_change_is_the_change_of_the_rolled_out_end(rng):
     """For a point mass the mean is affine in the torques: the end's change the curvature predicts from its constant
     sensitivities equals the difference of two expanded rollouts (an independent construction)."""

@@ -13,8 +13,9 @@ from comanip.optim.factorisation import cholesky_solve, decade_shifts, growing_s
 from comanip.optim.line_search import ARMIJO, backtrack
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import CONVERGED, Status
-from comanip.optim.newton_loop import NewtonMethod, Stop, newton_iterate
-from comanip.optim.active_set_newton import newton_minimize
+from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, newton_iterate
+from comanip.optim.active_set_newton import newton_minimize, newton_solve
 
-__all__ = ["ARMIJO", "CONVERGED", "LocalModel", "NewtonMethod", "SolverResult", "Status", "Stop", "backtrack", "cholesky_solve",
-           "decade_shifts", "growing_shifts", "newton_iterate", "newton_minimize", "shifted_cholesky"]
+__all__ = ["ARMIJO", "CONVERGED", "LocalModel", "NewtonMethod", "NewtonSolve", "SolverResult", "Status", "Stop", "backtrack",
+           "cholesky_solve", "decade_shifts", "growing_shifts", "newton_iterate", "newton_minimize", "newton_solve",
+           "shifted_cholesky"]

@@ -71,7 +71,7 @@ from comanip.optim.factorisation import cholesky_solve
 from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, finite, restoration_step
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import backtrack
-from comanip.optim.newton_loop import Stop, newton_iterate
+from comanip.optim.newton_loop import NewtonSolve, Stop
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import Status
 
@@ -86,21 +86,29 @@ _BUDGET = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
                     hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
-                    tolerance: float, max_iterations: int, secant: bool = False,
-                    constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
-                    constraint_tolerance: float = 1e-6, margin: float = 1e-3,
-                    expired: Callable[[], bool] = lambda: False,
-                    value: Callable[[np.ndarray], tuple[float, Any]] | None = None,
-                    hessian_refresh: int = 1) -> SolverResult[np.ndarray]:
-    """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0.
+                    max_iterations: int, **options) -> SolverResult[np.ndarray]:
+    """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0, in at most ``max_iterations`` iterations (each evaluates
+    the Hessian, except a last one that only finds the point converged); the arguments and the result are those of
+    :func:`newton_solve`."""
+    return newton_solve(evaluate, hessian, x0, lb, ub, **options).advance(max_iterations)
+
+
+def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
+                 hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
+                 tolerance: float, secant: bool = False,
+                 constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
+                 constraint_tolerance: float = 1e-6, margin: float = 1e-3,
+                 expired: Callable[[], bool] = lambda: False,
+                 value: Callable[[np.ndarray], tuple[float, Any]] | None = None,
+                 hessian_refresh: int = 1) -> NewtonSolve[SQPState]:
+    """The solve of f over the box [lb, ub] and c(x) ≤ 0 from x0, to run in stages (:class:`NewtonSolve`: its
+    ``advance(max_iterations)`` gives the result); f is evaluated at x0 here.
 
     Args:
         evaluate: x (N,) -> (f, grad f (N,), data); ``data`` is handed to ``hessian`` and ``constraints``.
         hessian: data -> ∇²f (N, N), symmetric (the solver does not modify it).
         x0: start (N,), projected onto the box; lb, ub: bounds (N,), ±inf allowed.
         tolerance: on max |gradient of the Lagrangian|.
-        max_iterations: iterations allowed (each evaluates the Hessian, except a last one that only finds the
-            point converged).
         secant: add symmetric rank-one corrections to an approximate Hessian.
         constraints: (x, data) -> (c (m,), rows), rows(indices) -> dc_indices/dx (len(indices), N); None
             for none. Entries of c may be -inf (no constraint).
@@ -115,7 +123,7 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
             every iteration. Must be 1 without ``secant`` (an exact Hessian is assembled at every iteration, chord
             steps apart).
 
-    Returns:
+    Results (of ``advance``):
         A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
         optimality max |∇f + A_Wᵀ multipliers| there, violation max(0, c) bounds included, local_model
         a :class:`~comanip.optim.LocalModel`: the factor of the last step's matrix and the evaluation's ``data`` at x.
@@ -131,9 +139,9 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     x = np.array(x0, dtype=float) if method.problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
     if not finite(f, g):
-        return SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf)
+        return NewtonSolve(None, None, final=SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
     point = method.at(x, f, g, data)
-    return newton_iterate(method, SQPState(point, history=[point.f]), max_iterations=max_iterations, expired=expired)
+    return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
 
 
 @dataclass(slots=True)

@@ -23,7 +23,7 @@ range) lives in their methods, never in this loop.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Callable, Protocol, TypeVar
+from typing import Callable, Generic, Protocol, TypeVar
 
 from comanip.optim.result import SolverResult
 from comanip.optim.status import Status
@@ -89,3 +89,28 @@ def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
                 stop = method.recover(state, direction)
         if stop is not None:
             return method.result(state, stop)
+
+
+class NewtonSolve(Generic[S]):
+    """A solve run in stages: :meth:`advance` iterates until the iterations spent reach a budget (or the method
+    stops) and returns the result there; a later call with a larger budget goes on from that iterate along the same
+    iterates one call with the larger budget would have taken (a pause only reads the state). ``final``: the result
+    of a solve that ended before it started (e.g. a start where f is not finite)."""
+
+    def __init__(self, method: NewtonMethod[S, D] | None, state: S | None, expired: Callable[[], bool] = lambda: False,
+                 final: SolverResult | None = None):
+        self.method, self.state, self.expired, self.final = method, state, expired, final
+
+    @property
+    def finished(self) -> bool:
+        """True once the solve has stopped for a reason other than its budget."""
+        return self.final is not None
+
+    def advance(self, max_iterations: int) -> SolverResult:
+        """The result after at most ``max_iterations`` iterations in all (the final result once finished)."""
+        if self.final is None:
+            result = newton_iterate(self.method, self.state, max_iterations=max_iterations, expired=self.expired)
+            if result.status is not Status.MAX_ITERATIONS:
+                self.final = result
+            return result
+        return self.final

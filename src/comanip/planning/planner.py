@@ -41,11 +41,11 @@ from comanip.arguments import as_bounded_vector, as_count, as_goal_width, as_opt
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.curvature import ReachCurvature
-from comanip.optim import SolverResult, Status
+from comanip.optim import CONVERGED, NewtonSolve, SolverResult, Status
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
-from comanip.optim.active_set_newton import newton_minimize
+from comanip.optim.active_set_newton import newton_solve
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
 from comanip.planning.reach_parameters import ReachParameters
@@ -121,6 +121,11 @@ class SolverOptions:
     """An arm's reach library for 'ranked' cold solves from its ready pose, at rest or moving (its nearest plan
     also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:
     the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.starts.arm_reach_library`)."""
+    abandon_after: int = 100
+    """Newton iterations after which a 'ranked' cold search that runs every start (an arm without a reach library)
+    abandons a start that has not converged, when a start that has converged within the limits by then has a lower
+    objective than it has there. Long starts crawl along a joint limit and seldom end best
+    (benchmarks/franka_abandon.py); 'all' runs every start to the end."""
     threads: int | None = None
     """Threads that solve a nonlinear body's cold starts side by side when every start runs to convergence (an arm
     without a reach library, or ``cold_search="all"``): a Newton iteration on an arm spends most of its time in
@@ -148,7 +153,7 @@ class SolverOptions:
             raise ValueError(f"method must be one of {SOLVER_METHODS}, got {self.method!r}")
         as_count("max_iterations", self.max_iterations, optional=True)
         as_count("threads", self.threads, optional=True)
-        for name in ("n_starts", "point_mass_iterations", "arm_iterations", "hessian_refresh"):
+        for name in ("n_starts", "point_mass_iterations", "arm_iterations", "hessian_refresh", "abandon_after"):
             as_count(name, getattr(self, name))
         as_positive("far_warm_start", self.far_warm_start, "goal widths")
         as_positive("narrow_ratio", self.narrow_ratio, "reach distance over goal width")
@@ -337,43 +342,70 @@ class Planner:
 
     def _solve_from(self, guesses, params: ReachParameters, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
-        """The best plan from the guesses (each (H, n)), solved in turn, or side by side on the start threads when
-        every guess is solved (:attr:`SolverOptions.threads`); ``until_converged``: stop at the
-        first whose solve converges ('solved') within the limits and ends at the goal (later guesses are
-        fallbacks). A solve that stalled ('solved_acceptable', along a redundant arm's flat directions) does not
-        stop the search: on 200 cold franka_rest problems 5 library starts did, one of them 6.4e-6 above the plan
-        of the full search (benchmarks/cold_quality.py, problem 175)."""
+        """The best plan from the guesses (each (H, n)): solved in turn, or, when every guess is solved, as the
+        cold search :meth:`_searched` runs them. ``until_converged``: stop at the first whose solve converges
+        ('solved') within the limits and ends at the goal (later guesses are fallbacks). A solve that stalled
+        ('solved_acceptable', along a redundant arm's flat directions) does not stop the search: on 200 cold
+        franka_rest problems 5 library starts did, one of them 6.4e-6 above the plan of the full search
+        (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
-        best = None
-        iterations = 0
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
         # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
         with self._blas:
-            solved = None
-            if self._start_threads is not None and not until_converged and len(guesses) > 1:
-                solved = self._start_threads.map(lambda guess, terms: self._run_solver(guess, params, deadline, terms), guesses)
-            for index, guess in enumerate(guesses):
-                if solved is None and time.perf_counter() > deadline and best is not None:
-                    break
-                candidate = self._run_solver(guess, params, deadline) if solved is None else solved[index]
-                iterations += candidate.nit
-                if not np.isfinite(candidate.x).all() or not np.isfinite(candidate.fun):
-                    candidate = SolverResult(guess, self.problem.objective_value(guess, params.start, params.goal, params.width)
-                                             / self.problem.normaliser(params.width),
-                                             Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
-                                             candidate.nit, np.inf)
-                # The plan within the limits with the lowest objective wins, whatever its status: a start that
-                # stalls short of the tolerances can still be far better than one that converged on the
-                # zero-reward plateau (seen on the Panda), and the status then says it did not converge.
-                if best is None or _rank(candidate) < _rank(best):
-                    best = candidate
-                if until_converged and best.status == Status.SOLVED and self._ends_at_goal(best.x, params):
-                    break
+            if until_converged or len(guesses) == 1 or self._curvature is None:
+                results = self._solved_in_turn(guesses, params, deadline, until_converged)
+            else:
+                results = [self._finite(result, guess, params) for guess, result in
+                           zip(guesses, self._searched(guesses, params, deadline))]
+        # The plan within the limits with the lowest objective wins, whatever its status: a start that stalls short
+        # of the tolerances can still be far better than one that converged on the zero-reward plateau (seen on the
+        # Panda), and the status then says it did not converge.
+        best = min(results, key=_rank)
         evaluation = None if best.local_model is None else (best.fun, best.local_model.data)
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
-                               solve_time=time.perf_counter() - t_begin, iterations=iterations)
+                               solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
         plan.goal_sensitivity = self._sensitivity_of(best)
         return plan
+
+    def _solved_in_turn(self, guesses, params: ReachParameters, deadline: float, until_converged: bool) -> list[SolverResult]:
+        """The guesses' solves one after another, each to convergence, until the deadline has passed (after the
+        first) or, ``until_converged``, the best so far is 'solved' and ends at the goal."""
+        results = []
+        for guess in guesses:
+            if results and time.perf_counter() > deadline:
+                break
+            results.append(self._finite(self._run_solver(guess, params, deadline), guess, params))
+            best = min(results, key=_rank)
+            if until_converged and best.status == Status.SOLVED and self._ends_at_goal(best.x, params):
+                break
+        return results
+
+    def _searched(self, guesses, params: ReachParameters, deadline: float) -> list[SolverResult]:
+        """Every guess's solve, side by side on the start threads if the planner has them (:attr:`SolverOptions.threads`).
+        'ranked' abandons a start that has not converged after ``abandon_after`` iterations when a start that has
+        converged within the limits by then has a lower objective than it has there; 'all' runs every start to the
+        end. The results do not depend on the threads: each start is solved alone, in the same two stages."""
+        threads = self._start_threads
+        terms = threads.terms(len(guesses)) if threads is not None else [self._curvature] * len(guesses)
+        run = threads.map if threads is not None else _one_after_another
+        budget = self._max_iterations
+        checkpoint = min(budget, self.options.abandon_after) if self.options.cold_search == "ranked" else budget
+        solves = [self._newton_solve(guess, params, deadline, curvature) for guess, curvature in zip(guesses, terms)]
+        results = run(lambda solve: solve.advance(checkpoint), solves)
+        lowest = min((result.fun for result in results if result.status in CONVERGED and result.violation <= LIMIT_TOLERANCE),
+                     default=np.inf)
+        going_on = [k for k, (solve, result) in enumerate(zip(solves, results)) if not solve.finished and not result.fun > lowest]
+        for k, result in zip(going_on, run(lambda k: solves[k].advance(budget), going_on)):
+            results[k] = result
+        return [self._as_torques(result) for result in results]
+
+    def _finite(self, result: SolverResult, guess: np.ndarray, params: ReachParameters) -> SolverResult:
+        """The result, or, where the solver returned a non-finite plan, the guess (H, n) with status 'failed'."""
+        if np.isfinite(result.x).all() and np.isfinite(result.fun):
+            return result
+        objective = self.problem.objective_value(guess, params.start, params.goal, params.width) / self.problem.normaliser(params.width)
+        return SolverResult(guess, objective, Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
+                            result.nit, np.inf)
 
     def _ends_at_goal(self, torque: np.ndarray, params: ReachParameters) -> bool:
         """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
@@ -394,22 +426,26 @@ class Planner:
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float,
-                    curvature: Curvature | None = None) -> SolverResult[np.ndarray]:
+    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
-        fun the normalised objective. ``curvature``: the terms to evaluate with (a start thread's own copy);
-        None: the planner's."""
+        fun the normalised objective."""
         if self._curvature is None:
             return self._run_ipopt(guess, params, deadline)
-        curvature = curvature or self._curvature
+        return self._as_torques(self._newton_solve(guess, params, deadline, self._curvature).advance(self._max_iterations))
+
+    def _newton_solve(self, guess: np.ndarray, params: ReachParameters, deadline: float, curvature: Curvature) -> NewtonSolve:
+        """The Newton method's solve from torques guess (H, n) until ``deadline`` (perf_counter, s), evaluated with
+        ``curvature`` (the planner's terms or a start's own copy of them), to run in stages."""
         value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
-        result = newton_minimize(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
-                                 *self._torque_bounds, tolerance=self._tolerance,
-                                 max_iterations=self._max_iterations, secant=not curvature.exact,
-                                 hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
-                                 constraints=self._limits.for_newton(curvature) if self._limits.active else None,
-                                 constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
-                                 value=value)
+        return newton_solve(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
+                            *self._torque_bounds, tolerance=self._tolerance, secant=not curvature.exact,
+                            hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
+                            constraints=self._limits.for_newton(curvature) if self._limits.active else None,
+                            constraint_tolerance=LIMIT_TOLERANCE, expired=lambda: time.perf_counter() > deadline,
+                            value=value)
+
+    def _as_torques(self, result: SolverResult) -> SolverResult[np.ndarray]:
+        """The result with x as torques (H, n)."""
         result.x = result.x.reshape(self.model.H, self.model.n)
         return result
 
@@ -451,6 +487,11 @@ class _SingleThreadBlas:
 def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
     """Distance (m) of the body's end effector at joint position q (n,) from a point (d,)."""
     return float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - point))
+
+
+def _one_after_another(function, items) -> list:
+    """[function(item) for each item]: the start threads' ``map``, in the calling thread."""
+    return [function(item) for item in items]
 
 
 def _rank(candidate: SolverResult) -> tuple[bool, float]:

@@ -1,9 +1,8 @@
 """Solving a cold search's starts side by side on threads (:class:`StartThreads`).
 
-An arm's cold solve without a reach library runs every minimum-jerk start to convergence and keeps the best
-plan. The starts are independent, and a Newton iteration on an arm spends most of its time in compiled CasADi
+An arm's cold solve without a reach library runs every minimum-jerk start and keeps the best plan. The starts are independent, and a Newton iteration on an arm spends most of its time in compiled CasADi
 functions and LAPACK, which run outside Python's interpreter lock, so threads solve them side by side on a
-machine's cores. Each thread evaluates with its own copy of the terms (their evaluation buffers are not
+machine's cores. Each start evaluates with its own copy of the terms (their evaluation buffers are not
 shared); every start is solved exactly as it would be alone, so the plans do not depend on the number of
 threads.
 """
@@ -11,7 +10,6 @@ threads.
 from __future__ import annotations
 
 import os
-import threading
 from concurrent.futures import ThreadPoolExecutor
 from typing import Callable, Sequence, TypeVar
 
@@ -29,28 +27,29 @@ def usable_cores() -> int:
 
 
 class StartThreads:
-    """Threads for one planner's starts, created on first use, each with its own copy of the planner's terms.
+    """Threads for one planner's starts, created on first use, and a copy of the planner's terms for each start (a
+    start's solve may go on, after a pause, on another thread than it began on).
 
     Args:
-        curvature: the planner's terms; each thread gets ``curvature.for_another_thread()``.
+        curvature: the planner's terms; each start gets ``curvature.for_another_thread()``.
         threads: the most starts solved at once.
     """
 
     def __init__(self, curvature: LinearisedCurvature, threads: int):
         self.curvature, self.threads = curvature, threads
         self._executor: ThreadPoolExecutor | None = None
-        self._local = threading.local()
+        self._copies: list[LinearisedCurvature] = []
 
-    def map(self, solve: Callable[[object, LinearisedCurvature], T], starts: Sequence) -> list[T]:
-        """[solve(start, terms) for each start], the solves running side by side, in the order of ``starts``;
-        ``terms`` is the calling thread's copy of the curvature. An exception in a solve is raised here."""
+    def terms(self, starts: int) -> list[LinearisedCurvature]:
+        """A copy of the terms for each of ``starts`` starts (made on first need, then kept)."""
+        while len(self._copies) < starts:
+            self._copies.append(self.curvature.for_another_thread())
+        return self._copies[:starts]
+
+    def map(self, function: Callable[[object], T], items: Sequence) -> list[T]:
+        """[function(item) for each item], the calls running side by side, in the order of ``items``. An exception
+        in a call is raised here."""
         if self._executor is None:
             self._executor = ThreadPoolExecutor(max_workers=self.threads, thread_name_prefix="comanip-start")
-        futures = [self._executor.submit(self._on_thread, solve, start) for start in starts]
+        futures = [self._executor.submit(function, item) for item in items]
         return [future.result() for future in futures]
-
-    def _on_thread(self, solve: Callable, start):
-        terms = getattr(self._local, "curvature", None)
-        if terms is None:
-            terms = self._local.curvature = self.curvature.for_another_thread()
-        return solve(start, terms)
