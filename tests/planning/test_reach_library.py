@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import comanip
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.planner import SolverOptions
 from comanip.planning.starts.reach_library import is_symmetric, reflection_onto
 
@@ -35,7 +36,10 @@ def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
         assert fast.success and reference.success
         # as good as the full search (the cold-search rule allows 1e-4 in 2 % of problems; these four are closer)
         assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
-        assert fast.iterations < reference.iterations  # one or two solves from near-optimal starts, not every guess
+        if ranked.starts.narrow(ReachParameters(start, goal, width)):  # local optima compete: the full search's starts
+            assert fast.iterations == reference.iterations
+        else:  # one solve from a near-optimal start, not every guess
+            assert fast.iterations < reference.iterations
 
 
 def test_library_entries_do_not_depend_on_the_order_of_the_solves():
@@ -139,3 +143,30 @@ def test_minimum_jerk_profiles_meet_their_boundary_conditions_one_duration_or_se
         # the velocity is the derivative of the position (central differences inside the move)
         inside = (t > 0.01) & (t < T - 0.01)
         np.testing.assert_allclose(np.gradient(pos, t, axis=0)[inside], vel[inside], atol=2e-3)
+
+
+@pytest.mark.parametrize("preset", ["cartesian", "human"])
+def test_a_moving_start_is_stopped_where_the_hand_comes_to_rest(preset):
+    """From a moving start the candidates are stops superposed on library reaches. A lightly damped hand (Cartesian,
+    D⁻¹M = 6.7 s) stops v0·T/2 on: the best such start has a lower objective than the best of the stops back at the
+    start position, and its rollout from the moving start ends at rest. A strongly damped one (human, D⁻¹M = 0.13 s,
+    shorter than T/2) is stopped back at the start position."""
+    from comanip.planning.starts.initial_guess import guess_durations, minimum_jerk_torques
+
+    model = comanip.presets.load(preset)
+    planner = comanip.Planner(model)
+    starts, n = planner.starts, model.n
+    durations = guess_durations(model.duration, planner.options.n_starts)
+    for velocity in (np.array([0.2, -0.15, 0.1][:n]), np.array([-0.25, 0.05, 0.2][:n])):
+        start, goal = np.r_[np.zeros(n), velocity], np.array([0.3, 0.1, 0.0][:n])
+        params = ReachParameters(start, goal, model.width)
+        stopped = starts.stopped_reaches(params, start)
+        at_start = list(starts.library.guess(start, goal, model.width)
+                        + minimum_jerk_torques(model.body, model.h, model.H, start, np.zeros(n), durations, starts.linear_dynamics))
+        if preset == "human":
+            np.testing.assert_allclose(np.array(stopped), np.array(at_start), rtol=0, atol=1e-12)
+            continue
+        assert min(starts.objective(c, params) for c in stopped) < min(starts.objective(c, params) for c in at_start)
+        for candidate in stopped:
+            rollout = planner.problem.trajectory(tau=np.ravel(candidate), s0=start, goal=goal, width=model.width)
+            assert np.linalg.norm(np.asarray(rollout["mean"])[n:2 * n, -1]) < 0.05 * np.linalg.norm(velocity)

@@ -109,10 +109,10 @@ class SolverOptions:
     without a library, or away from its ready pose, runs every guess as 'all' does. benchmarks/cold_quality.py
     compares 'ranked' with 'all' under the cold-search rule (docs/results/speed.md)."""
     narrow_ratio: float = 20.0
-    """Reach distance over goal width beyond which a 'ranked' cold solve also solves from the best minimum-jerk
-    guess (without a reach library: from every guess): far, narrow goals of the planar preset have several
-    local optima (the lowest-objective guess alone ended 0.7 % worse on 1 of 200 random problems, at 54 widths;
-    none below 20 widths on any point-mass preset)."""
+    """Reach distance over goal width beyond which a 'ranked' cold solve solves from every minimum-jerk guess:
+    far, narrow goals of the planar preset have several local optima (the lowest-objective start alone ended 0.7 %
+    worse on 1 of 200 random problems, at 54 widths, and with the best guess beside it 0.12 % worse on another, at
+    31 widths; none below 20 widths on any point-mass preset)."""
     far_warm_start: float = 3.0
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it. For

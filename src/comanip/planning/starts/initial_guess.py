@@ -79,7 +79,8 @@ def _quintic(x0, v0, x1, times: _QuinticTimes, positions: bool = True) -> tuple[
 def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration,
                          linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Commands (H, n) that make the mean follow a joint-space minimum-jerk reach from start (nx,) to goal_q (n,)
-    (through the body's activation stages, if it has them); for durations (m,), one per duration (m, H, n).
+    (through the body's activation stages, if it has them); for durations (m,), one per duration (m, H, n), to
+    goal_q (n,) or to a goal per duration (m, 1, n).
 
     ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics_of`, evaluated
     once by a caller that makes many guesses; None evaluates them here."""

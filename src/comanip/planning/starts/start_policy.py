@@ -48,6 +48,9 @@ class StartPolicy:
         self.torque_box = (np.tile(-body.tau_max, (H, 1)), np.tile(body.tau_max, (H, 1)))
         self.unbounded = not np.isfinite(body.tau_max).any()
         self.linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
+        self.damped_drift = _damped_drift(body, self.linear_dynamics)
+        """D⁻¹ M (n, n) of a linear body: how far (m) its damping alone carries it per m/s of start velocity (inf
+        without damping); None for other bodies."""
         # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
         self.task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
             if body.is_linear else None
@@ -159,10 +162,9 @@ class StartPolicy:
         body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
         candidate of lowest objective (evaluating one costs about a hundredth of solving from it) among the
         minimum-jerk guesses and the nearest solved reach of the :class:`ReachLibrary` (from a moving
-        start with minimum-jerk moves that bring the start's motion to rest superposed: the mean is affine in
-        the torques and the start). Where several local optima compete the lowest-objective start can end on
-        a worse one, so the plan is compared with another: a goal farther than ``narrow_ratio`` widths also runs
-        the best minimum-jerk guess. The full search stays ``cold_search="all"``; benchmarks/cold_quality.py checks
+        start: :meth:`stopped_reaches`). Where several local optima compete the lowest-objective start can end on
+        a worse one: a goal farther than ``narrow_ratio`` widths runs every minimum-jerk guess instead, as the full
+        search does. The full search stays ``cold_search="all"``; benchmarks/cold_quality.py checks
         the ranked starts against it under the cold-search rule (within 1e-4 of its objective in at least 98 % of
         random problems, never 1e-3 worse, as many successes).
         A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
@@ -178,21 +180,44 @@ class StartPolicy:
         motion[: model.n] = 0.0
         moving = bool(np.any(motion))
         guesses = self.cold_guesses(params, self.options.n_starts)
+        if self.narrow(params):  # several local optima compete: the full search's starts
+            return guesses
         objectives = [self.objective(guess, params) for guess in guesses]
         first_best = min(range(len(guesses)), key=objectives.__getitem__)
         best_guess = guesses[first_best]
-        turned = self.library.guess(start, goal, width, solve_missing=not budgeted)
-        if turned is None:  # the goal at the start, or a budgeted solve without the entry: as without a library
-            return guesses if self.narrow(params) else [best_guess]
-        candidates = [turned]
         if moving:
-            candidates = list(turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(model.n),
-                                                            guess_durations(model.duration, self.options.n_starts),
-                                                            self.linear_dynamics))
+            candidates = self.stopped_reaches(params, motion, budgeted)
+        else:
+            turned = self.library.guess(start, goal, width, solve_missing=not budgeted)
+            candidates = [] if turned is None else [turned]
+        if not candidates:  # the goal at the start, or a budgeted solve without the entry: as without a library
+            return [best_guess]
         scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
             [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
-        best = min(scored, key=lambda pair: pair[0])[1]
-        return [best, best_guess] if self.narrow(params) and best is not best_guess else [best]
+        return [min(scored, key=lambda pair: pair[0])[1]]
+
+    def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, budgeted: bool = False) -> list[np.ndarray]:
+        """A point mass's starts (H, n) from a moving start: for each minimum-jerk duration T, a stop from the start's
+        velocity v0 superposed on the library's reach from where the stop ends to the goal (the mean is affine in the
+        torques and the start, so the sum ends at the goal at rest). A lightly damped hand stops v0·T/2 on, where a
+        minimum-jerk stop with a free end comes to rest (the quintic's t⁵ term vanishes); one whose damping alone
+        would stop it sooner (D⁻¹ M v0 on) is braked back to its start position, the stop that serves strongly
+        damped hands better (benchmarks/cold_quality.py). Stops whose reach the library does not have for a
+        budgeted solve are left out. ``motion`` (nx,): the start with its position zeroed."""
+        model, start = self.model, params.start
+        n = model.n
+        durations = guess_durations(model.duration, self.options.n_starts)
+        velocity = motion[n:2 * n]
+        stops = 0.5 * durations[:, None] * velocity
+        stops[np.linalg.norm(stops, axis=1) > np.linalg.norm(self.damped_drift @ velocity)] = 0.0
+        brakes = minimum_jerk_torques(model.body, model.h, model.H, motion, stops[:, None, :], durations, self.linear_dynamics)
+        at_rest = np.zeros(model.state_size - n)
+        reaches = {}  # one library reach per distinct stop
+        for stop in stops:
+            if stop.tobytes() not in reaches:
+                reaches[stop.tobytes()] = self.library.guess(np.r_[start[:n] + stop, at_rest], params.goal, params.width,
+                                                             solve_missing=not budgeted)
+        return [reaches[stop.tobytes()] + brake for stop, brake in zip(stops, brakes) if reaches[stop.tobytes()] is not None]
 
     def arm_library_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """An arm's cold starts from its ready pose (:mod:`comanip.planning.starts.arm_reach_library`): first the
@@ -245,3 +270,14 @@ class StartPolicy:
         if self.curvature is not None:
             return self.curvature.value(np.ravel(torque), params)
         return self.problem.objective_value(torque, params.start, params.goal, params.width)
+
+
+def _damped_drift(body, linear_dynamics) -> np.ndarray | None:
+    """D⁻¹ M (n, n) of a linear body with mass matrix M and damping D (M v' = -D v carries it D⁻¹ M v0 from a start
+    velocity v0); entries inf when D is singular; None without linear dynamics."""
+    if linear_dynamics is None:
+        return None
+    mass, damping = linear_dynamics[0], np.asarray(body.damping, dtype=float)
+    if np.linalg.matrix_rank(damping) < len(damping):
+        return np.full(mass.shape, np.inf)
+    return np.linalg.solve(damping, mass)
