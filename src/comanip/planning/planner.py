@@ -122,10 +122,10 @@ class SolverOptions:
     also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:
     the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.starts.arm_reach_library`)."""
     abandon_after: int = 100
-    """Newton iterations after which a 'ranked' cold search that runs every start (an arm without a reach library)
-    abandons a start that has not converged, when a start that has converged within the limits by then has a lower
-    objective than it has there. Long starts crawl along a joint limit and seldom end best
-    (benchmarks/franka_abandon.py); 'all' runs every start to the end."""
+    """Newton iterations after which a 'ranked' cold search that runs every start (an arm without a reach library, a
+    point mass's narrow goal) abandons a start that has not converged, when a start that has converged within the
+    limits by then has a lower objective than it has there. On the Panda long starts crawl along a joint limit and
+    seldom end best (benchmarks/franka_abandon.py); 'all' runs every start to the end."""
     threads: int | None = None
     """Threads that solve a nonlinear body's cold starts side by side when every start runs to convergence (an arm
     without a reach library, or ``cold_search="all"``): a Newton iteration on an arm spends most of its time in
