@@ -127,3 +127,15 @@ def as_square_matrix(name: str, value, n: int, unit: str, positive_definite: boo
     if positive_definite and (not np.allclose(matrix, matrix.T) or np.linalg.eigvalsh(matrix).min() <= 0):
         raise ValueError(f"{name} must be symmetric positive definite ({unit}), got {matrix.tolist()}")
     return matrix
+
+
+def as_scheduler_address(name: str, value) -> str:
+    """A Dask scheduler address (protocol://location; for tcp and tls, host:port as in 'tcp://host:8786'), else
+    ValueError naming the argument."""
+    text = value if isinstance(value, str) else ""
+    protocol, _, location = text.partition("://")
+    host, _, port = location.rpartition(":")
+    if not (protocol and location) or (protocol in ("tcp", "tls") and not (host and port.isdigit())):
+        raise ValueError(f"{name} must be a Dask scheduler address such as 'tcp://host:8786' (protocol://host:port), "
+                         f"got {value!r}")
+    return text

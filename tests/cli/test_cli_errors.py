@@ -100,6 +100,7 @@ def test_help_has_no_literal_double_backticks(capsys):
     (["transition", "generate", "--widths", "0.01,-0.02"], ["widths must be > 0"]),
     (["transition", "generate", "--workers", "0"], ["workers must be an integer ≥ 1"]),
     (["ros", "--speed", "2"], ["--speed", "--replay"]),
+    (["fit", "--scheduler", "localhost", "--mt-table", "mt.csv"], ["--scheduler", "protocol://host:port"]),
 ])
 def test_long_commands_check_inputs_before_making_their_folder(tmp_path, capsys, argv, fragments):
     """A mistake in any goal or sweep setting is found before the first plan is solved or the folder is made."""

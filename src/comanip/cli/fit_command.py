@@ -6,7 +6,8 @@ from __future__ import annotations
 
 from comanip.arguments import as_count
 from comanip.cli.commands import command_help
-from comanip.cli.options import add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model
+from comanip.cli.options import (add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model,
+                                 scheduler_address)
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.fitting.parameters import DEFAULT_PARAMETERS, MT_DEFAULT_PARAMETERS, ParameterSpace
 
@@ -23,7 +24,7 @@ def add_parser(subparsers) -> None:
                         f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, {','.join(MT_DEFAULT_PARAMETERS)} for an MT table)")
     parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
     parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings, 100 for an MT table)")
-    parser.add_argument("--scheduler", help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
+    parser.add_argument("--scheduler", type=scheduler_address, help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
     add_output_arguments(parser, "out/fit")
     parser.add_argument("--no-progress", action="store_true", help="no progress line")
     parser.set_defaults(func=run)

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from comanip import presets
+from comanip.arguments import as_scheduler_address
 from comanip.cli.outputs import add_output_arguments
 
 if TYPE_CHECKING:
@@ -46,6 +47,14 @@ def load_model(args: argparse.Namespace) -> ReachingModel:
         return presets.load(args.preset)
     except ValueError as error:
         raise ValueError(f"--preset: {error}") from None
+
+
+def scheduler_address(text: str) -> str:
+    """An argparse type: a Dask scheduler address (protocol://host:port), checked before any work is done."""
+    try:
+        return as_scheduler_address("--scheduler", text)
+    except ValueError as error:
+        raise argparse.ArgumentTypeError(str(error)) from None
 
 
 def input_file(text: str) -> Path:

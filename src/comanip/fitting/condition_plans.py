@@ -20,6 +20,7 @@ import threading
 
 import numpy as np
 
+from comanip.arguments import as_scheduler_address
 from comanip.model import ReachingModel
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
@@ -98,9 +99,7 @@ def _client(scheduler):
 
     if isinstance(scheduler, Client):
         return scheduler, False
-    if not isinstance(scheduler, str) or "://" not in scheduler:
-        raise ValueError(f"scheduler must be None, a Dask scheduler address such as 'tcp://host:8786' or a "
-                         f"dask.distributed.Client, got {scheduler!r}")
+    as_scheduler_address("scheduler (or None, or a dask.distributed.Client)", scheduler)
     try:
         return Client(scheduler, timeout="10s"), True
     except (OSError, TimeoutError) as error:
