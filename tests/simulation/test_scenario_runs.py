@@ -40,6 +40,21 @@ def test_compared_policies_share_the_trials_and_count_in_the_timing():
     assert set(result.summary()["goals"]["near"]["policies"]) == set(policies)
 
 
+@pytest.mark.slow
+def test_the_comparison_figure_of_a_policy_that_estimates_nothing_draws_without_warnings(tmp_path):
+    """The passive robot makes no goal estimates: its comparison figure says so instead of an empty legend."""
+    import warnings
+
+    from comanip.plots.policy_comparison_figure import plot_policy_comparison
+
+    result = run_scenario("sync", {"near": SyncSettings(goal="near", trials=1, duration=DURATION, policy="passive")},
+                          policies=["passive"], progress=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        path = plot_policy_comparison(result.policy_trials(), tmp_path / "policies.png")
+    assert path.stat().st_size > 0
+
+
 def test_policies_are_sync_only_and_the_scenario_must_exist():
     with pytest.raises(ValueError, match="sync scenario only"):
         run_scenario("handover", {"near": HandoverSettings(goal="near", trials=1)}, policies=["passive"])

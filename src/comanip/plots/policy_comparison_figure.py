@@ -38,11 +38,16 @@ def plot_policy_comparison(results: dict[str, dict[str, list[SyncTrial]]], path:
             q25[seen], median[seen], q75[seen] = np.nanpercentile(error[:, seen], [25, 50, 75], axis=0)
             ax.plot(t, median, color=colors[name], lw=1.6, label=name)
             ax.fill_between(t, q25, q75, color=colors[name], alpha=0.2, lw=0)
+        estimated = bool(ax.lines)  # False when every policy estimates nothing (passive)
+        if not estimated:
+            ax.text(0.5, 0.5, "no goal estimates", transform=ax.transAxes, ha="center", va="center", color="gray")
         mt = np.median([trial.metrics["movement_time_s"] for trials in results[goal].values() for trial in trials])
         ax.axvline(mt, color="gray", ls=":", lw=1)
-        ax.set(xlabel="t (s)", ylabel="goal-estimate error (mm)", title=f"{goal}: goal error (median, IQR)", yscale="log")
+        ax.set(xlabel="t (s)", ylabel="goal-estimate error (mm)", title=f"{goal}: goal error (median, IQR)",
+               yscale="log" if estimated else "linear")
         ax.grid(alpha=0.3, which="both")
-    axes[0, 0].legend(fontsize=8)
+    if axes[0, 0].get_legend_handles_labels()[0]:
+        axes[0, 0].legend(fontsize=8)
     for ax in axes[0, len(goals):]:
         ax.set_visible(False)
     for ax, (key, (label, scale)) in zip(axes[1], BOXED.items()):
