@@ -122,21 +122,7 @@ def _point_mass_sections(model: ReachingModel, settings: ValidationSettings,
         len(settings.distances), len(settings.widths))
 
     report = {
-        "fitts_grid": {
-            "conditions": [c | {"id_fitts_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "fitts")),
-                                "id_shannon_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "shannon"))}
-                           for c in grid_row["conditions"]],
-            "fits": {fit.form: fit.to_dict() for fit in fits},
-            "width_trend": grid_row["width_trend"],
-            "distance_trend": grid_row["distance_trend"],
-            "trend_tolerance_s": TREND_TOLERANCE,
-            "mt_in_human_range": grid_row["mt_in_human_range"],
-            "human_mt_range_s": list(HUMAN_MT_RANGE),
-            "all_solves_converged": grid_row["all_solves_converged"],
-            "asymmetry_min": grid_row["asymmetry_min"], "asymmetry_median": grid_row["asymmetry_median"],
-            "asymmetry_max": grid_row["asymmetry_max"],
-            "minimum_jerk_asymmetry": minimum_jerk_asymmetry(),
-        },
+        "fitts_grid": _fitts_grid_report(grid_row, fits),
         "dispersion": {
             "goal_m": dispersion_goal.tolist(),
             "widths": [d.summary() | {"plan_success": plan.success} for plan, d in dispersions],
@@ -153,6 +139,26 @@ def _point_mass_sections(model: ReachingModel, settings: ValidationSettings,
         },
     }
     return report, figure_data, grid
+
+
+def _fitts_grid_report(grid_row: dict, fits) -> dict:
+    """The report entry of the distances × widths grid: its conditions with their indices of difficulty, the Fitts
+    and Shannon fits, the trends and the movement times against the human range."""
+    return {
+        "conditions": [c | {"id_fitts_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "fitts")),
+                            "id_shannon_bits": float(index_of_difficulty(c["distance_m"], c["width_m"], "shannon"))}
+                       for c in grid_row["conditions"]],
+        "fits": {fit.form: fit.to_dict() for fit in fits},
+        "width_trend": grid_row["width_trend"],
+        "distance_trend": grid_row["distance_trend"],
+        "trend_tolerance_s": TREND_TOLERANCE,
+        "mt_in_human_range": grid_row["mt_in_human_range"],
+        "human_mt_range_s": list(HUMAN_MT_RANGE),
+        "all_solves_converged": grid_row["all_solves_converged"],
+        "asymmetry_min": grid_row["asymmetry_min"], "asymmetry_median": grid_row["asymmetry_median"],
+        "asymmetry_max": grid_row["asymmetry_max"],
+        "minimum_jerk_asymmetry": minimum_jerk_asymmetry(),
+    }
 
 
 def _r2_if_log_linear_in_d_over_sqrt_w(grid, form: str) -> float:
