@@ -233,6 +233,17 @@ def test_starts_solved_side_by_side_give_the_plan_solved_one_after_another(frank
         (in_turn.objective, in_turn.iterations, in_turn.status)
 
 
+def test_a_budgeted_cold_search_on_threads_returns_its_best_plan_so_far(franka_planner):
+    """Every start on its thread stops at the wall-time budget; the best plan so far comes back, finite, with status
+    'max_wall_time' (a cold search of the paper preset takes several times this budget)."""
+    model = franka_planner.model
+    start = np.r_[model.body.home_position, np.zeros(7)]
+    goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
+    plan = franka_planner.solve(start, goal, max_wall_time=0.05)
+    assert plan.status == "max_wall_time" and not plan.success
+    assert np.all(np.isfinite(plan.torque)) and np.isfinite(plan.objective) and plan.iterations > 0
+
+
 def test_a_ranked_cold_search_abandons_starts_a_converged_start_beats():
     """With abandon_after one past the shortest start's iterations, the starts still running then are worse than
     the converged one (all three end on the same optimum here) and are abandoned: fewer iterations than the full
