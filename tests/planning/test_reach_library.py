@@ -170,3 +170,21 @@ def test_a_moving_start_is_stopped_where_the_hand_comes_to_rest(preset):
         for candidate in stopped:
             rollout = planner.problem.trajectory(tau=np.ravel(candidate), s0=start, goal=goal, width=model.width)
             assert np.linalg.norm(np.asarray(rollout["mean"])[n:2 * n, -1]) < 0.05 * np.linalg.norm(velocity)
+
+
+def test_an_undamped_hand_from_a_moving_start_stops_where_a_free_end_stop_comes_to_rest():
+    """Without damping nothing stops the hand but the stop itself: every stop ends v0·T/2 on, and the candidates'
+    rollouts from the moving start end at rest (no infinite or undefined drift on the way)."""
+    from comanip.bodies.point_mass import PointMass
+
+    model = comanip.presets.planar().replace(body=PointMass(2, damping=0.0))
+    planner = comanip.Planner(model)
+    velocity = np.array([0.2, -0.1])
+    start, goal = np.r_[np.zeros(2), velocity], np.array([0.25, 0.05])
+    assert planner.starts.damped_drift is None
+    candidates = planner.starts.stopped_reaches(ReachParameters(start, goal, model.width), start)
+    assert len(candidates) == planner.options.n_starts and all(np.all(np.isfinite(c)) for c in candidates)
+    for candidate in candidates:
+        rollout = planner.problem.trajectory(tau=np.ravel(candidate), s0=start, goal=goal, width=model.width)
+        assert np.linalg.norm(np.asarray(rollout["mean"])[2:4, -1]) < 0.05 * np.linalg.norm(velocity)
+    assert planner.solve(start, goal, model.width).success

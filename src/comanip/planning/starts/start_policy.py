@@ -49,8 +49,8 @@ class StartPolicy:
         self.unbounded = not np.isfinite(body.tau_max).any()
         self.linear_dynamics = linear_dynamics_of(body) if body.is_linear else None
         self.damped_drift = _damped_drift(body, self.linear_dynamics)
-        """D⁻¹ M (n, n) of a linear body: how far (m) its damping alone carries it per m/s of start velocity (inf
-        without damping); None for other bodies."""
+        """D⁻¹ M (n, n) of a linear body: how far (m) its damping alone carries it per m/s of start velocity; None for
+        other bodies and undamped ones."""
         # a linear body's joint move (n,) per task-space move (d,): the pseudo-inverse of its constant Jacobian
         self.task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
             if body.is_linear else None
@@ -209,7 +209,8 @@ class StartPolicy:
         durations = guess_durations(model.duration, self.options.n_starts)
         velocity = motion[n:2 * n]
         stops = 0.5 * durations[:, None] * velocity
-        stops[np.linalg.norm(stops, axis=1) > np.linalg.norm(self.damped_drift @ velocity)] = 0.0
+        drift = np.inf if self.damped_drift is None else np.linalg.norm(self.damped_drift @ velocity)
+        stops[np.linalg.norm(stops, axis=1) > drift] = 0.0
         brakes = minimum_jerk_torques(model.body, model.h, model.H, motion, stops[:, None, :], durations, self.linear_dynamics)
         at_rest = np.zeros(model.state_size - n)
         reaches = {}  # one library reach per distinct stop
@@ -274,10 +275,10 @@ class StartPolicy:
 
 def _damped_drift(body, linear_dynamics) -> np.ndarray | None:
     """D⁻¹ M (n, n) of a linear body with mass matrix M and damping D (M v' = -D v carries it D⁻¹ M v0 from a start
-    velocity v0); entries inf when D is singular; None without linear dynamics."""
+    velocity v0); None without linear dynamics or when D is singular (the damping alone does not stop it)."""
     if linear_dynamics is None:
         return None
     mass, damping = linear_dynamics[0], np.asarray(body.damping, dtype=float)
     if np.linalg.matrix_rank(damping) < len(damping):
-        return np.full(mass.shape, np.inf)
+        return None
     return np.linalg.solve(damping, mass)
