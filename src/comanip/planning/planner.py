@@ -127,8 +127,8 @@ class SolverOptions:
     limits by then has a lower objective than it has there. On the Panda long starts crawl along a joint limit and
     seldom end best (benchmarks/franka_abandon.py); 'all' runs every start to the end."""
     threads: int | None = None
-    """Threads that solve a nonlinear body's cold starts side by side when every start runs to convergence (an arm
-    without a reach library, or ``cold_search="all"``): a Newton iteration on an arm spends most of its time in
+    """Threads that solve a nonlinear body's cold starts side by side when every start is solved (an arm without a
+    reach library, or ``cold_search="all"``): a Newton iteration on an arm spends most of its time in
     compiled code and LAPACK, which run outside Python's interpreter lock (:mod:`comanip.planning.start_threads`).
     None: one thread per start, at most one per processor the process may use; 1: one start after another (e.g.
     for sweeps that already run a process per core). The plan is the same whatever this says: each start is solved

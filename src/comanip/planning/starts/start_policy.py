@@ -175,13 +175,12 @@ class StartPolicy:
             return self.arm_library_starts(params, goal_q)
         if self.library is None:
             return self.searched_guesses(params, goal_q)
-        model = self.model
-        motion = start.copy()
-        motion[: model.n] = 0.0
-        moving = bool(np.any(motion))
         guesses = self.cold_guesses(params, self.options.n_starts)
         if self.narrow(params):  # several local optima compete: the full search's starts
             return guesses
+        motion = start.copy()
+        motion[: self.model.n] = 0.0
+        moving = bool(np.any(motion))
         objectives = [self.objective(guess, params) for guess in guesses]
         first_best = min(range(len(guesses)), key=objectives.__getitem__)
         best_guess = guesses[first_best]
@@ -213,12 +212,13 @@ class StartPolicy:
         stops[np.linalg.norm(stops, axis=1) > drift] = 0.0
         brakes = minimum_jerk_torques(model.body, model.h, model.H, motion, stops[:, None, :], durations, self.linear_dynamics)
         at_rest = np.zeros(model.state_size - n)
-        reaches = {}  # one library reach per distinct stop
-        for stop in stops:
-            if stop.tobytes() not in reaches:
-                reaches[stop.tobytes()] = self.library.guess(np.r_[start[:n] + stop, at_rest], params.goal, params.width,
-                                                             solve_missing=not budgeted)
-        return [reaches[stop.tobytes()] + brake for stop, brake in zip(stops, brakes) if reaches[stop.tobytes()] is not None]
+
+        def reach_from(stop):
+            return self.library.guess(np.r_[start[:n] + stop, at_rest], params.goal, params.width, solve_missing=not budgeted)
+
+        back_at_start = reach_from(np.zeros(n)) if not stops.any(axis=1).all() else None  # one reach for every such stop
+        reaches = [reach_from(stop) if stop.any() else back_at_start for stop in stops]
+        return [reach + brake for reach, brake in zip(reaches, brakes) if reach is not None]
 
     def arm_library_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """An arm's cold starts from its ready pose (:mod:`comanip.planning.starts.arm_reach_library`): first the
