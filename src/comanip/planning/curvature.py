@@ -78,10 +78,10 @@ class ReachCurvature:
         self._G = _constant_sensitivities(model)
         self._velocity_hessian = _velocity_cost_hessian(problem)
         self._build_constant_products()
-        nz = self._nz = d + len(self._triangle)
+        reduced = d + self._U.shape[2]
         # where the terms' output vector's pieces end: the gradient, the per-step Hessians, the per-step gradients
-        self._term_ends = np.cumsum([1 + n * H, nz * nz * (H + 1), nz * (H + 1)])
-        self._diagonal = np.diag_indices(H * n)
+        self._term_ends = np.cumsum([1 + n * H, reduced * reduced * (H + 1), reduced * (H + 1)])
+        self._reduced_shapes = ((H + 1, reduced, reduced), (H + 1, reduced))
         params = ca.vertcat(problem.s0, problem.goal, problem.width)
         functions = [self._terms_function(problem),
                      ca.Function("reach_value", [ca.vec(problem.tau), params], [problem.objective / -problem.best_objective])]
@@ -95,21 +95,22 @@ class ReachCurvature:
 
     # -- the compiled per-solve function -------------------------------------------------------------
     def _terms_function(self, problem: ReachProblem) -> ca.Function:
-        """``(x, p) -> [f; grad f; ∇²phi_i stacked (nz, nz·(H+1)); ∇phi_i stacked (nz, H+1)]``, the matrices column
-        by column in one output vector (:meth:`evaluate` slices it: a call copies one array out instead of four)."""
+        """``(x, p) -> [f; grad f; ∇²_z~ phi_i for i = 0..H; ∇_z~ phi_i for i = 0..H]`` in one output vector, the
+        per-step pieces in the reduced coordinates z~_i (:meth:`_build_constant_products`), each Hessian row by
+        row: :meth:`evaluate` reshapes the slices as they are (a call copies one array out instead of four)."""
         x = ca.vec(problem.tau)
         scale = -problem.best_objective
         f = problem.objective / scale
         step_terms = _reward_derivatives_function(problem.model)
         hessians, gradients = [], []
-        for w, mu_x, Sigma_x in zip(problem.weights, problem.ee_means, problem.ee_covs):
+        for T, w, mu_x, Sigma_x in zip(self._T, problem.weights, problem.ee_means, problem.ee_covs):
             vech = ca.vertcat(*[Sigma_x[a, b] for a, b in self._triangle])
             hess, grad = step_terms(mu_x, vech, problem.goal, problem.width, w / scale)
-            hessians.append(hess)
-            gradients.append(grad)
+            T = ca.DM(T)
+            hessians.append(ca.vec(ca.mtimes([T.T, hess, T])))  # symmetric: column by column is row by row
+            gradients.append(ca.mtimes(T.T, grad))
         return ca.Function("reach_terms", [x, ca.vertcat(problem.s0, problem.goal, problem.width)],
-                           [ca.vertcat(f, ca.gradient(f, x), ca.vec(ca.horzcat(*hessians)), ca.vec(ca.horzcat(*gradients)))],
-                           ["x", "p"], ["f_grad_phi_hess_phi_grad"])
+                           [ca.vertcat(f, ca.gradient(f, x), *hessians, *gradients)], ["x", "p"], ["f_grad_phi_hess_phi_grad"])
 
     def _build_constant_products(self) -> None:
         """Z's mean rows and the coefficients of its covariance rows (linear in tau), fixed for a linear body.
@@ -139,7 +140,6 @@ class ReachCurvature:
         self._T = np.zeros((H + 1, d + len(a), d + rank))
         self._T[:, :d, :d] = np.eye(d)
         self._T[:, d:, d:] = self._U
-        self._T_transposed = np.swapaxes(self._T, 1, 2)  # a view
         self._rows = np.empty((H + 1, d + rank, H, n))  # Z~ (_reduced_rows), its mean rows fixed
         self._rows[:, :d] = self._mean_rows
         # flat indices of the Hessian's block-diagonal entries (k·n + j, k·n + l), in the order of the blocks output
@@ -175,10 +175,9 @@ class ReachCurvature:
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
         out = self._terms.vector(x, params.vector)
-        ends, nz, steps = self._term_ends, self._nz, self.model.H + 1
-        # the per-step pieces as views, column by column (as the compiled function wrote them)
-        return float(out[0]), out[1:ends[0]], ReachTerms(x, params.width, out[ends[0]:ends[1]].reshape((nz, nz * steps), order="F"),
-                                                         out[ends[1]:ends[2]].reshape((nz, steps), order="F"))
+        ends, (hessians, gradients) = self._term_ends, self._reduced_shapes
+        return float(out[0]), out[1:ends[0]], ReachTerms(x, params.width, out[ends[0]:ends[1]].reshape(hessians),
+                                                         out[ends[1]:ends[2]].reshape(gradients))
 
     def value(self, x: np.ndarray, params: ReachParameters) -> float:
         """f at torques x (H·n,) alone."""
@@ -195,21 +194,17 @@ class ReachCurvature:
 
     def hessian(self, data: ReachTerms) -> np.ndarray:
         """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
-        phi_hess, phi_grad = self._pieces(data)
         model = self.model
         n, d, H = model.n, model.d, model.H
-        nz = phi_hess.shape[0]
         rank = self._U.shape[2]
-        T = self._T
-        Q = self._T_transposed @ phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2) @ T
         Z = self._reduced_rows(data)
-        QZ = np.matmul(Q, Z)
+        QZ = np.matmul(data.phi_hess, Z)
         hessian = _causal_gram(Z.reshape(-1, H * n), QZ.reshape(-1, H * n), d + rank, n)
-        # ∇²_tau Σ_i Σ_v (dphi_i/dvech_v) Sigma_x,i[v]: the noise's own curvature, block-diagonal in k
-        weights = np.einsum("ivr,vi->ir", self._U, phi_grad[d:])
-        blocks = weights.reshape(1, -1) @ self._K.reshape((H + 1) * rank, H * n * n)
-        hessian.ravel()[self._block_entries] += blocks.ravel()
-        hessian[self._diagonal] += self._effort / self.normaliser(data.width)
+        # ∇²_tau Σ_i Σ_v (dphi_i/dvech_v) Sigma_x,i[v]: the noise's own curvature, block-diagonal in k, from the
+        # gradient's covariance coordinates U_iᵀ ∇_vech phi_i
+        blocks = data.phi_grad[:, d:].ravel() @ self._K.reshape((H + 1) * rank, H * n * n)
+        hessian.ravel()[self._block_entries] += blocks
+        hessian.ravel()[::H * n + 1] += self._effort / self.normaliser(data.width)
         if self._velocity_hessian is not None:  # the speed cost is scaled by |J_best| already
             hessian += self._velocity_hessian
         return hessian
@@ -222,27 +217,16 @@ class ReachCurvature:
         columns of the per-step derivatives the Hessian uses anyway. Then ∂f/∂g = Σ_i ∂phi_i/∂g,
         ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
         """
-        phi_hess, phi_grad = self._pieces(data)
-        H, d = self.model.H, self.model.d
-        Q = phi_hess.reshape(phi_hess.shape[0], H + 1, phi_hess.shape[0]).transpose(1, 0, 2)
-        return -phi_grad[:d].sum(axis=1), self.goal_cross_derivative(data), Q[:, :d, :d].sum(axis=0)
+        d = self.model.d
+        return -data.phi_grad[:, :d].sum(axis=0), self.goal_cross_derivative(data), data.phi_hess[:, :d, :d].sum(axis=0)
 
     def goal_cross_derivative(self, data: ReachTerms) -> np.ndarray:
         """∂²f/∂x∂g (H·n, d) of :meth:`goal_derivatives` alone (what the tangential predictor needs)."""
-        phi_hess, _ = self._pieces(data)
-        H, d = self.model.H, self.model.d
-        nz = phi_hess.shape[0]
-        Q = phi_hess.reshape(nz, H + 1, nz).transpose(1, 0, 2)
+        d = self.model.d
         Z = self._reduced_rows(data)
-        # Z_iᵀ M = Z~_iᵀ T_iᵀ M: the rows are kept in the reduced basis z~_i (see _build_constant_products)
-        goal_columns = -self._T_transposed @ Q[:, :, :d]  # ∂²phi_i/∂z~_i∂g (H+1, d + r, d)
+        # ∂²phi_i/∂z~_i∂g = -∂²phi_i/∂z~_i∂mu_x,i: the first d columns of the reduced Hessian (T_i is the identity there)
+        goal_columns = -data.phi_hess[:, :, :d]  # (H+1, d + r, d)
         return Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
-
-    @staticmethod
-    def _pieces(data: ReachTerms) -> tuple[np.ndarray, np.ndarray]:
-        """The data's per-step Hessians (nz, nz·(H+1)) and gradients (nz, H+1), row by row in memory (the products
-        above then run through the same code paths, and round the same, whatever the views' layout)."""
-        return np.ascontiguousarray(data.phi_hess), np.ascontiguousarray(data.phi_grad)
 
     def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
         """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear
@@ -322,15 +306,17 @@ def _constant_sensitivities(model) -> np.ndarray:
     return np.einsum("ar,ikrb->ikab", J, state_sensitivity[:, :, :n, :])
 
 
-def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int, chunks: int = 4) -> np.ndarray:
+def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int) -> np.ndarray:
     """Σ_i Z_iᵀ QZ_i for Z, QZ ((H+1)·nz, H·n) stacking per-step blocks of ``rows_per_step`` rows, where
     step i's block is zero beyond column n·i (causality).
 
-    Steps are taken in a few chunks so the products skip most of the zero upper part; the 2-D slices
-    are views, which BLAS reads in place.
+    Steps are taken in chunks so the products skip most of the zero upper part; the 2-D slices are views, which
+    BLAS reads in place. A chunk per 30 unknowns, at most 4: each product costs a few microseconds of its own,
+    more than the zeros it skips in a small problem.
     """
     size = Z.shape[1]
     steps = Z.shape[0] // rows_per_step
+    chunks = min(4, max(1, size // 30))
     out = np.zeros((size, size))
     bounds = [steps * k // chunks for k in range(chunks + 1)]
     for lo, hi in zip(bounds[:-1], bounds[1:]):

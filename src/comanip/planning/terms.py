@@ -30,9 +30,10 @@ class ReachTerms:
     width: float
     """Goal width w (m)."""
     phi_hess: np.ndarray
-    """∇²_z phi_i stacked (nz, nz·(H+1))."""
+    """∇²_z~ phi_i (H+1, d + r, d + r) in each step's reduced coordinates z~_i = (mu_x,i, U_iᵀ vech Sigma_x,i)
+    (:class:`~comanip.planning.curvature.ReachCurvature`; r the rank of the covariance rows)."""
     phi_grad: np.ndarray
-    """∇_z phi_i stacked (nz, H+1)."""
+    """∇_z~ phi_i (H+1, d + r) in the same coordinates."""
 
 
 @dataclass(eq=False)
