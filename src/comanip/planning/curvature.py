@@ -190,7 +190,7 @@ class ReachCurvature:
     def final_position_change(self, torque_change: np.ndarray) -> np.ndarray:
         """How far (d,) m the mean end-effector position at step H moves for a change of the torques (H, n) (exact:
         for a linear body the mean is affine in the torques)."""
-        return np.einsum("kan,kn->a", self._G[-1], torque_change)
+        return self._mean_rows[-1].reshape(self.model.d, -1) @ np.ravel(torque_change)
 
     def hessian(self, data: ReachTerms) -> np.ndarray:
         """∇²f (H·n, H·n) from the data :meth:`evaluate` returned."""
@@ -225,8 +225,8 @@ class ReachCurvature:
         d = self.model.d
         Z = self._reduced_rows(data)
         # ∂²phi_i/∂z~_i∂g = -∂²phi_i/∂z~_i∂mu_x,i: the first d columns of the reduced Hessian (T_i is the identity there)
-        goal_columns = -data.phi_hess[:, :, :d]  # (H+1, d + r, d)
-        return Z.reshape(-1, Z.shape[2]).T @ goal_columns.reshape(-1, d)
+        goal_columns = data.phi_hess[:, :, :d].reshape(-1, d)  # ((H+1)·(d + r), d)
+        return -(Z.reshape(-1, Z.shape[2]).T @ goal_columns)
 
     def _reduced_rows(self, data: ReachTerms) -> np.ndarray:
         """Z~_i = dz~_i/dx stacked (H+1, d + r, H·n) at the data's torques: mean rows fixed, covariance rows linear
