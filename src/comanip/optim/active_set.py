@@ -48,11 +48,13 @@ class ConstraintSet:
 
     def __init__(self, lb: np.ndarray, ub: np.ndarray, constraints):
         self.constraints = constraints
-        self.upper = np.flatnonzero(np.isfinite(ub))
-        self.lower = np.flatnonzero(np.isfinite(lb))
+        finite_upper, finite_lower = np.isfinite(ub), np.isfinite(lb)
+        self.unbounded = not (finite_upper.any() or finite_lower.any())
+        # no bound (the point masses' torques): no index arrays to look up
+        self.upper = NO_ROWS if self.unbounded else np.flatnonzero(finite_upper)
+        self.lower = NO_ROWS if self.unbounded else np.flatnonzero(finite_lower)
         self.lb, self.ub, self.size = lb, ub, len(lb)
         self.all_finite = len(self.upper) == len(self.lower) == self.size
-        self.unbounded = len(self.upper) == len(self.lower) == 0
 
     def __call__(self, x, data):
         """(c (bounds then the caller's), rows(indices) -> their Jacobian rows (len(indices), N)) at x."""
