@@ -28,7 +28,10 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
 - Secant correction (``secant=True``, for approximate Hessians): C is updated after every step s with
   the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (hessian + C) s, y the change of gradient, and
   hessian + C is used in its place. It learns the curvature the approximation misses along the directions
-  the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md).
+  the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md). Where
+  hessian + C needs a shift delta ≥ 0.1 (``CORRECTED_SHIFT_LIMIT``), C is dropped (reset to zero) and the hessian
+  alone is factored, shifted as it needs: the shift such a C needed (up to a hundred times s on the Panda) shrinks
+  only a third per iteration and held the steps short long after.
 - Chord steps (exact Hessians, ``secant=False``): while no constraint is in the working set and the last step
   cut max |∇f| at least tenfold, the next step reuses that step's factorisation instead of evaluating and
   factoring a new Hessian (Kelley 2003, sec. 5.4: the chord method); a step that cuts it less, or fails the

@@ -1,11 +1,13 @@
 """How the active-set Newton method (:mod:`comanip.optim.active_set_newton`) gets the regularised Hessian it
 steps with: :class:`ExactHessian` assembles the caller's Hessian at every iteration and reuses its factor for
 chord steps; :class:`SecantHessian` corrects an approximate Hessian with symmetric rank-one (SR1) updates,
-assembles it lazily and carries the updates into the last factor by the Woodbury identity. Both regularise by
+drops them where they leave it indefinite, assembles it lazily and carries the updates into the last factor by
+the Woodbury identity. Both regularise by
 IPOPT's growing shifts, more strongly after a failed line search."""
 
 from __future__ import annotations
 
+import itertools
 from typing import Callable
 
 import numpy as np
@@ -16,6 +18,9 @@ RECOVERY_SHIFT = 1e-3
 """The least relative shift delta after the first failed line search (ten times more after each further one)."""
 REUSE_RATIO = 0.1
 """An exact Hessian's factor is reused while each step cuts the gradient by at least this factor."""
+CORRECTED_SHIFT_LIMIT = 0.1
+"""The largest relative shift a secant-corrected Hessian is factored with: where it needs more, the corrections are
+dropped and the assembled Hessian alone is factored, with the shifts it needs."""
 
 
 class _Regularised:
@@ -23,10 +28,13 @@ class _Regularised:
 
     shift_last = 0.0
 
-    def _factored(self, matrix: np.ndarray, recoveries: int) -> tuple[tuple | None, float]:
+    def _factored(self, matrix: np.ndarray, recoveries: int, below: float = np.inf) -> tuple[tuple | None, float]:
+        """The factor of matrix with the first shift of the schedule that makes it positive definite, among the
+        shifts ``below`` this one; (None, nan) if none does."""
         # after a failed line search, a stronger shift turns the step towards steepest descent
         least = RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
-        factor, shift = shifted_cholesky(matrix, growing_shifts(self.shift_last, least))
+        factor, shift = shifted_cholesky(matrix, itertools.takewhile(lambda delta: delta < below,
+                                                                     growing_shifts(self.shift_last, least)))
         if factor is not None and shift > 0:
             self.shift_last = shift
         return factor, shift
@@ -108,11 +116,28 @@ class SecantHessian(_Regularised):
         reusable = reused and not recoveries and self.updated.shift == 0
         self.updated = self.updated.updated(update) if reusable else None
         if self.updated is None:
-            factor, shift = self._factored(self.assembled + self.correction, recoveries)
+            factor, shift = self._corrected_factor(recoveries)
             if factor is None:
                 return "no positive definite regularised Hessian"
             self.updated = UpdatedFactor(factor, shift)
         return self.updated.solve, self.updated.factor
+
+    def _corrected_factor(self, recoveries: int) -> tuple[tuple | None, float]:
+        """The factor of the assembled Hessian with the secant corrections, shifted by less than
+        ``CORRECTED_SHIFT_LIMIT``; where that needs more, the corrections are dropped and the assembled Hessian alone
+        is factored, with the shifts it needs.
+
+        Such corrections learnt curvature from steps the model does not hold along: on the Panda they put the
+        matrix's smallest eigenvalue tens of times its largest diagonal entry below zero while the assembled Hessian
+        was positive definite, and the shift that cured it, shrinking a third per iteration, held the steps short for
+        the next ten. Smaller shifts stay: along joint limits the corrections supply curvature the assembled Hessian
+        lacks, and without them the steps crawl."""
+        if self.correction.any():
+            factor, shift = self._factored(self.assembled + self.correction, recoveries, below=CORRECTED_SHIFT_LIMIT)
+            if factor is not None:
+                return factor, shift
+            self.correction = np.zeros_like(self.assembled)
+        return self._factored(self.assembled, recoveries)
 
     def stepped(self, factor, optimality: float, free: bool) -> None:
         """Nothing to remember: the corrections were updated in :meth:`factor`."""
