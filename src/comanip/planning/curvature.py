@@ -314,13 +314,13 @@ def _causal_gram(Z: np.ndarray, QZ: np.ndarray, rows_per_step: int, n: int) -> n
     BLAS reads in place. A chunk per 30 unknowns, at most 4: each product costs a few microseconds of its own,
     more than the zeros it skips in a small problem.
     """
-    size = Z.shape[1]
     steps = Z.shape[0] // rows_per_step
-    chunks = min(4, max(1, size // 30))
-    out = np.zeros((size, size))
+    chunks = min(4, max(1, Z.shape[1] // 30))
     bounds = [steps * k // chunks for k in range(chunks + 1)]
-    for lo, hi in zip(bounds[:-1], bounds[1:]):
-        cols = min(size, n * (hi - 1))
+    last = slice(bounds[-2] * rows_per_step, None)
+    out = Z[last].T @ QZ[last]  # the last chunk reaches every column: it makes the matrix the others add to
+    for lo, hi in zip(bounds[:-2], bounds[1:-1]):
+        cols = n * (hi - 1)
         if cols > 0:
             rows = slice(lo * rows_per_step, hi * rows_per_step)
             out[:cols, :cols] += Z[rows, :cols].T @ QZ[rows, :cols]
