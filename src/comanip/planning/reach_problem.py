@@ -68,11 +68,15 @@ class ReachProblem:
         # NumPy in and out without CasADi's DM conversions (they cost more than a point mass's rollout itself)
         self._trajectory = BufferedFunction(self.trajectory)
         self._trajectory_outputs = self.trajectory.name_out()
-        # a linear body's plan in one call: the trajectory with the end effector's mean velocity J(mu_q) mu_qdot
+        # a linear body's plan in one call: the trajectory with the end effector's mean velocity J(mu_q) mu_qdot, every
+        # output column by column in one vector (make_plan slices it)
+        rollout = self.trajectory.call([ca.vec(self.tau), self.s0, self.goal, self.width]) \
+            + [ca.horzcat(*[ca.mtimes(body.jacobian(m[:n]), m[n:2 * n]) for m in self.means])]
+        ends = np.cumsum([0] + [piece.numel() for piece in rollout])
+        self._plan_pieces = [slice(a, b) for a, b in zip(ends[:-1], ends[1:])]
         self._plan_rollout = BufferedFunction(ca.Function(
             "plan_rollout", [ca.vec(self.tau), self.s0, self.goal, self.width],
-            self.trajectory.call([ca.vec(self.tau), self.s0, self.goal, self.width])
-            + [ca.horzcat(*[ca.mtimes(body.jacobian(m[:n]), m[n:2 * n]) for m in self.means])])) if body.is_linear else None
+            [ca.densify(ca.vertcat(*[ca.vec(piece) for piece in rollout]))])) if body.is_linear else None
         self._ee_belief = BufferedFunction(ee.map(H + 1))
 
     def normaliser(self, width: float) -> float:
@@ -102,24 +106,27 @@ class ReachProblem:
         model = self.model
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
-        ee_velocity = None
         if belief is None and self._plan_rollout is not None:
-            mean, cov, ee_mean, ee_cov, J, ee_velocity = self._plan_rollout(np.ravel(torque), start, goal, width)
-            mean, cov, ee_velocity = mean.T, cov.reshape(n2, H + 1, n2).transpose(1, 0, 2), ee_velocity.T
-        elif belief is None:
-            rollout = self._rollout(torque, start, goal, width)
-            ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
-            mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
+            out = self._plan_rollout.vector(np.ravel(torque), start, goal, width)
+            mean, cov, ee_mean, ee_cov, J, ee_velocity = (out[piece] for piece in self._plan_pieces)
+            # (rows, H+1) matrices column by column are their transposes row by row; the covariances' blocks alike
+            mean, ee_mean, ee_velocity = mean.reshape(H + 1, n2), ee_mean.reshape(H + 1, d), ee_velocity.reshape(H + 1, d)
+            cov, ee_cov = cov.reshape(H + 1, n2, n2).transpose(0, 2, 1), ee_cov.reshape(H + 1, d, d).transpose(0, 2, 1)
         else:
-            mean, cov = belief
-            ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
-            J = np.asarray(objective, dtype=float)
-        if ee_velocity is None:
+            if belief is None:
+                rollout = self._rollout(torque, start, goal, width)
+                ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
+                mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
+            else:
+                mean, cov = belief
+                ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
+                J = np.asarray(objective, dtype=float)
+            ee_mean, ee_cov = ee_mean.T, ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2)
             ee_velocity = self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)[0].T
         return Plan(
             success=bool(success), status=status, message=message, objective=float(J.item()),
             solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),
             mean=mean, cov=cov, torque=torque,
-            ee_mean=ee_mean.T, ee_cov=ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2), ee_velocity=ee_velocity,
+            ee_mean=ee_mean, ee_cov=ee_cov, ee_velocity=ee_velocity,
             start=np.asarray(start, dtype=float), goal=np.asarray(goal, dtype=float), width=float(width),
             model_name=model.name, extras=extras or {})

@@ -21,7 +21,7 @@ import numpy as np
 from comanip.planning.reach_parameters import ReachParameters
 
 
-@dataclass(eq=False)
+@dataclass(eq=False, slots=True)
 class ReachTerms:
     """One evaluation at torques x: what the Hessian and the goal derivatives need (point masses)."""
 
