@@ -34,6 +34,11 @@ SIMPLEX_STEP = 0.5
 
 NLL_KIND = "negative log-likelihood (nats)"
 
+LIKELIHOOD_MARGIN = 1.92
+"""nats: a parameter whose nearest search bound has an NLL within this of the fit's is not bounded away from it by
+the data (the bound lies inside the 95 % likelihood-ratio interval, chi²₁(0.95)/2; lenient for the pseudo-likelihood,
+whose differences are inflated)."""
+
 
 def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], parameters: Sequence[str] = DEFAULT_PARAMETERS,
               *, trials: str | Path | None = None, sigma_obs: float = 1e-3, bounds: dict | None = None,
@@ -71,6 +76,7 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         try:
             u, status, message = _minimise(objective, space, max_evaluations)
             spread = curvature(objective.per_trial, u, step)
+            bounded = space.at_bounds(u) + bounds_not_excluded(objective, space, u)
             plans = objective.plans(u)
         except Exception as error:  # the fit never raises once planning started: report it as failed
             return failed_result(model, space, f"{type(error).__name__}: {error}", objective.evaluations,
@@ -78,15 +84,15 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
     fitted = fitted_model(space.model_for(u), model, f"{len(data)} recorded trials in {len(conditions)} conditions")
     curves = [condition_curves(data, c, plan) for c, plan in zip(conditions, plans)]
     trial_rows = trial_residuals(data, conditions, plans)
-    values, std_errors = space.values(u), space.natural_std_errors(u, spread.robust_std())
-    message = outcome_message(message, space, u)
+    values, std_errors = space.values(u), space.natural_std_errors(u, spread.robust_std(), bounded)
+    message = outcome_message(message, bounded)
     unidentified = identification(values, space.start_values, std_errors, sum(row["samples_used"] for row in trial_rows))
     if unidentified:
         status, message = "unidentified", f"{message}; but {unidentified}"
     return FitResult(
         success=status == "converged" and all(plan.converged for plan in plans), status=status,
         message=message, model=fitted, values=values, initial_values=space.start_values, std_errors=std_errors,
-        laplace_std_errors=space.natural_std_errors(u, spread.laplace_std()),
+        laplace_std_errors=space.natural_std_errors(u, spread.laplace_std(), bounded),
         objective=objective(u), objective_kind=NLL_KIND, evaluations=objective.evaluations,
         fit_time=time.perf_counter() - t_begin, conditions=condition_residuals(trial_rows, conditions, plans, curves),
         trials=trial_rows, sigma_obs=space.noise_for(u), curves=curves)
@@ -118,6 +124,23 @@ def _grouped(model, recordings, trials_table, start_tolerance, check_units) -> t
     if isinstance(start_tolerance, bool) or not isinstance(start_tolerance, (int, float)) or not start_tolerance >= 0:
         raise ValueError(f"start_tolerance must be a number ≥ 0 (m), got {start_tolerance!r}")
     return trials, group_conditions(trials, float(start_tolerance))
+
+
+def bounds_not_excluded(objective, space: ParameterSpace, u) -> list[str]:
+    """The free parameters not at a search bound (:meth:`ParameterSpace.at_bounds`) whose nearest bound the data do
+    not exclude: the objective (NLL) with that parameter moved onto the bound, the others as fitted, is within
+    ``LIKELIHOOD_MARGIN`` of its value at u (p,). Along such a flat direction Nelder-Mead stops anywhere, and the
+    curvature there says nothing about the uncertainty. One evaluation per such parameter."""
+    u = np.asarray(u, dtype=float)
+    fitted, at_bounds, names = objective(u), space.at_bounds(u), []
+    for i, (name, (low, high)) in enumerate(zip(space.names, space.bounds)):
+        if name in at_bounds:
+            continue
+        moved = u.copy()
+        moved[i] = low if u[i] - low <= high - u[i] else high
+        if objective(moved) - fitted <= LIKELIHOOD_MARGIN:
+            names.append(name)
+    return names
 
 
 def _minimise(objective, space: ParameterSpace, max_evaluations: int) -> tuple[np.ndarray, str, str]:

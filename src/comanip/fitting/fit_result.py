@@ -78,13 +78,13 @@ class FitResult:
         return f"{self.status}: {values}; {self.objective_kind} {self.objective:.6g} after {self.evaluations} evaluations in {self.fit_time:.1f} s"
 
 
-def outcome_message(optimiser: str, space: ParameterSpace, u) -> str:
-    """The optimiser's message, plus the parameters that ended at a search bound (if any)."""
-    bounded = space.at_bounds(u)
+def outcome_message(optimiser: str, bounded: list[str]) -> str:
+    """The optimiser's message, plus the parameters that ended at a search bound, or short of one the data do not
+    exclude (``bounded``; if any)."""
     if not bounded:
         return optimiser
-    return (f"{optimiser} {bounded} ended at a search bound: the data hardly constrain them there or the bounds are "
-            f"too tight (their standard errors are NaN)")
+    return (f"{optimiser} {bounded} ended at a search bound, or short of one the data do not exclude: the data hardly "
+            f"constrain them there or the bounds are too tight (their standard errors are NaN)")
 
 
 def identification(values: dict[str, float], start: dict[str, float], std_errors: dict[str, float],

@@ -94,7 +94,7 @@ def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTab
                                  time.perf_counter() - t_begin, SSE_KIND)
     std = _least_squares_std(result.fun, result.jac)
     status = "converged" if result.status > 0 else "max_evaluations"
-    message = outcome_message(str(result.message), space, result.x)
+    message = outcome_message(str(result.message), space.at_bounds(result.x))
     values, std_errors = space.values(result.x), space.natural_std_errors(result.x, std)
     unidentified = identification(values, space.start_values, std_errors)
     if unidentified:

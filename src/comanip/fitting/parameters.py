@@ -91,10 +91,12 @@ class ParameterSpace:
         bound once the objective changes by less than its tolerance."""
         return [name for name, x, (low, high) in zip(self.names, u, self.bounds) if min(x - low, high - x) <= tolerance]
 
-    def natural_std_errors(self, u, transformed_std) -> dict[str, float]:
+    def natural_std_errors(self, u, transformed_std, bounded: list[str] | None = None) -> dict[str, float]:
         """Standard errors in natural units by the delta method: se(theta) = |dtheta/du| se(u); NaN for a
-        parameter at a search bound, where the curvature says nothing about the uncertainty."""
-        values, bounded = self.values(u), self.at_bounds(u)
+        parameter at a search bound (``bounded``, default :meth:`at_bounds`), where the curvature says nothing about
+        the uncertainty."""
+        values = self.values(u)
+        bounded = self.at_bounds(u) if bounded is None else bounded
         return {name: np.nan if name in bounded else float(_slope(name, values[name]) * s)
                 for name, s in zip(self.names, transformed_std)}
 
