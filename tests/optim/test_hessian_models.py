@@ -54,3 +54,30 @@ def test_corrections_needing_a_small_shift_are_kept(assembled, rng):
     assert 0 < shift < CORRECTED_SHIFT_LIMIT
     b = rng.normal(size=len(assembled))
     np.testing.assert_allclose(solve(b), np.linalg.solve(corrected + shift * scale * np.eye(len(b)), b), rtol=1e-10)
+
+
+@pytest.mark.parametrize("entry, value", [((0, 3), np.nan), ((3, 0), np.nan), ((2, 2), np.nan), ((4, 4), np.inf),
+                                          ((1, 5), np.inf), ((11, 11), np.inf)])
+def test_an_exact_hessian_with_a_nan_or_inf_is_refused(assembled, entry, value):
+    """A NaN or inf anywhere in the (symmetric) matrix, on its diagonal last of all, gives no step, only the reason;
+    the finite matrix gives one."""
+    from comanip.optim.hessian_models import ExactHessian
+
+    point = SimpleNamespace(data=None)
+    assert not isinstance(ExactHessian(lambda data: assembled).factor(point, 0, False), str)
+    broken = assembled.copy()
+    broken[entry] = broken[entry[::-1]] = value
+    assert ExactHessian(lambda data: broken).factor(point, 0, False) == "Hessian not finite"
+
+
+@pytest.mark.parametrize("gradient, finite", [([0.0, -2.0], True), ([0.0, np.nan], False), ([np.inf, 1.0], False),
+                                              (None, True)])
+def test_an_iterate_is_finite_when_f_and_its_gradient_are(gradient, finite):
+    from comanip.optim.active_set import NO_MULTIPLIERS, Iterate
+
+    g = None if gradient is None else np.array(gradient)
+    point = Iterate(np.zeros(2), 1.0, g, None, NO_MULTIPLIERS, None)
+    assert point.finite is finite
+    assert Iterate(np.zeros(2), np.nan, g, None, NO_MULTIPLIERS, None).finite is False
+    if finite and g is not None:
+        assert point.steepest == 2.0

@@ -27,19 +27,23 @@ class Iterate:
     rows: Callable[[np.ndarray], np.ndarray]
     largest: float = field(init=False)
     """max c (-inf without constraints): the working set, the violation and the merit's penalty read it first."""
+    steepest: float = field(init=False)
+    """max |g| (NaN where g holds a NaN, inf where it holds an inf; NaN without a gradient): the convergence test
+    and :attr:`finite` read it."""
 
     def __post_init__(self):
         self.largest = float(self.c.max()) if len(self.c) else -math.inf
+        self.steepest = float(np.abs(self.g).max()) if self.g is not None else math.nan
 
     @property
     def violation(self) -> float:
         """max(0, c): the largest violation, bounds included."""
         return max(0.0, self.largest)
 
-
-def finite(f: float, g: np.ndarray | None) -> bool:
-    """f and every entry of g finite (a sum of finite gradient entries is finite short of overflow, 1e308)."""
-    return math.isfinite(f) and (g is None or math.isfinite(g.sum()))
+    @property
+    def finite(self) -> bool:
+        """f finite, and every entry of g if it was evaluated."""
+        return math.isfinite(self.f) and (self.g is None or math.isfinite(self.steepest))
 
 
 class ConstraintSet:

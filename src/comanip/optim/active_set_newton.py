@@ -64,6 +64,7 @@ f must be finite at x0; a trial point where f is not finite is treated as a fail
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any, Callable
 
@@ -71,7 +72,7 @@ import numpy as np
 
 from comanip.arguments import as_count
 from comanip.optim.factorisation import cholesky_solve
-from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, finite, restoration_step
+from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, restoration_step
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import backtrack
 from comanip.optim.newton_loop import NewtonSolve, Stop
@@ -141,9 +142,9 @@ def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]]
                              constraint_tolerance=constraint_tolerance, margin=margin)
     x = np.array(x0, dtype=float) if method.problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
     f, g, data = evaluate(x)
-    if not finite(f, g):
+    point = method.finite_point(x, f, g, data)
+    if point is None:
         return NewtonSolve(None, None, final=SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
-    point = method.at(x, f, g, data)
     return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
 
 
@@ -200,6 +201,13 @@ class ActiveSetNewton:
     def at(self, x, f, g, data) -> Iterate:
         return Iterate(x, f, g, data, *self.problem(x, data))
 
+    def finite_point(self, x, f, g, data) -> Iterate | None:
+        """The iterate at x, or None where f or an entry of g (if evaluated) is not finite."""
+        if not math.isfinite(f):
+            return None
+        point = self.at(x, f, g, data)
+        return point if point.finite else None
+
     def iterations(self, state: SQPState) -> int:
         return state.iterations
 
@@ -211,7 +219,7 @@ class ActiveSetNewton:
         """With no constraint in the working set the Lagrangian's gradient is the gradient, and a converged
         point needs no Hessian (a warm point-mass solve's last of about five)."""
         state.free = state.point.largest <= -self.margin
-        state.optimality = float(np.abs(state.point.g).max()) if state.free else np.inf
+        state.optimality = state.point.steepest if state.free else np.inf
         return self._converged(state) if state.free else None
 
     def direction(self, state: SQPState) -> SQPDirection | Stop:
@@ -335,8 +343,7 @@ class ActiveSetNewton:
             if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
             if trial.g is None:  # a trial evaluated with its gradient was checked finite by _trial
-                trial = self.at(trial.x, *self.evaluate(trial.x))
-                return trial if finite(trial.f, trial.g) else None
+                return self.finite_point(trial.x, *self.evaluate(trial.x))
             return trial
 
         alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
@@ -349,7 +356,7 @@ class ActiveSetNewton:
             f, g, data = self.evaluate(x)
         else:
             (f, data), g = self.value(x), None
-        return self.at(x, f, g, data) if finite(f, g) else None
+        return self.finite_point(x, f, g, data)
 
     def _restore(self, point: Iterate) -> Iterate | None:
         """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over

@@ -8,6 +8,7 @@ IPOPT's growing shifts, more strongly after a failed line search."""
 from __future__ import annotations
 
 import itertools
+import math
 from typing import Callable
 
 import numpy as np
@@ -61,11 +62,10 @@ class ExactHessian(_Regularised):
         """(solve(b), factor) of the regularised Hessian at ``point``, or why there is none."""
         self.kept = None
         hessian = self.hessian(point.data)
-        if not np.isfinite(hessian).all():
-            return "Hessian not finite"
         factor, _ = self._factored(hessian, recoveries)
-        if factor is None:
-            return "no positive definite regularised Hessian"
+        # a NaN or inf in the matrix fails the factorisation or reaches the factor's diagonal
+        if factor is None or not math.isfinite(np.trace(factor[0])):
+            return "Hessian not finite" if not np.isfinite(hessian).all() else "no positive definite regularised Hessian"
         return (lambda b: cholesky_solve(factor, b)), factor
 
     def stepped(self, factor: tuple, optimality: float, free: bool) -> None:
