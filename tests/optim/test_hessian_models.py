@@ -58,16 +58,20 @@ def test_corrections_needing_a_small_shift_are_kept(assembled, rng):
 
 @pytest.mark.parametrize("entry, value", [((0, 3), np.nan), ((3, 0), np.nan), ((2, 2), np.nan), ((4, 4), np.inf),
                                           ((1, 5), np.inf), ((11, 11), np.inf)])
-def test_an_exact_hessian_with_a_nan_or_inf_is_refused(assembled, entry, value):
+@pytest.mark.parametrize("model", ["exact", "secant"])
+def test_a_hessian_with_a_nan_or_inf_is_refused(assembled, entry, value, model):
     """A NaN or inf anywhere in the (symmetric) matrix, on its diagonal last of all, gives no step, only the reason;
     the finite matrix gives one."""
     from comanip.optim.hessian_models import ExactHessian
 
-    point = SimpleNamespace(data=None)
-    assert not isinstance(ExactHessian(lambda data: assembled).factor(point, 0, False), str)
+    def hessians(matrix):
+        return ExactHessian(lambda data: matrix) if model == "exact" else SecantHessian(lambda data: matrix, refresh=1)
+
+    point = SimpleNamespace(x=np.zeros(len(assembled)), g=np.zeros(len(assembled)), data=None)
+    assert not isinstance(hessians(assembled).factor(point, 0, False), str)
     broken = assembled.copy()
     broken[entry] = broken[entry[::-1]] = value
-    assert ExactHessian(lambda data: broken).factor(point, 0, False) == "Hessian not finite"
+    assert hessians(broken).factor(point, 0, False) == "Hessian not finite"
 
 
 @pytest.mark.parametrize("gradient, finite", [([0.0, -2.0], True), ([0.0, np.nan], False), ([np.inf, 1.0], False),

@@ -76,7 +76,7 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         try:
             u, status, message = _minimise(objective, space, max_evaluations)
             spread = curvature(objective.per_trial, u, step)
-            bounded = space.at_bounds(u) + bounds_not_excluded(objective, space, u)
+            bounded = unconstrained_by_bounds(objective, space, u)
             plans = objective.plans(u)
         except Exception as error:  # the fit never raises once planning started: report it as failed
             return failed_result(model, space, f"{type(error).__name__}: {error}", objective.evaluations,
@@ -126,15 +126,15 @@ def _grouped(model, recordings, trials_table, start_tolerance, check_units) -> t
     return trials, group_conditions(trials, float(start_tolerance))
 
 
-def bounds_not_excluded(objective, space: ParameterSpace, u) -> list[str]:
-    """The free parameters not at a search bound (:meth:`ParameterSpace.at_bounds`) whose nearest bound the data do
-    not exclude: the objective (NLL) with that parameter moved onto the bound, the others as fitted, is within
+def unconstrained_by_bounds(objective, space: ParameterSpace, u) -> list[str]:
+    """The free parameters at a search bound (:meth:`ParameterSpace.at_bounds`), then those whose nearest bound the
+    data do not exclude: the objective (NLL) with that parameter moved onto the bound, the others as fitted, is within
     ``LIKELIHOOD_MARGIN`` of its value at u (p,). Along such a flat direction Nelder-Mead stops anywhere, and the
-    curvature there says nothing about the uncertainty. One evaluation per such parameter."""
+    curvature there says nothing about the uncertainty. One evaluation per parameter not at a bound."""
     u = np.asarray(u, dtype=float)
-    fitted, at_bounds, names = objective(u), space.at_bounds(u), []
+    names, fitted = space.at_bounds(u), objective(u)
     for i, (name, (low, high)) in enumerate(zip(space.names, space.bounds)):
-        if name in at_bounds:
+        if name in names:
             continue
         moved = u.copy()
         moved[i] = low if u[i] - low <= high - u[i] else high

@@ -75,7 +75,7 @@ from comanip.optim.factorisation import cholesky_solve
 from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, restoration_step
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import backtrack
-from comanip.optim.newton_loop import NewtonSolve, Stop
+from comanip.optim.newton_loop import NewtonSolve, Stop, never
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import Status
 
@@ -102,7 +102,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]]
                  tolerance: float, secant: bool = False,
                  constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
                  constraint_tolerance: float = 1e-6, margin: float = 1e-3,
-                 expired: Callable[[], bool] = lambda: False,
+                 expired: Callable[[], bool] = never,
                  value: Callable[[np.ndarray], tuple[float, Any]] | None = None,
                  hessian_refresh: int = 1) -> NewtonSolve[SQPState]:
     """The solve of f over the box [lb, ub] and c(x) ≤ 0 from x0, to run in stages (:class:`NewtonSolve`: its

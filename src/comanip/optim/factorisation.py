@@ -3,6 +3,7 @@ until it is positive definite, with the shift schedule a policy of the caller.""
 
 from __future__ import annotations
 
+import math
 from typing import Iterable, Iterator
 
 import numpy as np
@@ -14,7 +15,8 @@ def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple
     shift delta in ``shifts`` that gives a positive definite matrix, s = max |diag matrix| (so delta is
     relative); (None, nan) if none. Solve with the factor by :func:`cholesky_solve`.
 
-    ``matrix`` (N, N) is read as symmetric (its upper triangle); delta = 0 factors it as it is.
+    ``matrix`` (N, N) is read as symmetric (its upper triangle); delta = 0 factors it as it is. A matrix with a NaN
+    or inf never gives a factor: it fails the factorisation or reaches the factor's diagonal, which is checked.
     """
     shifted, diagonal, scale = None, None, None
     for delta in shifts:
@@ -30,7 +32,7 @@ def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple
         # LAPACK directly: scipy.linalg.cho_factor's checks and wrappers cost as much as factoring a point
         # mass's 60 x 60 Hessian
         factor, info = _potrf(candidate, lower=False, clean=False, overwrite_a=False)
-        if info == 0:
+        if info == 0 and math.isfinite(np.trace(factor)):
             return (factor, False), delta
         if info < 0:
             raise ValueError(f"LAPACK potrf rejected argument {-info} (matrix {matrix.shape})")

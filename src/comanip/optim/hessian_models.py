@@ -8,7 +8,6 @@ IPOPT's growing shifts, more strongly after a failed line search."""
 from __future__ import annotations
 
 import itertools
-import math
 from typing import Callable
 
 import numpy as np
@@ -63,9 +62,8 @@ class ExactHessian(_Regularised):
         self.kept = None
         hessian = self.hessian(point.data)
         factor, _ = self._factored(hessian, recoveries)
-        # a NaN or inf in the matrix fails the factorisation or reaches the factor's diagonal
-        if factor is None or not math.isfinite(np.trace(factor[0])):
-            return "Hessian not finite" if not np.isfinite(hessian).all() else "no positive definite regularised Hessian"
+        if factor is None:
+            return _why_not_factored(hessian)
         return (lambda b: cholesky_solve(factor, b)), factor
 
     def stepped(self, factor: tuple, optimality: float, free: bool) -> None:
@@ -102,8 +100,6 @@ class SecantHessian(_Regularised):
         reused = self.assembled is not None and self.age < self.refresh and model_held
         if not reused:
             self.assembled, self.age = self.hessian(point.data), 0
-            if not np.isfinite(self.assembled).all():
-                return "Hessian not finite"
         self.age += 1
         self.correction = np.zeros_like(self.assembled) if self.correction is None else self.correction
         update = None
@@ -118,7 +114,7 @@ class SecantHessian(_Regularised):
         if self.updated is None:
             factor, shift = self._corrected_factor(recoveries)
             if factor is None:
-                return "no positive definite regularised Hessian"
+                return _why_not_factored(self.assembled)
             self.updated = UpdatedFactor(factor, shift)
         return self.updated.solve, self.updated.factor
 
@@ -146,6 +142,11 @@ class SecantHessian(_Regularised):
         """After a failed line search: drop the corrections (they may have learnt curvature from far away) and
         assemble anew."""
         self.correction, self.previous, self.assembled = None, None, None
+
+
+def _why_not_factored(hessian: np.ndarray) -> str:
+    """Why no shift of the schedule gave a factor of ``hessian``, in words."""
+    return "Hessian not finite" if not np.isfinite(hessian).all() else "no positive definite regularised Hessian"
 
 
 def symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float] | None:

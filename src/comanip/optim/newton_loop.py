@@ -66,8 +66,13 @@ class NewtonMethod(Protocol[S, D]):
         """The solve's result at the iterate."""
 
 
+def never() -> bool:
+    """The ``expired`` of a solve without a wall-time budget (no clock read per iteration)."""
+    return False
+
+
 def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
-                   expired: Callable[[], bool] = lambda: False) -> SolverResult:
+                   expired: Callable[[], bool] = never) -> SolverResult:
     """Run ``method`` from ``state`` until it stops (module docstring); never raises for an unconverged solve."""
     while True:
         spent = method.iterations(state) >= max_iterations
@@ -97,7 +102,7 @@ class NewtonSolve(Generic[S]):
     iterates one call with the larger budget would have taken (a pause only reads the state). ``final``: the result
     of a solve that ended before it started (e.g. a start where f is not finite)."""
 
-    def __init__(self, method: NewtonMethod[S, D] | None, state: S | None, expired: Callable[[], bool] = lambda: False,
+    def __init__(self, method: NewtonMethod[S, D] | None, state: S | None, expired: Callable[[], bool] = never,
                  final: SolverResult | None = None):
         self.method, self.state, self.expired, self.final = method, state, expired, final
 

@@ -46,6 +46,7 @@ from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_solve
+from comanip.optim.newton_loop import never
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan, with_reach_check
 from comanip.planning.reach_parameters import ReachParameters
@@ -442,7 +443,7 @@ class Planner:
                             hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
                             constraints=self._limits.for_newton(curvature) if self._limits.active else None,
                             constraint_tolerance=LIMIT_TOLERANCE, value=value,
-                            expired=(lambda: time.perf_counter() > deadline) if deadline < np.inf else _never_expired)
+                            expired=(lambda: time.perf_counter() > deadline) if deadline < np.inf else never)
 
     def _as_torques(self, result: SolverResult) -> SolverResult[np.ndarray]:
         """The result with x as torques (H, n)."""
@@ -492,11 +493,6 @@ def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
 def _one_after_another(function, items) -> list:
     """[function(item) for each item]: the start threads' ``map``, in the calling thread."""
     return [function(item) for item in items]
-
-
-def _never_expired() -> bool:
-    """A solve without a wall-time budget: never out of time (no clock read per iteration)."""
-    return False
 
 
 def _rank(candidate: SolverResult) -> tuple[bool, float]:

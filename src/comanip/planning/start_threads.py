@@ -2,9 +2,9 @@
 
 An arm's cold solve without a reach library runs every minimum-jerk start and keeps the best plan. The starts are
 independent, and a Newton iteration on an arm spends most of its time in compiled CasADi functions and LAPACK, which
-run outside Python's interpreter lock, so threads solve them side by side on a machine's cores. Each start evaluates with its own copy of the terms (their evaluation buffers are not
-shared); every start is solved exactly as it would be alone, so the plans do not depend on the number of
-threads.
+run outside Python's interpreter lock, so threads solve them side by side on a machine's cores. Each start evaluates
+with its own copy of the terms (their evaluation buffers are not shared); every start is solved exactly as it would
+be alone, so the plans do not depend on the number of threads.
 """
 
 from __future__ import annotations
