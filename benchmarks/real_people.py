@@ -32,6 +32,7 @@ from scipy.stats import chi2
 from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
+ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
 WORSE_MARGIN = 0.05
 
 
@@ -198,11 +199,14 @@ def figure(summary, path: Path, title: str):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--source", choices=("cursory", "simulated"), default="cursory")
+    parser.add_argument("--source", choices=("cursory", "arms", "simulated"), default="cursory",
+                        help="cursory: mouse movements; arms: motion-capture arm reaches (--arms); simulated: the model's own")
+    parser.add_argument("--arms", type=Path, default=ARMS, help="a TAT-HUM 3-D data folder (trajectory_data/, trial_data/)")
     parser.add_argument("--split", choices=("development", "held_out"), default="development",
                         help="cursory split; held_out only to report a claimed improvement")
     parser.add_argument("--limit", type=int, default=None, help="at most this many movements")
-    parser.add_argument("--models", default="planar,human,people", help="presets whose OnlineGoalEstimator is scored")
+    parser.add_argument("--models", default=None, help="presets whose OnlineGoalEstimator is scored "
+                        "(default: planar,human,people; arms: arm,human_cartesian)")
     parser.add_argument("--only", default=None, help="comma-separated predictor names to run (default: all)")
     parser.add_argument("--scale", type=float, default=None, help="cursory pixels to metres (m/px)")
     parser.add_argument("--count", type=int, default=100, help="simulated reaches")
@@ -212,40 +216,53 @@ def main(argv=None):
     args = parser.parse_args(argv)
     log = sys.stderr if args.markdown else sys.stdout
     from comanip.estimation.template_matching import TemplateLibrary
-    from comanip.recordings import load_cursory
+    from comanip.estimation.people_model import PeopleModel, shipped_people_model
+    from comanip.recordings import load_cursory, load_tathum
     from comanip.recordings.cursory_data import SCALE
 
     scale = args.scale or SCALE
-    development = load_cursory("development", scale=scale)
-    if args.source == "cursory":
-        recordings = development if args.split == "development" else load_cursory("held_out", scale=scale)
-        title = f"cursory mouse movements, {args.split} split"
+    models = args.models or ("arm,human_cartesian" if args.source == "arms" else "planar,human,people")
+    kind = "arm" if args.source == "arms" else "mouse"
+    if args.source == "arms":
+        if args.split != "development":
+            sys.exit("the arm reaches' held-out split is not in this folder: it is scored elsewhere")
+        trials = load_tathum(args.arms)
+        if args.limit:
+            trials = trials[:args.limit]
+        development = [trial.streamed_recording() for trial in trials]      # as a live tracker delivers them
+        movements = development
+        title = f"motion-capture arm reaches ({args.arms.name}), development split, streamed at 125 Hz"
     else:
-        recordings = simulated_recordings("planar", args.count, seed=1)
-        title = "reaches sampled from the planar preset's own noise"
-    if args.limit:
-        recordings = recordings[:args.limit]
-    library = TemplateLibrary(development)
-    from comanip.estimation.people_model import PeopleModel, shipped_people_model
-    if args.source == "cursory" and args.split == "development":
-        # the shipped people model was fitted on this split: score each movement with one fitted on the other half
-        print("fitting the people model on each half of the development split ...", flush=True, file=log)
-        folds = [PeopleModel.fit(development[1 - k::2]) for k in (0, 1)]
+        development = load_cursory("development", scale=scale)
+        if args.source == "cursory":
+            recordings = development if args.split == "development" else load_cursory("held_out", scale=scale)
+            title = f"cursory mouse movements, {args.split} split"
+        else:
+            recordings = simulated_recordings("planar", args.count, seed=1)
+            title = "reaches sampled from the planar preset's own noise"
+        if args.limit:
+            recordings = recordings[:args.limit]
+        movements = recordings
+    library = TemplateLibrary(development, step=0.01)
+    if args.source != "simulated" and args.split == "development":
+        # the shipped people models were fitted on this split: score each movement with one fitted on the other half
+        print(f"fitting the {kind} people model on each half of the development split ...", flush=True, file=log)
+        folds = [PeopleModel.fit(development[1 - k::2], kind=kind) for k in (0, 1)]
         half = {r.name: k % 2 for k, r in enumerate(development)}
         people_for = lambda r: folds[half[r.name]]
     else:
-        people_for = lambda r: shipped_people_model()
-    made = predictors([m for m in args.models.split(",") if m], library, exclude_self=args.split == "development",
+        people_for = lambda r: shipped_people_model(kind)
+    made = predictors([m for m in models.split(",") if m], library, exclude_self=args.split == "development",
                       people_for=people_for)
     if args.only:
         made = {k: v for k, v in made.items() if any(o.strip() in k for o in args.only.split(","))}
     names = list(made)
-    out = args.out or Path(__file__).parent / "results" / f"real_people_{args.source}_{args.split if args.source == 'cursory' else 'planar'}"
+    out = args.out or Path(__file__).parent / "results" / f"real_people_{args.source}_{args.split if args.source != 'simulated' else 'planar'}"
     out.mkdir(parents=True, exist_ok=True)
     rows, latency = [], {name: [] for name in names}
     first = {name: [] for name in names}
     begin = time.perf_counter()
-    for i, recording in enumerate(recordings):
+    for i, recording in enumerate(movements):
         D = recording.distance
         current = None
         for name in names:
@@ -267,12 +284,12 @@ def main(argv=None):
                              "movement_time_s": recording.movement_time, "error": error, "covered": covered})
         for row in rows[-len(names) * len(FRACTIONS):]:
             row["current_error"] = current[FRACTIONS.index(row["fraction"])] if current else math.nan
-        if (i + 1) % 50 == 0 or i + 1 == len(recordings):
-            print(f"  {i + 1}/{len(recordings)} movements, {time.perf_counter() - begin:.0f} s", flush=True, file=log)
+        if (i + 1) % 50 == 0 or i + 1 == len(movements):
+            print(f"  {i + 1}/{len(movements)} movements, {time.perf_counter() - begin:.0f} s", flush=True, file=log)
     summary = summarise(rows, names)
     lat = {name: {"median": float(np.median(v)) if v else math.nan, "p95": float(np.percentile(v, 95)) if v else math.nan,
                   "first_median": float(np.median(first[name]))} for name, v in latency.items()}
-    table = markdown(summary, lat, len(recordings), title)
+    table = markdown(summary, lat, len(movements), title)
     if args.source == "cursory" and "template matching" in names:
         table += "\n\n" + published_comparison(rows, scale)
     print(table)
@@ -282,7 +299,7 @@ def main(argv=None):
         writer.writeheader()
         writer.writerows(rows)
     (out / "summary.json").write_text(json.dumps({"source": args.source, "split": args.split, "scale_m_per_px": scale,
-                                                  "movements": len(recordings), "summary": summary, "latency_s": lat},
+                                                  "movements": len(movements), "summary": summary, "latency_s": lat},
                                                  indent=1))
     (out / "summary.md").write_text(table + "\n")
     figure(summary, out / "error_by_fraction.png", title)

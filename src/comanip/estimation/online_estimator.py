@@ -147,7 +147,9 @@ class OnlineOptions:
     the model at its own pace still explains the observations (about 1 for the model's own reaches)."""
     people_model: PeopleModel | None = None
     """With ``timing="estimated"``: the model of people's movements (:class:`comanip.estimation.people_model.PeopleModel`,
-    e.g. fitted to your own recordings); None: the one that ships with comanip."""
+    e.g. fitted to your own recordings); None: the one that ships with comanip for the kind of movement the
+    reaching model makes (``arm`` for a 3-D model, ``mouse`` for a 2-D one). A model fitted to mouse movements
+    is refused for a 3-D reach."""
     paced_threshold: float = 0.05
     """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
@@ -296,6 +298,7 @@ class OnlineGoalEstimator:
         self._history: list[np.ndarray] = []       # [t, position, velocity] of every observation, for the people model
         self._off_model: str | None = None          # why the model at its own pace does not explain the hand
         self._paced = PacedModel(self.family)
+        self._people = self._people_model(d)
         self._whitening: ObservationWhitening | None = None
         self._blas = ThreadpoolController()
         self._whitening_goal = np.zeros(d)
@@ -317,6 +320,10 @@ class OnlineGoalEstimator:
             position: observed hand position (d,), m.
             velocity: observed hand velocity (d,), m/s.
 
+        A sample the tracker lost (position or velocity all NaN) is skipped: the previous estimate is returned
+        unchanged (before any tracked sample, the prior with status ``uninformative``) and the next good
+        sample carries on. A position or velocity with some entries NaN is refused (ValueError).
+
         Returns:
             A :class:`GoalEstimate`: the predicted reach from the start to g_hat (a Plan), ``goal_covariance``
             (d, d) m², ``t_obs`` the latest time, ``observation_residual`` the predicted [q; qdot] at that time
@@ -332,6 +339,13 @@ class OnlineGoalEstimator:
             raise ValueError(f"time_s must be ≥ 0 s (time since the reach's start), got {time_s:g}")
         if time_s < self._last_time:
             raise ValueError(f"time_s must not go backwards: got {time_s:g} s after an observation at {self._last_time:g} s")
+        if _lost(position) or _lost(velocity):
+            # a sample the tracker lost: skipped, the estimate stands until the next good one
+            if self.latest is None:
+                self._last_time = time_s
+                return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE,
+                                    "no tracked sample yet: the estimate is the prior", 0, t_begin)
+            return self.latest
         position = as_vector("position", position, model.d, "hand position, m")
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
         observation = np.r_[position, velocity]
@@ -377,10 +391,18 @@ class OnlineGoalEstimator:
             goal, covariance = self._with_prior(self._not_behind(paced.goal, position[-1]), paced.covariance + landing)
             return self._result(goal, covariance, Status.SOLVED, f"{self._off_model}; the model's reach at the person's "
                                 f"pace (×{paced.pace:.3g}, onset {paced.onset:.3g} s) does", 0, t_begin)
-        people = (self.options.people_model or shipped_people_model()).predict(t, position, velocity, self.start_position)
+        people = self._people.predict(t, position, velocity, self.start_position)
         goal, covariance = self._with_prior(self._not_behind(people.goal, position[-1]), people.covariance)
         return self._result(goal, covariance, Status.PEOPLE_MODEL, f"{self._off_model}, nor does it clearly at the "
                             f"person's pace (misfit {paced.misfit:.3g}): the goal is the people model's", 0, t_begin)
+
+    def _people_model(self, d: int) -> PeopleModel:
+        """The people model for a reach in d dimensions (:attr:`OnlineOptions.people_model`)."""
+        people = self.options.people_model or shipped_people_model("arm" if d == 3 else "mouse")
+        if d == 3 and people.kind == "mouse":
+            raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: "
+                             "fit one to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
+        return people
 
     def _humanlike(self, position: np.ndarray, velocity: np.ndarray) -> bool:
         """Whether the observed hand stays within the reach family's distances and a person's hand speeds
@@ -553,6 +575,15 @@ class OnlineGoalEstimator:
                                    direction=np.eye(d)[0], curvature=np.zeros((H + 1, nx // model.n)),
                                    mixed=np.zeros((H + 1, nx // model.n)))
         return self.family.prediction(self.start_position, goal, order=order, covariance=covariance)
+
+
+def _lost(value) -> bool:
+    """Whether an observed position or velocity is a sample the tracker lost: given, but all NaN."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return array.size > 0 and bool(np.all(np.isnan(array)))
 
 
 def _grid_position(time_s: float, h: float, H: int) -> tuple[int, float]:

@@ -12,25 +12,29 @@ endpoint is never behind the hand along u, and a hand that has stopped (speed be
 peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors).
 
-The fitted model ships with comanip (``comanip/data/people_endpoint_model.pkl``), fitted on the development
-split of the ``cursory`` mouse recordings mapped to arm scale (:mod:`comanip.recordings.cursory_data`):
-``studies/how_far_beyond_the_hand_do_people_stop/fit_people_model.py`` fits it again.
+A model is fitted per **kind** of movement (:data:`KINDS`): people move a mouse and an arm differently, and a
+model fitted on one is not applied to the other. An arm model uses only the features without units
+(:data:`SCALE_FREE`): fitted on reaches of one length and pace, it predicts in units of the path so far and
+of the time since the onset, so it carries over to other distances and paces as far as people's profiles
+keep their shape.
+
+Models are saved as plain arrays (``.npz``: every tree's nodes, :class:`TreeEnsemble`) and loaded without
+scikit-learn (:meth:`PeopleModel.load`). Two ship with comanip (``comanip/data/people_endpoint_<kind>.npz``):
+``mouse``, fitted on the development split of the ``cursory`` mouse recordings mapped to arm scale
+(:mod:`comanip.recordings.cursory_data`), and ``arm``, fitted on motion-capture arm reaches
+(:mod:`comanip.recordings.motion_capture`); ``studies/how_far_beyond_the_hand_do_people_stop/fit_people_model.py``
+fits them again.
 """
 
 from __future__ import annotations
 
 import math
-import pickle
 from dataclasses import dataclass
-from functools import cached_property
 from importlib import resources
 from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
-
-from sklearn.ensemble import HistGradientBoostingRegressor
-from threadpoolctl import ThreadpoolController
 
 from comanip.estimation.endpoint_baselines import MOVING_SPEED, EndpointPrediction
 from comanip.estimation.profile_fit import onset_index
@@ -38,8 +42,11 @@ from comanip.estimation.profile_fit import onset_index
 FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak", "acceleration_scaled",
             "since_peak_over_tau", "path_at_peak_over_path", "straightness", "direction_cosine", "peak_speed_tau_over_path")
 """Names of :func:`movement_features`' numbers, in order."""
-SHIPPED = "people_endpoint_model.pkl"
-"""File name of the fitted model in ``comanip/data``."""
+SCALE_FREE = ("speed_over_peak", "acceleration_scaled", "since_peak_over_tau", "path_at_peak_over_path", "straightness",
+              "direction_cosine", "peak_speed_tau_over_path")
+"""The features without units (neither m nor s): what an ``arm`` model uses."""
+KINDS = {"mouse": FEATURES, "arm": SCALE_FREE}
+"""Kinds of movement a people model is fitted to, and the features each uses."""
 DIRECTION_SPEED = 0.1
 """The direction of motion u is the velocity's while the speed is above this fraction of its peak so far..."""
 DIRECTION_WINDOW = 0.05
@@ -53,7 +60,6 @@ REST_SPREAD = 0.03
 """Standard deviation of a stopped hand's endpoint estimate, a fraction of the path length."""
 _MIN_PATH = 1e-4
 _MIN_RECENT = 2e-3
-_ONE_THREAD = ThreadpoolController()
 
 
 def movement_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray, start: np.ndarray):
@@ -89,30 +95,47 @@ def movement_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray,
     return features, u, path
 
 
-@dataclass
+@dataclass(frozen=True)
 class PeopleModel:
     """The fitted endpoint model (module docstring)."""
 
-    along: object
+    along: "TreeEnsemble"
     """Regressor of the endpoint's distance beyond the hand along u, over L (its ``QUANTILE`` quantile)."""
-    spread: object
+    spread: "TreeEnsemble"
     """Regressor of log(|error|² / L²) from the features."""
     coverage_factor: float
     """Multiplies the predicted squared error so the 95 % region holds 95 % of the fitting samples' endpoints."""
+    kind: str = "mouse"
+    """The kind of movement it was fitted to, a key of :data:`KINDS` (which features it reads)."""
     trained_on: str = ""
     """What the model was fitted on."""
 
-    @classmethod
-    def fit(cls, recordings, trained_on: str = "", seed: int = 0, progress=None) -> "PeopleModel":
-        """Fit on recordings (:class:`comanip.recordings.Recording`), every sample from each one's onset to its
-        end: the spread and the coverage factor on two-fold out-of-sample errors of the along regressor, then
-        the along regressor on all samples. ``progress``: called with a line of text per stage."""
-        with _ONE_THREAD.limit(limits=1, user_api="openmp"):    # reproducible, and no spinning threads on a busy machine
-            return cls._fit(recordings, trained_on, seed, progress or (lambda line: None))
+    def __post_init__(self):
+        if self.kind not in KINDS:
+            raise ValueError(f"kind must be one of {sorted(KINDS)}, got {self.kind!r}")
+
+    @property
+    def columns(self) -> np.ndarray:
+        """Indices into :data:`FEATURES` of the features this model reads."""
+        return np.array([FEATURES.index(name) for name in KINDS[self.kind]])
 
     @classmethod
-    def _fit(cls, recordings, trained_on: str, seed: int, say) -> "PeopleModel":
+    def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None) -> "PeopleModel":
+        """Fit on recordings (:class:`comanip.recordings.Recording`) of one ``kind`` of movement, every sample
+        from each one's onset to its end: the spread and the coverage factor on two-fold out-of-sample errors
+        of the along regressor, then the along regressor on all samples. ``progress``: called with a line of
+        text per stage. Needs scikit-learn."""
+        from threadpoolctl import ThreadpoolController
+        if kind not in KINDS:
+            raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
+        with ThreadpoolController().limit(limits=1, user_api="openmp"):   # reproducible, no spinning threads
+            return cls._fit(recordings, kind, trained_on, seed, progress or (lambda line: None))
+
+    @classmethod
+    def _fit(cls, recordings, kind: str, trained_on: str, seed: int, say) -> "PeopleModel":
+        from sklearn.ensemble import HistGradientBoostingRegressor
         X, along, across, owner = _samples(recordings)
+        X = X[:, [FEATURES.index(name) for name in KINDS[kind]]]
         fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
         predicted = np.zeros(len(X))
         for k in (0, 1):
@@ -124,7 +147,7 @@ class PeopleModel:
         d = recordings[0].position.shape[1]
         factor = float(np.quantile(squared / np.exp(spread.predict(X)), 0.95) / chi2.ppf(0.95, d) * d)
         say("along regressor, all samples")
-        return cls(_along_regressor(X, along, seed), spread, factor, trained_on)
+        return cls(TreeEnsemble.of(_along_regressor(X, along, seed)), TreeEnsemble.of(spread), factor, kind, trained_on)
 
     def predict(self, t, position, velocity, start) -> EndpointPrediction | None:
         """The endpoint (d,) m and its covariance (d, d) m² from the movement so far (:func:`movement_features`'
@@ -137,42 +160,74 @@ class PeopleModel:
         if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
             # a hand that has stopped is at its endpoint (until it moves again)
             return EndpointPrediction(position[-1].copy(), (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
-        along, log_squared = self._forests[0](features), self._forests[1](features)
+        x = features[self.columns]
+        along, log_squared = self.along(x), self.spread(x)
         goal = position[-1] + path * max(along, 0.0) * u
         variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
         return EndpointPrediction(goal, variance * np.eye(len(u)))
 
-    @cached_property
-    def _forests(self) -> tuple["_Forest", "_Forest"]:
-        return _Forest(self.along), _Forest(self.spread)
-
     def save(self, path: str | Path) -> Path:
-        """Write the model (pickle) to ``path``."""
+        """Write the model to ``path`` as plain arrays (``.npz``); :meth:`load` reads it back."""
         path = Path(path)
-        path.write_bytes(pickle.dumps(self))
+        arrays = {f"{name}_{field}": value for name in ("along", "spread")
+                  for field, value in getattr(self, name).arrays().items()}
+        with open(path, "wb") as stream:
+            np.savez_compressed(stream, coverage_factor=self.coverage_factor, kind=self.kind, trained_on=self.trained_on,
+                                **arrays)
         return path
 
+    @classmethod
+    def load(cls, path: str | Path) -> "PeopleModel":
+        """A model written by :meth:`save` (a one-line ValueError for a file that is not one)."""
+        try:
+            with np.load(path, allow_pickle=False) as data:
+                ensembles = [TreeEnsemble(**{field: data[f"{name}_{field}"] for field in TreeEnsemble.FIELDS})
+                             for name in ("along", "spread")]
+                return cls(*ensembles, float(data["coverage_factor"]), str(data["kind"]), str(data["trained_on"]))
+        except (OSError, KeyError, ValueError) as error:
+            raise ValueError(f"{str(path)!r} is not a people model written by PeopleModel.save ({error})") from None
 
-class _Forest:
-    """A fitted scikit-learn HistGradientBoostingRegressor evaluated on one row by walking all its trees at
-    once (arrays of every tree's nodes): the same number as its ``predict`` (to rounding, a test checks), in
-    tens of microseconds instead of milliseconds (``predict`` calls each tree in turn)."""
 
-    def __init__(self, regressor):
+class TreeEnsemble:
+    """A fitted gradient-boosted regressor as arrays of its trees' nodes, evaluated on one row by walking all
+    its trees at once: the same number as scikit-learn's ``predict`` of the regressor it came from (to
+    rounding, a test checks), in tens of microseconds, and saved as plain arrays."""
+
+    FIELDS = ("feature", "threshold", "left", "right", "leaf", "value", "baseline")
+
+    def __init__(self, feature, threshold, left, right, leaf, value, baseline):
+        self.feature, self.left, self.right = (np.asarray(a, dtype=np.intp) for a in (feature, left, right))
+        self.threshold, self.value = np.asarray(threshold, dtype=float), np.asarray(value, dtype=float)
+        self.leaf = np.asarray(leaf, dtype=bool)
+        self.baseline = float(baseline)
+        self._rows = np.arange(self.feature.shape[0])
+        self.depth = self._depth()
+
+    @classmethod
+    def of(cls, regressor) -> "TreeEnsemble":
+        """The trees of a fitted scikit-learn ``HistGradientBoostingRegressor``."""
         trees = [predictors[0].nodes for predictors in regressor._predictors]
-        size = max(len(nodes) for nodes in trees)
-        shape = (len(trees), size)
-        self.feature, self.left, self.right = (np.zeros(shape, dtype=np.intp) for _ in range(3))
-        self.threshold, self.value = np.zeros(shape), np.zeros(shape)
-        self.leaf = np.ones(shape, dtype=bool)
+        shape = (len(trees), max(len(nodes) for nodes in trees))
+        feature, left, right = (np.zeros(shape, dtype=np.intp) for _ in range(3))
+        threshold, value, leaf = np.zeros(shape), np.zeros(shape), np.ones(shape, dtype=bool)
         for k, nodes in enumerate(trees):
             m = len(nodes)
-            self.feature[k, :m], self.threshold[k, :m] = nodes["feature_idx"], nodes["num_threshold"]
-            self.left[k, :m], self.right[k, :m] = nodes["left"], nodes["right"]
-            self.leaf[k, :m], self.value[k, :m] = nodes["is_leaf"].astype(bool), nodes["value"]
-        self.depth = int(max(nodes["depth"].max() for nodes in trees))
-        self.baseline = float(np.ravel(regressor._baseline_prediction)[0])
-        self._rows = np.arange(len(trees))
+            feature[k, :m], threshold[k, :m] = nodes["feature_idx"], nodes["num_threshold"]
+            left[k, :m], right[k, :m] = nodes["left"], nodes["right"]
+            leaf[k, :m], value[k, :m] = nodes["is_leaf"].astype(bool), nodes["value"]
+        return cls(feature, threshold, left, right, leaf, value, float(np.ravel(regressor._baseline_prediction)[0]))
+
+    def arrays(self) -> dict:
+        """The arrays :meth:`__init__` takes, by name."""
+        return {name: getattr(self, name) for name in self.FIELDS}
+
+    def _depth(self) -> int:
+        """Steps from the root to the deepest leaf, over all trees (a child's index is above its parent's)."""
+        depth = np.zeros(self.feature.shape, dtype=np.intp)
+        for i in range(self.feature.shape[1]):
+            inner = np.flatnonzero(~self.leaf[:, i])
+            depth[inner, self.left[inner, i]] = depth[inner, self.right[inner, i]] = depth[inner, i] + 1
+        return int(depth.max())
 
     def __call__(self, x: np.ndarray) -> float:
         """The regressor's prediction for one row of finite features x (F,)."""
@@ -185,6 +240,7 @@ class _Forest:
 
 
 def _along_regressor(X, along, seed: int):
+    from sklearn.ensemble import HistGradientBoostingRegressor
     return HistGradientBoostingRegressor(max_iter=250, learning_rate=0.06, loss="quantile", quantile=QUANTILE,
                                          random_state=seed).fit(X, along)
 
@@ -208,11 +264,8 @@ def _samples(recordings):
     return np.array(X), np.array(along), np.array(across), np.array(owner)
 
 
-_LOADED: dict[str, PeopleModel] = {}
-
-
-def shipped_people_model() -> PeopleModel:
-    """The model fitted to recorded people that ships with comanip (loaded once)."""
-    if SHIPPED not in _LOADED:
-        _LOADED[SHIPPED] = pickle.loads((resources.files("comanip") / "data" / SHIPPED).read_bytes())
-    return _LOADED[SHIPPED]
+def shipped_people_model(kind: str = "mouse") -> PeopleModel:
+    """The model of ``kind`` (a key of :data:`KINDS`) fitted to recorded people that ships with comanip."""
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
+    return PeopleModel.load(resources.files("comanip") / "data" / f"people_endpoint_{kind}.npz")
