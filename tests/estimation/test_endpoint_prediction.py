@@ -168,9 +168,32 @@ def test_a_recorded_hand_that_stalls_after_a_failed_update_keeps_the_whitening_i
 
 
 def test_the_people_models_tree_walk_equals_scikit_learns_predict(people):
-    from comanip.estimation.people_model import _Forest, _samples, shipped_people_model
-    X = _samples(people[:20])[0]
-    model = shipped_people_model()
-    for regressor in (model.along, model.spread):
-        walked = np.array([_Forest(regressor)(x) for x in X])
-        np.testing.assert_allclose(walked, regressor.predict(X), rtol=0, atol=1e-9)
+    from comanip.estimation.people_model import TreeEnsemble, _along_regressor, _samples
+    X, along, _, _ = _samples(people[:20])
+    regressor = _along_regressor(X, along, seed=0)
+    walked = np.array([TreeEnsemble.of(regressor)(x) for x in X])
+    np.testing.assert_allclose(walked, regressor.predict(X), rtol=0, atol=1e-9)
+
+
+def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(people, tmp_path):
+    from comanip.estimation.people_model import PeopleModel, shipped_people_model
+    model = shipped_people_model("mouse")
+    back = PeopleModel.load(model.save(tmp_path / "people.npz"))
+    assert (back.kind, back.trained_on, back.coverage_factor) == (model.kind, model.trained_on, model.coverage_factor)
+    r = people[0]
+    for k in (5, 15, len(r.t)):
+        a, b = (m.predict(r.t[:k], r.position[:k], r.velocity[:k], r.position[0]) for m in (model, back))
+        np.testing.assert_array_equal(a.goal, b.goal)
+        np.testing.assert_array_equal(a.covariance, b.covariance)
+    (tmp_path / "other.npz").write_bytes(b"not a model")
+    with pytest.raises(ValueError, match="is not a people model"):
+        PeopleModel.load(tmp_path / "other.npz")
+
+
+def test_a_mouse_people_model_is_refused_for_an_arm_and_an_arm_one_ships():
+    from comanip.estimation.people_model import SCALE_FREE, shipped_people_model
+    arm = shipped_people_model("arm")
+    assert arm.kind == "arm" and len(arm.columns) == len(SCALE_FREE)
+    options = comanip.estimation.OnlineOptions(people_model=shipped_people_model("mouse"))
+    with pytest.raises(ValueError, match="fitted to mouse movements"):
+        comanip.OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6), options=options)

@@ -388,3 +388,20 @@ def test_cli_estimate_takes_prior_std(tmp_path, capsys, planar_planner):
     assert np.linalg.norm(goals["10"] - [0.2, 0.1]) < 0.005          # a weak one leaves it to the observation
     assert main(["estimate", "--observations", str(tmp_path / "observed.csv"), "--prior", "0.3,0.0", "--prior-std", "wide"]) != 0
     assert "--prior-std" in capsys.readouterr().err
+
+
+def test_a_lost_tracker_sample_is_skipped_and_the_estimate_carries_on():
+    model = comanip.presets.cartesian()
+    person = comanip.Planner(model).solve(np.zeros(6), [0.2, 0.1, 0.0], model.width)
+    with_gap, without = (comanip.OnlineGoalEstimator(model, np.zeros(6)) for _ in range(2))
+    first = with_gap.update(person.t[0], np.full(3, np.nan), np.full(3, np.nan))
+    assert first.status == "uninformative" and np.allclose(first.goal, 0.0)
+    for i in range(1, 9):
+        estimate = with_gap.update(person.t[i], person.mean[i, :3], person.mean[i, 3:])
+        reference = without.update(person.t[i], person.mean[i, :3], person.mean[i, 3:])
+        if i == 5:
+            lost = with_gap.update(person.t[i] + 0.01, [np.nan] * 3, [np.nan] * 3)
+            assert lost is estimate                                            # skipped: the estimate stands
+    np.testing.assert_allclose(estimate.goal, reference.goal, atol=1e-9)
+    with pytest.raises(ValueError, match="position"):
+        with_gap.update(person.t[9], [0.1, np.nan, 0.0], person.mean[9, 3:])

@@ -18,6 +18,7 @@ import numpy as np
 
 from comanip.arguments import as_positive
 from comanip.fitting.csv_table import read_table
+from comanip.recordings.motion_capture import load_tathum
 from comanip.units import check_positions_m, check_times_s
 
 AXES = ("x", "y", "z")
@@ -49,7 +50,8 @@ def load_recordings(path: str | Path, trials: str | Path | None = None, *, check
     """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name).
 
     Args:
-        path: a recordings file, or a folder of recordings files.
+        path: a recordings file, a folder of recordings files, or a motion-capture folder in the TAT-HUM
+            layout (:func:`tracked_trials`: goals and widths from the endpoints of each target's trials).
         trials: a trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal and
             width columns; a file of that name inside the folder is not read as recordings.
         check_units: refuse a trial whose times look like ms or whose positions and goal look like mm
@@ -65,6 +67,8 @@ def load_recordings(path: str | Path, trials: str | Path | None = None, *, check
         positions in mm.
     """
     path = Path(path)
+    if is_tathum_folder(path):
+        return tracked_trials(load_tathum(path))
     if path.is_dir():
         skip = None if trials is None else Path(trials).resolve()
         files = [f for f in sorted(path.glob("*.csv")) if f.resolve() != skip]
@@ -85,6 +89,36 @@ def load_recordings(path: str | Path, trials: str | Path | None = None, *, check
     dimensions = {trial.position.shape[1] for trial in result}
     if len(dimensions) > 1:
         raise ValueError(f"recordings mix {sorted(dimensions)}-D trials; every file needs the same position columns")
+    return result
+
+
+def is_tathum_folder(path: Path) -> bool:
+    """Whether ``path`` is a motion-capture data folder in the TAT-HUM layout (:mod:`comanip.recordings.motion_capture`)."""
+    return path.is_dir() and (path / "trajectory_data").is_dir() and (path / "trial_data").is_dir()
+
+
+def tracked_trials(samples, lead: float = 0.0) -> list[Trial]:
+    """Trials for a fit from tracked reaches (:class:`~comanip.recordings.TrackedSamples`) whose goals are not
+    recorded, only which target each aimed at (``label["target"]``, per ``label["participant"]``).
+
+    Each trial starts ``lead`` s before its onset (:meth:`~comanip.recordings.TrackedSamples.recording`; the
+    first sample is the start at rest) and runs to its end, its samples the preprocessed recording's. The
+    goal of a (participant, target) group is the mean of its endpoints, and its width the root-mean-square
+    over the axes of the endpoints' standard deviation: the goal's standard deviation that the model's
+    W = w²·I reads it as (``goal_covariance: std``), as the people's endpoints spread around it."""
+    recordings = [trial.recording() for trial in samples]
+    groups: dict[tuple, list[int]] = {}
+    for k, trial in enumerate(samples):
+        groups.setdefault((trial.label.get("participant"), trial.label.get("target")), []).append(k)
+    result = []
+    for members in groups.values():
+        ends = np.array([recordings[k].end for k in members])
+        goal = ends.mean(axis=0)
+        width = float(np.sqrt(np.mean(ends.var(axis=0)))) if len(members) > 1 else 0.01
+        for k in members:
+            r = recordings[k]
+            keep = (r.t >= r.onset - lead - 1e-9) & (r.t <= r.end_time + 1e-9)
+            result.append(Trial(r.name, r.t[keep] - r.t[keep][0], r.position[keep], goal, width))
     return result
 
 

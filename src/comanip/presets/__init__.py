@@ -94,6 +94,12 @@ def human_cartesian() -> ReachingModel:
     return load("human_cartesian")
 
 
+def arm() -> ReachingModel:
+    """A person's arm reaching in 3-D (n = d = 3): human_cartesian with an arm's hand mass, its movement time
+    set by motion-capture arm reaches; the online estimator's model for a tracked hand."""
+    return load("arm")
+
+
 def franka() -> ReachingModel:
     """Franka Emika Panda (n = 7 joints, d = 3), H = 50, h = 0.035 s; start from ``model.body.home_position``."""
     return load("franka")

@@ -145,8 +145,9 @@ def _checked(name: str, t: np.ndarray, position: np.ndarray, where: str, check_u
     if not np.all(np.isfinite(t)):
         raise ValueError(f"{where}: a time is missing or not a finite number; every row needs its time in s")
     if np.any(np.diff(t) <= 0):
-        row = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 2
-        raise ValueError(f"{where}: times must increase from row to row, row {row} does not ({t[row - 2]:g} then {t[row - 1]:g} s)")
+        sample = int(np.flatnonzero(np.diff(t) <= 0)[0]) + 2
+        raise ValueError(f"{where}: times must increase from sample to sample, sample {sample} (counting from 1, "
+                         f"without a header) does not ({t[sample - 2]:g} then {t[sample - 1]:g} s)")
     if check_units:
         check_times_s(t, f"{where}, times")
         seen = np.all(np.isfinite(position), axis=1)
