@@ -4,8 +4,9 @@ lists them. A run imports only the module of the subcommand it runs (``comanip -
 the command starts without loading the solvers of the others.
 
 Every user mistake ends the command with one line on stderr, ``comanip <command>: error: ...``, and exit
-status 2: argparse's own errors (through :class:`OneLineParser`) and the ValueError, OSError and YAML errors
-raised while loading and checking inputs (through :func:`main`). ``comanip --debug <command>`` shows the traceback.
+status 2: argparse's own errors (through :class:`OneLineParser`), the ValueError, OSError and YAML errors
+raised while loading and checking inputs, and a missing extra (:class:`comanip.extras.MissingExtra`), through
+:func:`main`. ``comanip --debug <command>`` shows the traceback.
 """
 
 from __future__ import annotations
@@ -17,9 +18,11 @@ from importlib import import_module
 import yaml
 
 from comanip.cli.commands import COMMANDS
+from comanip.extras import MissingExtra
 
-#: errors that mean the user gave something wrong (an argument, a file): one line, exit status 2
-USER_ERRORS = (ValueError, OSError, yaml.YAMLError)
+#: errors that mean the user gave something wrong (an argument, a file) or asked for a part whose extra is not
+#: installed: one line, exit status 2
+USER_ERRORS = (ValueError, OSError, yaml.YAMLError, MissingExtra)
 
 
 class OneLineParser(argparse.ArgumentParser):

@@ -4,8 +4,8 @@
 mapping of the node's parameters or ROS 2's ``node: {ros__parameters: ...}`` layout; ``--ros-args ...``
 passes the rest to ROS, e.g. remappings). ``--replay hand.csv`` instead feeds a CSV of hand states (the
 format ``comanip estimate --observations`` reads) through the node in-process, at ``--speed`` times real
-time or in lock step with it (the default), and writes what it published to ``--out``. Needs the optional
-extra: pip install -e ".[ros]".
+time or in lock step with it (the default), and writes what it published to ``--out``. Needs the 'ros'
+extra: pip install 'comanip[ros]'.
 """
 
 from __future__ import annotations
@@ -16,6 +16,7 @@ from comanip.arguments import as_positive
 from comanip.cli.commands import command_help
 from comanip.cli.options import add_unit_check_argument, input_file
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
+from comanip.extras import missing
 
 
 def add_parser(subparsers) -> None:
@@ -37,10 +38,9 @@ def run(args) -> int:
     speed = None if args.speed is None else as_positive("--speed", args.speed, "times real time")
     if speed is not None and args.replay is None:
         raise ValueError("--speed sets the pace of a --replay; give --replay CSV with it (the live node runs at its inputs' pace)")
-    try:
-        import rclpy  # noqa: F401 - only to say what is missing
-    except ImportError as error:
-        raise ValueError(f"the ROS 2 node needs the 'ros' extra: pip install -e \".[ros]\" (rclpy: {error})") from None
+    absent = missing("ros")
+    if absent is not None:
+        raise absent
     if args.replay is not None:
         from comanip.ros.replay import replay_csv
 

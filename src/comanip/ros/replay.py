@@ -24,15 +24,21 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import rclpy
-from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
-from nav_msgs.msg import Path as PathMessage
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
-from rosgraph_msgs.msg import Clock
-from std_msgs.msg import Float64MultiArray
+
+from comanip.extras import MissingExtra
+
+try:  # the 'ros' extra; without it, one line naming the extra
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
+    from nav_msgs.msg import Path as PathMessage
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rosgraph_msgs.msg import Clock
+    from std_msgs.msg import Float64MultiArray
+except ModuleNotFoundError as error:
+    raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.recordings.observation_files import read_observations
 from comanip.ros.messages import SCHEDULE_COLUMNS, read_schedule, seconds, stamp_of, status_text, status_values
