@@ -67,6 +67,6 @@ def run(args) -> int:
         written.append(plot_fit(result, out / "fit.png"))
     write_manifest(out, "fit", written)
     summary = {key: value for key, value in result.to_dict().items() if key not in ("model", "conditions", "trials")}
-    report(args, [f"fit ({model.name}): {result.summary()}", result.message], summary | {"files": [str(p) for p in written]},
-           out, written)
+    lines = [f"fit ({model.name}): {result.summary()}"] + ([result.message] if result.message else [])
+    report(args, lines, summary | {"files": [str(p) for p in written]}, out, written)
     return 0 if result.success else 1

@@ -17,6 +17,7 @@ from importlib import import_module
 
 import yaml
 
+from comanip import __version__
 from comanip.cli.commands import COMMANDS
 from comanip.extras import MissingExtra
 
@@ -40,6 +41,7 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     """The ``comanip`` parser with every subcommand; given the ``argv`` to parse, only the subcommand it names
     is built in full (the others are listed with their one-line help)."""
     parser = OneLineParser(prog="comanip", description="Human reaching prediction and co-manipulation planning.")
+    parser.add_argument("--version", action="version", version=f"comanip {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     subparsers = parser.add_subparsers(dest="command", required=True)
     chosen = None if argv is None else next((word for word in argv if not word.startswith("-")), "")
