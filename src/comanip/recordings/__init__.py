@@ -1,8 +1,9 @@
-"""Recorded human movements: a typed :class:`Recording`, its preprocessing and loaders (CSV, ``cursory``)."""
+"""Recorded human movements: a typed :class:`Recording`, its preprocessing and loaders (CSV, ROS 2 bags, ``cursory``)."""
 
 from comanip.recordings.csv_recordings import load_csv_recordings
 from comanip.recordings.cursory_data import load_cursory
 from comanip.recordings.preprocessing import recording_from_samples
 from comanip.recordings.recording import Recording
+from comanip.recordings.ros_bags import read_bag
 
-__all__ = ["Recording", "load_csv_recordings", "load_cursory", "recording_from_samples"]
+__all__ = ["Recording", "load_csv_recordings", "load_cursory", "read_bag", "recording_from_samples"]
