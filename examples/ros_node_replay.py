@@ -14,9 +14,13 @@ toward [0.35, 0.1, 0.05] m). The same from the command line:
 import matplotlib.pyplot as plt
 import numpy as np
 
-from comanip.ros.replay import BASE_STAMP, replay_csv
-from comanip.ros.node_settings import NodeSettings
-from _common import DATA, figure_path
+from comanip.extras import exit_without
+
+exit_without("ros")  # without the 'ros' extra: one line saying how to install it, no traceback
+
+from comanip.ros.replay import BASE_STAMP, replay_csv  # noqa: E402
+from comanip.ros.node_settings import NodeSettings  # noqa: E402
+from _common import DATA, figure_path  # noqa: E402
 
 settings = NodeSettings.from_yaml(DATA / "node.yaml")
 recording, files = replay_csv(settings, DATA / "hand.csv", figure_path("ros_node_replay").parent / "ros_node_replay")

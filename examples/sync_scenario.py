@@ -13,8 +13,12 @@ goals and policies, and writes every trial as CSV.
 import matplotlib.pyplot as plt
 import numpy as np
 
-from comanip.simulation import ScenarioSetup, SyncSettings, run_sync
-from _common import SMALL, figure_path
+from comanip.extras import exit_without
+
+exit_without("sim")  # without the 'sim' extra: one line saying how to install it, no traceback
+
+from comanip.simulation import ScenarioSetup, SyncSettings, run_sync  # noqa: E402
+from _common import SMALL, figure_path  # noqa: E402
 
 trials = 1 if SMALL else 3
 runs = {}

@@ -1,19 +1,29 @@
-"""MkDocs hook: the CLI reference page, generated from the ``comanip`` argparse parsers at every build.
+"""The command-line reference page, ``docs/reference/cli.md``, generated from the ``comanip`` argparse parsers.
 
-The page ``reference/cli.md`` holds the line ``<!-- cli-reference -->``; this hook replaces it with one section
-per subcommand (and per sub-subcommand, e.g. ``transition generate``): its description, its usage line and a
-table of its arguments with their defaults and help, exactly as ``comanip X --help`` has them. Nothing is
-typed by hand, so the page cannot go stale. Also runnable on its own:
-``python docs/hooks/cli_reference.py > cli.md``.
+The page is :data:`INTRODUCTION` followed by one section per subcommand (and per sub-subcommand, e.g.
+``transition generate``): its description, its usage line and a table of its arguments with their defaults and
+help, exactly as ``comanip X --help`` has them. Nothing is typed by hand. The page is kept in the repository,
+so that it reads where users land; ``python docs/hooks/cli_reference.py --write`` regenerates it, ``--check``
+exits 1 when it is stale (the tests run that check), and as an MkDocs hook it warns at build time when the
+page is stale (a failure under ``--strict``).
 """
 
 from __future__ import annotations
 
 import argparse
+import logging
 import re
 import sys
+from pathlib import Path
 
-MARKER = "<!-- cli-reference -->"
+PAGE = Path(__file__).resolve().parents[1] / "reference" / "cli.md"
+INTRODUCTION = """# Command line
+
+Every subcommand of `comanip`, its arguments, defaults and help, generated from the command's own parsers
+(`python docs/hooks/cli_reference.py --write`; a test fails when this page is stale), so it matches
+`comanip X --help`. Every user mistake ends a command with one line on stderr (`comanip X: error: …`) and exit
+status 2; `comanip --debug X …` shows the traceback instead. `comanip --version` prints the version.
+"""
 
 
 def _subparsers(parser: argparse.ArgumentParser) -> dict[str, argparse.ArgumentParser]:
@@ -79,12 +89,24 @@ def cli_markdown() -> str:
     return "\n".join(sections)
 
 
+def page_text() -> str:
+    """The whole page: the introduction, then :func:`cli_markdown`."""
+    return INTRODUCTION + "\n" + cli_markdown()
+
+
 def on_page_markdown(markdown: str, page, **_) -> str:
-    """MkDocs event: fill the marker of the CLI reference page."""
-    if MARKER in markdown:
-        markdown = markdown.replace(MARKER, cli_markdown())
+    """MkDocs event: warn (a failure under --strict) when the committed page is not the generated one."""
+    if page is not None and page.file.src_uri == "reference/cli.md" and PAGE.read_text(encoding="utf-8") != page_text():
+        logging.getLogger("mkdocs.plugins.cli_reference").warning(
+            "docs/reference/cli.md is stale: regenerate it with python docs/hooks/cli_reference.py --write")
     return markdown
 
 
 if __name__ == "__main__":
-    sys.stdout.write(cli_markdown())
+    if sys.argv[1:] == ["--write"]:
+        PAGE.write_text(page_text(), encoding="utf-8")
+    elif sys.argv[1:] == ["--check"]:
+        sys.exit(0 if PAGE.read_text(encoding="utf-8") == page_text() else "docs/reference/cli.md is stale: "
+                 "python docs/hooks/cli_reference.py --write")
+    else:
+        sys.stdout.write(page_text())

@@ -292,14 +292,7 @@ def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(f
     assert fastest_joint > 0.99
 
 
-ROUNDING_SENSITIVE = pytest.mark.xfail(strict=False, reason=(
-    "known: at 0.25 m two of the three starts stall along the joint limit with gradients of about 1.1e-4, just "
-    "above the 1e-4 that makes a stalled point 'solved_acceptable'; since rows past their limits are no longer "
-    "dropped when the step would drive them further out (comanip.optim.active_set.constrained_step) the third converges "
-    "('solved'), before that all three could stall, depending on rounding (git log -- benchmarks/HISTORY.md)"))
-
-
-@pytest.mark.parametrize("drop", [0.2, pytest.param(0.25, marks=ROUNDING_SENSITIVE)])
+@pytest.mark.parametrize("drop", [0.2, 0.25])
 def test_cold_reach_along_a_joint_limit_converges(franka_planner, drop):
     """Reaching down from the ready pose, joint 4 runs along its lower limit for the second half of the
     reach. The solver once stalled there (a limit met to 3e-8 kept in the working set against a negative

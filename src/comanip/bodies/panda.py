@@ -72,9 +72,10 @@ class Panda(Body):
     @cached_property
     def _rigid_body(self) -> dict[str, ca.Function]:
         """adam's M, x_ee, J, G as CasADi functions of q (7,) alone, built once on first use (under 1 s)."""
-        from adam.casadi import KinDynComputations  # heavy import, paid only when the Panda is used
+        from comanip.extras import require
 
-        kindyn = KinDynComputations(self.urdf, list(ARM_JOINTS))
+        adam_casadi = require("adam.casadi", "panda")  # heavy import, paid only when the Panda is used
+        kindyn = adam_casadi.KinDynComputations(self.urdf, list(ARM_JOINTS))
         base = ca.DM.eye(4)
         q = ca.SX.sym("q", self.n)
         expressions = {

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import numpy as np
 
+from comanip.extras import MissingExtra, missing
+
 #: The actuated joints, base to wrist.
 ARM_JOINTS = tuple(f"panda_joint{i}" for i in range(1, 8))
 #: The flange frame (tool mounting plate), parent of the end-effector link.
@@ -32,10 +34,13 @@ _URDF_IN_PACKAGE = "robots/panda_description/urdf/panda.urdf"
 
 def panda_urdf_path() -> Path:
     """Path of ``panda.urdf`` inside the installed ``example-robot-data`` distribution."""
+    absent = missing("panda")
+    if absent is not None:
+        raise absent
     try:
         files = importlib.metadata.files("example-robot-data") or []
     except importlib.metadata.PackageNotFoundError:
-        raise RuntimeError("the Panda body needs the PyPI package example-robot-data (pip install comanip)") from None
+        raise MissingExtra("panda", "example-robot-data") from None
     for file in files:
         if str(file).endswith(_URDF_IN_PACKAGE):
             return Path(file.locate())

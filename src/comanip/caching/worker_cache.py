@@ -5,12 +5,13 @@ from __future__ import annotations
 
 from typing import Callable
 
-from distributed import WorkerPlugin, get_worker
-
 from comanip.caching.model_cache import ModelCache
+from comanip.extras import require
+
+distributed = require("distributed", "sweeps")
 
 
-class WorkerCache(WorkerPlugin):
+class WorkerCache(distributed.WorkerPlugin):
     """Registered on a cluster (``client.register_plugin(WorkerCache(...))``), gives every worker, present
     or joining later, its own ``ModelCache(build, size)``; a task on a worker reaches it with
     :func:`worker_cache`. ``build`` must be picklable (a module-level function or a class)."""
@@ -27,4 +28,4 @@ class WorkerCache(WorkerPlugin):
 
 def worker_cache(name: str) -> ModelCache:
     """The cache the :class:`WorkerCache` called ``name`` gave the worker running this task."""
-    return get_worker().plugins[name].cache
+    return distributed.get_worker().plugins[name].cache

@@ -3,8 +3,9 @@
 
 #: name -> (module with ``add_parser(subparsers)``, one-line help)
 COMMANDS = {
+    "demo": ("comanip.cli.demo_command", "plan a reach, predict a recorded person's goal online, run a robot beside them"),
     "plan": ("comanip.cli.plan_command", "plan one reach"),
-    "validate": ("comanip.cli.validate_command", "run the validation analyses, the calibration study and the Franka section"),
+    "validate": ("comanip.cli.validate_command", "compare the model with the paper's validation analyses (and the calibration study, the Franka section)"),
     "transition": ("comanip.cli.transition_command", "transition-point data, model and figure (multi-component reaching)"),
     "handover": ("comanip.cli.handover_command", "robot→person authority handover at the predicted transition"),
     "estimate": ("comanip.cli.estimate_command", "estimate a reach's goal from an observed state"),

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from comanip.arguments import as_count
 from comanip.cli.commands import command_help
-from comanip.cli.options import (add_model_arguments, add_unit_check_argument, input_file, input_file_or_folder, load_model,
-                                 scheduler_address)
+from comanip.cli.options import (add_bag_arguments, add_model_arguments, add_unit_check_argument, input_file,
+                                 input_file_or_folder, load_model, scheduler_address)
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.fitting.parameters import DEFAULT_PARAMETERS, MT_DEFAULT_PARAMETERS, ParameterSpace
 
@@ -15,9 +15,11 @@ from comanip.fitting.parameters import DEFAULT_PARAMETERS, MT_DEFAULT_PARAMETERS
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("fit", help=command_help("fit"), description=__doc__)
     data = parser.add_mutually_exclusive_group(required=True)
-    data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns) or a folder of them")
+    data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns), "
+                      "a folder of them, or a ROS 2 bag of one trial (its goal and width from --trials)")
     data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
     parser.add_argument("--trials", type=input_file, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
+    add_bag_arguments(parser, "--recordings")
     add_unit_check_argument(parser, "the recordings")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
@@ -50,9 +52,9 @@ def run(args) -> int:
     as_count("--max-evaluations", args.max_evaluations, optional=True)
     ParameterSpace(model, options.get("parameters", DEFAULT_PARAMETERS if args.recordings else MT_DEFAULT_PARAMETERS), args.sigma_obs)
     if args.recordings is not None:
-        data = load_recordings(args.recordings, args.trials, check_units=args.check_units)
-    elif args.trials is not None:
-        raise ValueError("--trials goes with --recordings; an MT table holds its conditions itself")
+        data = load_recordings(args.recordings, args.trials, check_units=args.check_units, topic=args.topic, frame=args.frame)
+    elif args.trials is not None or args.topic is not None or args.frame is not None:
+        raise ValueError("--trials, --topic and --frame go with --recordings; an MT table holds its conditions itself")
     else:
         data = MovementTimeTable.read(args.mt_table)
     out = output_dir(args.out, "fit", args.force)
@@ -67,6 +69,6 @@ def run(args) -> int:
         written.append(plot_fit(result, out / "fit.png"))
     write_manifest(out, "fit", written)
     summary = {key: value for key, value in result.to_dict().items() if key not in ("model", "conditions", "trials")}
-    report(args, [f"fit ({model.name}): {result.summary()}", result.message], summary | {"files": [str(p) for p in written]},
-           out, written)
+    lines = [f"fit ({model.name}): {result.summary()}"] + ([result.message] if result.message else [])
+    report(args, lines, summary | {"files": [str(p) for p in written]}, out, written)
     return 0 if result.success else 1

@@ -4,8 +4,9 @@ lists them. A run imports only the module of the subcommand it runs (``comanip -
 the command starts without loading the solvers of the others.
 
 Every user mistake ends the command with one line on stderr, ``comanip <command>: error: ...``, and exit
-status 2: argparse's own errors (through :class:`OneLineParser`) and the ValueError, OSError and YAML errors
-raised while loading and checking inputs (through :func:`main`). ``comanip --debug <command>`` shows the traceback.
+status 2: argparse's own errors (through :class:`OneLineParser`), the ValueError, OSError and YAML errors
+raised while loading and checking inputs, and a missing extra (:class:`comanip.extras.MissingExtra`), through
+:func:`main`. ``comanip --debug <command>`` shows the traceback.
 """
 
 from __future__ import annotations
@@ -16,10 +17,13 @@ from importlib import import_module
 
 import yaml
 
+from comanip import __version__
 from comanip.cli.commands import COMMANDS
+from comanip.extras import MissingExtra
 
-#: errors that mean the user gave something wrong (an argument, a file): one line, exit status 2
-USER_ERRORS = (ValueError, OSError, yaml.YAMLError)
+#: errors that mean the user gave something wrong (an argument, a file) or asked for a part whose extra is not
+#: installed: one line, exit status 2
+USER_ERRORS = (ValueError, OSError, yaml.YAMLError, MissingExtra)
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -37,6 +41,7 @@ def build_parser(argv: list[str] | None = None) -> argparse.ArgumentParser:
     """The ``comanip`` parser with every subcommand; given the ``argv`` to parse, only the subcommand it names
     is built in full (the others are listed with their one-line help)."""
     parser = OneLineParser(prog="comanip", description="Human reaching prediction and co-manipulation planning.")
+    parser.add_argument("--version", action="version", version=f"comanip {__version__}")
     parser.add_argument("--debug", action="store_true", help="show the full traceback of an error")
     subparsers = parser.add_subparsers(dest="command", required=True)
     chosen = None if argv is None else next((word for word in argv if not word.startswith("-")), "")

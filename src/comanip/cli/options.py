@@ -41,6 +41,14 @@ def add_unit_check_argument(parser: argparse.ArgumentParser, what: str) -> None:
                              "ms or the positions like mm")
 
 
+def add_bag_arguments(parser: argparse.ArgumentParser, what: str) -> None:
+    """--topic and --frame: which samples of a ROS 2 bag given as ``what`` are the hand's."""
+    parser.add_argument("--topic", help=f"the hand's topic when {what} is a ROS 2 bag (PoseStamped, PointStamped, TransformStamped "
+                                        "or TFMessage; default: the bag's only such topic)")
+    parser.add_argument("--frame", help=f"when {what} is a bag: the frame of the positions (poses, points) or the hand's "
+                                        "child frame (transforms) (default: the topic's only frame)")
+
+
 def load_model(args: argparse.Namespace) -> ReachingModel:
     """The model named by --preset; a ValueError names the argument."""
     try:
@@ -60,6 +68,14 @@ def scheduler_address(text: str) -> str:
 def input_file(text: str) -> Path:
     """An argparse type: a path to an existing, readable, non-empty file (not a directory)."""
     return _readable(Path(text), folders=False)
+
+
+def input_file_or_bag(text: str) -> Path:
+    """An argparse type: a path to an existing, readable, non-empty file, or to a ROS 2 bag's folder."""
+    from comanip.recordings.ros_bags import is_bag
+
+    path = Path(text)
+    return path if path.is_dir() and is_bag(path) else _readable(path, folders=False)
 
 
 def input_file_or_folder(text: str) -> Path:

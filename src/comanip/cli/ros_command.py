@@ -3,9 +3,9 @@
 ``comanip ros --params config.yaml`` starts the node (topics, rates, model and frame from the YAML, a flat
 mapping of the node's parameters or ROS 2's ``node: {ros__parameters: ...}`` layout; ``--ros-args ...``
 passes the rest to ROS, e.g. remappings). ``--replay hand.csv`` instead feeds a CSV of hand states (the
-format ``comanip estimate --observations`` reads) through the node in-process, at ``--speed`` times real
-time or in lock step with it (the default), and writes what it published to ``--out``. Needs the optional
-extra: pip install -e ".[ros]".
+format ``comanip estimate --observations`` reads; or a ROS 2 bag of the hand's position) through the node in-process, at ``--speed`` times real
+time or in lock step with it (the default), and writes what it published to ``--out``. Needs the 'ros'
+extra: pip install 'comanip[ros]'.
 """
 
 from __future__ import annotations
@@ -14,15 +14,18 @@ import argparse
 
 from comanip.arguments import as_positive
 from comanip.cli.commands import command_help
-from comanip.cli.options import add_unit_check_argument, input_file
+from comanip.cli.options import add_bag_arguments, add_unit_check_argument, input_file, input_file_or_bag
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
+from comanip.extras import missing
 
 
 def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("ros", help=command_help("ros"), description=__doc__,
                                    formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--params", type=input_file, help="the node's parameters, a YAML file (default: the defaults)")
-    parser.add_argument("--replay", type=input_file, help="replay this CSV of hand states (t_s, q0.., qdot0..) through the node")
+    parser.add_argument("--replay", type=input_file_or_bag, help="replay this CSV of hand states (t_s, q0.., qdot0..), or a ROS 2 "
+                                                             "bag of the hand's position, through the node")
+    add_bag_arguments(parser, "--replay")
     add_unit_check_argument(parser, "the --replay CSV")
     parser.add_argument("--speed", type=float, help="replay at this multiple of real time (default: in lock step with the node)")
     add_output_arguments(parser, "out/ros", "replay output folder")
@@ -37,15 +40,15 @@ def run(args) -> int:
     speed = None if args.speed is None else as_positive("--speed", args.speed, "times real time")
     if speed is not None and args.replay is None:
         raise ValueError("--speed sets the pace of a --replay; give --replay CSV with it (the live node runs at its inputs' pace)")
-    try:
-        import rclpy  # noqa: F401 - only to say what is missing
-    except ImportError as error:
-        raise ValueError(f"the ROS 2 node needs the 'ros' extra: pip install -e \".[ros]\" (rclpy: {error})") from None
+    absent = missing("ros")
+    if absent is not None:
+        raise absent
     if args.replay is not None:
         from comanip.ros.replay import replay_csv
 
         out = output_dir(args.out, "ros", args.force, create=False)     # made once the replay CSV is read
-        recording, written = replay_csv(settings, args.replay, out, speed, check_units=args.check_units)
+        recording, written = replay_csv(settings, args.replay, out, speed, check_units=args.check_units, topic=args.topic,
+                                        frame=args.frame)
         write_manifest(out, "ros", written)
         last = recording.statuses[-1][3] if recording.statuses else {}
         full = {"estimates": len(recording.goals), "last_goal_m": recording.goals[-1][1].tolist() if recording.goals else None,

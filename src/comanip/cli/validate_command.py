@@ -35,6 +35,7 @@ def add_parser(subparsers) -> None:
 def run(args) -> int:
     from comanip.plots.validation_figures import draw_validation_figures
     from comanip.validation import ValidationSettings, run_validation
+    from comanip.validation.paper_comparison import comparison_lines, paper_comparison
 
     model = load_model(args)
     options = {"workers": args.workers, "seed": args.seed, "franka": args.franka, "human_reference": args.targets_reference}
@@ -43,20 +44,20 @@ def run(args) -> int:
     # checks the model against the settings before creating out; the figures are drawn as a step of their own
     results = run_validation(model, out, settings, draw=draw_validation_figures)
     summary = {"model": model.name, "out": str(out)}
-    lines = [f"validate ({model.name}): {results['wall_time_s']:.1f} s"]
+    lines = [f"validate ({model.name}): the paper's analyses on this model, {results['wall_time_s']:.1f} s",
+             *comparison_lines(results)]
     if "fitts_grid" in results:
         grid = results["fitts_grid"]
-        summary |= {"fitts_r2": grid["fits"]["fitts"]["r2"], "shannon_r2": grid["fits"]["shannon"]["r2"],
+        summary |= {"paper_comparison": paper_comparison(results), "fitts_r2": grid["fits"]["fitts"]["r2"],
+                    "shannon_r2": grid["fits"]["shannon"]["r2"],
                     "configurations_with_fitts_law_and_early_peak": results["calibration"]["both"]}
-        lines.append(f"Fitts' law R² {summary['fitts_r2']:.3g}, Shannon R² {summary['shannon_r2']:.3g}")
     if "human_targets" in results:
-        summary["human_targets_passed"] = {m["model"]: f"{m['passed']}/{m['targets']}" for m in results["human_targets"]["models"]}
-        lines += [f"human-likeness targets met by {name}: {passed}" for name, passed in summary["human_targets_passed"].items()]
+        summary["human_targets_within_range"] = {m["model"]: f"{m['passed']}/{m['targets']}" for m in results["human_targets"]["models"]}
     if "franka" in results:
         summary["franka"] = results["franka"]["summary"]
     files = ["report.json", "report.md", *results["figures"], *results.get("franka", {}).get("files", [])]
     write_manifest(out, "validate", [out / f for f in files])
-    lines.append(f"tables in {out / 'report.md'}")
+    lines.append(f"the comparison and every table: {out / 'report.md'}")
     report(args, lines, summary | {"files": files, "wall_time_s": round(results["wall_time_s"], 1)}, out, files)
     return 0
 

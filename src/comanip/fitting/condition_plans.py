@@ -95,7 +95,9 @@ def _client(scheduler):
     """(Dask client or None, whether this object owns it) for a scheduler argument."""
     if scheduler is None:
         return None, False
-    from dask.distributed import Client
+    from comanip.extras import require
+
+    Client = require("dask.distributed", "sweeps").Client
 
     if isinstance(scheduler, Client):
         return scheduler, False

@@ -85,10 +85,10 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
     curves = [condition_curves(data, c, plan) for c, plan in zip(conditions, plans)]
     trial_rows = trial_residuals(data, conditions, plans)
     values, std_errors = space.values(u), space.natural_std_errors(u, spread.robust_std(), bounded)
-    message = outcome_message(message, bounded)
     unidentified = identification(values, space.start_values, std_errors, sum(row["samples_used"] for row in trial_rows))
+    message = outcome_message(message, bounded, unidentified)
     if unidentified:
-        status, message = "unidentified", f"{message}; but {unidentified}"
+        status = "unidentified"
     return FitResult(
         success=status == "converged" and all(plan.converged for plan in plans), status=status,
         message=message, model=fitted, values=values, initial_values=space.start_values, std_errors=std_errors,
@@ -144,7 +144,8 @@ def unconstrained_by_bounds(objective, space: ParameterSpace, u) -> list[str]:
 
 
 def _minimise(objective, space: ParameterSpace, max_evaluations: int) -> tuple[np.ndarray, str, str]:
-    """Bounded Nelder-Mead from the start values: (best u, status 'converged' or 'max_evaluations', message)."""
+    """Bounded Nelder-Mead from the start values: (best u, status 'converged' or 'max_evaluations', SciPy's
+    message when it did not converge, else "")."""
     u0 = space.initial
     if not np.isfinite(objective(u0)):
         raise RuntimeError("the objective is not finite at the start values (a plan is not finite or the model rejected a value)")
@@ -156,4 +157,4 @@ def _minimise(objective, space: ParameterSpace, max_evaluations: int) -> tuple[n
     result = minimize(objective, u0, method="Nelder-Mead", bounds=space.bounds,
                       options={"initial_simplex": np.array(simplex), "xatol": 1e-3, "fatol": 1e-2, "maxfev": max_evaluations})
     status = "converged" if result.success else "max_evaluations"
-    return np.asarray(result.x), status, str(result.message)
+    return np.asarray(result.x), status, "" if result.success else str(result.message)

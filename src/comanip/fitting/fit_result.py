@@ -28,7 +28,7 @@ class FitResult:
     status: str
     """One of :data:`FIT_STATUSES`."""
     message: str
-    """What happened, in words."""
+    """What happened, in words, where the status does not say it all ("" for a plain convergence)."""
     model: ReachingModel
     """The model with the fitted values (the start model when the fit failed)."""
     values: dict[str, float]
@@ -78,13 +78,17 @@ class FitResult:
         return f"{self.status}: {values}; {self.objective_kind} {self.objective:.6g} after {self.evaluations} evaluations in {self.fit_time:.1f} s"
 
 
-def outcome_message(optimiser: str, bounded: list[str]) -> str:
-    """The optimiser's message, plus the parameters that ended at a search bound, or short of one the data do not
-    exclude (``bounded``; if any)."""
-    if not bounded:
-        return optimiser
-    return (f"{optimiser} {bounded} ended at a search bound, or short of one the data do not exclude: the data hardly "
-            f"constrain them there or the bounds are too tight (their standard errors are NaN)")
+def outcome_message(optimiser: str, bounded: list[str], unidentified: str | None = None) -> str:
+    """The optimiser's message ("" when it converged), then the parameters that ended at a search bound, or short
+    of one the data do not exclude (``bounded``; if any), then why the data do not determine the fit
+    (``unidentified``, :func:`identification`; if any)."""
+    parts = [optimiser]
+    if bounded:
+        parts.append(f"{bounded} ended at a search bound, or short of one the data do not exclude: the data hardly "
+                     f"constrain them there or the bounds are too tight (their standard errors are NaN)")
+    if unidentified:
+        parts.append(f"but {unidentified}")
+    return "; ".join(part for part in parts if part)
 
 
 def identification(values: dict[str, float], start: dict[str, float], std_errors: dict[str, float],

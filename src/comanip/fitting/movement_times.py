@@ -94,11 +94,11 @@ def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTab
                                  time.perf_counter() - t_begin, SSE_KIND)
     std = _least_squares_std(result.fun, result.jac)
     status = "converged" if result.status > 0 else "max_evaluations"
-    message = outcome_message(str(result.message), space.at_bounds(result.x))
     values, std_errors = space.values(result.x), space.natural_std_errors(result.x, std)
     unidentified = identification(values, space.start_values, std_errors)
+    message = outcome_message("" if result.status > 0 else str(result.message), space.at_bounds(result.x), unidentified)
     if unidentified:
-        status, message = "unidentified", f"{message}; but {unidentified}"
+        status = "unidentified"
     rows = [{"condition": c, "distance_m": float(D), "width_m": float(w), "mt_recorded_s": float(mt),
              "mt_predicted_s": movement_time(plan.t, plan.ee_speed), "plan_status": plan.status, "plan_success": plan.success}
             for c, (D, w, mt, plan) in enumerate(zip(table.distance, table.width, table.mt, plans))]

@@ -6,7 +6,9 @@ without it the whole file is one trial, named after the file. The first sample o
 where the hand is taken to be at rest. Each trial's goal and width come from columns
 ``goal_x, goal_y[, goal_z], width`` (m) repeated on its rows, or from a separate trials table with the
 columns ``trial, goal_x, goal_y[, goal_z], width``. Times that look like ms or positions that look like mm
-(:mod:`comanip.units`) are refused unless ``check_units=False``. See docs/fitting.md.
+(:mod:`comanip.units`) are refused unless ``check_units=False``. A ROS 2 bag
+(:mod:`comanip.recordings.ros_bags`) is one trial named after the bag, its goal and width from a trials table,
+its positions the first d of x, y, z for the table's d-coordinate goals. See docs/fitting.md.
 """
 
 from __future__ import annotations
@@ -46,16 +48,19 @@ class Trial:
         return self.position[0]
 
 
-def load_recordings(path: str | Path, trials: str | Path | None = None, *, check_units: bool = True) -> list[Trial]:
-    """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name).
+def load_recordings(path: str | Path, trials: str | Path | None = None, *, check_units: bool = True,
+                    topic: str | None = None, frame: str | None = None) -> list[Trial]:
+    """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name), or from a ROS 2 bag.
 
     Args:
-        path: a recordings file, a folder of recordings files, or a motion-capture folder in the TAT-HUM
-            layout (:func:`tracked_trials`: goals and widths from the endpoints of each target's trials).
+        path: a recordings file, a folder of recordings files, a bag (its trial's goal and width from
+            ``trials``), or a motion-capture folder in the TAT-HUM layout (:func:`tracked_trials`: goals and
+            widths from the endpoints of each target's trials).
         trials: a trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal and
             width columns; a file of that name inside the folder is not read as recordings.
         check_units: refuse a trial whose times look like ms or whose positions and goal look like mm
             (:mod:`comanip.units`); False reads them as s and m whatever they look like.
+        topic, frame: a bag's hand topic and frame (:func:`comanip.recordings.ros_bags.bag_samples`).
 
     Returns:
         The trials, in file order and then in order of first appearance.
@@ -66,7 +71,13 @@ def load_recordings(path: str | Path, trials: str | Path | None = None, *, check
         a trial without goal and width, the same trial name twice, or (``check_units``) times in ms or
         positions in mm.
     """
+    from comanip.recordings.ros_bags import is_bag  # comanip.recordings reads CSVs with this module
+
     path = Path(path)
+    if is_bag(path):
+        return [_bag_trial(path, trials, check_units, topic, frame)]
+    if topic is not None or frame is not None:
+        raise ValueError(f"a topic and a frame choose the samples of a ROS 2 bag; {str(path)!r} is not a bag")
     if is_tathum_folder(path):
         return tracked_trials(load_tathum(path))
     if path.is_dir():
@@ -160,6 +171,25 @@ def _trials_in_file(path: Path, targets: dict | None, check_units: bool = True) 
             check_positions_m(np.vstack([trial.position, trial.goal]), f"{where}, columns {list(AXES[:d])} and the goal")
         trials.append(trial)
     return trials
+
+
+def _bag_trial(path: Path, trials: str | Path | None, check_units: bool, topic: str | None, frame: str | None) -> Trial:
+    """The trial in a bag, named after it, its goal and width from the trials table."""
+    from comanip.recordings.ros_bags import bag_name, bag_samples
+
+    name = bag_name(path)
+    if trials is None:
+        raise ValueError(f"bag {str(path)!r} holds no goal and width; give a trials table (trial, goal_x, goal_y[, goal_z], "
+                         f"width) with a row for trial {name!r}")
+    targets = read_trials_table(trials)
+    if name not in targets:
+        raise ValueError(f"trials table {str(trials)!r} has no row for trial {name!r} (the bag's name)")
+    goal, width = targets[name]
+    t, position = bag_samples(path, topic, frame=frame, axes="xyz"[:len(goal)], check_units=check_units)
+    where = f"bag {str(path)!r}"
+    if check_units:
+        check_positions_m(np.vstack([position, goal]), f"{where}, positions and the goal")
+    return _checked_trial(name, t, position, goal, width, where)
 
 
 def _constant_targets(table: dict, rows: np.ndarray, d: int, where: str) -> tuple[np.ndarray, float]:

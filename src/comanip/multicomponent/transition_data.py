@@ -162,18 +162,19 @@ def generate_transition_data(distances_over_arm_length, widths, n_trials: int = 
 
 def _run_on_local_cluster(tasks: list[tuple], workers: int, bar: tqdm) -> list[dict]:
     """Run condition tasks on a Dask LocalCluster of single-threaded worker processes; rows in task order."""
-    from dask.distributed import Client, LocalCluster, as_completed
-
     from comanip.caching.worker_cache import WorkerCache
+    from comanip.extras import require
+
+    distributed = require("dask.distributed", "sweeps")
 
     # processes, not threads: CasADi/IPOPT solves hold the GIL; no dashboard (no web server in a batch job)
-    with LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
-            Client(cluster) as client:
+    with distributed.LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None) as cluster, \
+            distributed.Client(cluster) as client:
         client.register_plugin(WorkerCache(_PLANNERS, Planner, size=2))
         futures = client.map(_condition_task, *zip(*tasks), pure=False)
         index = {future.key: i for i, future in enumerate(futures)}
         rows = [None] * len(tasks)
-        for future in as_completed(futures):
+        for future in distributed.as_completed(futures):
             rows[index[future.key]] = future.result()
             bar.update()
     return rows

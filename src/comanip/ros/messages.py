@@ -11,11 +11,17 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from builtin_interfaces.msg import Time
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
-from geometry_msgs.msg import Pose, PoseStamped, PoseWithCovarianceStamped
-from nav_msgs.msg import Path
-from std_msgs.msg import Float64MultiArray, MultiArrayDimension
+
+from comanip.extras import MissingExtra
+
+try:  # the 'ros' extra; without it, one line naming the extra
+    from builtin_interfaces.msg import Time
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus, KeyValue
+    from geometry_msgs.msg import Pose, PoseStamped, PoseWithCovarianceStamped
+    from nav_msgs.msg import Path
+    from std_msgs.msg import Float64MultiArray, MultiArrayDimension
+except ModuleNotFoundError as error:
+    raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.multicomponent.handover import HandoverSchedule
 from comanip.planning.plan import Plan

@@ -40,14 +40,20 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
-from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped, TwistStamped
-from nav_msgs.msg import Path
-import rclpy
-from rcl_interfaces.msg import ParameterDescriptor
-from rclpy.node import Node
-from rclpy.parameter import Parameter
-from std_msgs.msg import Empty, Float64MultiArray
+
+from comanip.extras import MissingExtra
+
+try:  # the 'ros' extra; without it, one line naming the extra
+    from diagnostic_msgs.msg import DiagnosticArray, DiagnosticStatus
+    from geometry_msgs.msg import PointStamped, PoseStamped, PoseWithCovarianceStamped, TwistStamped
+    from nav_msgs.msg import Path
+    import rclpy
+    from rcl_interfaces.msg import ParameterDescriptor
+    from rclpy.node import Node
+    from rclpy.parameter import Parameter
+    from std_msgs.msg import Empty, Float64MultiArray
+except ModuleNotFoundError as error:
+    raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator
 from comanip.estimation.online_estimator import CORRECTING_PERSON, FamilyCache

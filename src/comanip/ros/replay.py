@@ -1,7 +1,8 @@
 """Replay recorded hand states through the goal node, in-process, and record what it publishes.
 
 The recording is a CSV of timestamped states in the format ``comanip estimate --observations`` reads (header
-``t_s, q0.., qdot0..``; for a point mass q is the hand position in m and qdot its velocity in m/s). Row k is
+``t_s, q0.., qdot0..``; for a point mass q is the hand position in m and qdot its velocity in m/s), or a ROS 2
+bag of the hand's position read as that command reads it. Row k is
 published as a TwistStamped and a PoseStamped stamped ``BASE_STAMP + t_k`` while a /clock message sets the
 node's clock (use_sim_time) to the same time, so the node sees the recording's own time whatever the speed:
 
@@ -24,17 +25,23 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
-import rclpy
-from diagnostic_msgs.msg import DiagnosticArray
-from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
-from nav_msgs.msg import Path as PathMessage
-from rclpy.context import Context
-from rclpy.executors import SingleThreadedExecutor
-from rclpy.node import Node
-from rosgraph_msgs.msg import Clock
-from std_msgs.msg import Float64MultiArray
 
-from comanip.recordings.observation_files import read_observations
+from comanip.extras import MissingExtra
+
+try:  # the 'ros' extra; without it, one line naming the extra
+    import rclpy
+    from diagnostic_msgs.msg import DiagnosticArray
+    from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
+    from nav_msgs.msg import Path as PathMessage
+    from rclpy.context import Context
+    from rclpy.executors import SingleThreadedExecutor
+    from rclpy.node import Node
+    from rosgraph_msgs.msg import Clock
+    from std_msgs.msg import Float64MultiArray
+except ModuleNotFoundError as error:
+    raise MissingExtra("ros", error.name or "rclpy") from None
+
+from comanip.recordings.hand_states import read_hand_states
 from comanip.ros.messages import SCHEDULE_COLUMNS, read_schedule, seconds, stamp_of, status_text, status_values
 from comanip.ros.node import GoalNode
 from comanip.ros.node_settings import NodeSettings
@@ -262,11 +269,15 @@ class Replay:
 
 
 def replay_csv(settings: NodeSettings, observations: str | Path, out: str | Path, speed: float | None = None,
-               transition_model=None, check_units: bool = True) -> tuple[Recording, list[Path]]:
-    """Replay a CSV of hand states (``comanip estimate`` format) through the node; write the recording to ``out``.
-    ``check_units`` refuses times that look like ms and positions like mm (or angles like degrees)."""
+               transition_model=None, check_units: bool = True, topic: str | None = None,
+               frame: str | None = None) -> tuple[Recording, list[Path]]:
+    """Replay a CSV of hand states (``comanip estimate`` format), or a ROS 2 bag of the hand's position (its
+    ``topic`` and ``frame``: :func:`comanip.recordings.hand_states.read_hand_states`), through the node; write the
+    recording to ``out``. ``check_units`` refuses times that look like ms and positions like mm (or angles like
+    degrees)."""
     model = settings.model()
-    times, states = read_observations(Path(observations), model.n, check_units=check_units, joint_angles=not model.body.is_linear)
+    times, states = read_hand_states(Path(observations), model.n, check_units=check_units, joint_angles=not model.body.is_linear,
+                                     name="replay", topic=topic, frame=frame)
     with Replay(settings, transition_model) as replay:
         recording = replay.run(times, states, speed)
     return recording, recording.write(out, model.d)

@@ -6,11 +6,13 @@ is not compensated, as in the paper's experiments), whatever the simulated plant
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from comanip.control.impedance import RobotState
+from comanip.extras import require
 from comanip.simulation.panda_model import TCP_SITE, build_panda_model
+
+mujoco = require("mujoco", "sim")
 
 
 class MujocoKinematics:

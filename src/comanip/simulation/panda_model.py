@@ -21,11 +21,13 @@ import xml.etree.ElementTree as ET
 from functools import lru_cache
 from pathlib import Path
 
-import mujoco
 import numpy as np
 
 from comanip.bodies.panda import PANDA_ARMATURE, READY_POSE
 from comanip.bodies.panda_urdf import ARM_JOINTS, TCP_LINK, panda_urdf_path, reduced_panda_urdf
+from comanip.extras import require
+
+mujoco = require("mujoco", "sim")
 
 #: Site at the TCP: the controlled point, and the handle where the person pushes.
 TCP_SITE = "tcp"

@@ -8,13 +8,15 @@ integrates the arm, the object and gravity.
 
 from __future__ import annotations
 
-import mujoco
 import numpy as np
 
 from comanip.arguments import as_vector
 from comanip.control.impedance import CartesianImpedanceController, ImpedanceGains, RobotState
+from comanip.extras import require
 from comanip.simulation.kinematics import MujocoKinematics
 from comanip.simulation.panda_model import OBJECT_BODY, READY_POSTURE, build_panda_model
+
+mujoco = require("mujoco", "sim")
 
 
 class CoManipulationWorld:

@@ -11,6 +11,7 @@ import math
 from comanip.analysis.arm_reaches import LIMIT_KINDS
 from comanip.analysis.calibration import EARLY_PEAK_MAX, FITTS_R2_MIN
 from comanip.analysis.minimum_jerk_baseline import minimum_jerk_asymmetry
+from comanip.validation.paper_comparison import paper_comparison
 
 
 def report_markdown(report: dict) -> str:
@@ -20,6 +21,11 @@ def report_markdown(report: dict) -> str:
     lines = [f"# comanip validation report: {model['name']}", "",
              f"Model: {_model_line(model)}. Run: {'quick' if settings['quick'] else 'full'}, seed {settings['seed']}, "
              f"{_num(report['wall_time_s'], 1)} s.", ""]
+    comparison = paper_comparison(report)
+    if comparison:
+        lines += ["## The paper's claims and this model", "",
+                  "What the paper's Section IV-D shows, and what this model gives on the grid below.", "",
+                  _table(["the paper", "where", "this model"], [[r["claim"], r["paper"], r["model"]] for r in comparison]), ""]
     if "fitts_grid" in report:
         lines += _point_mass_sections(report)
     if "human_targets" in report:
@@ -113,8 +119,8 @@ def _franka_section(section: dict, run_model: dict) -> list[str]:
 def _calibration_section(calibration: dict, settings: dict) -> list[str]:
     rows = calibration["configurations"]
     both = calibration["both"]
-    verdict = (f"**Configurations that get both: {', '.join(both)}.**" if both else
-               "**No configuration gets both Fitts' law and an early peak.**")
+    verdict = (f"Configurations with both Fitts' law and an early peak: {', '.join(both)}." if both else
+               f"Configurations with both Fitts' law and an early peak: none of the {len(rows)} on this grid.")
     return [
         "## Calibration study (`calibration.png`)", "",
         f"Grid D ∈ {list(settings['distances'])} m × w ∈ {list(settings['widths'])} m. Fitts' law: every reach finished, "
