@@ -190,10 +190,10 @@ def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(peopl
         PeopleModel.load(tmp_path / "other.npz")
 
 
-def test_a_mouse_people_model_is_refused_for_an_arm_and_an_arm_one_ships():
+def test_an_arm_people_model_ships_and_reads_only_the_features_without_units():
     from comanip.estimation.people_model import SCALE_FREE, shipped_people_model
     arm = shipped_people_model("arm")
     assert arm.kind == "arm" and len(arm.columns) == len(SCALE_FREE)
-    options = comanip.estimation.OnlineOptions(people_model=shipped_people_model("mouse"))
-    with pytest.raises(ValueError, match="fitted to mouse movements"):
-        comanip.OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6), options=options)
+    options = comanip.estimation.OnlineOptions(people_model=arm)
+    estimator = comanip.OnlineGoalEstimator(comanip.presets.arm(), np.zeros(comanip.presets.arm().state_size), options=options)
+    assert estimator.update(0.0, np.zeros(3), np.zeros(3)).status == "uninformative"
