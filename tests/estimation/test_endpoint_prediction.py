@@ -190,10 +190,20 @@ def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(peopl
         PeopleModel.load(tmp_path / "other.npz")
 
 
-def test_an_arm_people_model_ships_and_reads_only_the_features_without_units():
+def test_an_arm_people_model_ships_reads_only_the_features_without_units_and_a_mouse_one_is_refused_for_an_arm():
     from comanip.estimation.people_model import SCALE_FREE, shipped_people_model
     arm = shipped_people_model("arm")
     assert arm.kind == "arm" and len(arm.columns) == len(SCALE_FREE)
-    options = comanip.estimation.OnlineOptions(people_model=arm)
-    estimator = comanip.OnlineGoalEstimator(comanip.presets.arm(), np.zeros(comanip.presets.arm().state_size), options=options)
-    assert estimator.update(0.0, np.zeros(3), np.zeros(3)).status == "uninformative"
+    options = comanip.estimation.OnlineOptions(people_model=shipped_people_model("mouse"))
+    with pytest.raises(ValueError, match="fitted to mouse movements"):
+        comanip.OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6), options=options)
+
+
+def test_a_people_model_that_has_seen_one_moving_sample_claims_no_more_than_the_hand_can_still_travel():
+    from comanip.estimation.people_model import STOPPING_TIME, shipped_people_model
+    velocity = np.array([[0.0, 0.0, 0.0], [0.6, 0.8, 0.0]])                    # 1 m/s, one sample after rest
+    for kind in ("arm", "mouse"):
+        model = shipped_people_model(kind)
+        d = 3 if kind == "arm" else 2
+        answer = model.predict(np.array([0.0, 0.01]), np.zeros((2, d)), velocity[:, :d], np.zeros(d))
+        assert np.linalg.eigvalsh(answer.covariance).min() >= (STOPPING_TIME * 1.0) ** 2 * (1 - 1e-12)

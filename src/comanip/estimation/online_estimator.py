@@ -147,8 +147,9 @@ class OnlineOptions:
     the model at its own pace still explains the observations (about 1 for the model's own reaches)."""
     people_model: PeopleModel | None = None
     """With ``timing="estimated"``: the model of people's movements (:class:`comanip.estimation.people_model.PeopleModel`,
-    e.g. fitted to your own recordings); None: the ``mouse`` one that ships with comanip. For a tracked arm pass
-    ``shipped_people_model("arm")``, fitted to arm reaches."""
+    e.g. fitted to your own recordings); None: the one that ships with comanip for the kind of movement the
+    reaching model makes (``arm``, fitted to arm reaches, for a 3-D model; ``mouse`` for a 2-D one). A model
+    fitted to mouse movements is refused for a 3-D reach."""
     paced_threshold: float = 0.05
     """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
@@ -297,7 +298,7 @@ class OnlineGoalEstimator:
         self._history: list[np.ndarray] = []       # [t, position, velocity] of every observation, for the people model
         self._off_model: str | None = None          # why the model at its own pace does not explain the hand
         self._paced = PacedModel(self.family)
-        self._people = self.options.people_model or shipped_people_model("mouse")
+        self._people = self._people_model(d)
         self._whitening: ObservationWhitening | None = None
         self._blas = ThreadpoolController()
         self._whitening_goal = np.zeros(d)
@@ -394,6 +395,14 @@ class OnlineGoalEstimator:
         goal, covariance = self._with_prior(self._not_behind(people.goal, position[-1]), people.covariance)
         return self._result(goal, covariance, Status.PEOPLE_MODEL, f"{self._off_model}, nor does it clearly at the "
                             f"person's pace (misfit {paced.misfit:.3g}): the goal is the people model's", 0, t_begin)
+
+    def _people_model(self, d: int) -> PeopleModel:
+        """The people model for a reach in d dimensions (:attr:`OnlineOptions.people_model`)."""
+        people = self.options.people_model or shipped_people_model("arm" if d == 3 else "mouse")
+        if d == 3 and people.kind == "mouse":
+            raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: fit one "
+                             "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
+        return people
 
     def _humanlike(self, position: np.ndarray, velocity: np.ndarray) -> bool:
         """Whether the observed hand stays within the reach family's distances and a person's hand speeds

@@ -10,7 +10,8 @@ them how far beyond the hand the endpoint lies along the direction of motion u (
 moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
 endpoint is never behind the hand along u, and a hand that has stopped (speed below ``REST_FRACTION`` of its
 peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
-factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors).
+factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors), and
+never below the distance the hand can still cover at its current speed (``STOPPING_TIME``).
 
 A model is fitted per **kind** of movement (:data:`KINDS`): people move a mouse and an arm differently, and a
 model fitted on one is not applied to the other. An arm model uses only the features without units
@@ -56,6 +57,10 @@ QUANTILE = 0.3
 predicted beyond where the hand stops costs a robot more than one predicted short of it."""
 REST_FRACTION, REST_TIME = 0.05, 0.1
 """A hand whose speed has stayed below this fraction of its peak speed for this long (s) has stopped."""
+STOPPING_TIME = 0.1
+"""A hand moving at speed v can still cover about v times this (s) before it stops, whatever the regressors
+say: the predicted endpoint's standard deviation (per axis) is never below it. Where the movement so far says
+little (one sample after the onset), this keeps a prediction from claiming millimetres."""
 REST_SPREAD = 0.03
 """Standard deviation of a stopped hand's endpoint estimate, a fraction of the path length."""
 _MIN_PATH = 1e-4
@@ -163,7 +168,7 @@ class PeopleModel:
         x = features[self.columns]
         along, log_squared = self.along(x), self.spread(x)
         goal = position[-1] + path * max(along, 0.0) * u
-        variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
+        variance = max(self.coverage_factor * path**2 * math.exp(log_squared) / len(u), (STOPPING_TIME * speed[-1]) ** 2)
         return EndpointPrediction(goal, variance * np.eye(len(u)))
 
     def save(self, path: str | Path) -> Path:
