@@ -3,10 +3,13 @@
 People: every reach of a TAT-HUM 3-D data folder (default: the development split beside the repository),
 preprocessed by :meth:`comanip.recordings.TrackedSamples.recording` (4 ms grid, Savitzky–Golay velocities,
 onset and end at 5 % of the peak speed): movement time MT, t_peak / MT, peak speed, endpoint spread (SD of
-the endpoints of each target's reaches, per axis, pooled). Model: the preset's mean reach (its plan) from
-rest over the people's median distance, with the width its YAML gives, timed the same way
-(docs/formulation.md §6); its endpoint SD from the plan's covariance at MT; Fitts' law on the validation grid
-(D 0.15–0.45 m × w 0.005–0.04 m). Prints a markdown table and writes a figure of the speed profiles,
+the endpoints of each target's reaches, per axis, pooled). Model: the preset's mean reach from rest over
+the people's median distance, with the width its YAML gives, timed the same way (docs/formulation.md §6),
+twice: its plan (open loop, what the online estimator's reach family holds) and its closed loop (the mean of
+``--trials`` executions that replan every step from what the person sees, 100 ms late: the fast first
+sub-movement and the corrections after it); the endpoint SD from the plan's covariance at MT and over the
+closed-loop executions at their end; Fitts' law of the plans on the validation grid (D 0.15–0.45 m × w
+0.005–0.04 m). Prints a markdown table and writes a figure of the speed profiles,
 normalised in time (by MT, from the onset) and amplitude (by the peak), the model over the people's
 10–90 % band.
 
@@ -23,6 +26,7 @@ import numpy as np
 import comanip
 from comanip.analysis.fitts import fit_fitts
 from comanip.analysis.speed_profile import speed_metrics
+from comanip.execution import execute_receding_horizon
 from comanip.recordings import load_tathum
 
 ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
@@ -49,48 +53,61 @@ def people(folder: Path) -> dict:
             "endpoint_sd": float(np.sqrt(np.mean(spread)))}
 
 
-def model_reach(model, distance: float) -> dict:
+def timing(t: np.ndarray, speed: np.ndarray) -> dict:
+    """MT, t_peak / MT and the normalised profile of a mean speed profile, timed from its onset as people's."""
+    metrics = speed_metrics(t, speed)
+    onset = t[int(np.argmax(speed > 0.05 * metrics.peak_speed))]
+    duration = metrics.movement_time - onset
+    return {"movement_time": duration, "asymmetry": (metrics.t_peak - onset) / duration, "peak_speed": metrics.peak_speed,
+            "profile": np.interp(onset + PHASE * duration, t, speed) / metrics.peak_speed}
+
+
+def model_reach(model, distance: float, trials: int) -> dict:
     planner = comanip.Planner(model)
     start = np.zeros(model.state_size)
-    plan = planner.solve(start, [distance, 0.0, 0.0], model.width)
-    metrics = speed_metrics(plan.t, plan.ee_speed)
-    onset = plan.t[int(np.argmax(plan.ee_speed > 0.05 * metrics.peak_speed))]
-    profile = np.interp(onset + PHASE * (metrics.movement_time - onset), plan.t, plan.ee_speed) / metrics.peak_speed
-    at_mt = int(np.searchsorted(plan.t, metrics.movement_time))
-    endpoint_sd = float(np.sqrt(np.trace(plan.ee_cov[at_mt]) / model.d))
+    goal = np.array([distance, 0.0, 0.0])
+    plan = planner.solve(start, goal, model.width)
+    planned = timing(plan.t, plan.ee_speed)
+    at_mt = int(np.searchsorted(plan.t, speed_metrics(plan.t, plan.ee_speed).movement_time))
+    planned["endpoint_sd"] = float(np.sqrt(np.trace(plan.ee_cov[at_mt]) / model.d))
+    rng = np.random.default_rng(0)
+    runs = [execute_receding_horizon(planner, start, goal, model.width, steps=2 * model.H, rng=rng) for _ in range(trials)]
+    closed = timing(runs[0].t, np.linalg.norm(np.mean([run.ee_velocity for run in runs], axis=0), axis=1))
+    closed["endpoint_sd"] = float(np.sqrt(np.mean(np.var([run.ee[-1] for run in runs], axis=0))))
     grid = [(D, w, speed_metrics(*(lambda p: (p.t, p.ee_speed))(planner.solve(start, [D, 0.0, 0.0], w))).movement_time)
             for D in (0.15, 0.3, 0.45) for w in (0.005, 0.01, 0.02, 0.04)]
-    fitts = fit_fitts(*map(np.array, zip(*grid)))
-    return {"movement_time": metrics.movement_time - onset, "asymmetry": (metrics.t_peak - onset) / (metrics.movement_time - onset),
-            "peak_speed": metrics.peak_speed, "profile": profile, "endpoint_sd": endpoint_sd, "fitts": fitts,
-            "success": plan.success}
+    return {"plan": planned, "closed": closed, "fitts": fit_fitts(*map(np.array, zip(*grid)))}
 
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--arms", type=Path, default=ARMS, help="a TAT-HUM 3-D data folder")
     parser.add_argument("--preset", default="arm")
+    parser.add_argument("--trials", type=int, default=32, help="closed-loop executions averaged")
     parser.add_argument("--figure", type=Path, default=None)
     args = parser.parse_args(argv)
     recorded = people(args.arms)
     model = comanip.presets.load(args.preset)
     D = float(np.median(recorded["distance"]))
-    mine = model_reach(model, D)
+    mine = model_reach(model, D, args.trials)
     q = lambda x: f"{np.median(x):.3g} [{np.percentile(x, 25):.3g}–{np.percentile(x, 75):.3g}]"
     mt = float(np.median(recorded["movement_time"]))
     low, high = np.percentile(recorded["asymmetry"], [25, 75])
-    fitts = mine["fitts"]
+    plan, closed, fitts = mine["plan"], mine["closed"], mine["fitts"]
+    met = lambda ok: "yes" if ok else "no"
     print(f"Recorded arm reaches ({recorded['count']}, median distance {D:.3f} m) against the `{args.preset}` preset's "
-          f"mean reach over that distance (width {model.width:g} m): median [IQR]\n")
-    print("| quantity | people | model | target | met |\n|---|---|---|---|---|")
-    print(f"| movement time (s) | {q(recorded['movement_time'])} | {mine['movement_time']:.3f} | within 10 % of {mt:.3f} | "
-          f"{'yes' if abs(mine['movement_time'] / mt - 1) <= 0.1 else 'no'} |")
-    print(f"| t_peak / MT | {q(recorded['asymmetry'])} | {mine['asymmetry']:.3f} | inside {low:.3f}–{high:.3f} | "
-          f"{'yes' if low <= mine['asymmetry'] <= high else 'no'} |")
-    print(f"| peak speed (m/s) | {q(recorded['peak_speed'])} | {mine['peak_speed']:.3f} | | |")
-    print(f"| endpoint SD per axis (mm) | {1e3 * recorded['endpoint_sd']:.2f} | {1e3 * mine['endpoint_sd']:.2f} (open loop, at MT) | | |")
-    print(f"| Fitts' law on the validation grid | | slope {1e3 * fitts.b:.0f} ms/bit, R² {fitts.r2:.3f} | 80–160 ms/bit, R² ≥ 0.95 | "
-          f"{'yes' if 0.08 <= fitts.b <= 0.16 and fitts.r2 >= 0.95 else 'no'} |")
+          f"mean reach over that distance (width {model.width:g} m; closed loop: {args.trials} executions): "
+          f"people median [IQR]\n")
+    print("| quantity | people | plan | closed loop | target | met (closed loop) |\n|---|---|---|---|---|---|")
+    print(f"| movement time (s) | {q(recorded['movement_time'])} | {plan['movement_time']:.3f} | {closed['movement_time']:.3f} | "
+          f"within 10 % of {mt:.3f} | {met(abs(closed['movement_time'] / mt - 1) <= 0.1)} |")
+    print(f"| t_peak / MT | {q(recorded['asymmetry'])} | {plan['asymmetry']:.3f} | {closed['asymmetry']:.3f} | "
+          f"inside {low:.3f}–{high:.3f} | {met(low <= closed['asymmetry'] <= high)} |")
+    print(f"| peak speed (m/s) | {q(recorded['peak_speed'])} | {plan['peak_speed']:.3f} | {closed['peak_speed']:.3f} | | |")
+    print(f"| endpoint SD per axis (mm) | {1e3 * recorded['endpoint_sd']:.2f} | {1e3 * plan['endpoint_sd']:.2f} (at MT) | "
+          f"{1e3 * closed['endpoint_sd']:.2f} | | |")
+    print(f"| Fitts' law on the validation grid (plans) | | slope {1e3 * fitts.b:.0f} ms/bit, R² {fitts.r2:.3f} | | "
+          f"80–160 ms/bit, R² ≥ 0.95 | {met(0.08 <= fitts.b <= 0.16 and fitts.r2 >= 0.95)} |")
     if args.figure:
         import matplotlib
         matplotlib.use("Agg")
@@ -99,7 +116,8 @@ def main(argv=None):
         band = np.percentile(recorded["profiles"], [10, 50, 90], axis=0)
         ax.fill_between(PHASE, band[0], band[2], color="0.8", label="people, 10–90 %")
         ax.plot(PHASE, band[1], color="0.3", label="people, median")
-        ax.plot(PHASE, mine["profile"], color="C3", label=f"{args.preset} preset, mean reach")
+        ax.plot(PHASE, plan["profile"], color="C3", ls="--", label=f"{args.preset} preset, plan")
+        ax.plot(PHASE, closed["profile"], color="C3", label=f"{args.preset} preset, closed loop (mean)")
         ax.set_xlabel("time since the onset / MT")
         ax.set_ylabel("speed / peak speed")
         ax.legend(fontsize=8)

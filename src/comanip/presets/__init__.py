@@ -95,8 +95,8 @@ def human_cartesian() -> ReachingModel:
 
 
 def arm() -> ReachingModel:
-    """A person's arm reaching in 3-D (n = d = 3): human_cartesian with an arm's hand mass, its movement time
-    set by motion-capture arm reaches; the online estimator's model for a tracked hand."""
+    """A person's arm reaching in 3-D (n = d = 3): human_cartesian with a lighter hand and its own kappa and
+    gamma, set so that its closed-loop reaches time like motion-capture arm reaches; for a tracked hand."""
     return load("arm")
 
 
