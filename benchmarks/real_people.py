@@ -70,18 +70,38 @@ class _People(PrefixPredictor):
 
 
 class _Online:
-    """OnlineGoalEstimator behind the predictors' interface (goal and covariance of its estimate)."""
+    """OnlineGoalEstimator behind the predictors' interface (goal and covariance of its estimate), keeping
+    each update's goal, status and the arrival time (s) of its predicted reach for :func:`diagnostics`."""
 
     def __init__(self, estimator):
         self.estimator = estimator
+        self.trace: list[tuple[float, np.ndarray, str, float]] = []
 
     def update(self, t, position, velocity):
+        from comanip.analysis.speed_profile import speed_metrics
         estimate = self.estimator.update(t, position, velocity)
+        speed = estimate.ee_speed                       # a GoalEstimate is the Plan of its predicted reach
+        arrival = speed_metrics(estimate.t, speed).movement_time if speed.max() > 0 else math.nan
+        self.trace.append((float(t), estimate.goal.copy(), str(estimate.status), arrival))
         return EndpointPrediction(estimate.goal, estimate.goal_covariance)
 
 
+def diagnostics(trace, recording) -> dict:
+    """From an online estimator's updates on one movement: the share of updates after a quarter of the
+    movement that the reaching model carries (status not ``people_model``), the share whose goal moved by more
+    than 0.1 D, and the predicted reach's arrival minus the hand's (its end), over MT, at half of the movement."""
+    t = np.array([row[0] for row in trace])
+    after = t >= recording.onset + 0.25 * recording.movement_time
+    goals = np.array([row[1] for row in trace])
+    jumps = np.linalg.norm(np.diff(goals, axis=0), axis=1) / recording.distance
+    half = min(int(np.searchsorted(t, recording.onset + 0.5 * recording.movement_time, side="right")), len(t)) - 1
+    return {"model_share": float(np.mean([row[2] != "people_model" for row, a in zip(trace, after) if a])) if after.any() else math.nan,
+            "jumps": float(np.mean(jumps[after[1:]] > 0.1)) if after[1:].any() else math.nan,
+            "arrival": (trace[half][3] - recording.end_time) / recording.movement_time}
+
+
 def run_predictor(factory, recording):
-    """[(goal, covariance or None)] at FRACTIONS, and the update times (s)."""
+    """[(goal, covariance or None)] at FRACTIONS, the update times (s) and the predictor."""
     predictor = factory(recording)
     until = [recording.seen_until(f) for f in FRACTIONS]
     results, times, latest = [], [], None
@@ -94,7 +114,7 @@ def run_predictor(factory, recording):
             results.append(latest)
     while len(results) < len(until):
         results.append(latest)
-    return results, times
+    return results, times, predictor
 
 
 def simulated_recordings(model_name: str, count: int, seed: int):
@@ -156,6 +176,19 @@ def markdown(summary, latency, count, title):
         lat = latency[name]
         lines.append(f"| {name} | " + " | ".join(cells)
                      + f" | {1e3 * lat['median']:.2f} / {1e3 * lat['p95']:.2f}; {1e3 * lat['first_median']:.2f} |")
+    return "\n".join(lines)
+
+
+def diagnostics_markdown(diagnosed) -> str:
+    """The online estimators' diagnostics (:func:`diagnostics`) as a markdown table."""
+    lines = ["| online estimator | updates after 25 % of MT carried by the reaching model | updates after 25 % of MT "
+             "moving the goal > 0.1 D | predicted arrival − hand's at 50 % of MT, / MT: median |·| [p90] |", "|---|---|---|---|"]
+    for name, rows in diagnosed.items():
+        share = np.nanmean([r["model_share"] for r in rows])
+        jumps = np.nanmean([r["jumps"] for r in rows])
+        arrival = np.abs([r["arrival"] for r in rows])
+        lines.append(f"| {name} | {100 * share:.0f} % | {100 * jumps:.1f} % | {np.nanmedian(arrival):.2f} "
+                     f"[{np.nanpercentile(arrival, 90):.2f}] |")
     return "\n".join(lines)
 
 
@@ -259,14 +292,16 @@ def main(argv=None):
     names = list(made)
     out = args.out or Path(__file__).parent / "results" / f"real_people_{args.source}_{args.split if args.source != 'simulated' else 'planar'}"
     out.mkdir(parents=True, exist_ok=True)
-    rows, latency = [], {name: [] for name in names}
+    rows, latency, diagnosed = [], {name: [] for name in names}, {}
     first = {name: [] for name in names}
     begin = time.perf_counter()
     for i, recording in enumerate(movements):
         D = recording.distance
         current = None
         for name in names:
-            answers, times = run_predictor(made[name], recording)
+            answers, times, predictor = run_predictor(made[name], recording)
+            if isinstance(predictor, _Online):
+                diagnosed.setdefault(name, []).append(diagnostics(predictor.trace, recording))
             latency[name] += times[1:]
             first[name].append(times[0])
             errors = [float(np.linalg.norm(goal - recording.end)) / D for goal, _ in answers]
@@ -290,6 +325,8 @@ def main(argv=None):
     lat = {name: {"median": float(np.median(v)) if v else math.nan, "p95": float(np.percentile(v, 95)) if v else math.nan,
                   "first_median": float(np.median(first[name]))} for name, v in latency.items()}
     table = markdown(summary, lat, len(movements), title)
+    if diagnosed:
+        table += "\n\n" + diagnostics_markdown(diagnosed)
     if args.source == "cursory" and "template matching" in names:
         table += "\n\n" + published_comparison(rows, scale)
     print(table)

@@ -65,6 +65,7 @@ from comanip.estimation.corrected_deviation import (CORRECTION_TIME, DEVIATION_T
                                                    correction_factor)
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
+from comanip.estimation.hand_rest import REST_RADIUS_M, has_left
 from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
@@ -368,6 +369,10 @@ class OnlineGoalEstimator:
         n = self.model.n
         history = np.asarray(self._history)
         t, position, velocity = history[:, 0], history[:, 1:1 + n], history[:, 1 + n:1 + 2 * n]
+        if not has_left(position, self.start_position):
+            # a tracker's noise makes a resting hand's velocities look like motion; its positions do not
+            return self._result(self.prior_mean, self.prior_cov, Status.UNINFORMATIVE, "the hand has not left its "
+                                f"start (within {1e3 * REST_RADIUS_M:g} mm): the estimate is the prior", 0, t_begin)
         onset = detected_onset(t, np.sqrt((velocity * velocity).sum(axis=1)), MOVING_SPEED)
         previous = self.latest
         if self._off_model is None:

@@ -8,8 +8,9 @@ straightness |x_K - x_0| / L, the angle between the velocity and the displacemen
 Two gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
 them how far beyond the hand the endpoint lies along the direction of motion u (the velocity's while the hand
 moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
-endpoint is never behind the hand along u, and a hand that has stopped (speed below ``REST_FRACTION`` of its
-peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
+endpoint is never behind the hand along u, and a hand that has stopped (its positions still for a tenth of a
+second after it left the start, :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of
+its peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors), and
 never below the distance the hand can still cover at its current speed (``STOPPING_TIME``).
 
@@ -38,6 +39,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from comanip.estimation.endpoint_baselines import MOVING_SPEED, EndpointPrediction
+from comanip.estimation.hand_rest import has_left, resting_position
 from comanip.estimation.profile_fit import onset_index
 
 FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak", "acceleration_scaled",
@@ -162,8 +164,11 @@ class PeopleModel:
             return None
         features, u, path = described
         speed = np.sqrt((velocity * velocity).sum(axis=1))
-        if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
+        resting = resting_position(t, position)
+        if resting is not None and has_left(position, start):
             # a hand that has stopped is at its endpoint (until it moves again)
+            return EndpointPrediction(resting, (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
+        if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
             return EndpointPrediction(position[-1].copy(), (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
         x = features[self.columns]
         along, log_squared = self.along(x), self.spread(x)

@@ -1,0 +1,43 @@
+"""Whether a tracked hand is at rest, judged from its positions, not its velocities.
+
+A tracker's velocities are differences of noisy positions: 1 mm of position noise at 100 Hz is about 0.1 m/s
+of velocity noise, as fast as the slow end of a reach. So rest is judged on positions (m) at times (s):
+
+- the hand **has left its start** once a position lies farther than ``radius`` from the start;
+- the hand **rests** when every position of the last ``window`` seconds lies within ``radius`` of their mean,
+  and those positions span at least the window (a hand seen for a shorter time is not known to rest).
+
+``REST_RADIUS_M`` is well above a motion-capture or camera tracker's noise (about 0.1–2 mm) and well below any
+reach's amplitude; ``REST_WINDOW_S`` is a tenth of a second, the time a person's hand stays still between
+the sub-movements of one reach only rarely exceeds.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+REST_RADIUS_M = 0.005
+"""Positions within this distance (m) of their mean, or of the start, count as still."""
+REST_WINDOW_S = 0.1
+"""How long (s) the positions must stay still for the hand to rest."""
+
+
+def has_left(position: np.ndarray, start: np.ndarray, radius: float = REST_RADIUS_M) -> bool:
+    """Whether any position (K, d) m lies farther than ``radius`` (m) from ``start`` (d,) m."""
+    offset = position - start
+    return bool(np.any((offset * offset).sum(axis=1) > radius * radius))
+
+
+def resting_position(t: np.ndarray, position: np.ndarray, window: float = REST_WINDOW_S,
+                     radius: float = REST_RADIUS_M) -> np.ndarray | None:
+    """The mean position (d,) m of the last ``window`` s when the hand rests there (module docstring), else None.
+
+    Args:
+        t: times (K,) s, increasing; position: (K, d) m.
+    """
+    if len(t) < 2 or t[-1] - t[0] < window:
+        return None
+    recent = position[int(np.searchsorted(t, t[-1] - window, side="left")):]
+    mean = recent.mean(axis=0)
+    offset = recent - mean
+    return mean if bool(np.all((offset * offset).sum(axis=1) <= radius * radius)) else None
