@@ -1,6 +1,8 @@
 """Endpoint prediction: the baselines on synthetic reaches, the people model against recorded people, and the
 online estimator on reaches at another pace than the model's and with a corrective sub-movement."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -207,3 +209,25 @@ def test_a_people_model_that_has_seen_one_moving_sample_claims_no_more_than_the_
         d = 3 if kind == "arm" else 2
         answer = model.predict(np.array([0.0, 0.01]), np.zeros((2, d)), velocity[:, :d], np.zeros(d))
         assert np.linalg.eigvalsh(answer.covariance).min() >= (STOPPING_TIME * 1.0) ** 2 * (1 - 1e-12)
+
+
+ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
+
+
+@pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
+def test_the_online_estimator_predicts_recorded_arm_reaches_better_than_where_the_hand_is():
+    from comanip.recordings import load_tathum
+    model = comanip.presets.arm()
+    reaches = [trial.streamed_recording() for trial in load_tathum(ARMS)[::9]]          # 20 reaches, as a tracker streams them
+    mine, current = {f: [] for f in FRACTIONS}, {f: [] for f in FRACTIONS}
+    for r in reaches:
+        estimator = comanip.OnlineGoalEstimator(model, np.r_[r.position[0], np.zeros(model.state_size - 3)])
+        until = {f: r.seen_until(f) for f in FRACTIONS}
+        for k in range(max(until.values())):
+            estimate = estimator.update(r.t[k], r.position[k], r.velocity[k])
+            for f, seen in until.items():
+                if seen == k + 1:
+                    mine[f].append(np.linalg.norm(estimate.goal - r.end) / r.distance)
+                    current[f].append(np.linalg.norm(r.position[k] - r.end) / r.distance)
+    for f in FRACTIONS:
+        assert np.median(mine[f]) < 0.8 * np.median(current[f]), (f, np.median(mine[f]), np.median(current[f]))
