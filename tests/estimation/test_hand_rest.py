@@ -24,6 +24,8 @@ def test_rest_is_read_from_positions_within_the_radius_over_the_window():
     moving = still + np.outer(t, [0.2, 0, 0])                    # 0.2 m/s: 20 mm in the window
     assert resting_position(t, moving) is None
     assert resting_position(t[:5], still[:5]) is None            # seen for less than the window
+    creeping = np.outer(t, [0.03, 0, 0])                         # 3 cm/s: 3 mm in the window, inside the radius
+    assert resting_position(t, creeping) is not None and resting_position(t, creeping, creep=0.02) is None
 
 
 def test_a_noisy_tracked_hand_keeps_one_status_before_its_reach_and_its_goal_once_it_rests():

@@ -28,16 +28,27 @@ def has_left(position: np.ndarray, start: np.ndarray, radius: float = REST_RADIU
     return bool(np.any((offset * offset).sum(axis=1) > radius * radius))
 
 
-def resting_position(t: np.ndarray, position: np.ndarray, window: float = REST_WINDOW_S,
-                     radius: float = REST_RADIUS_M) -> np.ndarray | None:
+def resting_position(t: np.ndarray, position: np.ndarray, window: float = REST_WINDOW_S, radius: float = REST_RADIUS_M,
+                     creep: float = np.inf) -> np.ndarray | None:
     """The mean position (d,) m of the last ``window`` s when the hand rests there (module docstring), else None.
 
     Args:
         t: times (K,) s, increasing; position: (K, d) m.
+        creep: a hand whose velocity over the window (the slope of a straight line fitted to its positions,
+            m/s) is above this still moves, however small the radius it stays in (a slow final correction);
+            a slope within three standard errors of zero (the positions' scatter about the line) counts as
+            rest whatever ``creep`` is, since the tracker's noise cannot tell it from rest.
     """
-    if len(t) < 2 or t[-1] - t[0] < window:
+    if len(t) < 3 or t[-1] - t[0] < window:
         return None
-    recent = position[int(np.searchsorted(t, t[-1] - window, side="left")):]
+    first = int(np.searchsorted(t, t[-1] - window, side="left"))
+    recent, times = position[first:], t[first:] - t[first:].mean()
     mean = recent.mean(axis=0)
     offset = recent - mean
-    return mean if bool(np.all((offset * offset).sum(axis=1) <= radius * radius)) else None
+    if not bool(np.all((offset * offset).sum(axis=1) <= radius * radius)):
+        return None
+    spread = float(times @ times)
+    slope = times @ offset / spread                                     # (d,) m/s
+    residual = offset - np.outer(times, slope)
+    error = np.sqrt(float((residual * residual).sum()) / max(len(times) - 2, 1) / spread)   # per axis, pooled
+    return mean if np.linalg.norm(slope) <= max(creep, 3.0 * error * np.sqrt(len(slope))) else None

@@ -9,10 +9,12 @@ Two gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`Pe
 them how far beyond the hand the endpoint lies along the direction of motion u (the velocity's while the hand
 moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
 endpoint is never behind the hand along u, and a hand that has stopped (its positions still for a tenth of a
-second after it left the start, :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of
-its peak for ``REST_TIME``) is at its endpoint. Its covariance is isotropic: the predicted squared error times a
+second after it left the start and its net speed over that time below half ``REST_FRACTION`` of its peak speed,
+:mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of its peak for ``REST_TIME``) is at its
+endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors), and
-never below the distance the hand can still cover at its current speed (``STOPPING_TIME``).
+while the path so far is short, never below the distance the hand can still cover at its speed
+(``STOPPING_TIME``).
 
 A model is fitted per **kind** of movement (:data:`KINDS`): people move a mouse and an arm differently, and a
 model fitted on one is not applied to the other. An arm model uses only the features without units
@@ -60,9 +62,9 @@ predicted beyond where the hand stops costs a robot more than one predicted shor
 REST_FRACTION, REST_TIME = 0.05, 0.1
 """A hand whose speed has stayed below this fraction of its peak speed for this long (s) has stopped."""
 STOPPING_TIME = 0.1
-"""A hand moving at speed v can still cover about v times this (s) before it stops, whatever the regressors
-say: the predicted endpoint's standard deviation (per axis) is never below it. Where the movement so far says
-little (one sample after the onset), this keeps a prediction from claiming millimetres."""
+"""A hand moving at speed v can still cover about v times this (s) before it stops. While its path so far is
+shorter than that, the movement says little (a sample or two after the onset) and the predicted endpoint's
+standard deviation (per axis) is never below it, whatever the regressors say."""
 REST_SPREAD = 0.03
 """Standard deviation of a stopped hand's endpoint estimate, a fraction of the path length."""
 _MIN_PATH = 1e-4
@@ -164,7 +166,7 @@ class PeopleModel:
             return None
         features, u, path = described
         speed = np.sqrt((velocity * velocity).sum(axis=1))
-        resting = resting_position(t, position)
+        resting = resting_position(t, position, creep=0.5 * REST_FRACTION * features[3])
         if resting is not None and has_left(position, start):
             # a hand that has stopped is at its endpoint (until it moves again)
             return EndpointPrediction(resting, (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
@@ -173,7 +175,9 @@ class PeopleModel:
         x = features[self.columns]
         along, log_squared = self.along(x), self.spread(x)
         goal = position[-1] + path * max(along, 0.0) * u
-        variance = max(self.coverage_factor * path**2 * math.exp(log_squared) / len(u), (STOPPING_TIME * speed[-1]) ** 2)
+        variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
+        if path < STOPPING_TIME * speed[-1]:
+            variance = max(variance, (STOPPING_TIME * speed[-1]) ** 2)
         return EndpointPrediction(goal, variance * np.eye(len(u)))
 
     def save(self, path: str | Path) -> Path:
