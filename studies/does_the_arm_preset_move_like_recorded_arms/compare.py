@@ -47,7 +47,17 @@ def people(folder: Path) -> dict:
     for target in {t.label["target"] for t in trials}:
         ends = np.array([r.end for r, t in zip(recordings, trials) if t.label["target"] == target])
         spread.append(ends.var(axis=0))
+    deviation, angle = [], []
+    for r in recordings:
+        moving = (r.t >= r.onset) & (r.t <= r.end_time)
+        offset = r.position[moving] - r.start
+        line = (r.end - r.start) / r.distance
+        across = offset - np.outer(offset @ line, line)
+        deviation.append(np.sqrt((across * across).sum(axis=1)).max() / r.distance)
+        early = offset[int(np.searchsorted(offset @ line, 0.1 * r.distance))]     # where a tenth of the way is covered
+        angle.append(np.degrees(np.arccos(np.clip(early @ line / np.linalg.norm(early), -1.0, 1.0))))
     return {"count": len(recordings), "distance": np.array([r.distance for r in recordings]),
+            "deviation": np.array(deviation), "angle": np.array(angle),
             "movement_time": np.array([r.movement_time for r in recordings]), "asymmetry": np.array(asymmetry),
             "peak_speed": np.array(peaks), "profiles": np.array(profiles),
             "endpoint_sd": float(np.sqrt(np.mean(spread)))}
@@ -106,6 +116,8 @@ def main(argv=None):
     print(f"| peak speed (m/s) | {q(recorded['peak_speed'])} | {plan['peak_speed']:.3f} | {closed['peak_speed']:.3f} | | |")
     print(f"| endpoint SD per axis (mm) | {1e3 * recorded['endpoint_sd']:.2f} | {1e3 * plan['endpoint_sd']:.2f} (at MT) | "
           f"{1e3 * closed['endpoint_sd']:.2f} | | |")
+    print(f"| path's largest distance from the straight line, / D | {q(recorded['deviation'])} | 0 | 0 | | |")
+    print(f"| angle to the straight line a tenth of the way (°) | {q(recorded['angle'])} | 0 | 0 | | |")
     print(f"| Fitts' law on the validation grid (plans) | | slope {1e3 * fitts.b:.0f} ms/bit, R² {fitts.r2:.3f} | | "
           f"80–160 ms/bit, R² ≥ 0.95 | {met(0.08 <= fitts.b <= 0.16 and fitts.r2 >= 0.95)} |")
     if args.figure:
