@@ -4,7 +4,7 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_estimator import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
 from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
 from comanip.estimation.online_estimator import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.reach_stream import ReachStream, SegmentationSettings, StreamEstimate
+from comanip.estimation.reach_stream import ReachSegmenter, ReachStart, ReachStream, SegmentationSettings, StreamEstimate
 
 __all__ = ["EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior", "estimate_goal", "goal_posterior", "OnlineGoalEstimator", "OnlineOptions",
-           "ReachStream", "SegmentationSettings", "StreamEstimate"]
+           "ReachSegmenter", "ReachStart", "ReachStream", "SegmentationSettings", "StreamEstimate"]
