@@ -192,3 +192,32 @@ def test_stale_when_estimates_overrun_the_budget_and_still_published(reach, tran
             values = replay.wait_handled(k + 1)
         assert values["stale"] == "true" and values["stale_reason"].startswith("last estimate took")
         assert int(values["late"]) == int(values["estimates"]) == len(replay.recording.goals) > 0
+
+
+def test_an_uninterrupted_stream_of_reaches_gets_a_reach_number_and_a_goal_each_without_a_reset(transition):
+    """Three minimum-jerk reaches of 0.3 m, each after 0.6 s at rest, from one 100 Hz tracker with 0.5 mm noise and
+    no reset: the node starts each reach itself, says which is under way, and estimates each one's goal."""
+    rng = np.random.default_rng(1)
+    goals, position, t, x = [], np.zeros(3), [], []
+    for direction in ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, -1.0, 0.0]):
+        goal = position + 0.3 * np.array(direction) / np.linalg.norm(direction)
+        for k in range(60):
+            t.append(len(t) * 0.01), x.append(position.copy())
+        for k in range(60):
+            s = k / 60
+            t.append(len(t) * 0.01), x.append(position + (goal - position) * (10 * s**3 - 15 * s**4 + 6 * s**5))
+        position = goal
+        goals.append(goal)
+    for k in range(60):
+        t.append(len(t) * 0.01), x.append(position.copy())
+    x = np.array(x) + rng.normal(0, 5e-4, (len(t), 3))
+    v = np.r_[np.zeros((3, 3)), (x[3:] - x[:-3]) / 0.03]
+    with Replay(NodeSettings(preset="arm", estimation_rate=20.0), transition) as replay:
+        recording = replay.run(np.array(t), np.c_[x, v], None)
+    reaches = [int(values["reach"]) for _, _, _, values in recording.statuses]
+    assert sorted(set(reaches) - {0}) == [1, 2, 3] and reaches == sorted(reaches)        # 0: before the first pose
+    for number, goal in enumerate(goals, start=1):
+        # the last estimate published while reach ``number`` was the one under way
+        last = max(stamp for stamp, _, _, values in recording.statuses if int(values["reach"]) == number)
+        estimate = [g for stamp, g, _, _ in recording.goals if stamp <= last][-1]
+        assert np.linalg.norm(estimate - goal) < 0.01, (number, estimate, goal)

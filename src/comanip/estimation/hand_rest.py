@@ -28,27 +28,34 @@ def has_left(position: np.ndarray, start: np.ndarray, radius: float = REST_RADIU
     return bool(np.any((offset * offset).sum(axis=1) > radius * radius))
 
 
+def fitted_velocity(t: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, float]:
+    """The velocity (d,) m/s of a straight line fitted to positions (K, d) m at times (K,) s (K ≥ 3), and its
+    standard error per axis (m/s) from the positions' scatter about the line (pooled over the axes)."""
+    times = t - t.mean()
+    offset = position - position.mean(axis=0)
+    spread = float(times @ times)
+    slope = times @ offset / spread
+    residual = offset - np.outer(times, slope)
+    return slope, float(np.sqrt(float((residual * residual).sum()) / max(len(times) - 2, 1) / spread))
+
+
 def resting_position(t: np.ndarray, position: np.ndarray, window: float = REST_WINDOW_S, radius: float = REST_RADIUS_M,
                      creep: float = np.inf) -> np.ndarray | None:
     """The mean position (d,) m of the last ``window`` s when the hand rests there (module docstring), else None.
 
     Args:
         t: times (K,) s, increasing; position: (K, d) m.
-        creep: a hand whose velocity over the window (the slope of a straight line fitted to its positions,
-            m/s) is above this still moves, however small the radius it stays in (a slow final correction);
-            a slope within three standard errors of zero (the positions' scatter about the line) counts as
-            rest whatever ``creep`` is, since the tracker's noise cannot tell it from rest.
+        creep: a hand whose velocity over the window (:func:`fitted_velocity`, m/s) is above this still moves,
+            however small the radius it stays in (a slow final correction); a velocity within three standard
+            errors of zero counts as rest whatever ``creep`` is, since the tracker's noise cannot tell it from rest.
     """
     if len(t) < 3 or t[-1] - t[0] < window:
         return None
     first = int(np.searchsorted(t, t[-1] - window, side="left"))
-    recent, times = position[first:], t[first:] - t[first:].mean()
+    recent = position[first:]
     mean = recent.mean(axis=0)
     offset = recent - mean
-    if not bool(np.all((offset * offset).sum(axis=1) <= radius * radius)):
+    if len(recent) < 3 or not bool(np.all((offset * offset).sum(axis=1) <= radius * radius)):
         return None
-    spread = float(times @ times)
-    slope = times @ offset / spread                                     # (d,) m/s
-    residual = offset - np.outer(times, slope)
-    error = np.sqrt(float((residual * residual).sum()) / max(len(times) - 2, 1) / spread)   # per axis, pooled
+    slope, error = fitted_velocity(t[first:], recent)
     return mean if np.linalg.norm(slope) <= max(creep, 3.0 * error * np.sqrt(len(slope))) else None

@@ -3,7 +3,11 @@
 Inputs (topic names are parameters, :class:`~comanip.ros.node_settings.NodeSettings`): the hand's pose and twist,
 a prior goal, a reset. A reach starts at the first hand pose (after startup, a reset, or a gap in the input
 longer than ``input_timeout``): that pose and the twist paired with it are the start s_0 = [x; xdot], and its
-stamp is t = 0. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
+stamp is t = 0. The stream needs no reset between reaches: every paired pose also goes to a
+:class:`~comanip.estimation.reach_stream.ReachSegmenter`, and when the hand has rested (within ``rest_radius``
+for ``rest_window``) and leaves its rest again, the next reach starts, from where it rested, its t = 0 the
+segmenter's (the rest just before it left); the status says which reach is under way and whether the hand
+moves. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
 t = stamp - start stamp. ``estimation_rate`` of them per second of input time go to the estimator: the due times
 lie on a grid of 1 / estimation_rate from the reach's start, and the pose nearest each due time (the first within
 half the input's spacing of it) is estimated, so a tracker whose stamps jitter still gets the configured rate
@@ -56,6 +60,7 @@ except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator
+from comanip.estimation.reach_stream import ReachSegmenter, SegmentationSettings
 from comanip.estimation.online_estimator import CORRECTING_PERSON, FamilyCache
 from comanip.estimation.estimation_planner import estimation_planner
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
@@ -134,6 +139,7 @@ class GoalNode(Node):
         self._transition = transition_model if transition_model is not None else TransitionModel()
         self._reach: Reach | None = None
         self._reach_estimator = None
+        self._segmenter = ReachSegmenter(SegmentationSettings(radius=s.rest_radius, window=s.rest_window))
         self._prior = None if s.prior_goal is None else np.array(s.prior_goal)
         self._last_pose: float | None = None
         self._last_twist: float | None = None
@@ -228,17 +234,19 @@ class GoalNode(Node):
         s = self.settings
         reach = self._reach
         if reach is None or (previous is not None and sample.stamp - previous > s.input_timeout):
-            number = 1 if reach is None else reach.number + 1
-            self._reach = Reach(number, sample.stamp, np.r_[sample.vector, np.zeros_like(velocity)], self._prior)
-            self._next_due = sample.stamp + 1.0 / s.estimation_rate
-            self._recent = []
-            self._last["event"] = f"reach {number} started at stamp {sample.stamp:.6f} s"
-            self.get_logger().info(self._last["event"])
+            self._segmenter.reset()
+            self._segmenter.update(sample.stamp, sample.vector, velocity)
+            self._start_reach(1 if reach is None else reach.number + 1, sample.stamp, sample.vector)
             return
+        started = self._segmenter.update(sample.stamp, sample.vector, velocity)
+        if started is not None and started.number > 1:       # the first is the reach begun at the first pose
+            self._start_reach(reach.number + 1, started.clock, started.start)
+            reach = self._reach
         t = sample.stamp - reach.start_stamp
         if t >= self._horizon:
             self._counts["ignored"] += 1
-            self._last["event"] = f"pose at t = {t:.3f} s is past the model's horizon {self._horizon:g} s; waiting for a reset"
+            self._last["event"] = (f"pose at t = {t:.3f} s is past the model's horizon {self._horizon:g} s; waiting for "
+                                   "the hand to rest and start the next reach")
             return
         period, due = 1.0 / s.estimation_rate, self._next_due
         half_spacing = 0.5 * (sample.stamp - previous) if previous is not None else 0.0
@@ -250,6 +258,14 @@ class GoalNode(Node):
         self._pending = Observation(reach, t, sample.stamp, sample.vector, velocity, received)
         self._next_due = due + period if sample.stamp < due + period else sample.stamp + period
         self._lock.notify()
+
+    def _start_reach(self, number: int, stamp: float, position: np.ndarray) -> None:
+        """Start reach ``number`` at ``stamp`` (s, its t = 0) from rest at ``position`` (d,) m (holding the lock)."""
+        self._reach = Reach(number, stamp, np.r_[position, np.zeros_like(position)], self._prior)
+        self._next_due = stamp + 1.0 / self.settings.estimation_rate
+        self._recent = []
+        self._last["event"] = f"reach {number} started at stamp {stamp:.6f} s"
+        self.get_logger().info(self._last["event"])
 
     def _on_prior(self, message: PointStamped) -> None:
         with self._lock:
@@ -265,6 +281,7 @@ class GoalNode(Node):
     def _on_reset(self, _message: Empty) -> None:
         with self._lock:
             self._reach, self._pending, self._good, self._next_due, self._unpaired = None, None, None, None, []
+            self._segmenter.reset()
             self._last["event"] = "reset: the next hand pose starts a reach"
             self.get_logger().info(self._last["event"])
 
@@ -387,7 +404,7 @@ class GoalNode(Node):
             good, reach = self._good, self._reach
             return reason, dict(stale=bool(reason), stale_reason=reason, **self._counts,
                                 pending=bool(self._pending is not None or self._busy or self._unpaired),
-                                reach=0 if reach is None else reach.number,
+                                reach=0 if reach is None else reach.number, moving=self._segmenter.moving,
                                 reach_start_stamp_s=float("nan") if reach is None else reach.start_stamp,
                                 estimate_stamp_s=float("nan") if good is None else good.stamp,
                                 goal_m=[] if good is None else good.estimate.goal.tolist(),

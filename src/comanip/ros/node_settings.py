@@ -13,6 +13,7 @@ from pathlib import Path
 import yaml
 
 from comanip import presets
+from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S
 from comanip.arguments import as_goal_width, as_nonnegative, as_positive, as_vector
 from comanip.bodies.point_mass import PointMass
 from comanip.model import ReachingModel
@@ -24,8 +25,9 @@ class NodeSettings:
     """Everything the node is told (ROS parameters of the same names). Units: m, s, Hz, N/m, N·m/rad."""
 
     preset: str = "cartesian"
-    """Model: a built-in preset name or a model YAML path. Its body must be a point mass, whose state is the
-    hand's task-space [x; xdot] (the Cartesian preset: x, y, z; the planar one: x, y)."""
+    """Model: a built-in preset name or a model YAML path. Its body must be a point mass (with or without muscle
+    activation stages), whose position is the hand's in task space (the Cartesian and arm presets: x, y, z; the
+    planar one: x, y)."""
     width: float | None = None
     """Goal width w (m); None: the preset's."""
     prior_goal: tuple[float, ...] | None = None
@@ -63,6 +65,11 @@ class NodeSettings:
     """Rate at which the last good estimate and the status are republished (Hz)."""
     input_timeout: float = 0.25
     """Input older than this (s) makes the estimate stale; a pose after a longer gap starts a new reach."""
+    rest_radius: float = REST_RADIUS_M
+    """A hand pose farther than this (m) from where the hand rests starts the next reach; a hand whose poses stay
+    within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.reach_stream`)."""
+    rest_window: float = REST_WINDOW_S
+    """How long (s) the hand must stay still to rest between reaches."""
     twist_tolerance: float = 0.005
     """Largest stamp difference (s) between a pose and the twist paired with it."""
     ramp_time: float = DEFAULT_RAMP_TIME
@@ -80,14 +87,15 @@ class NodeSettings:
             if not isinstance(value, str) or not value.strip():
                 raise ValueError(f"{name} must be a non-empty string, got {value!r}")
         model = self.model()  # the preset's own ValueError, prefixed with the parameter's name
-        if not isinstance(model.body, PointMass):
+        if not isinstance(getattr(model.body, "inner", model.body), PointMass):    # activation stages allowed
             raise ValueError(f"preset: the node estimates a hand in task space and needs a point-mass model "
                              f"(e.g. 'cartesian' or 'planar'), got the {type(model.body).__name__} body of {self.preset!r}")
         if self.width is not None:
             object.__setattr__(self, "width", as_goal_width("width", self.width))
         if self.prior_goal is not None:
             object.__setattr__(self, "prior_goal", tuple(as_vector("prior_goal", self.prior_goal, model.d, "m").tolist()))
-        for name in ("max_wall_time", "estimation_rate", "command_rate", "status_rate", "input_timeout", "rotational_stiffness"):
+        for name in ("max_wall_time", "estimation_rate", "command_rate", "status_rate", "input_timeout", "rotational_stiffness",
+                     "rest_radius", "rest_window"):
             object.__setattr__(self, name, as_positive(name, getattr(self, name), UNITS[name]))
         object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
         check_schedule_arguments(self.ramp_time, self.leading_stiffness, None)
@@ -138,4 +146,4 @@ TOPICS = ("hand_pose_topic", "hand_twist_topic", "prior_goal_topic", "reset_topi
           "equilibrium_topic", "stiffness_topic", "schedule_topic", "status_topic")
 
 UNITS = {"max_wall_time": "s", "estimation_rate": "Hz", "command_rate": "Hz", "status_rate": "Hz", "input_timeout": "s",
-         "rotational_stiffness": "N·m/rad"}
+         "rotational_stiffness": "N·m/rad", "rest_radius": "m", "rest_window": "s"}
