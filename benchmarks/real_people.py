@@ -192,6 +192,41 @@ def diagnostics_markdown(diagnosed) -> str:
     return "\n".join(lines)
 
 
+AIMS = {0.25: 0.40, 0.5: 0.15, 0.75: 0.05, 0.9: 0.02}
+"""The online estimator's aimed median error / D on arm reaches, by fraction of MT."""
+
+
+def aims_markdown(name, summary, latency, diagnosed) -> str:
+    """The online estimator ``name`` against the aims set for arm reaches, as a markdown table."""
+    mine = summary[name]
+    others = [other for other in summary if other != name]
+    beaten = {f: [o for o in others if summary[o][f]["median"] <= mine[f]["median"]] for f in AIMS}
+    rows = diagnosed[name]
+    share = np.nanmean([r["model_share"] for r in rows])
+    jumps = np.nanmean([r["jumps"] for r in rows])
+    arrival = float(np.nanmedian(np.abs([r["arrival"] for r in rows])))
+    coverage = [mine[f]["coverage"] for f in AIMS]
+    worse = max(mine[f]["worse_than_current"] for f in AIMS)
+    yes = lambda ok: "yes" if ok else "no"
+    errors = " / ".join(f"{mine[f]['median']:.3f}" for f in AIMS)
+    lines = [f"`{name}` against its aims on these reaches:", "", "| aim | measured | met |", "|---|---|---|",
+             f"| below every other predictor at 25 / 50 / 75 / 90 % of MT | as good or better: "
+             + "; ".join(f"{int(100 * f)} %: {', '.join(b) or 'none'}" for f, b in beaten.items())
+             + f" | {yes(not any(beaten.values()))} |",
+             f"| ≤ {' / '.join(f'{a:g}' for a in AIMS.values())} D | {errors} D | "
+             f"{yes(all(mine[f]['median'] <= a for f, a in AIMS.items()))} |",
+             f"| worse than the current position by > {WORSE_MARGIN} D in ≤ 5 % of (reach, fraction) pairs | at most "
+             f"{100 * worse:.0f} % at a fraction | {yes(worse <= 0.05)} |",
+             f"| 95 % region holds the endpoint in 85–98 % | {' / '.join(f'{100 * c:.0f}' for c in coverage)} % | "
+             f"{yes(all(0.85 <= c <= 0.98 for c in coverage))} |",
+             f"| after 25 % of MT, ≤ 1 % of updates move the goal by > 0.1 D | {100 * jumps:.1f} % | {yes(jumps <= 0.01)} |",
+             f"| predicted arrival within 0.10 MT of the hand's at 50 % of MT | {arrival:.2f} MT (median) | {yes(arrival <= 0.1)} |",
+             f"| the reaching model carries ≥ half of the updates after 25 % of MT | {100 * share:.0f} % | {yes(share >= 0.5)} |",
+             f"| update median ≤ 2 ms, p95 ≤ 4 ms | {1e3 * latency[name]['median']:.1f} / {1e3 * latency[name]['p95']:.1f} ms | "
+             f"{yes(latency[name]['median'] <= 2e-3 and latency[name]['p95'] <= 4e-3)} |"]
+    return "\n".join(lines)
+
+
 PUBLISHED_PX = {0.5: 83, 0.75: 48, 0.9: 39}
 """Kinematic template matching's published errors on mouse movements of 100–800 px (Pasqual & Wobbrock 2014), px."""
 
@@ -327,6 +362,9 @@ def main(argv=None):
     table = markdown(summary, lat, len(movements), title)
     if diagnosed:
         table += "\n\n" + diagnostics_markdown(diagnosed)
+    if args.source == "arms":
+        for name in diagnosed:
+            table += "\n\n" + aims_markdown(name, summary, lat, diagnosed)
     if args.source == "cursory" and "template matching" in names:
         table += "\n\n" + published_comparison(rows, scale)
     print(table)
