@@ -53,9 +53,9 @@ def bag_samples(path: str | Path, topic: str | None = None, *, frame: str | None
         check_units: refuse positions that look like mm.
 
     Raises:
-        ValueError (one line) for a path that is no bag, a topic that is missing, of another type or empty,
-        samples in several frames without ``frame``, a frame the topic does not have, or positions in mm.
-        :class:`comanip.extras.MissingExtra` without the ``bags`` extra.
+        ValueError: (one line) for a path that is no bag, a topic that is missing, of another type or empty,
+            samples in several frames without ``frame``, a frame the topic does not have, or positions in mm.
+        comanip.extras.MissingExtra: without the ``bags`` extra.
     """
     path = Path(path)
     if not path.exists():
