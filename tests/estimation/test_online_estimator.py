@@ -187,13 +187,15 @@ def test_updates_at_any_time_use_every_observation(online):
     plan = planner.solve(np.zeros(6), goal)
     estimator = fresh(online)
     assert estimator.latest is None
-    times = [0.0, 0.013, 0.013, 0.05, 0.0551, 0.1, 0.171, 0.3, 0.41, 0.77]     # off the 55 ms grid, repeated
+    times = [0.0, 0.013, 0.013, 0.05, 0.0551, 0.1, 0.171, 0.3, 0.41, 0.77]     # off the 55 ms grid, one sample twice
     for t in times:
         s = state_at(plan.mean, model.h, t)
         estimate = estimator.update(t, s[:3], s[3:])
         assert np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.goal_covariance))
         assert estimator.latest is estimate and estimate.t_obs == t
-    assert estimator.observation_count == len(times)
+    assert estimator.observation_count == len(set(times))                      # the same sample again is skipped
+    with pytest.raises(ValueError, match="repeats the previous observation's time"):
+        estimator.update(times[-1], s[:3] + 0.01, s[3:])
     assert estimate.success and estimate.method == "online"
     assert np.linalg.norm(estimate.goal - goal) < 1e-3
     # the predicted reach is the model's plan to the estimate, through the observations
@@ -405,3 +407,45 @@ def test_a_lost_tracker_sample_is_skipped_and_the_estimate_carries_on():
     np.testing.assert_allclose(estimate.goal, reference.goal, atol=1e-9)
     with pytest.raises(ValueError, match="position"):
         with_gap.update(person.t[9], [0.1, np.nan, 0.0], person.mean[9, 3:])
+
+
+def test_reset_starts_a_new_reach_as_a_fresh_estimator_would(online, cartesian_planner):
+    first = cartesian_planner.solve(np.zeros(6), [0.25, 0.1, 0.0])
+    second = cartesian_planner.solve(np.r_[first.mean[-1, :3], np.zeros(3)], first.mean[-1, :3] + [-0.1, 0.2, 0.05])
+    estimator = fresh(online)
+    for i in range(1, 8):
+        estimator.update(first.t[i], first.mean[i, :3], first.mean[i, 3:])
+    estimator.reset(np.r_[first.mean[-1, :3], np.zeros(3)])
+    new = fresh(online)
+    new.reset(np.r_[first.mean[-1, :3], np.zeros(3)])
+    for i in range(1, 8):
+        mine = estimator.update(second.t[i], second.mean[i, :3], second.mean[i, 3:])
+        theirs = new.update(second.t[i], second.mean[i, :3], second.mean[i, 3:])
+    np.testing.assert_allclose(mine.goal, theirs.goal, rtol=0, atol=1e-12)
+    assert estimator.observation_count == 7 and np.linalg.norm(mine.goal - second.goal) < 1e-3
+
+
+def test_observations_in_mm_or_ms_warn_once(online):
+    estimator = fresh(online)
+    with pytest.warns(UserWarning, match="mm"):
+        estimator.update(0.1, np.array([120.0, 40.0, 0.0]), np.array([900.0, 300.0, 0.0]))
+    estimator = fresh(online)
+    with pytest.warns(UserWarning, match="in ms"):
+        estimator.update(200.0, np.array([0.12, 0.04, 0.0]), np.array([0.9, 0.3, 0.0]))
+
+
+def test_a_batch_of_recordings_gets_the_estimates_of_streaming_them(online, cartesian_planner):
+    from comanip.estimation import estimate_recordings
+    from comanip.recordings import Recording
+    recordings = []
+    for k, goal in enumerate(([0.25, 0.1, 0.0], [-0.1, 0.3, 0.1])):
+        plan = cartesian_planner.solve(np.zeros(6), goal)
+        recordings.append(Recording(f"r{k}", plan.t[:12] + 1.0, plan.mean[:12, :3], plan.mean[:12, 3:], 1.0, 1.6))
+    from comanip.estimation.online_estimator import DEFAULT_FAMILIES
+    batch = estimate_recordings(online.planner, recordings, cache=DEFAULT_FAMILIES)
+    for recording, estimates in zip(recordings, batch):
+        by_hand = fresh(online)
+        for k, estimate in enumerate(estimates):
+            expected = by_hand.update(recording.t[k] - 1.0, recording.position[k], recording.velocity[k])
+            np.testing.assert_allclose(estimate.goal, expected.goal, rtol=0, atol=1e-12)
+        assert len(estimates) == len(recording.t)

@@ -53,6 +53,7 @@ from __future__ import annotations
 
 import math
 import time
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -77,7 +78,8 @@ from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.estimation.estimation_planner import checked_model, estimation_planner
 from comanip.model import ReachingModel
 from comanip.optim import CONVERGED, Status
-from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
+from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
+from comanip.units import MAX_REACH_DURATION_S, MAX_REACH_SPAN_M
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
@@ -265,14 +267,9 @@ class OnlineGoalEstimator:
         self.planner = families.planner
         self.model = model = self.planner.model
         n, d = model.n, model.d
-        start, _, width = self.planner.check_inputs(start, np.zeros(d), width)
-        if np.any(start[n:] != 0):
-            raise ValueError("start must be at rest (zero velocity and activation), got "
-                             f"{start[n:].tolist()} after the position: the online estimator's plans start from rest")
-        self.start, self.width = start, width
-        self.start_position = start[:n].copy()
+        _, _, width = self.planner.check_inputs(start, np.zeros(d), width)
+        self.width = width
         self.prior_goal = None if prior_goal is None else as_vector("prior_goal", prior_goal, d, "task-space position, m")
-        self.prior_mean = self.start_position.copy() if self.prior_goal is None else self.prior_goal
         self.prior_cov = prior_covariance(prior_std, model, width)
         self._prior_precision = np.linalg.inv(self.prior_cov)
         self.family = families.family(width, self.options)
@@ -289,7 +286,27 @@ class OnlineGoalEstimator:
         self._deviation_times = np.full((model.H, n), self.options.deviation_time)
         led_steps = model.h * np.arange(1, model.H + 1) > self.options.led_from
         self._deviation_times[np.ix_(led_steps, list(self.options.led_axes))] = self.options.led_deviation_time
-        H = model.H
+        self._paced = PacedModel(self.family)
+        self._people = self._people_model(d)
+        self._blas = ThreadpoolController()
+        self.reset(start)
+
+    def reset(self, start=None) -> None:
+        """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:
+        at rest where the hand was last seen, or where the last reach started). The model, width, prior std,
+        options and reach family stay; a prior goal given at construction stays, else the prior mean is the new
+        start."""
+        model, n, H = self.model, self.model.n, self.model.H
+        if start is None:
+            position = self._last_observation[:n] if getattr(self, "_history", None) else self.start_position
+            start = np.r_[position, np.zeros(model.state_size - n)]
+        start, _, _ = self.planner.check_inputs(start, np.zeros(model.d), self.width)
+        if np.any(start[n:] != 0):
+            raise ValueError("start must be at rest (zero velocity and activation), got "
+                             f"{start[n:].tolist()} after the position: the online estimator's plans start from rest")
+        self.start = start
+        self.start_position = start[:n].copy()
+        self.prior_mean = self.start_position.copy() if self.prior_goal is None else self.prior_goal
         self._counts = np.zeros(H + 1)
         self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations
         self._sums = np.zeros((H + 1, 2 * n))
@@ -298,12 +315,10 @@ class OnlineGoalEstimator:
         self._last_observation = np.zeros(2 * n)
         self._history: list[np.ndarray] = []       # [t, position, velocity] of every observation, for the people model
         self._off_model: str | None = None          # why the model at its own pace does not explain the hand
-        self._paced = PacedModel(self.family)
-        self._people = self._people_model(d)
         self._whitening: ObservationWhitening | None = None
-        self._blas = ThreadpoolController()
-        self._whitening_goal = np.zeros(d)
+        self._whitening_goal = np.zeros(model.d)
         self._whitened_observations = 0             # observations the whitening holds
+        self._warned = False
         self.latest: GoalEstimate | None = None
         """The last estimate, None before the first update."""
 
@@ -316,14 +331,17 @@ class OnlineGoalEstimator:
         """Add an observation and re-estimate the goal.
 
         Args:
-            time_s: time since the reach's start (s), ≥ 0 and not before the previous observation's; any time,
-                not only on the planning grid (after the horizon H·h it is read at the last step).
+            time_s: time since the reach's start (s), ≥ 0 and not before the previous observation's (the same
+                time again only for the same sample, which is skipped); any time, not only on the planning grid
+                (after the horizon H·h it is read at the last step).
             position: observed hand position (d,), m.
             velocity: observed hand velocity (d,), m/s.
 
         A sample the tracker lost (position or velocity all NaN) is skipped: the previous estimate is returned
         unchanged (before any tracked sample, the prior with status ``uninformative``) and the next good
-        sample carries on. A position or velocity with some entries NaN is refused (ValueError).
+        sample carries on. A position or velocity with some entries NaN is refused (ValueError). Units that
+        look like ms or mm (a time over a minute, a hand over 3 m from its start or at over 50 m/s) and a
+        hand beyond a person's reach (1 m) are warned about, once per reach.
 
         Returns:
             A :class:`GoalEstimate`: the predicted reach from the start to g_hat (a Plan), ``goal_covariance``
@@ -350,6 +368,12 @@ class OnlineGoalEstimator:
         position = as_vector("position", position, model.d, "hand position, m")
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
         observation = np.r_[position, velocity]
+        if time_s == self._last_time:
+            if np.array_equal(observation, self._last_observation):
+                return self.latest                      # the same sample again
+            raise ValueError(f"time_s {time_s:g} s repeats the previous observation's time with another position or "
+                             "velocity; each observation needs its own time")
+        self._check_plausible(time_s, position, velocity)
         before, fraction = _grid_position(time_s, model.h, model.H)
         self._counts[before] += 1
         self._sums[before] += observation
@@ -362,6 +386,28 @@ class OnlineGoalEstimator:
         with self._blas.limit(limits=1, user_api="blas"):   # threads only slow products of this size down
             self.latest = self._estimate(t_begin)
         return self.latest
+
+    def _check_plausible(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
+        """A warning, once per reach, for an observation no person's reach makes: a time over a minute since
+        the start (ms?), a hand over 3 m from its start or at over 50 m/s (mm?), or beyond a person's reach."""
+        if self._warned:
+            return
+        distance = float(np.linalg.norm(position - self.start_position))
+        speed = float(np.linalg.norm(velocity))
+        problem = None
+        if time_s > MAX_REACH_DURATION_S:
+            problem = (f"time_s {time_s:g} s is longer than one reach ({MAX_REACH_DURATION_S:g} s at most): is it in ms "
+                       "(comanip takes s), or is this the next reach (reset())?")
+        elif distance > MAX_REACH_SPAN_M or speed > 10 * MAX_HUMAN_HAND_SPEED_M_S:
+            problem = (f"the hand is {distance:.3g} m from its start at {speed:.3g} m/s, beyond any reach (at most "
+                       f"{MAX_REACH_SPAN_M:g} m, about {MAX_HUMAN_HAND_SPEED_M_S:g} m/s): is it in mm and mm/s (comanip "
+                       "takes m and m/s)?")
+        elif distance > MAX_HUMAN_REACH_M:
+            problem = (f"the hand is {distance:.3g} m from its start, beyond a person's reach of about "
+                       f"{MAX_HUMAN_REACH_M:g} m: is the start right, or is this the next reach (reset())?")
+        if problem is not None:
+            self._warned = True
+            warnings.warn(problem, stacklevel=3)
 
     def _estimate(self, t_begin: float) -> GoalEstimate:
         if self.options.timing == "model":
