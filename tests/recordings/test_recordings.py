@@ -101,3 +101,18 @@ def test_csv_recordings_are_preprocessed_with_their_targets(tmp_path):
     [recording] = load_csv_recordings(tmp_path / "reach.csv")
     assert recording.name == "reach" and recording.width == 0.02
     assert np.allclose(recording.target, [0.2, 0.0]) and abs(recording.distance - 0.2) < 2e-3
+
+
+def test_a_recording_refuses_nan_and_bad_shapes_and_warns_about_millimetres():
+    from comanip.recordings import Recording
+    t = np.linspace(0.0, 1.0, 11)
+    position = np.c_[0.3 * t, 0 * t]
+    Recording("ok", t, position, np.gradient(position, t, axis=0), 0.0, 1.0)
+    with pytest.raises(ValueError, match="NaN"):
+        Recording("lost", t, np.where(t[:, None] == 0.5, np.nan, position), position, 0.0, 1.0)
+    with pytest.raises(ValueError, match="shapes"):
+        Recording("short", t, position[:5], position[:5], 0.0, 1.0)
+    with pytest.raises(ValueError, match="increase"):
+        Recording("back", t[::-1], position, position, 0.0, 1.0)
+    with pytest.warns(UserWarning, match="millimetres"):
+        Recording("mm", t, 1000 * position, 1000 * position, 0.0, 1.0)

@@ -7,7 +7,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+import warnings
+
 import numpy as np
+
+from comanip.units import check_positions_m, check_times_s
 
 
 @dataclass(frozen=True)
@@ -34,6 +38,27 @@ class Recording:
     """Target width (m) when known."""
     target: np.ndarray | None = None
     """The target the person aimed at (d,), m, when known (the endpoint ``end`` is where the hand stopped)."""
+
+    def __post_init__(self):
+        t, position, velocity = (np.asarray(a, dtype=float) for a in (self.t, self.position, self.velocity))
+        if t.ndim != 1 or t.size < 2 or position.ndim != 2 or position.shape[0] != t.size or velocity.shape != position.shape:
+            raise ValueError(f"recording {self.name!r} needs times (K,), positions (K, d) and velocities (K, d) with K ≥ 2, "
+                             f"got shapes {t.shape}, {position.shape} and {velocity.shape}")
+        if not (np.all(np.isfinite(t)) and np.all(np.isfinite(position)) and np.all(np.isfinite(velocity))):
+            raise ValueError(f"recording {self.name!r} holds NaN or inf; a lost sample is a gap: leave it out")
+        if np.any(np.diff(t) <= 0):
+            raise ValueError(f"recording {self.name!r}: times must increase from sample to sample (s)")
+        step = float(np.median(np.diff(t)))
+        if not (t[0] - 2 * step <= self.onset <= self.end_time <= t[-1] + 2 * step):
+            raise ValueError(f"recording {self.name!r}: onset {self.onset:g} s and end {self.end_time:g} s must lie in "
+                             f"order within its times {t[0]:g}..{t[-1]:g} s (give or take two samples)")
+        for check, values, what in ((check_times_s, t, "times"), (check_positions_m, position, "positions")):
+            try:
+                check(values, f"recording {self.name!r}, {what}")
+            except ValueError as error:      # valid numbers a person hardly makes: say so, do not refuse
+                warnings.warn(str(error), stacklevel=3)
+        for name, value in (("t", t), ("position", position), ("velocity", velocity)):
+            object.__setattr__(self, name, value)
 
     @property
     def step(self) -> float:
