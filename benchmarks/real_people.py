@@ -29,6 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
+from comanip.analysis.speed_profile import speed_metrics
 from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
@@ -78,7 +79,6 @@ class _Online:
         self.trace: list[tuple[float, np.ndarray, str, float]] = []
 
     def update(self, t, position, velocity):
-        from comanip.analysis.speed_profile import speed_metrics
         estimate = self.estimator.update(t, position, velocity)
         speed = estimate.ee_speed                       # a GoalEstimate is the Plan of its predicted reach
         arrival = speed_metrics(estimate.t, speed).movement_time if speed.max() > 0 else math.nan

@@ -298,7 +298,7 @@ class OnlineGoalEstimator:
         start."""
         model, n, H = self.model, self.model.n, self.model.H
         if start is None:
-            position = self._last_observation[:n] if getattr(self, "_history", None) else self.start_position
+            position = self._last_observation[:n] if self._history else self.start_position
             start = np.r_[position, np.zeros(model.state_size - n)]
         start, _, _ = self.planner.check_inputs(start, np.zeros(model.d), self.width)
         if np.any(start[n:] != 0):
