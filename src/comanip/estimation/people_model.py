@@ -137,6 +137,8 @@ class PeopleModel:
         from threadpoolctl import ThreadpoolController
         if kind not in KINDS:
             raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
+        if len(recordings) < 4:
+            raise ValueError(f"PeopleModel.fit needs at least 4 recordings (two folds of two), got {len(recordings)}")
         with ThreadpoolController().limit(limits=1, user_api="openmp"):   # reproducible, no spinning threads
             return cls._fit(recordings, kind, trained_on, seed, progress or (lambda line: None))
 
