@@ -331,9 +331,8 @@ class OnlineGoalEstimator:
         """Add an observation and re-estimate the goal.
 
         Args:
-            time_s: time since the reach's start (s), ≥ 0 and not before the previous observation's (the same
-                time again only for the same sample, which is skipped); any time, not only on the planning grid
-                (after the horizon H·h it is read at the last step).
+            time_s: time since the reach's start (s), ≥ 0 and after the previous observation's; any time, not
+                only on the planning grid (after the horizon H·h it is read at the last step).
             position: observed hand position (d,), m.
             velocity: observed hand velocity (d,), m/s.
 
@@ -369,10 +368,8 @@ class OnlineGoalEstimator:
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
         observation = np.r_[position, velocity]
         if time_s == self._last_time:
-            if np.array_equal(observation, self._last_observation):
-                return self.latest                      # the same sample again
-            raise ValueError(f"time_s {time_s:g} s repeats the previous observation's time with another position or "
-                             "velocity; each observation needs its own time")
+            raise ValueError(f"time_s {time_s:g} s repeats the previous observation's time; each observation needs its "
+                             "own time (a sample sent twice: send it once)")
         self._check_plausible(time_s, position, velocity)
         before, fraction = _grid_position(time_s, model.h, model.H)
         self._counts[before] += 1
