@@ -72,17 +72,15 @@ class _People(PrefixPredictor):
 
 class _Online:
     """OnlineGoalEstimator behind the predictors' interface (goal and covariance of its estimate), keeping
-    each update's goal, status and the arrival time (s) of its predicted reach for :func:`diagnostics`."""
+    each update's time and estimate for :func:`diagnostics` (read after the movement, outside the timed update)."""
 
     def __init__(self, estimator):
         self.estimator = estimator
-        self.trace: list[tuple[float, np.ndarray, str, float]] = []
+        self.trace: list = []
 
     def update(self, t, position, velocity):
         estimate = self.estimator.update(t, position, velocity)
-        speed = estimate.ee_speed                       # a GoalEstimate is the Plan of its predicted reach
-        arrival = speed_metrics(estimate.t, speed).movement_time if speed.max() > 0 else math.nan
-        self.trace.append((float(t), estimate.goal.copy(), str(estimate.status), arrival))
+        self.trace.append((float(t), estimate))
         return EndpointPrediction(estimate.goal, estimate.goal_covariance)
 
 
@@ -90,14 +88,17 @@ def diagnostics(trace, recording) -> dict:
     """From an online estimator's updates on one movement: the share of updates after a quarter of the
     movement that the reaching model carries (status not ``people_model``), the share whose goal moved by more
     than 0.1 D, and the predicted reach's arrival minus the hand's (its end), over MT, at half of the movement."""
-    t = np.array([row[0] for row in trace])
+    t = np.array([time_s for time_s, _ in trace])
     after = t >= recording.onset + 0.25 * recording.movement_time
-    goals = np.array([row[1] for row in trace])
+    goals = np.array([estimate.goal for _, estimate in trace])
     jumps = np.linalg.norm(np.diff(goals, axis=0), axis=1) / recording.distance
-    half = min(int(np.searchsorted(t, recording.onset + 0.5 * recording.movement_time, side="right")), len(t)) - 1
-    return {"model_share": float(np.mean([row[2] != "people_model" for row, a in zip(trace, after) if a])) if after.any() else math.nan,
+    half = trace[min(int(np.searchsorted(t, recording.onset + 0.5 * recording.movement_time, side="right")), len(t)) - 1][1]
+    speed = half.ee_speed                               # a GoalEstimate is the Plan of its predicted reach
+    arrival = speed_metrics(half.t, speed).movement_time if speed.max() > 0 else math.nan
+    carried = [str(estimate.status) != "people_model" for (_, estimate), a in zip(trace, after) if a]
+    return {"model_share": float(np.mean(carried)) if carried else math.nan,
             "jumps": float(np.mean(jumps[after[1:]] > 0.1)) if after[1:].any() else math.nan,
-            "arrival": (trace[half][3] - recording.end_time) / recording.movement_time}
+            "arrival": (arrival - recording.end_time) / recording.movement_time}
 
 
 def run_predictor(factory, recording):

@@ -22,6 +22,15 @@ REST_WINDOW_S = 0.1
 """How long (s) the positions must stay still for the hand to rest."""
 
 
+def lost_sample(value) -> bool:
+    """Whether a tracker's position or velocity is a sample it lost: given, but all NaN."""
+    try:
+        array = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        return False
+    return array.size > 0 and bool(np.all(np.isnan(array)))
+
+
 def has_left(position: np.ndarray, start: np.ndarray, radius: float = REST_RADIUS_M) -> bool:
     """Whether any position (K, d) m lies farther than ``radius`` (m) from ``start`` (d,) m."""
     offset = position - start

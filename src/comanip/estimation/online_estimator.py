@@ -66,7 +66,7 @@ from comanip.estimation.corrected_deviation import (CORRECTION_TIME, DEVIATION_T
                                                    correction_factor)
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
-from comanip.estimation.hand_rest import REST_RADIUS_M, has_left
+from comanip.estimation.hand_rest import REST_RADIUS_M, has_left, lost_sample
 from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
@@ -357,7 +357,7 @@ class OnlineGoalEstimator:
             raise ValueError(f"time_s must be ≥ 0 s (time since the reach's start), got {time_s:g}")
         if time_s < self._last_time:
             raise ValueError(f"time_s must not go backwards: got {time_s:g} s after an observation at {self._last_time:g} s")
-        if _lost(position) or _lost(velocity):
+        if lost_sample(position) or lost_sample(velocity):
             # a sample the tracker lost: skipped, the estimate stands until the next good one
             if self.latest is None:
                 self._last_time = time_s
@@ -623,15 +623,6 @@ class OnlineGoalEstimator:
                                    direction=np.eye(d)[0], curvature=np.zeros((H + 1, nx // model.n)),
                                    mixed=np.zeros((H + 1, nx // model.n)))
         return self.family.prediction(self.start_position, goal, order=order, covariance=covariance)
-
-
-def _lost(value) -> bool:
-    """Whether an observed position or velocity is a sample the tracker lost: given, but all NaN."""
-    try:
-        array = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        return False
-    return array.size > 0 and bool(np.all(np.isnan(array)))
 
 
 def _grid_position(time_s: float, h: float, H: int) -> tuple[int, float]:

@@ -168,12 +168,13 @@ class PeopleModel:
             return None
         features, u, path = described
         speed = np.sqrt((velocity * velocity).sum(axis=1))
+        # a hand that has stopped is at its endpoint (until it moves again)
+        stopped = (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u))
         resting = resting_position(t, position, creep=0.5 * REST_FRACTION * features[3])
         if resting is not None and has_left(position, start):
-            # a hand that has stopped is at its endpoint (until it moves again)
-            return EndpointPrediction(resting, (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
+            return EndpointPrediction(resting, stopped)
         if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
-            return EndpointPrediction(position[-1].copy(), (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u)))
+            return EndpointPrediction(position[-1].copy(), stopped)
         x = features[self.columns]
         along, log_squared = self.along(x), self.spread(x)
         goal = position[-1] + path * max(along, 0.0) * u

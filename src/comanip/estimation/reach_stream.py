@@ -31,7 +31,7 @@ import numpy as np
 from comanip.arguments import as_positive
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.goal_estimate import GoalEstimate
-from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S, fitted_velocity, has_left, resting_position
+from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S, fitted_velocity, has_left, lost_sample, resting_position
 from comanip.estimation.online_estimator import OnlineGoalEstimator
 
 START_SPAN = 0.05
@@ -196,9 +196,9 @@ class ReachStream:
         time_s = float(time_s)
         if not time_s > self._last_time:
             raise ValueError(f"time_s must increase from sample to sample: got {time_s:g} s after {self._last_time:g} s")
-        position, velocity = np.asarray(position, dtype=float), np.asarray(velocity, dtype=float)
-        if np.all(np.isnan(position)) or np.all(np.isnan(velocity)):
+        if lost_sample(position) or lost_sample(velocity):
             return self.latest
+        position, velocity = np.asarray(position, dtype=float), np.asarray(velocity, dtype=float)
         self._last_time = time_s
         latest = self.latest
         started = self.segmenter.update(time_s, position, velocity)
