@@ -108,15 +108,20 @@ def is_tathum_folder(path: Path) -> bool:
     return path.is_dir() and (path / "trajectory_data").is_dir() and (path / "trial_data").is_dir()
 
 
-def tracked_trials(samples, lead: float = 0.0) -> list[Trial]:
+SINGLE_TRIAL_WIDTH_M = 0.01
+"""Width (m) of a target with a single trial, whose endpoints have no spread to measure."""
+
+
+def tracked_trials(samples) -> list[Trial]:
     """Trials for a fit from tracked reaches (:class:`~comanip.recordings.TrackedSamples`) whose goals are not
     recorded, only which target each aimed at (``label["target"]``, per ``label["participant"]``).
 
-    Each trial starts ``lead`` s before its onset (:meth:`~comanip.recordings.TrackedSamples.recording`; the
-    first sample is the start at rest) and runs to its end, its samples the preprocessed recording's. The
+    Each trial starts at its onset (:meth:`~comanip.recordings.TrackedSamples.recording`; the first sample is
+    the start at rest) and runs to its end, its samples the preprocessed recording's. The
     goal of a (participant, target) group is the mean of its endpoints, and its width the root-mean-square
     over the axes of the endpoints' standard deviation: the goal's standard deviation that the model's
-    W = w²·I reads it as (``goal_covariance: std``), as the people's endpoints spread around it."""
+    W = w²·I reads it as (``goal_covariance: std``), as the people's endpoints spread around it
+    (:data:`SINGLE_TRIAL_WIDTH_M` for a target with one trial)."""
     recordings = [trial.recording() for trial in samples]
     groups: dict[tuple, list[int]] = {}
     for k, trial in enumerate(samples):
@@ -125,10 +130,10 @@ def tracked_trials(samples, lead: float = 0.0) -> list[Trial]:
     for members in groups.values():
         ends = np.array([recordings[k].end for k in members])
         goal = ends.mean(axis=0)
-        width = float(np.sqrt(np.mean(ends.var(axis=0)))) if len(members) > 1 else 0.01
+        width = float(np.sqrt(np.mean(ends.var(axis=0)))) if len(members) > 1 else SINGLE_TRIAL_WIDTH_M
         for k in members:
             r = recordings[k]
-            keep = (r.t >= r.onset - lead - 1e-9) & (r.t <= r.end_time + 1e-9)
+            keep = (r.t >= r.onset - 1e-9) & (r.t <= r.end_time + 1e-9)
             result.append(Trial(r.name, r.t[keep] - r.t[keep][0], r.position[keep], goal, width))
     return result
 

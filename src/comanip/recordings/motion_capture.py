@@ -106,15 +106,14 @@ class TrackedSamples:
         begin = t[0] if start is None else start
         end = t[-1] if stop is None else stop
         chosen = np.flatnonzero((t >= begin - 1e-9) & (t <= end + 1e-9))[::every]
-        seen = self.tracked
+        seen = np.flatnonzero(self.tracked)
+        # for each chosen sample, the newest tracked sample at least the window earlier (-1: none)
+        earlier = np.searchsorted(t[seen], t[chosen] - velocity_window + 1e-9, side="right") - 1
         velocity = np.full((len(chosen), position.shape[1]), np.nan)
-        for row, k in enumerate(chosen):
-            earlier = np.flatnonzero(seen[:k + 1] & (t[:k + 1] <= t[k] - velocity_window + 1e-9))
-            if seen[k] and earlier.size:
-                j = earlier[-1]
-                velocity[row] = (position[k] - position[j]) / (t[k] - t[j])
+        ok = self.tracked[chosen] & (earlier >= 0)
+        j = seen[earlier[ok]]
+        velocity[ok] = (position[chosen[ok]] - position[j]) / (t[chosen[ok]] - t[j])[:, None]
         return t[chosen] - begin, position[chosen].copy(), velocity
-
 
     def streamed_recording(self, *, lead: float = STREAM_LEAD_S, rate_hz: float = STREAM_RATE_HZ,
                            velocity_window: float = VELOCITY_WINDOW_S) -> Recording:
