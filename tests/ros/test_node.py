@@ -9,7 +9,7 @@ rclpy = pytest.importorskip("rclpy", reason="the ROS 2 node needs the 'ros' extr
 
 from geometry_msgs.msg import PointStamped  # noqa: E402
 
-from comanip.estimation.online_estimator import FamilyCache  # noqa: E402
+from comanip.estimation.model_families import FamilyCache  # noqa: E402
 from comanip.estimation.estimation_planner import estimation_planner  # noqa: E402
 from comanip.multicomponent.handover import plan_handover  # noqa: E402
 from comanip.multicomponent.transition_model import TransitionModel  # noqa: E402

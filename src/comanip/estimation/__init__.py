@@ -3,7 +3,8 @@
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_estimator import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
 from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
-from comanip.estimation.online_estimator import OnlineGoalEstimator, OnlineOptions
+from comanip.estimation.online_estimator import OnlineGoalEstimator
+from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.recorded_trials import estimate_recordings
 from comanip.estimation.reach_stream import ReachSegmenter, ReachStart, ReachStream, SegmentationSettings, StreamEstimate
 

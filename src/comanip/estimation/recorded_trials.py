@@ -11,7 +11,8 @@ from __future__ import annotations
 import numpy as np
 
 from comanip.estimation.goal_estimate import GoalEstimate
-from comanip.estimation.online_estimator import FamilyCache, OnlineGoalEstimator
+from comanip.estimation.model_families import FamilyCache
+from comanip.estimation.online_estimator import OnlineGoalEstimator
 
 
 def estimate_recordings(model, recordings, *, cache: FamilyCache | None = None, **estimator_options) -> list[list[GoalEstimate]]:

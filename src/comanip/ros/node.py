@@ -61,7 +61,8 @@ except ModuleNotFoundError as error:
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator
 from comanip.estimation.reach_stream import ReachSegmenter, SegmentationSettings
-from comanip.estimation.online_estimator import CORRECTING_PERSON, FamilyCache
+from comanip.estimation.model_families import FamilyCache
+from comanip.estimation.online_options import CORRECTING_PERSON
 from comanip.estimation.estimation_planner import estimation_planner
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel

@@ -10,7 +10,7 @@ import dataclasses
 import numpy as np
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.online_estimator import CORRECTING_PERSON
+from comanip.estimation.online_options import CORRECTING_PERSON
 from comanip.simulation.policies.protocol import PolicyContext, Prediction
 from comanip.simulation.rest_trajectory import RestTrajectory
 

@@ -1,0 +1,27 @@
+"""A hand that has not left its start: nothing is known of the goal beyond the prior.
+
+A tracker's noise makes a resting hand's velocities look like motion; its positions do not
+(:mod:`comanip.estimation.hand_rest`). So until a position lies farther than
+:data:`~comanip.estimation.hand_rest.REST_RADIUS_M` from the start, this explains the hand with the prior,
+status ``uninformative``."""
+
+from __future__ import annotations
+
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach
+from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.hand_rest import REST_RADIUS_M
+from comanip.optim import Status
+
+
+class HandAtRest:
+    """The prior while the hand has not left its start (module docstring)."""
+
+    def reset(self, reach: Reach) -> None:
+        self.reach = reach
+
+    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+        reach = self.reach
+        resting = not hand.has_left(reach.start_position)
+        return Explained(reach.prior_mean, reach.prior_cov, resting, Status.UNINFORMATIVE,
+                         f"the hand has not left its start (within {1e3 * REST_RADIUS_M:g} mm): the estimate is the prior"
+                         if resting else "the hand has left its start")

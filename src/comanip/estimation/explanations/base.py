@@ -1,0 +1,151 @@
+"""What an explanation of a reach in progress sees and gives.
+
+An explanation is one account of the hand's movement so far, e.g. the reaching model at its own pace. Given
+the observations of the reach (:class:`HandTrace`) and the estimator's latest estimate, it gives a goal, its
+covariance and whether it explains the hand (:class:`Explained`). The online estimator asks its explanations in
+order and takes the first that explains the hand (:mod:`comanip.estimation.online_estimator`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Protocol
+
+import numpy as np
+
+from comanip.estimation.endpoint_baselines import MOVING_SPEED
+from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.hand_rest import has_left
+from comanip.estimation.online_options import OnlineOptions
+from comanip.estimation.profile_fit import detected_onset
+from comanip.estimation.reach_family import ReachFamily, ReachPrediction
+from comanip.optim import Status
+
+
+class HandTrace:
+    """The observations of one reach: times (K,) s, positions (K, d) m and velocities (K, d) m/s, in order."""
+
+    def __init__(self, d: int):
+        self._rows = np.zeros((64, 1 + 2 * d))
+        self.count = 0
+        """Observations so far."""
+        self.d = d
+
+    def append(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
+        if self.count == len(self._rows):
+            self._rows = np.concatenate([self._rows, np.zeros_like(self._rows)])
+        self._rows[self.count] = np.r_[time_s, position, velocity]
+        self.count += 1
+
+    @property
+    def t(self) -> np.ndarray:
+        return self._rows[:self.count, 0]
+
+    @property
+    def position(self) -> np.ndarray:
+        return self._rows[:self.count, 1:1 + self.d]
+
+    @property
+    def velocity(self) -> np.ndarray:
+        return self._rows[:self.count, 1 + self.d:]
+
+    @property
+    def last_time(self) -> float:
+        """Time of the newest observation (s); -inf before the first."""
+        return float(self._rows[self.count - 1, 0]) if self.count else -math.inf
+
+    @property
+    def last_observation(self) -> np.ndarray:
+        """The newest [position; velocity] (2d,); zeros before the first."""
+        return self._rows[self.count - 1, 1:].copy() if self.count else np.zeros(2 * self.d)
+
+    def onset(self) -> float | None:
+        """The first time (s) the hand's speed exceeds :data:`~comanip.estimation.endpoint_baselines.MOVING_SPEED`, or None."""
+        velocity = self.velocity
+        return detected_onset(self.t, np.sqrt((velocity * velocity).sum(axis=1)), MOVING_SPEED)
+
+    def has_left(self, start_position: np.ndarray) -> bool:
+        """Whether the hand has left its start (:func:`comanip.estimation.hand_rest.has_left`)."""
+        return has_left(self.position, start_position)
+
+
+class Reach:
+    """The reach under way: its start, the prior on its goal and the model's reach family.
+
+    Args:
+        family: the model's reach family for the goal width.
+        start: the state at the start (nx,), at rest.
+        prior_mean: g_bar (d,) m; prior_cov: P0 (d, d) m².
+        options: the estimator's options.
+    """
+
+    def __init__(self, family: ReachFamily, start: np.ndarray, prior_mean: np.ndarray, prior_cov: np.ndarray,
+                 options: OnlineOptions):
+        self.family, self.model, self.options = family, family.model, options
+        self.start = start
+        self.start_position = start[:family.model.n].copy()
+        self.prior_mean, self.prior_cov = prior_mean, prior_cov
+        self.prior_precision = np.linalg.inv(prior_cov)
+
+    def prediction(self, goal, *, order: int = 1, covariance: bool = True) -> ReachPrediction:
+        """The plan from the start to ``goal`` (:meth:`ReachFamily.prediction`), or holding still for a goal at
+        the start (the plan there: zero torque, no noise)."""
+        if np.linalg.norm(np.asarray(goal) - self.start_position) == 0.0:
+            model = self.model
+            H, nx, d = model.H, model.state_size, model.d
+            return ReachPrediction(mean=np.tile(self.start, (H + 1, 1)), cov=np.zeros((H + 1, nx, nx)),
+                                   torque=np.zeros((H, model.n)), objective=0.0, mean_jacobian=np.zeros((H + 1, nx, d)),
+                                   direction=np.eye(d)[0], curvature=np.zeros((H + 1, nx // model.n)),
+                                   mixed=np.zeros((H + 1, nx // model.n)))
+        return self.family.prediction(self.start_position, goal, order=order, covariance=covariance)
+
+    def landed(self, goal: np.ndarray, covariance: np.ndarray, hand: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A goal (d,) m with covariance (d, d) m² fitted to the hand's movement, as an estimate: moved along the
+        line from the start through it up to the ``hand``'s projection on that line when the hand is farther
+        along (a hand that has moved on is not heading for a goal behind it), and combined with the prior."""
+        offset = goal - self.start_position
+        distance = float(np.linalg.norm(offset))
+        if distance > 0:
+            along = float((hand - self.start_position) @ offset) / distance
+            goal = goal + max(along - distance, 0.0) * offset / distance
+        precision = np.linalg.inv(covariance) + self.prior_precision
+        combined = np.linalg.inv(precision)
+        return combined @ (np.linalg.solve(covariance, goal) + self.prior_precision @ self.prior_mean), combined
+
+
+@dataclass(frozen=True)
+class Explained:
+    """One explanation's account of the hand so far."""
+
+    goal: np.ndarray
+    """Goal (d,), m."""
+    covariance: np.ndarray
+    """Its covariance (d, d), m²."""
+    explains: bool
+    """Whether this explanation explains the hand (else the next one is asked)."""
+    status: Status
+    """The estimate's status when this explanation gives it."""
+    message: str
+    """What it found: why it explains the hand, or why not."""
+    iterations: int = 0
+    """Newton iterations spent."""
+
+
+class Explanation(Protocol):
+    """An account of the hand's movement (module docstring)."""
+
+    def reset(self, reach: Reach) -> None:
+        """Start a new reach."""
+
+    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+        """The goal this explanation gives for the observations so far; ``latest`` is the estimator's last
+        estimate (None before the first)."""
+
+
+def grid_position(time_s: float, h: float, H: int) -> tuple[int, float]:
+    """Where time_s (s, ≥ 0) falls on the grid of step h (s): the step i ≤ H at or before it and the fraction
+    of a step (in [0, 1]) it lies after t_i; times at or after the horizon H·h read as (H, 0)."""
+    grid = time_s / h
+    before = min(H, int(math.floor(grid * (1 + 1e-9))))
+    return before, (0.0 if before == H else min(max(grid - before, 0.0), 1.0))

@@ -1,0 +1,28 @@
+"""The model of recorded people's movements (:class:`~comanip.estimation.people_model.PeopleModel`): where people
+whose hand moved like this one stopped. It explains any hand that has started to move; its goal is combined with
+the prior and never lies behind a hand that has moved past it."""
+
+from __future__ import annotations
+
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach
+from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.people_model import PeopleModel
+from comanip.optim import Status
+
+
+class RecordedPeople:
+    """Where recorded people whose hand moved like this one stopped (module docstring)."""
+
+    def __init__(self, people: PeopleModel):
+        self.people = people
+
+    def reset(self, reach: Reach) -> None:
+        self.reach = reach
+
+    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+        reach = self.reach
+        predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
+        if predicted is None:
+            return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
+        goal, covariance = reach.landed(predicted.goal, predicted.covariance, hand.position[-1])
+        return Explained(goal, covariance, True, Status.PEOPLE_MODEL, "the goal is the people model's")

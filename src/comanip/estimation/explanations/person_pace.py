@@ -1,0 +1,92 @@
+"""The reaching model's mean reach at the person's own pace and onset (:mod:`comanip.estimation.paced_model`).
+
+It explains the hand where that fit does (misfit at most ``OnlineOptions.paced_threshold``) and pins the goal's
+distance (:meth:`ModelAtPersonPace.settled`). Its goal is combined with the prior and never lies behind a hand
+that has moved past it; its covariance is the fit's plus the spread of the model's reach around its goal at
+the end (where the hand stops spreads as the model's own reach to it does).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from scipy.stats import chi2
+
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach
+from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.paced_model import PacedFit, PacedModel
+from comanip.optim import Status
+
+#: A paced fit whose relative std of the goal's distance is at most this pins the goal.
+SETTLED_SPREAD = 0.1
+#: Observations since the onset a paced fit needs to pin the goal.
+SETTLED_OBSERVATIONS = 8
+#: |log pace|, and |onset delay| / MT, beyond which a settled paced fit contradicts the model's own timing.
+PACE_TOLERANCE = 0.14
+
+
+class ModelAtPersonPace:
+    """The model's reach at the person's pace (module docstring), fitted once per observation."""
+
+    def __init__(self, paced: PacedModel, options):
+        self.paced, self.options = paced, options
+
+    def reset(self, reach: Reach) -> None:
+        self.reach = reach
+        self._fitted: tuple[int, PacedFit] | None = None
+
+    def fit(self, hand: HandTrace, goal) -> PacedFit:
+        """The paced fit to the observations so far (the first one asked for since the newest observation): its
+        shape tried at the distance of ``goal`` (kept between 1 and 3 times the hand's displacement: a shape far
+        from the distance it fits can lock into a wrong pace and distance) and at 1.5 times the displacement."""
+        if self._fitted is not None and self._fitted[0] == hand.count:
+            return self._fitted[1]
+        start = self.reach.start_position
+        displacement = max(float(np.linalg.norm(hand.position[-1] - start)), 1e-3)
+        guesses = [1.5 * displacement]
+        if goal is not None:
+            guesses.insert(0, min(max(float(np.linalg.norm(np.asarray(goal) - start)), displacement), 3 * displacement))
+        fitted = self.paced.fit(hand.t, hand.position, hand.velocity, start, hand.onset(), guesses)
+        self._fitted = (hand.count, fitted)
+        return fitted
+
+    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+        reach = self.reach
+        if hand.onset() is None:
+            return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED,
+                             "nor does it at the person's pace (no movement seen)")
+        fitted = self.fit(hand, None if latest is None else latest.goal)
+        if fitted.misfit > self.options.paced_threshold or not self.settled(fitted):
+            return Explained(fitted.goal, fitted.covariance, False, Status.FAILED,
+                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})")
+        landing = reach.prediction(fitted.goal, order=0).cov[-1, :reach.model.n, :reach.model.n]
+        goal, covariance = reach.landed(fitted.goal, fitted.covariance + landing, hand.position[-1])
+        return Explained(goal, covariance, True, Status.SOLVED, f"the model's reach at the person's pace "
+                         f"(×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does")
+
+    def settled(self, fitted: PacedFit) -> bool:
+        """Whether a paced fit pins the goal's distance: its relative std along the reach at most
+        :data:`SETTLED_SPREAD` (before the speed peaks, a shorter quicker and a longer slower reach fit alike),
+        from at least :data:`SETTLED_OBSERVATIONS` observations since the onset."""
+        if fitted.observations < SETTLED_OBSERVATIONS:
+            return False
+        offset = fitted.goal - self.reach.start_position
+        distance = float(np.linalg.norm(offset))
+        return distance > 0 and math.sqrt(float(offset @ fitted.covariance @ offset)) / distance**2 <= SETTLED_SPREAD
+
+    def contradiction(self, hand: HandTrace, estimate: Explained) -> str | None:
+        """Why the model at its own pace (``estimate``) is contradicted by its reach at the person's pace, or
+        None: the paced fit explains the hand, pins the goal, finds a pace off the model's by more than
+        :data:`PACE_TOLERANCE` (as a log) or an onset off the model's by more than that fraction of the movement
+        time, and a goal the estimate's 99.9 % region (with the paced fit's) does not hold."""
+        fitted = self.fit(hand, estimate.goal)
+        on_time = abs(math.log(fitted.pace)) <= PACE_TOLERANCE and abs(fitted.delay) <= PACE_TOLERANCE * fitted.duration
+        if fitted.misfit > self.options.paced_threshold or not self.settled(fitted) or on_time:
+            return None
+        difference = fitted.goal - estimate.goal
+        distance2 = float(difference @ np.linalg.solve(fitted.covariance + estimate.covariance, difference))
+        if distance2 <= chi2.ppf(0.999, len(difference)):
+            return None
+        return (f"the model at its own pace is contradicted by its reach at the person's pace (×{fitted.pace:.3g}, "
+                f"{fitted.delay:+.3g} s late), whose goal lies {math.sqrt(distance2):.3g} standard deviations away")

@@ -1,0 +1,42 @@
+"""A model's reach families, built once and kept between online estimators (:class:`FamilyCache`)."""
+
+from __future__ import annotations
+
+from comanip.caching.model_cache import ModelCache
+from comanip.estimation.estimation_planner import checked_model, estimation_planner
+from comanip.estimation.online_options import OnlineOptions
+from comanip.estimation.reach_family import ReachFamily
+from comanip.model import ReachingModel
+from comanip.planning.planner import Planner
+
+
+class ModelFamilies:
+    """A model's planner and its reach families, one per (width, family options)."""
+
+    def __init__(self, model: ReachingModel | Planner):
+        self.planner = estimation_planner(model)
+        self._families: dict[tuple, ReachFamily] = {}
+
+    def family(self, width: float, options: OnlineOptions) -> ReachFamily:
+        key = (float(width), options.family_distances, options.family_size, options.family_tolerance)
+        if key not in self._families:
+            self._families[key] = ReachFamily(self.planner, width, options.family_distances, options.family_size,
+                                              options.family_tolerance)
+        return self._families[key]
+
+
+class FamilyCache(ModelCache[ModelFamilies]):
+    """Reach families kept between online estimators: by the model's parameters (a Planner is its own key)."""
+
+    def __init__(self, size: int = 4):
+        super().__init__(ModelFamilies, size)
+
+    def key(self, model):
+        return model if isinstance(model, Planner) else super().key(model)
+
+    def families(self, model: ReachingModel | Planner) -> ModelFamilies:
+        return self.get(checked_model(model))
+
+
+DEFAULT_FAMILIES = FamilyCache()
+"""The cache :class:`OnlineGoalEstimator` uses when given none."""
