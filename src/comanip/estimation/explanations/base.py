@@ -35,7 +35,8 @@ class HandTrace:
     def append(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
         if self.count == len(self._rows):
             self._rows = np.concatenate([self._rows, np.zeros_like(self._rows)])
-        self._rows[self.count] = np.r_[time_s, position, velocity]
+        row = self._rows[self.count]
+        row[0], row[1:1 + self.d], row[1 + self.d:] = time_s, position, velocity
         self.count += 1
 
     @property

@@ -38,15 +38,19 @@ class ModelAtPersonPace:
 
     def fit(self, hand: HandTrace, goal) -> PacedFit:
         """The paced fit to the observations so far (the first one asked for since the newest observation): its
-        shape tried at the distance of ``goal`` (kept between 1 and 3 times the hand's displacement: a shape far
-        from the distance it fits can lock into a wrong pace and distance) and at 1.5 times the displacement."""
+        shape tried at the distance the previous fit found, or on the first fit at the distance of ``goal`` (kept
+        between 1 and 3 times the hand's displacement: a shape far from the distance it fits can lock into a
+        wrong pace and distance) and at 1.5 times the displacement."""
         if self._fitted is not None and self._fitted[0] == hand.count:
             return self._fitted[1]
         start = self.reach.start_position
         displacement = max(float(np.linalg.norm(hand.position[-1] - start)), 1e-3)
-        guesses = [1.5 * displacement]
-        if goal is not None:
-            guesses.insert(0, min(max(float(np.linalg.norm(np.asarray(goal) - start)), displacement), 3 * displacement))
+        if self._fitted is not None:
+            guesses = [float(np.linalg.norm(self._fitted[1].goal - start))]
+        else:
+            guesses = [1.5 * displacement]
+            if goal is not None:
+                guesses.insert(0, min(max(float(np.linalg.norm(np.asarray(goal) - start)), displacement), 3 * displacement))
         fitted = self.paced.fit(hand.t, hand.position, hand.velocity, start, hand.onset(), guesses)
         self._fitted = (hand.count, fitted)
         return fitted
