@@ -9,7 +9,7 @@ The cache key is a SHA-256 of the generated C source (which holds every model co
 command and the CasADi version, so a changed model, a changed formulation or a new CasADi builds a new
 library; stale files are simply never looked up again. A library filed under a tag (the model's parameters) is
 found again without generating its source, keyed on the tag and the source fingerprint: the source of the
-modules the compiled functions are built from (:data:`COMPILED_FROM` and what they import), so editing any other
+modules the compiled functions are built from (:func:`compiling_modules` and what they import), so editing any other
 module keeps the cache. The folder is ``$COMANIP_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/comanip`` or ``~/.cache/comanip``. Without a working C compiler (``$CC``, default
 ``gcc``) the uncompiled function is returned with a warning: same numbers, slower. Each compile shows a
@@ -41,7 +41,7 @@ from typing import Callable
 
 import casadi as ca
 
-from comanip.caching.module_imports import PACKAGE, import_closure, import_graph, module_files
+from comanip.caching.module_imports import PACKAGE, import_closure, module_files, names_imported_from
 from comanip.progress import elapsed
 
 COMPILE_FLAGS = ("-O1", "-fPIC", "-shared")
@@ -124,19 +124,24 @@ FUNCTION_SOURCES = ("casadi", "adam-robotics", "example-robot-data")
 dynamics come from adam and the URDF of example-robot-data)."""
 
 
-COMPILED_FROM = ("comanip.planning.curvature", "comanip.planning.linearised_curvature")
-"""The modules that build the functions this package compiles: their source and that of every module they import
-(:func:`~comanip.caching.module_imports.import_closure`) enter the fingerprint, so editing a module they do not
-import (a plot, a command, a scenario, the people model) keeps the cache."""
+BUILDERS = ("compiled", "compiled_or_cached", "cached_compiled", "compile_in_background")
+"""The functions of this module that hand CasADi functions to the compiler (or look up their builds)."""
+
+
+def compiling_modules(package: Path = PACKAGE) -> set[str]:
+    """The modules of ``package`` that import one of :data:`BUILDERS`: those the compiled functions are built in."""
+    return {name for name, path in module_files(package).items()
+            if "comanip.caching.compiled" in path.read_text() and set(BUILDERS) & names_imported_from(path, "comanip.caching.compiled")}
 
 
 @functools.cache
 def _source_fingerprint(package: Path = PACKAGE) -> str:
-    """SHA-256 of the source of :data:`COMPILED_FROM` and the modules they import in ``package``, and of the
-    versions of :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint)."""
+    """SHA-256 of the source of :func:`compiling_modules` and every module they import in ``package``, and of the
+    versions of :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint): editing a
+    module they do not import (a plot, a command, a scenario, the people model) keeps the cache."""
     files = module_files(package)
     digest = hashlib.sha256()
-    for module in sorted(import_closure(import_graph(package), set(COMPILED_FROM))):
+    for module in sorted(import_closure(compiling_modules(package), package)):
         digest.update(module.encode())
         digest.update(files[module].read_bytes())
     for distribution in FUNCTION_SOURCES:

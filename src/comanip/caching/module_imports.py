@@ -6,8 +6,8 @@ module of the package, alone or as ``module:attribute`` (the names handed to ``i
 when that is a module, else ``comanip.x``. Module names are dotted (``comanip.planning.curvature``); a package is
 named by its ``__init__.py`` (``comanip.planning``).
 
-The compile cache keys compiled functions on the source of the modules they are built from
-(:func:`import_closure`), and the architecture's layer check reads the package graph from :func:`import_graph`.
+The compile cache keys compiled functions on the source of the modules they are built from (the modules that import
+its builders, :func:`names_imported_from`, and their :func:`import_closure`), and the architecture's layer check reads the package graph from :func:`import_graph`.
 """
 
 from __future__ import annotations
@@ -54,6 +54,12 @@ def _owning_module(name: str, modules: set[str]) -> str | None:
     return None
 
 
+def names_imported_from(path: Path, module: str) -> set[str]:
+    """The names the source file ``path`` imports with ``from module import ...`` (wherever the statement stands)."""
+    return {alias.name for node in ast.walk(ast.parse(path.read_text(), str(path)))
+            if isinstance(node, ast.ImportFrom) and node.module == module for alias in node.names}
+
+
 def import_graph(package: Path = PACKAGE) -> dict[str, set[str]]:
     """Each module of ``package`` and the modules of ``package`` it imports (itself left out)."""
     files = module_files(package)
@@ -61,12 +67,15 @@ def import_graph(package: Path = PACKAGE) -> dict[str, set[str]]:
     return {name: imported_modules(path, names) - {name} for name, path in files.items()}
 
 
-def import_closure(graph: dict[str, set[str]], roots: set[str]) -> set[str]:
-    """``roots`` and every module they import, directly or through others, in ``graph``."""
+def import_closure(roots: set[str], package: Path = PACKAGE) -> set[str]:
+    """``roots`` (modules of ``package``) and every module they import, directly or through others (only these
+    modules' sources are read)."""
+    files = module_files(package)
+    names = set(files)
     reached, frontier = set(), list(roots)
     while frontier:
         module = frontier.pop()
         if module not in reached:
             reached.add(module)
-            frontier.extend(graph[module])
+            frontier.extend(imported_modules(files[module], names))
     return reached
