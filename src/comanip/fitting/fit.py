@@ -29,8 +29,8 @@ from comanip.fitting.fit_result import FitResult, failed_result, fitted_model, i
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
 
-#: Edge of Nelder-Mead's first simplex in transformed units (a factor e^0.5 = 1.65 for log parameters).
 SIMPLEX_STEP = 0.5
+"""Edge of Nelder-Mead's first simplex in transformed units (a factor e^0.5 = 1.65 for log parameters)."""
 
 NLL_KIND = "negative log-likelihood (nats)"
 
