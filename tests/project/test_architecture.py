@@ -72,3 +72,12 @@ def test_each_row_lists_what_its_package_imports():
     differ = {package for package in graph if package in drawn and drawn[package][1] != set(graph[package])}
     assert not differ, f"rows of {sorted(differ)} differ from the import graph; the table should read:\n" + \
         layer_table({package: layer for package, (layer, _) in drawn.items()}, graph)
+
+
+def test_the_test_folders_mirror_the_packages():
+    """tests/<package>/ holds the tests of src/comanip/<package>/; tests/project/ (what spans the package) and
+    tests/data/ (stored reference results) are the only other folders."""
+    folders = {path.name for path in ARCHITECTURE.parents[1].joinpath("tests").iterdir()
+               if path.is_dir() and not path.name.startswith((".", "__"))}
+    packages = {package.rstrip("/") for package in package_graph() if package.endswith("/")}
+    assert folders - {"project", "data"} <= packages, sorted(folders - {"project", "data"} - packages)
