@@ -16,9 +16,9 @@ module keeps the cache. The folder is ``$COMANIP_CACHE_DIR`` if set, else
 progress line with its elapsed time (:mod:`comanip.progress`).
 
 :func:`compile_in_background` builds one in a daemon thread while the caller goes on with the uncompiled
-function (CasADi's virtual machine evaluates it meanwhile; compiled and uncompiled give identical numbers). Background builds run one at a time, a build whose owner has been
-garbage-collected before it started is skipped, and a compiler still running when Python exits is stopped
-and its scratch folder removed.
+function (CasADi's virtual machine evaluates it meanwhile; compiled and uncompiled give identical numbers).
+Background builds run one at a time, a build whose owner has been garbage-collected before it started is skipped,
+and a compiler still running when Python exits is stopped and its scratch folder removed.
 """
 
 from __future__ import annotations
@@ -131,7 +131,7 @@ BUILDERS = ("compiled", "compiled_or_cached", "cached_compiled", "compile_in_bac
 def compiling_modules(package: Path = PACKAGE) -> set[str]:
     """The modules of ``package`` that import one of :data:`BUILDERS`: those the compiled functions are built in."""
     return {name for name, path in module_files(package).items()
-            if "comanip.caching.compiled" in path.read_text() and set(BUILDERS) & names_imported_from(path, "comanip.caching.compiled")}
+            if __name__ in path.read_text() and set(BUILDERS) & names_imported_from(path, __name__)}
 
 
 @functools.cache

@@ -2,12 +2,13 @@
 
 A module's imports are its ``import comanip.x`` and ``from comanip.x import y`` statements wherever they stand (at
 the top, or inside a function, imported on first use) and its string constants that are the dotted name of a
-module of the package, alone or as ``module:attribute`` (the names handed to ``importlib.import_module``). ``from comanip.x import y`` imports ``comanip.x.y``
-when that is a module, else ``comanip.x``. Module names are dotted (``comanip.planning.curvature``); a package is
-named by its ``__init__.py`` (``comanip.planning``).
+module of the package, alone or as ``module:attribute`` (the names handed to ``importlib.import_module``).
+``from comanip.x import y`` imports ``comanip.x.y`` when that is a module, else ``comanip.x``. Module names are
+dotted (``comanip.planning.curvature``); a package is named by its ``__init__.py`` (``comanip.planning``).
 
 The compile cache keys compiled functions on the source of the modules they are built from (the modules that import
-its builders, :func:`names_imported_from`, and their :func:`import_closure`), and the architecture's layer check reads the package graph from :func:`import_graph`.
+its builders, :func:`names_imported_from`, and their :func:`import_closure`); the architecture's layer check reads
+the package graph from :func:`import_graph`.
 """
 
 from __future__ import annotations
