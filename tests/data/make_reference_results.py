@@ -125,7 +125,7 @@ def franka_reference_results() -> dict[str, np.ndarray]:
     the terms on first use, then seconds). The solver runs as the entries were made: the cold plan from every
     initial guess (``cold_search="all"``; the default starts from the shipped reach library), the Hessian
     assembled at every iteration and the tolerance 1e-8 (``hessian_refresh=1, arm_tolerance=None``; the defaults
-    reach the same plans to about 1e-9 relative in J in fewer, cheaper iterations, benchmarks/franka_solver_options.py, but the
+    reach the same plans to about 1e-9 relative in J in fewer, cheaper iterations, studies/which_newton_options_suit_the_arm/compare_solver_options.py, but the
     paper preset's plans lie on a flat valley where any change of rounding moves iteration counts)."""
     options = SolverOptions(cold_search="all", hessian_refresh=1, arm_tolerance=None)
     planner = comanip.Planner(comanip.presets.franka(), options)

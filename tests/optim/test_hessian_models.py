@@ -1,10 +1,12 @@
 """The secant-corrected Hessian (comanip.optim.hessian_models.SecantHessian): corrections that would need a large
-shift are dropped, smaller shifts keep them."""
+shift are dropped, smaller shifts keep them; the symmetric rank-one update and the Woodbury solve of an updated
+factor."""
 
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import scipy.linalg
 
 from comanip.optim.hessian_models import CORRECTED_SHIFT_LIMIT, SecantHessian
 
@@ -85,3 +87,46 @@ def test_an_iterate_is_finite_when_f_and_its_gradient_are(gradient, finite):
     assert Iterate(np.zeros(2), np.nan, g, None, NO_MULTIPLIERS, None).finite is False
     if finite and g is not None:
         assert point.steepest == 2.0
+
+
+def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
+    """After the update in place, (H + C) s = y, C stays symmetric and C's change is rank one; a residual r
+    orthogonal to s (no finite update meets the equation) leaves C alone."""
+    from comanip.optim.hessian_models import symmetric_rank_one_update
+
+    size = 40
+    H, C = (lambda M: M + M.T)(rng.normal(size=(size, size))), (lambda M: M + M.T)(rng.normal(size=(size, size)))
+    s, y = rng.normal(size=size), rng.normal(size=size)
+    before = C.copy()
+    symmetric_rank_one_update(C, H, s, y)
+    np.testing.assert_allclose((H + C) @ s, y, atol=1e-10 * np.abs(y).max())
+    np.testing.assert_array_equal(C, C.T)
+    assert np.linalg.matrix_rank(C - before, tol=1e-8 * np.abs(C - before).max()) == 1
+    unchanged = C.copy()
+    w = rng.normal(size=size)
+    symmetric_rank_one_update(C, H, s, (H + C) @ s + w - (w @ s) / (s @ s) * s)  # r ⟂ s: no finite update
+    np.testing.assert_array_equal(C, unchanged)
+
+
+def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite_one(rng):
+    """The Woodbury solve after secant updates equals a direct solve with F + Σ sign_j u_j u_jᵀ, and an update
+    that makes the matrix indefinite (eigenvalues checked directly) gives None."""
+    from comanip.optim.hessian_models import UpdatedFactor
+
+    size = 30
+    root = rng.normal(size=(size, size))
+    F = root @ root.T + size * np.eye(size)
+    factor = UpdatedFactor(scipy.linalg.cho_factor(F), 0.0)
+    matrix = F.copy()
+    for sign in (1.0, -1.0):
+        u = rng.normal(size=size)
+        factor = factor.updated((u, sign))
+        matrix += sign * np.outer(u, u)
+        assert np.linalg.eigvalsh(matrix)[0] > 0 and factor is not None
+        b = rng.normal(size=(size, 3))
+        np.testing.assert_allclose(factor.solve(b), np.linalg.solve(matrix, b), rtol=1e-9, atol=1e-12)
+    eigenvalues, vectors = np.linalg.eigh(matrix)
+    breaking = vectors[:, 0] * np.sqrt(2 * eigenvalues[0])  # subtracting it leaves eigenvalue -eigenvalues[0]
+    assert np.linalg.eigvalsh(matrix - np.outer(breaking, breaking))[0] < 0
+    assert factor.updated((breaking, -1.0)) is None
+    assert factor.updated(None) is factor

@@ -359,7 +359,7 @@ def test_warm_solve_to_a_nearby_goal_needs_no_inverse_kinematics(franka_rest_pla
 def test_lazy_hessian_reaches_the_optimum_of_eager_assembly(franka_rest_planner, offset):
     """The default solver (Hessian assembled every third iteration, arm tolerance 1e-6) and the Hessian assembled
     at every iteration with tolerance 1e-8 end at the same cold and warm plans: J within 1e-6 relative (measured:
-    about 1e-9, benchmarks/franka_solver_options.py) and mean hand paths within 1 mm."""
+    about 1e-9, studies/which_newton_options_suit_the_arm/compare_solver_options.py) and mean hand paths within 1 mm."""
     from comanip.planning.planner import SolverOptions
 
     eager = comanip.Planner(franka_rest_planner.model, SolverOptions(hessian_refresh=1, arm_tolerance=None))

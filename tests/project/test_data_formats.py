@@ -27,7 +27,7 @@ from comanip.cli.outputs import write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.fitting.movement_times import MT_COLUMNS
-from comanip.fitting.recordings import load_recordings
+from comanip.recordings.trial_files import load_recordings
 from comanip.planning.starts.arm_reach_library import bundled_library
 from comanip.fitting.fit_result import FIT_STATUSES, FitResult
 from comanip.model import ReachingModel

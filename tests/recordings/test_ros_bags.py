@@ -11,7 +11,7 @@ import pytest
 
 import comanip
 from comanip.cli.main import main
-from comanip.fitting.recordings import load_recordings
+from comanip.recordings.trial_files import load_recordings
 from comanip.recordings import read_bag, recording_from_samples
 from comanip.recordings.ros_bags import bag_observations, bag_samples, is_bag
 

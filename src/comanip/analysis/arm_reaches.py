@@ -26,8 +26,8 @@ from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 
-#: The kinds of joint limit, in the order the reports list them.
 LIMIT_KINDS = ("position", "velocity", "torque")
+"""The kinds of joint limit, in the order the reports list them."""
 
 
 @dataclass(frozen=True)
@@ -73,8 +73,8 @@ def _velocity_usage_after(model, plan: Plan, time: float) -> float:
     return float(np.max(np.abs(plan.mean[after, model.n:2 * model.n]) / model.body.qdot_max))
 
 
-#: A joint counts as at its velocity limit at |qdot| ≥ this fraction of qdot_max.
 AT_VELOCITY_LIMIT = 0.95
+"""A joint counts as at its velocity limit at |qdot| ≥ this fraction of qdot_max."""
 
 
 @dataclass(frozen=True)

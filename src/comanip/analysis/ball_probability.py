@@ -23,8 +23,8 @@ import numpy as np
 from scipy.integrate import quad
 from scipy.special import ndtr
 
-#: Half-width, in standard deviations, of the interval the outer integral covers.
 _TAIL = 9.0
+"""Half-width, in standard deviations, of the interval the outer integral covers."""
 
 
 def ball_probability(mean, cov, radius: float) -> float:

@@ -36,14 +36,14 @@ from comanip.objectives.reward import goal_covariance
 from comanip.planning.planner_cache import PlannerCache
 from comanip.progress import progress_bar
 
-#: Fitts' law holds when the better of the two fits has at least this R².
 FITTS_R2_MIN = 0.9
-#: Human movement times (s), roughly.
+"""Fitts' law holds when the better of the two fits has at least this R²."""
 HUMAN_MT_RANGE = (0.2, 1.5)
-#: The paper's early-peak claim: t_peak/MT below this in every condition.
+"""Human movement times (s), roughly."""
 EARLY_PEAK_MAX = 0.5
-#: Movement times closer than this (s) count as equal in the width and distance trends.
+"""The paper's early-peak claim: t_peak/MT below this in every condition."""
 TREND_TOLERANCE = 1e-3
+"""Movement times closer than this (s) count as equal in the width and distance trends."""
 
 
 @dataclass(frozen=True)

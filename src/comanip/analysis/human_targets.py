@@ -33,9 +33,10 @@ from comanip.analysis.target_verdicts import HumanTargets, TargetVerdict, target
 from comanip.model import ReachingModel
 from comanip.planning.planner import Planner
 
-#: The grid of the targets (m): distances D and goal radii w.
 TARGET_DISTANCES = (0.15, 0.3, 0.45)
+"""The grid of the targets: distances D (m)."""
 TARGET_WIDTHS = (0.005, 0.01, 0.02, 0.04)
+"""... and goal radii w (m)."""
 
 
 @dataclass(frozen=True)

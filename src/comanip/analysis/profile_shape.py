@@ -22,10 +22,10 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-#: Time after the start at which the onset is measured (s).
 ONSET_TIME = 0.05
-#: Local maxima of the speed below this fraction of the peak are not counted as peaks.
+"""Time after the start at which the onset is measured (s)."""
 PEAK_FLOOR = 0.1
+"""Local maxima of the speed below this fraction of the peak are not counted as peaks."""
 
 
 @dataclass(frozen=True)

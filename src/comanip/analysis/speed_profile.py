@@ -19,8 +19,8 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-#: Fraction of the peak speed below which a reach counts as finished (docs/formulation.md §6).
 SETTLING_FRACTION = 0.05
+"""Fraction of the peak speed below which a reach counts as finished (docs/formulation.md §6)."""
 
 
 @dataclass(frozen=True)

@@ -9,9 +9,9 @@ import numpy as np
 class BufferedFunction:
     """Calls a CasADi function on NumPy arrays through CasADi's zero-copy ``Function.buffer()`` interface.
 
-    A plain call converts every input and output between NumPy and CasADi's DM (about 0.3 ms for the
-    planner's Cartesian terms, four times the evaluation itself); the buffer reads and writes preallocated
-    arrays in place. Inputs must be dense and are copied into the buffer; outputs are returned as fresh
+    A plain call converts every input and output between NumPy and CasADi's DM, which for the planner's small
+    per-solve functions costs more than evaluating them; the buffer reads and writes preallocated arrays in
+    place. Inputs must be dense and are copied into the buffer; outputs are returned as fresh
     dense arrays of each output's shape (structural zeros filled in).
     """
 

@@ -7,16 +7,18 @@ the shared library in a cache folder. Nothing binary is shipped.
 
 The cache key is a SHA-256 of the generated C source (which holds every model constant), the compiler
 command and the CasADi version, so a changed model, a changed formulation or a new CasADi builds a new
-library; stale files are simply never looked up again. The folder is ``$COMANIP_CACHE_DIR`` if set, else
+library; stale files are simply never looked up again. A library filed under a tag (the model's parameters) is
+found again without generating its source, keyed on the tag and the source fingerprint: the source of the
+modules the compiled functions are built from (:func:`compiling_modules` and what they import), so editing any other
+module keeps the cache. The folder is ``$COMANIP_CACHE_DIR`` if set, else
 ``$XDG_CACHE_HOME/comanip`` or ``~/.cache/comanip``. Without a working C compiler (``$CC``, default
 ``gcc``) the uncompiled function is returned with a warning: same numbers, slower. Each compile shows a
 progress line with its elapsed time (:mod:`comanip.progress`).
 
 :func:`compile_in_background` builds one in a daemon thread while the caller goes on with the uncompiled
-function (CasADi evaluates it meanwhile, measured at the same speed on the Cartesian terms; compiled and
-uncompiled give identical numbers). Background builds run one at a time, a build whose owner has been
-garbage-collected before it started is skipped, and a compiler still running when Python exits is stopped
-and its scratch folder removed.
+function (CasADi's virtual machine evaluates it meanwhile; compiled and uncompiled give identical numbers).
+Background builds run one at a time, a build whose owner has been garbage-collected before it started is skipped,
+and a compiler still running when Python exits is stopped and its scratch folder removed.
 """
 
 from __future__ import annotations
@@ -39,11 +41,12 @@ from typing import Callable
 
 import casadi as ca
 
+from comanip.caching.module_imports import PACKAGE, import_closure, module_files, names_imported_from
 from comanip.progress import elapsed
 
 COMPILE_FLAGS = ("-O1", "-fPIC", "-shared")
-"""Flags for the C compiler: -O1 runs the straight-line SX code as fast as -O2 (measured on the Panda's
-terms: 2.4 ms both) and compiles in half the time (52 s against 97 s)."""
+"""Flags for the C compiler: -O1, because the generated code is straight-line SX instructions, which -O2 does not
+make faster but takes longer to compile."""
 
 
 def cache_dir() -> Path:
@@ -62,7 +65,7 @@ def compiled(function: ca.Function, tag: str | None = None) -> ca.Function:
 
     ``tag``: a string that, with this package's source code, determines the function (e.g. the model's
     parameters); the library is then also filed under it, so :func:`cached_compiled` finds it later without
-    generating the C source (which takes 0.07–0.5 s for a point mass's terms).
+    generating the C source (itself costly for large functions).
     """
     name = function.name()
     generator = ca.CodeGenerator(name, {"with_header": False})
@@ -121,21 +124,26 @@ FUNCTION_SOURCES = ("casadi", "adam-robotics", "example-robot-data")
 dynamics come from adam and the URDF of example-robot-data)."""
 
 
-FORMULATION = ("bodies", "belief", "objectives", "optim", "planning", "estimation", "model.py", "arguments.py")
-"""The parts of the package (folders and files under ``comanip/``) the compiled functions are built from:
-only their source enters the fingerprint, so editing a plot, a command or a scenario keeps the cache."""
-PACKAGE = Path(__file__).resolve().parents[1]
+BUILDERS = ("compiled", "compiled_or_cached", "cached_compiled", "compile_in_background")
+"""The functions of this module that hand CasADi functions to the compiler (or look up their builds)."""
+
+
+def compiling_modules(package: Path = PACKAGE) -> set[str]:
+    """The modules of ``package`` that import one of :data:`BUILDERS`: those the compiled functions are built in."""
+    return {name for name, path in module_files(package).items()
+            if __name__ in path.read_text() and set(BUILDERS) & names_imported_from(path, __name__)}
 
 
 @functools.cache
 def _source_fingerprint(package: Path = PACKAGE) -> str:
-    """SHA-256 of the Python files of the :data:`FORMULATION` parts of ``package`` and the versions of
-    :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint)."""
+    """SHA-256 of the source of :func:`compiling_modules` and every module they import in ``package``, and of the
+    versions of :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint): editing a
+    module they do not import (a plot, a command, a scenario, the people model) keeps the cache."""
+    files = module_files(package)
     digest = hashlib.sha256()
-    paths = [path for part in FORMULATION for path in ([package / part] if part.endswith(".py") else (package / part).rglob("*.py"))]
-    for path in sorted(paths):
-        digest.update(str(path.relative_to(package)).encode())
-        digest.update(path.read_bytes())
+    for module in sorted(import_closure(compiling_modules(package), package)):
+        digest.update(module.encode())
+        digest.update(files[module].read_bytes())
     for distribution in FUNCTION_SOURCES:
         try:
             digest.update(f"{distribution}=={metadata.version(distribution)}".encode())

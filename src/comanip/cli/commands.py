@@ -1,7 +1,6 @@
 """The subcommands of ``comanip``: where each is implemented and its one-line help, in the order ``comanip
 --help`` lists them. Kept apart from the command modules so that listing them imports none."""
 
-#: name -> (module with ``add_parser(subparsers)``, one-line help)
 COMMANDS = {
     "demo": ("comanip.cli.demo_command", "plan a reach, predict a recorded person's goal online, run a robot beside them"),
     "plan": ("comanip.cli.plan_command", "plan one reach"),
@@ -14,6 +13,7 @@ COMMANDS = {
     "library": ("comanip.cli.library_command", "solve an arm's reach library for cold solves from its ready pose"),
     "ros": ("comanip.cli.ros_command", "the ROS 2 goal node (needs the 'ros' extra)"),
 }
+"""name -> (module with ``add_parser(subparsers)``, one-line help)"""
 
 
 def command_help(name: str) -> str:

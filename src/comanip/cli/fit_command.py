@@ -40,7 +40,7 @@ def names(text: str) -> tuple[str, ...]:
 def run(args) -> int:
     from comanip.fitting.fit import fit_model
     from comanip.fitting.movement_times import MovementTimeTable, fit_movement_times
-    from comanip.fitting.recordings import load_recordings
+    from comanip.recordings.trial_files import load_recordings
 
     model = load_model(args)
     options = {"scheduler": args.scheduler, "progress": not args.no_progress}

@@ -20,8 +20,8 @@ from comanip.cli.outputs import add_output_arguments, output_dir, point_text, re
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover
 from comanip.multicomponent.transition_data import ARM_LENGTH
 
-#: A near and a far goal from the origin (m), as in the paper's experiment (Fig. 8).
 DEFAULT_GOALS = ("0.2,0.1,0", "0.4,0.25,-0.1")
+"""A near and a far goal from the origin (m), as in the paper's experiment (Fig. 8)."""
 
 
 def add_parser(subparsers) -> None:

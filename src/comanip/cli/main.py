@@ -21,9 +21,9 @@ from comanip import __version__
 from comanip.cli.commands import COMMANDS
 from comanip.extras import MissingExtra
 
-#: errors that mean the user gave something wrong (an argument, a file) or asked for a part whose extra is not
-#: installed: one line, exit status 2
 USER_ERRORS = (ValueError, OSError, yaml.YAMLError, MissingExtra)
+"""errors that mean the user gave something wrong (an argument, a file) or asked for a part whose extra is not
+installed: one line, exit status 2"""
 
 
 class OneLineParser(argparse.ArgumentParser):

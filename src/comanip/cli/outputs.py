@@ -20,7 +20,6 @@ from pathlib import Path
 
 MANIFEST = "manifest.json"
 
-#: (file-name pattern, what the file is), first match wins
 FILE_KINDS = (
     ("plan.json", "the plan: status, success, objective, times, state and end-effector mean and covariance, torques"),
     ("plan.csv", "the plan, one row per step: t, q, qdot, activation-stage forces (if any), hand position, velocity and std, torque"),
@@ -59,6 +58,7 @@ FILE_KINDS = (
     ("*.csv", "table (CSV with a header row)"),
     ("*.json", "results (JSON)"),
 )
+"""(file-name pattern, what the file is), first match wins"""
 
 
 def add_output_arguments(parser: argparse.ArgumentParser, default: str | None, what: str = "output folder",

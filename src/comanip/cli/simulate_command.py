@@ -131,8 +131,8 @@ def _handover_figure(result, out: Path) -> list[Path]:
     return [plot_handover(runs, out / "handover.png")] if runs else []
 
 
-#: scenario name -> its figure
 FIGURES = {"sync": _sync_figure, "handover": _handover_figure}
+"""scenario name -> its figure"""
 
 
 def _report_text(result, summary: dict, out: Path) -> tuple[list[str], object]:

@@ -4,11 +4,11 @@ The recording format and the method are described in docs/fitting.md."""
 
 from importlib import import_module
 
-#: the public names and their modules, imported on first use (the CLI reads DEFAULT_PARAMETERS without scipy)
 _EXPORTS = {"fit_model": "comanip.fitting.fit", "recordings_nll": "comanip.fitting.fit",
             "fit_movement_times": "comanip.fitting.movement_times", "MovementTimeTable": "comanip.fitting.movement_times",
-            "Trial": "comanip.fitting.recordings", "load_recordings": "comanip.fitting.recordings",
+            "Trial": "comanip.recordings.trial_files", "load_recordings": "comanip.recordings.trial_files",
             "FitResult": "comanip.fitting.fit_result"}
+"""the public names and their modules, imported on first use (the CLI reads DEFAULT_PARAMETERS without scipy)"""
 
 __all__ = ["fit_model", "recordings_nll", "fit_movement_times", "MovementTimeTable", "Trial", "load_recordings", "FitResult"]
 

@@ -7,11 +7,9 @@ Planner once per configuration and reuses it for every condition.
 
 Every solve is cold (the planner's multi-start from minimum-jerk guesses), not warm-started from the
 previous evaluation's plan, so that the objective is a function of the parameters alone and the fitted
-model predicts what ``Planner(model).solve`` gives. Warm starts were tried and measured: the planning
-problem has several local optima, and a solve warm-started from another parameter value's plan can stay in
-a different one (at gamma = 0.95 a reach of 0.3 m to a 1 cm goal took 0.355 s warm-started from the
-gamma = 0.99 plan, 0.374 s cold), which made the objective depend on the optimiser's path. A cold solve
-costs about 35 ms against 6 ms warm for the planar preset, next to 80 ms for building the Planner.
+model predicts what ``Planner(model).solve`` gives: the planning problem has several local optima, and a solve
+warm-started from another parameter value's plan can stay in a different one, which would make the objective
+depend on the optimiser's path.
 """
 
 from __future__ import annotations

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from comanip.fitting.recordings import Trial
+from comanip.recordings.trial_files import Trial
 from comanip.model import ReachingModel
 
 

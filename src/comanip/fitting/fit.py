@@ -22,15 +22,15 @@ from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.conditions import Condition, group_conditions
 from comanip.fitting.objective import RecordingsObjective
 from comanip.fitting.parameters import DEFAULT_PARAMETERS, ParameterSpace
-from comanip.fitting.recordings import Trial, load_recordings
+from comanip.recordings.trial_files import Trial, load_recordings
 from comanip.fitting.residuals import condition_curves, condition_residuals, trial_residuals
 from comanip.fitting.evaluation_progress import ProgressBar
 from comanip.fitting.fit_result import FitResult, failed_result, fitted_model, identification, outcome_message
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
 
-#: Edge of Nelder-Mead's first simplex in transformed units (a factor e^0.5 = 1.65 for log parameters).
 SIMPLEX_STEP = 0.5
+"""Edge of Nelder-Mead's first simplex in transformed units (a factor e^0.5 = 1.65 for log parameters)."""
 
 NLL_KIND = "negative log-likelihood (nats)"
 

@@ -12,11 +12,11 @@ from comanip import presets
 from comanip.fitting.parameters import ParameterSpace
 from comanip.model import ReachingModel
 
-#: Statuses: 'converged' (the optimiser met its tolerances and the data determine every parameter),
-#: 'unidentified' (the optimiser stopped, but no recorded sample was scored, or a parameter stayed at its start
-#: value without a standard error: the data say nothing about it), 'max_evaluations' (it ran out of
-#: evaluations; the values are the best found), 'failed' (an error stopped the fit; values are the start).
 FIT_STATUSES = ("converged", "unidentified", "max_evaluations", "failed")
+"""Statuses: 'converged' (the optimiser met its tolerances and the data determine every parameter), 'unidentified'
+(the optimiser stopped, but no recorded sample was scored, or a parameter stayed at its start value without a
+standard error: the data say nothing about it), 'max_evaluations' (it ran out of evaluations; the values are the best
+found), 'failed' (an error stopped the fit; values are the start)."""
 
 
 @dataclass

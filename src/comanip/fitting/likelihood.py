@@ -23,7 +23,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from comanip.fitting.recordings import Trial
+from comanip.recordings.trial_files import Trial
 from comanip.planning.plan import Plan
 
 

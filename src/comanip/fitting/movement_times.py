@@ -22,7 +22,7 @@ from scipy.optimize import least_squares
 
 from comanip.arguments import as_count, as_positive, as_positive_array
 from comanip.fitting.condition_plans import ConditionPlanner
-from comanip.fitting.csv_table import read_table
+from comanip.recordings.csv_table import read_table
 from comanip.fitting.parameters import MT_DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.evaluation_progress import ProgressBar
 from comanip.fitting.residuals import movement_time

@@ -10,7 +10,7 @@ from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.conditions import Condition
 from comanip.fitting.likelihood import trial_nll
 from comanip.fitting.parameters import ParameterSpace
-from comanip.fitting.recordings import Trial
+from comanip.recordings.trial_files import Trial
 from comanip.planning.plan import Plan
 
 

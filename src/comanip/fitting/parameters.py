@@ -24,13 +24,13 @@ DEFAULT_PARAMETERS = ("kappa", "nu", "gamma")
 MT_DEFAULT_PARAMETERS = ("kappa", "gamma")
 """The parameters a movement-time fit frees by default."""
 
-#: Parameters searched as logit(value), in (0, 1); all others as log(value), > 0.
 UNIT_INTERVAL = ("gamma",)
+"""Parameters searched as logit(value), in (0, 1); all others as log(value), > 0."""
 
-#: Default search range around the start value: a factor of 1000 either way for log parameters; logit
-#: parameters in [-12, 12] (gamma from 6e-6 to 0.999994).
 LOG_RANGE = np.log(1e3)
+"""Default search range around the start value of a log parameter: a factor of 1000 either way."""
 LOGIT_RANGE = 12.0
+"""... and of a logit parameter: [-12, 12] (gamma from 6e-6 to 0.999994)."""
 
 
 class ParameterSpace:

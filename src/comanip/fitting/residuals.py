@@ -14,7 +14,7 @@ import numpy as np
 from comanip.analysis.speed_profile import speed_metrics
 from comanip.fitting.conditions import Condition
 from comanip.fitting.likelihood import interpolate, predicted_mean, scored_samples
-from comanip.fitting.recordings import Trial
+from comanip.recordings.trial_files import Trial
 from comanip.planning.plan import Plan
 
 

@@ -38,11 +38,11 @@ from comanip.arguments import as_optional_positive, as_positive
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan
 
-#: Translational stiffness while the robot leads (N/m), paper VI-B.
 LEADING_STIFFNESS = 400.0
+"""Translational stiffness while the robot leads (N/m), paper VI-B."""
 
-#: Default duration (s) of the stiffness ramp to 0; see the module docstring for the bound it gives.
 DEFAULT_RAMP_TIME = 0.2
+"""Default duration (s) of the stiffness ramp to 0; see the module docstring for the bound it gives."""
 
 
 @dataclass

@@ -29,11 +29,11 @@ from comanip.multicomponent.perpendicular_dispersion import bootstrap_transition
 from comanip.planning.planner import Planner
 from comanip.progress import progress_bar
 
-#: Default arm length L (m) that normalises the goal distance.
 ARM_LENGTH = 0.7
+"""Default arm length L (m) that normalises the goal distance."""
 
-#: Settling criterion (docs/formulation.md §6): final speed below this fraction of the trial's peak speed.
 SETTLED_SPEED_FRACTION = 0.05
+"""Settling criterion (docs/formulation.md §6): final speed below this fraction of the trial's peak speed."""
 
 
 def default_steps(model: ReachingModel) -> int:

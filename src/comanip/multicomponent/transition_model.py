@@ -29,8 +29,8 @@ from comanip.multicomponent.transition_csv import (
 )
 from comanip.multicomponent.transition_data import ARM_LENGTH
 
-#: Matern smoothness: twice differentiable predictions, less prone than RBF to ringing between points.
 MATERN_NU = 2.5
+"""Matern smoothness: twice differentiable predictions, less prone than RBF to ringing between points."""
 
 _SHIPPED = object()
 

@@ -12,13 +12,13 @@ from scipy import stats
 
 from comanip.multicomponent.transition_model import TransitionModel
 
-#: (input column, output column) -> (published sign of the slope, the claim in words)
 PUBLISHED_TRENDS = {
     ("distance_over_arm_length", "transition_distance_m"): (+1, "a farther goal moves the peak farther from the goal"),
     ("distance_over_arm_length", "peak_dispersion_m"): (+1, "a farther goal makes the peak dispersion larger"),
     ("width_m", "transition_distance_m"): (-1, "a larger goal moves the peak closer to the goal"),
     ("width_m", "peak_dispersion_m"): (+1, "a larger goal makes the peak dispersion larger"),
 }
+"""(input column, output column) -> (published sign of the slope, the claim in words)"""
 
 _INPUTS = ("distance_over_arm_length", "width_m")
 

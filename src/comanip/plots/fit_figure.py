@@ -12,8 +12,8 @@ from comanip.analysis.fitts import index_of_difficulty
 from comanip.fitting.fit_result import FitResult
 from comanip.plots.figure_file import save_figure
 
-#: At most this many conditions get a column of their own.
 MAX_CONDITIONS = 8
+"""At most this many conditions get a column of their own."""
 
 
 def plot_fit(result: FitResult, path: str | Path) -> Path:

@@ -13,11 +13,11 @@ import numpy as np
 from comanip.plots.figure_file import save_figure
 from comanip.simulation.sync_scenario import SyncTrial
 
-#: Measures drawn as box plots: key in the trial metrics -> (axis label, scale).
 BOXED = {"goal_error_mean_m": ("goal error, mean t_o–MT (mm)", 1e3),
          "rms_force_change_N": ("RMS force change (N)", 1.0),
          "work_against_robot_J": ("work against robot (J)", 1.0),
          "sync_error_rms": ("sync error x–y vs z (% of reach)", 100.0)}
+"""Measures drawn as box plots: key in the trial metrics -> (axis label, scale)."""
 
 
 def plot_policy_comparison(results: dict[str, dict[str, list[SyncTrial]]], path: str | Path, title: str = "") -> Path:

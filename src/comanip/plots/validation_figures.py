@@ -15,10 +15,10 @@ from comanip.plots.phase_figure import plot_phase
 from comanip.plots.velocity_profiles import plot_velocity_profiles
 from comanip.validation.figure_data import ArmFigureData, PointMassFigureData, ValidationFigureData
 
-#: Figure file of the human-likeness section.
 HUMAN_FIGURE = "human_targets.png"
-#: Figure files of the Franka section, in the order the report lists them.
+"""Figure file of the human-likeness section."""
 ARM_FIGURES = ("franka_speed_profiles.png", "franka_joint_positions.png", "franka_joint_velocities.png", "franka_paths.png")
+"""Figure files of the Franka section, in the order the report lists them."""
 
 
 def draw_validation_figures(data: ValidationFigureData, out: str | Path) -> list[Path]:

@@ -25,12 +25,12 @@ from comanip.recordings.preprocessing import STEP, recording_from_samples
 from comanip.recordings.recording import Recording
 from comanip.units import check_positions_m
 
-#: the message types a hand topic may have
 POSITION_TYPES = ("geometry_msgs/msg/PoseStamped", "geometry_msgs/msg/PointStamped")
+"""the message types a hand topic may have"""
 TRANSFORM_TYPES = ("geometry_msgs/msg/TransformStamped", "tf2_msgs/msg/TFMessage")
 HAND_TYPES = POSITION_TYPES + TRANSFORM_TYPES
-#: suffixes of a bag's storage file
 BAG_SUFFIXES = (".mcap", ".db3")
+"""suffixes of a bag's storage file"""
 
 
 def is_bag(path: str | Path) -> bool:

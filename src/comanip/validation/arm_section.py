@@ -58,7 +58,7 @@ def build_arm_planner(model: ReachingModel, progress: bool = True) -> tuple[Plan
     """
     before = _cached_libraries()
     began = time.perf_counter()
-    description = f"franka: building the {model.body.name.capitalize()}'s compiled functions (first use ~1 min, cached after)"
+    description = f"franka: building the {model.body.name.capitalize()}'s functions (compiled to C on first use, cached after)"
     with elapsed(description, progress):
         planner = Planner(model)
     return planner, time.perf_counter() - began, bool(_cached_libraries() - before)

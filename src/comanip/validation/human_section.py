@@ -20,8 +20,8 @@ from comanip.model import ReachingModel
 from comanip.progress import progress_bar
 from comanip.validation.run_settings import ValidationSettings
 
-#: The one definition of w and ID the section states.
 DEFINITION = "w is the goal radius: a reach hits when ‖x − g‖ ≤ w at MT (2w is the full width), and ID = log2(2D/w) bits"
+"""The one definition of w and ID the section states."""
 
 
 def run_human_section(model: ReachingModel, reference: ReachingModel, grid: list[ReachOutcome],

@@ -8,11 +8,11 @@ from dataclasses import asdict, dataclass
 
 from comanip.arguments import as_count
 
-#: Goals of the Franka section: offsets (m) from the ready pose's end effector (about [0.307, 0, 0.487] m in
-#: the base frame, x forward, z up), 0.15–0.2 m along each axis both ways, all within reach. Ordered so
-#: that the first three (the quick run's) already go forward, sideways and down.
 FRANKA_GOAL_OFFSETS = ((0.2, 0.0, 0.0), (0.0, 0.2, 0.0), (0.0, 0.0, -0.15),
                        (-0.15, 0.0, 0.0), (0.0, -0.2, 0.0), (0.0, 0.0, 0.15))
+"""Goals of the Franka section: offsets (m) from the ready pose's end effector (about [0.307, 0, 0.487] m in the base
+frame, x forward, z up), 0.15–0.2 m along each axis both ways, all within reach. Ordered so that the first three (the
+quick run's) already go forward, sideways and down."""
 
 
 @dataclass(frozen=True)

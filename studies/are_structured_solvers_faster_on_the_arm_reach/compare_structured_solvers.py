@@ -1,6 +1,6 @@
 """CasADi's structure-exploiting solvers on the Franka reach, multiple shooting over the belief state .
 
-    nice .venv/bin/python benchmarks/structured_solvers.py [--repeats 10] [--only fatrop,sqp_hpipm,ipopt]
+    nice .venv/bin/python studies/are_structured_solvers_faster_on_the_arm_reach/compare_structured_solvers.py [--repeats 10] [--only fatrop,sqp_hpipm,ipopt]
 
 Notation (docs/formulation.md §2–4): stage state y_k = (mu_k (2n,), vech Sigma_k (n2(n2+1)/2,)), n2 = 2n, control tau_k (n,),
 k = 0..H. The OCP, in the planner's normalised units (J / |J_best(w)|, same minimiser):
@@ -16,7 +16,7 @@ timed solves to goals within ±5 cm of home EE + [0.15, 0.1, -0.1] m (the franka
 each warm-started from that solver's previous primal and dual solution. The package planner solves the
 same goal sequence (warm from its previous plan) for the objective comparison; J is recomputed for every
 solver by single shooting of its torques (so multiple-shooting defects cannot flatter it).
-Results are printed and written to benchmarks/results/structured_solvers.json.
+Results are printed and written to studies/are_structured_solvers_faster_on_the_arm_reach/structured_solvers.json.
 """
 
 from __future__ import annotations
@@ -225,7 +225,7 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=10)
     parser.add_argument("--only", default=",".join(SOLVERS))
-    parser.add_argument("--out", default=str(Path(__file__).parent / "results" / "structured_solvers.json"))
+    parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "structured_solvers.json"))
     args = parser.parse_args(argv)
     print("casadi", ca.__version__, {s: ca.has_nlpsol(s) for s in ("fatrop", "ipopt", "sqpmethod")},
           {s: ca.has_conic(s) for s in ("hpipm", "fatrop")}, flush=True)

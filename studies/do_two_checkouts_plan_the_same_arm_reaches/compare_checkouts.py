@@ -1,7 +1,7 @@
 """Do two versions of the code plan the same Panda reaches? Per goal, J, iterations, status and torques of both.
 
-    .venv/bin/python benchmarks/franka_plan_agreement.py --compare REF [--presets franka_rest,franka] [--goals 8]
-    .venv/bin/python benchmarks/franka_plan_agreement.py --compare . --perturb 2.2e-16
+    .venv/bin/python studies/do_two_checkouts_plan_the_same_arm_reaches/compare_checkouts.py --compare REF [--presets franka_rest,franka] [--goals 8]
+    .venv/bin/python studies/do_two_checkouts_plan_the_same_arm_reaches/compare_checkouts.py --compare . --perturb 2.2e-16
 
 Goals as in franka_rest.py (``--goals`` points 0.15–0.3 m from the ready pose in uniformly drawn directions, seed
 0): per goal one cold solve from rest at the ready pose, then one warm solve to the goal moved by up to 5 cm per
@@ -27,12 +27,12 @@ import numpy as np
 
 import comanip
 
-HERE = Path(__file__).resolve().parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def plans(presets: list[str], goals: int, perturb: float) -> dict:
     """{"preset/goal/cold|warm": {J, iterations, status, torque}} with this process's comanip."""
-    sys.path.insert(0, str(HERE))
+    sys.path.insert(0, str(ROOT / "benchmarks"))  # franka_rest.py
     from franka_rest import goal_offsets
 
     if perturb:
@@ -79,7 +79,7 @@ def main(argv=None) -> None:
     if args.compare is None:
         raise SystemExit("--compare REF is required: the checkout to compare this one with")
     # both codes at once (the plans, not their times, are compared)
-    new, ref = run(HERE.parent / "src", presets, args.goals, 0.0), run(args.compare.resolve() / "src", presets,
+    new, ref = run(ROOT / "src", presets, args.goals, 0.0), run(args.compare.resolve() / "src", presets,
                                                                         args.goals, args.perturb)
     new, ref = (json.loads(p.communicate()[0].strip().splitlines()[-1]) for p in (new, ref))
     print("| plan | J new | J ref | relative difference | iterations new / ref | status new / ref | max torque difference (N·m) "

@@ -1,7 +1,7 @@
 """Abandoning a cold search's long starts: would a start still running after K Newton iterations, beaten by then
 by a start that has converged, have ended best?
 
-    PYTHONPATH=src .venv/bin/python benchmarks/franka_abandon.py [--preset franka] [--problems 100] [--checkpoints 60,80,100,150]
+    PYTHONPATH=src .venv/bin/python studies/may_an_arm_cold_search_abandon_long_starts/measure_abandoned_starts.py [--preset franka] [--problems 100] [--checkpoints 60,80,100,150]
 
 On cold_quality.py's random cold problems of an arm (from the ready pose, every tenth start moving), each
 minimum-jerk start is solved to the end in stages (``NewtonSolve.advance``), its objective read at every checkpoint
@@ -10,7 +10,7 @@ iterations is dropped when a start that converged within the limits by then has 
 against the full search (every start to the end, ``cold_search="all"``): how often its plan is within 1e-4 of the
 full search's objective, its largest relative excess, successes, and the iterations it spends (summed over the
 starts, median and p90) against the full search's; with the cold-search rule's verdict (cold_quality.py:
-RULE_CLOSE, RULE_SHARE, RULE_WORST). Writes every start's row to benchmarks/results/franka_abandon.csv.
+RULE_CLOSE, RULE_SHARE, RULE_WORST). Writes every start's row to studies/may_an_arm_cold_search_abandon_long_starts/franka_abandon.csv.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
 
 import comanip  # noqa: E402
 from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
@@ -67,7 +67,7 @@ def main(argv=None) -> None:
     parser.add_argument("--problems", type=int, default=100)
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--checkpoints", default="60,80,100,150", help="comma-separated iteration counts K")
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results" / "franka_abandon.csv")
+    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "franka_abandon.csv")
     args = parser.parse_args(argv)
     checkpoints = sorted(int(k) for k in args.checkpoints.split(","))
     model = comanip.presets.load(args.preset)

@@ -1,4 +1,5 @@
-"""Recorded reaches read from CSV: one file, or a folder of files, of hand positions over time.
+"""Recorded reaches read as trials (times, positions, goal and width): a CSV file, a folder of them, a motion-capture
+folder or a ROS 2 bag. The fit (:mod:`comanip.fitting`) takes its trials from here.
 
 A recordings file has the columns ``t, x, y`` (and ``z`` for 3-D reaches): t in s from the movement's
 start, positions in m. A ``trial`` column names the trial of each row (rows of one trial in time order);
@@ -19,8 +20,9 @@ from pathlib import Path
 import numpy as np
 
 from comanip.arguments import as_positive
-from comanip.fitting.csv_table import read_table
+from comanip.recordings.csv_table import read_table
 from comanip.recordings.motion_capture import load_tathum
+from comanip.recordings.ros_bags import bag_name, bag_samples, is_bag
 from comanip.units import check_positions_m, check_times_s
 
 AXES = ("x", "y", "z")
@@ -71,8 +73,6 @@ def load_recordings(path: str | Path, trials: str | Path | None = None, *, check
         a trial without goal and width, the same trial name twice, or (``check_units``) times in ms or
         positions in mm.
     """
-    from comanip.recordings.ros_bags import is_bag  # comanip.recordings reads CSVs with this module
-
     path = Path(path)
     if is_bag(path):
         return [_bag_trial(path, trials, check_units, topic, frame)]
@@ -180,8 +180,6 @@ def _trials_in_file(path: Path, targets: dict | None, check_units: bool = True) 
 
 def _bag_trial(path: Path, trials: str | Path | None, check_units: bool, topic: str | None, frame: str | None) -> Trial:
     """The trial in a bag, named after it, its goal and width from the trials table."""
-    from comanip.recordings.ros_bags import bag_name, bag_samples
-
     name = bag_name(path)
     if trials is None:
         raise ValueError(f"bag {str(path)!r} holds no goal and width; give a trials table (trial, goal_x, goal_y[, goal_z], "

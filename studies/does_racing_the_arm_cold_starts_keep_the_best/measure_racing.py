@@ -1,7 +1,7 @@
 """Racing the minimum-jerk starts of an arm's cold solve: would a few Newton iterations from each start pick the
 start the full search would have kept?
 
-    PYTHONPATH=src .venv/bin/python benchmarks/franka_racing.py [--preset franka] [--problems 200] [--budgets 2,3,5,8]
+    PYTHONPATH=src .venv/bin/python studies/does_racing_the_arm_cold_starts_keep_the_best/measure_racing.py [--preset franka] [--problems 200] [--budgets 2,3,5,8]
 
 On cold_quality.py's random cold problems of an arm (from the ready pose, every tenth start moving), each
 minimum-jerk start is solved to convergence (the full search, ``cold_search="all"``, keeps the best) and, for
@@ -10,7 +10,7 @@ each budget k, for k iterations only. Racing with budget k keeps the start whose
 solve, so its quality is read off the full solves. Prints per budget how often racing keeps a plan within 1e-4
 of the full search's objective, its largest relative excess, and whether the cold-search rule holds
 (cold_quality.py: RULE_CLOSE, RULE_SHARE, RULE_WORST); with the iterations racing would spend against the full
-search's. Writes every problem's row to benchmarks/results/franka_racing.csv.
+search's. Writes every problem's row to studies/does_racing_the_arm_cold_starts_keep_the_best/franka_racing.csv.
 """
 
 from __future__ import annotations
@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
 
 import comanip  # noqa: E402
 from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
@@ -41,7 +41,7 @@ def main(argv=None) -> None:
     parser.add_argument("--preset", default="franka")
     parser.add_argument("--problems", type=int, default=200)
     parser.add_argument("--budgets", default="2,3,5,8", help="comma-separated iteration budgets of the race")
-    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results" / "franka_racing.csv")
+    parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "franka_racing.csv")
     args = parser.parse_args(argv)
     budgets = [int(b) for b in args.budgets.split(",")]
     model = comanip.presets.load(args.preset)

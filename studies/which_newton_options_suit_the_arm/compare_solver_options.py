@@ -1,9 +1,9 @@
 """How the arm's Newton options trade solve time against the plan: ``hessian_refresh`` and ``arm_tolerance``.
 
-    .venv/bin/python benchmarks/franka_solver_options.py [--goals 16] [--preset franka_rest]
+    .venv/bin/python studies/which_newton_options_suit_the_arm/compare_solver_options.py [--goals 16] [--preset franka_rest]
         [--variants "1,1e-8 3,1e-8 1,1e-6 3,1e-6 3,1e-5"]
 
-Problems as in franka_plan_agreement.py (``--goals`` points 0.15–0.3 m from the ready pose in uniformly drawn
+Problems as in studies/do_two_checkouts_plan_the_same_arm_reaches/compare_checkouts.py (``--goals`` points 0.15–0.3 m from the ready pose in uniformly drawn
 directions, seed 0): per goal one cold solve from rest at the ready pose, then one warm solve to the goal moved
 by up to 5 cm per axis (seed 1), warm-started from that variant's cold plan. Each variant ``k,tol`` is a planner
 with ``SolverOptions(hessian_refresh=k, arm_tolerance=tol)``; the variants take turns goal by goal in one
@@ -25,7 +25,7 @@ import numpy as np
 import comanip
 from comanip.planning.planner import SolverOptions
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # franka_rest.py
 from franka_rest import goal_offsets  # noqa: E402
 
 

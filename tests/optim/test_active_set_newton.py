@@ -1,0 +1,104 @@
+"""The active-set Newton method (comanip.optim.active_set_newton.newton_minimize and its staged newton_solve) on
+the bounded Rosenbrock function, against scipy's L-BFGS-B."""
+
+import numpy as np
+import pytest
+import scipy.optimize
+
+from comanip.optim.active_set_newton import newton_minimize
+
+
+def test_newton_matches_scipy_on_a_bounded_rosenbrock():
+    """An independent check of the method: the bounded Rosenbrock minimiser found by L-BFGS-B."""
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    lb, ub = np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5]
+    result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(6, -1.2), lb, ub, tolerance=1e-8, max_iterations=200)
+    reference = scipy.optimize.minimize(scipy.optimize.rosen, np.full(6, -1.2), jac=scipy.optimize.rosen_der,
+                                        method="L-BFGS-B", bounds=list(zip(lb, ub)), options={"ftol": 1e-15, "gtol": 1e-12})
+    assert result.status == "solved"
+    assert result.x[-1] == pytest.approx(0.5)  # the bound is active
+    np.testing.assert_allclose(result.x, reference.x, atol=1e-6)
+    assert result.fun <= reference.fun + 1e-12
+
+
+def test_hessian_refresh_reaches_the_same_minimiser_with_fewer_assemblies():
+    """An approximate Hessian (the Rosenbrock function's with its off-diagonal halved) assembled every third
+    iteration, secant corrections in between, reaches the minimiser of every-iteration assembly, and of L-BFGS-B
+    with a bound active; without bounds it assembles at most one Hessian per two iterations (a short step or a
+    constraint in the working set brings an assembly back sooner)."""
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    def approximate_hessian(x):
+        assemblies.append(x)
+        exact = scipy.optimize.rosen_hess(x)
+        return 0.5 * (exact + np.diag(np.diag(exact)))
+
+    free = (np.full(6, -np.inf), np.full(6, np.inf))
+    bounded = (np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5])
+    for lb, ub in (free, bounded):
+        results = {}
+        for refresh in (1, 3):
+            assemblies = []
+            result = newton_minimize(evaluate, approximate_hessian, np.full(6, -1.2), lb, ub, tolerance=1e-8,
+                                     max_iterations=500, secant=True, hessian_refresh=refresh)
+            assert result.success, result.message
+            results[refresh] = (result, len(assemblies))
+        lazy, eager = results[3][0], results[1][0]
+        np.testing.assert_allclose(lazy.x, eager.x, atol=1e-6)
+        assert lazy.fun == pytest.approx(eager.fun, rel=1e-9, abs=1e-15)
+        assert results[3][1] <= (lazy.nit / 2 if lb is free[0] else lazy.nit - 1)
+    reference = scipy.optimize.minimize(scipy.optimize.rosen, np.full(6, -1.2), jac=scipy.optimize.rosen_der,
+                                        method="L-BFGS-B", bounds=list(zip(*bounded)), options={"ftol": 1e-15, "gtol": 1e-12})
+    np.testing.assert_allclose(lazy.x, reference.x, atol=1e-6)
+
+
+@pytest.mark.parametrize("refresh, secant, word", [(0, True, "≥ 1"), (1.5, True, "≥ 1"), (True, True, "≥ 1"),
+                                                   (2, False, "without secant")])
+def test_hessian_refresh_is_checked(refresh, secant, word):
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    with pytest.raises(ValueError, match="hessian_refresh") as error:
+        newton_minimize(evaluate, scipy.optimize.rosen_hess, np.zeros(3), np.full(3, -1.0), np.full(3, 1.0),
+                        tolerance=1e-8, max_iterations=10, secant=secant, hessian_refresh=refresh)
+    assert word in str(error.value)
+
+
+def test_newton_stops_at_the_deadline():
+    calls = []
+
+    def evaluate(x):
+        calls.append(1)
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(4, -1.2), np.full(4, -np.inf), np.full(4, np.inf),
+                             tolerance=1e-12, max_iterations=100, expired=lambda: len(calls) > 3)
+    assert result.status == "max_wall_time" and np.isfinite(result.fun)
+
+
+@pytest.mark.parametrize("secant", [False, True])
+def test_a_solve_paused_and_resumed_takes_the_iterates_of_one_run(secant):
+    """newton_solve's stages: advancing to 7 iterations, then to the end, ends on the point, objective and status of
+    one run to the end (bounded Rosenbrock, exact Hessian or secant corrections: the method's memory survives the
+    pause); the pause itself reports 'max_iterations' at iteration 7."""
+    from comanip.optim import Status, newton_solve
+
+    def evaluate(x):
+        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+
+    hessian = (lambda x: 0.5 * (scipy.optimize.rosen_hess(x) + np.diag(np.diag(scipy.optimize.rosen_hess(x))))) if secant \
+        else scipy.optimize.rosen_hess
+    arguments = (evaluate, hessian, np.full(6, -1.2), np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5])
+    options = dict(tolerance=1e-10, secant=secant, hessian_refresh=3 if secant else 1)
+    whole = newton_solve(*arguments, **options).advance(500)
+    staged = newton_solve(*arguments, **options)
+    paused = staged.advance(7)
+    assert paused.status == Status.MAX_ITERATIONS and paused.nit == 7 and not staged.finished
+    resumed = staged.advance(500)
+    assert staged.finished and resumed.status == whole.status and resumed.success
+    np.testing.assert_array_equal(resumed.x, whole.x)
+    assert resumed.fun == whole.fun and abs(resumed.nit - whole.nit) <= 1
+    assert staged.advance(1000) is resumed  # a finished solve only reports
