@@ -9,6 +9,7 @@ rclpy = pytest.importorskip("rclpy", reason="the ROS 2 node needs the 'ros' extr
 
 from geometry_msgs.msg import PointStamped  # noqa: E402
 
+import comanip  # noqa: E402
 from comanip.estimation.model_families import FamilyCache  # noqa: E402
 from comanip.estimation.estimation_planner import estimation_planner  # noqa: E402
 from comanip.multicomponent.handover import plan_handover  # noqa: E402
@@ -194,9 +195,9 @@ def test_stale_when_estimates_overrun_the_budget_and_still_published(reach, tran
         assert int(values["late"]) == int(values["estimates"]) == len(replay.recording.goals) > 0
 
 
-def test_an_uninterrupted_stream_of_reaches_gets_a_reach_number_and_a_goal_each_without_a_reset(transition):
-    """Three minimum-jerk reaches of 0.3 m, each after 0.6 s at rest, from one 100 Hz tracker with 0.5 mm noise and
-    no reset: the node starts each reach itself, says which is under way, and estimates each one's goal."""
+def three_reaches():
+    """Three minimum-jerk reaches of 0.3 m, each after 0.6 s at rest, from one 100 Hz tracker with 0.5 mm noise:
+    times (K,) s, positions (K, 3) m, velocities (K, 3) m/s (a 30 ms backward difference), and the goals."""
     rng = np.random.default_rng(1)
     goals, position, t, x = [], np.zeros(3), [], []
     for direction in ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, -1.0, 0.0]):
@@ -211,9 +212,15 @@ def test_an_uninterrupted_stream_of_reaches_gets_a_reach_number_and_a_goal_each_
     for k in range(60):
         t.append(len(t) * 0.01), x.append(position.copy())
     x = np.array(x) + rng.normal(0, 5e-4, (len(t), 3))
-    v = np.r_[np.zeros((3, 3)), (x[3:] - x[:-3]) / 0.03]
+    return np.array(t), x, np.r_[np.zeros((3, 3)), (x[3:] - x[:-3]) / 0.03], goals
+
+
+def test_an_uninterrupted_stream_of_reaches_gets_a_reach_number_and_a_goal_each_without_a_reset(transition):
+    """Three reaches from one tracker and no reset: the node starts each reach itself, says which is under way,
+    and estimates each one's goal."""
+    t, x, v, goals = three_reaches()
     with Replay(NodeSettings(preset="arm", estimation_rate=20.0), transition) as replay:
-        recording = replay.run(np.array(t), np.c_[x, v], None)
+        recording = replay.run(t, np.c_[x, v], None)
     reaches = [int(values["reach"]) for _, _, _, values in recording.statuses]
     assert sorted(set(reaches) - {0}) == [1, 2, 3] and reaches == sorted(reaches)        # 0: before the first pose
     for number, goal in enumerate(goals, start=1):
@@ -221,3 +228,27 @@ def test_an_uninterrupted_stream_of_reaches_gets_a_reach_number_and_a_goal_each_
         last = max(stamp for stamp, _, _, values in recording.statuses if int(values["reach"]) == number)
         estimate = [g for stamp, g, _, _ in recording.goals if stamp <= last][-1]
         assert np.linalg.norm(estimate - goal) < 0.01, (number, estimate, goal)
+
+
+def test_a_reach_found_in_the_stream_is_estimated_as_reach_stream_estimates_it(transition):
+    """Every pose estimated: the node's goals for the reaches it finds in the stream are ReachStream's, which
+    gives each reach's estimator the samples from the reach's start on (those before the pose that started it
+    included). The stamps are the sample times to a nanosecond, so the times are jittered: with samples exactly
+    a rest window apart, a nanosecond decides whether the hand rests."""
+    t, x, v, _ = three_reaches()
+    t = t + np.random.default_rng(2).uniform(0, 1e-3, len(t))     # a tracker's jitter: no two samples exactly a window apart
+    with Replay(NodeSettings(preset="arm", estimation_rate=1000.0), transition) as replay:
+        recording = replay.run(t, np.c_[x, v], None)
+    stream = comanip.ReachStream(comanip.presets.arm())
+    library = {}
+    for k in range(len(t)):
+        latest = stream.update(t[k], x[k], v[k])
+        if latest.moving and latest.reach >= 2:
+            library[round(t[k], 6)] = latest.estimate.goal
+    compared = 0
+    for stamp, goal, _, _ in recording.goals:
+        expected = library.get(round(stamp - BASE_STAMP, 6))
+        if expected is not None:
+            np.testing.assert_allclose(goal, expected, atol=1e-9)
+            compared += 1
+    assert compared > 60

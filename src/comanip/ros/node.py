@@ -59,7 +59,7 @@ try:  # the 'ros' extra; without it, one line naming the extra
 except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
-from comanip.estimation import GoalEstimate, OnlineGoalEstimator
+from comanip.estimation import GoalEstimate, OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.reach_stream import ReachSegmenter, SegmentationSettings
 from comanip.estimation.model_families import FamilyCache
 from comanip.estimation.online_options import CORRECTING_PERSON
@@ -77,21 +77,25 @@ RATE_WINDOW = 1.0
 """Input time (s) over which the status's achieved rate and median latency are taken."""
 
 
-def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width) -> OnlineGoalEstimator:
-    """The goal estimator of one reach from ``start`` (2n,), at rest: the one place that names the estimator. The
-    person in a robot's loop corrects deviations from their plan (CORRECTING_PERSON, as in the simulated scenarios)."""
-    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=CORRECTING_PERSON)
+def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded") -> OnlineGoalEstimator:
+    """The goal estimator of one reach from ``start`` (2n,), at rest, for the ``person`` of
+    :attr:`NodeSettings.person`: the one place that names the estimator."""
+    options = CORRECTING_PERSON if person == "correcting" else OnlineOptions()
+    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=options)
 
 
 @dataclass
 class Reach:
     """The reach in progress: its number, start stamp (s), start state s_0 (2n,) (at rest at the first pose's
-    position: the estimator's plans start from rest) and prior goal (d,) or None."""
+    position: the estimator's plans start from rest), prior goal (d,) or None, and the samples (stamp s,
+    position (d,) m, velocity (d,) m/s) from its start up to the pose that started it, which its estimator
+    sees first."""
 
     number: int
     start_stamp: float
     start: np.ndarray
     prior_goal: np.ndarray | None
+    lead: list
 
 
 @dataclass
@@ -136,7 +140,7 @@ class GoalNode(Node):
         self._horizon = model.H * model.h
         self._planner = estimation_planner(model)
         self._families = FamilyCache(size=1)
-        reach_estimator(self._planner, self._families, np.zeros(model.state_size), None, s.width)  # builds the reach family once
+        reach_estimator(self._planner, self._families, np.zeros(model.state_size), None, s.width, s.person)  # builds the reach family once
         self._transition = transition_model if transition_model is not None else TransitionModel()
         self._reach: Reach | None = None
         self._reach_estimator = None
@@ -241,7 +245,7 @@ class GoalNode(Node):
             return
         started = self._segmenter.update(sample.stamp, sample.vector, velocity)
         if started is not None and started.number > 1:       # the first is the reach begun at the first pose
-            self._start_reach(reach.number + 1, started.clock, started.start)
+            self._start_reach(reach.number + 1, started.clock, started.start, started.samples[:-1])
             reach = self._reach
         t = sample.stamp - reach.start_stamp
         if t >= self._horizon:
@@ -260,9 +264,10 @@ class GoalNode(Node):
         self._next_due = due + period if sample.stamp < due + period else sample.stamp + period
         self._lock.notify()
 
-    def _start_reach(self, number: int, stamp: float, position: np.ndarray) -> None:
-        """Start reach ``number`` at ``stamp`` (s, its t = 0) from rest at ``position`` (d,) m (holding the lock)."""
-        self._reach = Reach(number, stamp, np.r_[position, np.zeros_like(position)], self._prior)
+    def _start_reach(self, number: int, stamp: float, position: np.ndarray, lead=()) -> None:
+        """Start reach ``number`` at ``stamp`` (s, its t = 0) from rest at ``position`` (d,) m, its ``lead`` samples
+        before the pose that started it (:class:`Reach`) (holding the lock)."""
+        self._reach = Reach(number, stamp, np.r_[position, np.zeros_like(position)], self._prior, list(lead))
         self._next_due = stamp + 1.0 / self.settings.estimation_rate
         self._recent = []
         self._last["event"] = f"reach {number} started at stamp {stamp:.6f} s"
@@ -321,7 +326,10 @@ class GoalNode(Node):
         the publication, NaN when nothing was published."""
         s = self.settings
         if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
-            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width)
+            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width, s.person)
+            for stamp, position, velocity in job.reach.lead:
+                if stamp - job.reach.start_stamp < job.t:
+                    estimator.update(stamp - job.reach.start_stamp, position, velocity)
             self._reach_estimator = (job.reach, estimator)
         estimator = self._reach_estimator[1]
         try:

@@ -20,6 +20,10 @@ from comanip.model import ReachingModel
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments
 
 
+PERSONS = ("recorded", "correcting")
+"""The values of :attr:`NodeSettings.person`."""
+
+
 @dataclass(frozen=True)
 class NodeSettings:
     """Everything the node is told (ROS parameters of the same names). Units: m, s, Hz, N/m, N·m/rad."""
@@ -70,6 +74,11 @@ class NodeSettings:
     within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.reach_stream`)."""
     rest_window: float = REST_WINDOW_S
     """How long (s) the hand must stay still to rest between reaches."""
+    person: str = "recorded"
+    """Whom the estimator expects (:data:`PERSONS`): "recorded", a person who may not move as the model does (the
+    model at its own pace, at the person's, and the model of recorded people:
+    :class:`comanip.estimation.OnlineOptions` as it comes); "correcting", the model's own plan with deviations
+    corrected (the simulated scenarios' person, :data:`comanip.estimation.online_options.CORRECTING_PERSON`)."""
     twist_tolerance: float = 0.005
     """Largest stamp difference (s) between a pose and the twist paired with it."""
     ramp_time: float = DEFAULT_RAMP_TIME
@@ -98,6 +107,8 @@ class NodeSettings:
                      "rest_radius", "rest_window"):
             object.__setattr__(self, name, as_positive(name, getattr(self, name), UNITS[name]))
         object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
+        if self.person not in PERSONS:
+            raise ValueError(f"person must be one of {PERSONS}, got {self.person!r}")
         check_schedule_arguments(self.ramp_time, self.leading_stiffness, None)
         quaternion = as_vector("equilibrium_orientation", self.equilibrium_orientation, 4, "quaternion x, y, z, w")
         if abs(float(quaternion @ quaternion) - 1.0) > 1e-6:
