@@ -206,6 +206,19 @@ def test_the_sync_scenario_runs_with_people_who_are_not_the_model(person):
     assert (trial.record.replans > 1) == (person.hand_path == "model")
 
 
+@pytest.mark.slow
+@pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
+def test_the_sync_scenario_runs_with_a_recorded_arm_beside_the_arm_preset_robot():
+    from comanip.simulation import ScenarioSetup, SyncSettings, run_sync
+
+    settings = SyncSettings(goal="near", trials=1, policy="continuous", online_preset="arm",
+                            person=PersonParameters(hand_path="recorded-arm", pace=2.5))
+    trial, = run_sync(settings, ScenarioSetup(settings, arm_reaches=ARMS), progress=False)
+    assert trial.estimate.goal.shape == (3,) and trial.record.replans == 0
+    assert trial.metrics["final_error_m"] < 0.01
+    assert trial.metrics["goal_error_final_m"] < 0.05
+
+
 def test_a_slower_person_gets_their_horizon_on_their_own_clock():
     from comanip.simulation import ScenarioSetup, SyncSettings
 
