@@ -26,6 +26,7 @@ import argparse
 import csv
 import sys
 import time
+from collections import Counter
 from dataclasses import replace
 from pathlib import Path
 
@@ -122,24 +123,28 @@ def main(argv: list[str] | None = None) -> int:
              f"person–goal pairs; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}; "
              f"person's work below the passive robot's: {len(rows) - len(above_passive)} of {len(rows)}, not above any "
              f"baseline's: {len(rows) - len(more_work)} of {len(rows)}.\n\n"
-             f"{_verdicts_by_person(rows)}\n"
+             f"{_verdicts_by_person(rows, results)}\n"
              f"![policies with people who are not the model](../figures/{figure.name})")
     print(block)
     print("wrote", HERE / "people_comparison_sync.csv", file=sys.stderr)
     return 0
 
 
-def _verdicts_by_person(rows: list[dict]) -> str:
-    """One line per person: the goals where the candidate's mean goal error is below the baseline's, and those
-    where the person's mean work beyond holding is below the passive robot's."""
+def _verdicts_by_person(rows: list[dict], results: dict) -> str:
+    """One line per person: the goals where the candidate's mean goal error is below the baseline's, those
+    where the person's mean work beyond holding is below the passive robot's, and the statuses of the
+    candidate's last estimates over the person's trials."""
     lines = []
     for person in dict.fromkeys(row["person"] for row in rows):
         mine = [row for row in rows if row["person"] == person]
         below = [row["goal"] for row in mine if row.get("goal_error_below")]
         lighter = [row["goal"] for row in mine if "passive" not in row.get("work_above", ["passive"])]
+        statuses = Counter(str(trial.estimate.status) for by_policy in results[person].values()
+                           for trial in by_policy.get(CANDIDATE, []) if trial.estimate is not None)
         lines.append(f"- {person}: `{CANDIDATE}` below `{GOAL_ERROR_BASELINE}` in goal error at "
                      f"{', '.join(below) or 'no goal'} ({len(below)} of {len(mine)}); person's work below the passive "
-                     f"robot's at {', '.join(lighter) or 'no goal'} ({len(lighter)} of {len(mine)})")
+                     f"robot's at {', '.join(lighter) or 'no goal'} ({len(lighter)} of {len(mine)}); status of "
+                     f"`{CANDIDATE}`'s last estimate: {', '.join(f'{name} {count}' for name, count in statuses.most_common())}")
     return "\n".join(lines) + "\n"
 
 
