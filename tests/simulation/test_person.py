@@ -1,13 +1,16 @@
 """Simulated people who are not the model: a person at another pace, a person whose intended path is a recording."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
 from comanip.recordings.recording import Recording
 from comanip.simulation.person import PersonParameters, SimulatedPerson
-from comanip.simulation.recorded_person import PLAYBACK_LEAD, RecordedPerson, recorded_reach, usable_for_reach
+from comanip.simulation.recorded_person import PLAYBACK_LEAD, RecordedPerson, recorded_reach, surface_normal, usable_for_reach
 
 GOAL = np.array([0.30, 0.10, -0.15])
+ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
 
 
 def _intentions(planner, pace: float, times: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -70,6 +73,85 @@ def test_a_recorded_path_starts_at_the_start_and_ends_at_the_scaled_turned_endpo
     assert reach[0] * offset[1] - reach[1] * offset[0] > 0
 
 
+def _tracked_reach(chord, up, side: float, rise: float, origin=(0.1, 0.2, 0.3)) -> Recording:
+    """A 3-D reach like _synthetic_recording's along chord (3,) m, at rest for 0.1 s, bulging side (m) along
+    up × chord and rise (m) along chord × (up × chord) mid-way."""
+    step = 0.005
+    t = np.arange(0.0, 0.6 + step / 2, step)
+    s = np.clip((t - 0.1) / 0.5, 0.0, 1.0)
+    progress = 10 * s**3 - 15 * s**4 + 6 * s**5
+    chord, up = np.asarray(chord, dtype=float), np.asarray(up, dtype=float)
+    across = np.cross(up, chord)
+    across /= np.linalg.norm(across)
+    upward = np.cross(chord, across)
+    upward /= np.linalg.norm(upward)
+    bump = np.sin(np.pi * s)
+    position = np.asarray(origin) + np.outer(progress, chord) + np.outer(side * bump, across) + np.outer(rise * bump, upward)
+    return Recording(name="tracked", t=t, position=position, velocity=np.gradient(position, step, axis=0), onset=0.1,
+                     end_time=0.6)
+
+
+def test_a_3d_recorded_path_keeps_its_timing_and_its_scaled_deviations_sideways_and_upward():
+    up = np.array([0.0, 1.0, 0.0])                              # a tracker whose y axis points up
+    recording = _tracked_reach([-0.06, 0.01, -0.2], up, side=0.01, rise=0.03)
+    start, goal = np.array([0.31, 0.0, 0.47]), np.array([0.45, 0.15, 0.20])
+    t, position = recorded_reach(recording, start, goal, up)
+    np.testing.assert_allclose(t, recording.t[recording.t >= 0.1 - PLAYBACK_LEAD - 1e-9] - (0.1 - PLAYBACK_LEAD), atol=1e-12)
+    np.testing.assert_allclose(position[0], start, atol=1e-12)
+    np.testing.assert_allclose(position[-1], goal, atol=1e-12)
+    reach = goal - start
+    scale = np.linalg.norm(reach) / np.linalg.norm(recording.position[-1] - recording.position[0])
+    across = np.cross([0.0, 0.0, 1.0], reach)
+    across /= np.linalg.norm(across)
+    upward = np.cross(reach, across) / np.linalg.norm(reach)
+    assert upward[2] > 0
+    # the progress along the chord keeps the recording's normalised timing
+    recorded_progress = (recording.position - recording.position[0]) @ (recording.position[-1] - recording.position[0])
+    recorded_progress /= recorded_progress[-1]
+    progress = (position - start) @ reach / (reach @ reach)
+    np.testing.assert_allclose(progress, np.interp(t + 0.1 - PLAYBACK_LEAD, recording.t, recorded_progress), atol=1e-9)
+    middle = int(np.argmin(np.abs(t - (PLAYBACK_LEAD + 0.25))))
+    offset = position[middle] - (start + 0.5 * reach)
+    assert offset @ across == pytest.approx(0.01 * scale, rel=1e-6)      # sideways stays horizontal, scaled
+    assert offset @ upward == pytest.approx(0.03 * scale, rel=1e-6)      # upward stays upward, scaled
+
+
+def test_a_3d_recording_needs_its_up_direction_and_a_planar_one_takes_none():
+    start, goal = np.array([0.31, 0.0, 0.47]), np.array([0.45, 0.15, 0.20])
+    with pytest.raises(ValueError, match="up"):
+        recorded_reach(_tracked_reach([0.2, 0.0, 0.0], [0.0, 0.0, 1.0], 0.0, 0.01), start, goal)
+    with pytest.raises(ValueError, match="up"):
+        recorded_reach(_synthetic_recording(0.0), start, goal, up=[0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize("sign", [1.0, -1.0])
+def test_the_surface_normal_is_the_plane_of_starts_and_ends_turned_to_where_the_hands_rise(sign):
+    normal = np.array([0.2, 0.9, 0.4]) / np.linalg.norm([0.2, 0.9, 0.4])
+    in_plane = [np.cross(normal, axis) for axis in ([1.0, 0.0, 0.0], [0.0, 0.0, 1.0])]
+    recordings = [_tracked_reach(0.2 * direction / np.linalg.norm(direction), sign * normal, side=0.0, rise=0.03,
+                                 origin=0.05 * k * in_plane[1]) for k, direction in enumerate(in_plane + [in_plane[0] + in_plane[1]])]
+    np.testing.assert_allclose(surface_normal(recordings), sign * normal, atol=1e-9)
+
+
+@pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
+def test_recorded_arm_people_play_the_development_arm_reaches_onto_the_reach():
+    from comanip.simulation import ScenarioSetup, SyncSettings
+
+    setup = ScenarioSetup(SyncSettings(), arm_reaches=ARMS)
+    assert len(setup.arm_recordings) > 100
+    start, goal = np.array([0.31, 0.0, 0.47]), np.array([0.35, -0.15, 0.20])
+    for seed in range(5):
+        recording = setup.recording(seed, "recorded-arm")
+        assert recording.position.shape[1] == 3
+        t, position = recorded_reach(recording, start, goal, setup.arm_up)
+        np.testing.assert_allclose(position[[0, -1]], [start, goal], atol=1e-12)
+        chord = goal - start
+        height = (position - start) @ np.cross(chord, np.cross([0.0, 0.0, 1.0], chord))
+        assert np.mean(height) > 0                                 # the hand rises off the surface, as recorded
+    with pytest.raises(ValueError, match="arm_reaches"):
+        ScenarioSetup(SyncSettings()).recording(0, "recorded-arm")
+
+
 def test_a_recorded_person_holds_the_offset_leaves_from_rest_and_stays_at_the_goal():
     start, goal, hold = np.array([0.31, 0.0, 0.47]), np.array([0.45, 0.15, 0.20]), np.array([0.31, 0.0, 0.48])
     parameters = PersonParameters(hand_path="recorded", anticipates_inertia=False, pace=1.3)
@@ -122,6 +204,19 @@ def test_the_sync_scenario_runs_with_people_who_are_not_the_model(person):
     assert trial.metrics["final_error_m"] < 0.01
     assert trial.metrics["goal_error_final_m"] < 0.02
     assert (trial.record.replans > 1) == (person.hand_path == "model")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
+def test_the_sync_scenario_runs_with_a_recorded_arm_beside_the_arm_preset_robot():
+    from comanip.simulation import ScenarioSetup, SyncSettings, run_sync
+
+    settings = SyncSettings(goal="near", trials=1, policy="continuous", online_preset="arm",
+                            person=PersonParameters(hand_path="recorded-arm", pace=2.5))
+    trial, = run_sync(settings, ScenarioSetup(settings, arm_reaches=ARMS), progress=False)
+    assert trial.estimate.goal.shape == (3,) and trial.record.replans == 0
+    assert trial.metrics["final_error_m"] < 0.01
+    assert trial.metrics["goal_error_final_m"] < 0.05
 
 
 def test_a_slower_person_gets_their_horizon_on_their_own_clock():

@@ -175,7 +175,8 @@ def test_continuous_policy_does_not_lead_before_its_first_observation():
     model = presets.cartesian()
     start = np.r_[0.4, 0.0, 0.3, np.zeros(3)]
     context = PolicyContext(start=start, prior_goal=np.array([0.6, 0.1, 0.3]), width=model.width, observation_time=0.2,
-                            dt=0.01, duration=1.5, model=model, estimator=None, prior_plan=None, update_interval=0.5)
+                            dt=0.01, duration=1.5, model=model, online_model=model, online_width=model.width, estimator=None, prior_plan=None,
+                            update_interval=0.5)
     policy = ContinuousPolicy(context)
     policy.observe(0.2, start[:3], np.zeros(3))
     assert policy.predict(0.2) is None
@@ -204,3 +205,38 @@ def test_sync_metrics_of_a_movement_that_ends_before_the_observation_time_are_na
     assert metrics["movement_time_s"] < 1.0
     assert np.isnan(metrics["rms_error_xy_m"]) and np.isnan(metrics["max_error_z_m"])
     assert metrics["goal_error_m"] == 0.0
+
+
+def test_people_rows_weigh_every_effort_of_the_candidate_against_each_baseline():
+    from types import SimpleNamespace
+
+    from comanip.simulation.policy_comparison import people_rows, people_table
+
+    def trials(goal_error, force, work):
+        return [SimpleNamespace(metrics={"goal_error_mean_m": goal_error + 0.001 * k, "rms_force_change_N": force + k,
+                                         "person_work_J": work + 0.1 * k}) for k in range(3)]
+
+    results = {"arm": {"near": {"passive": trials(float("nan"), 10.0, 2.0), "constant-velocity": trials(0.05, 12.0, 0.5),
+                                "continuous": trials(0.04, 11.0, 1.0)}}}
+    row, = people_rows(results)
+    assert row["goal_error_below"] is True
+    assert row["goal_error_difference_mm"][0] == pytest.approx(-10.0)
+    assert row["force_change_above"] == ["passive"] and row["work_above"] == ["constant-velocity"]
+    assert row["work_excess_constant-velocity_J"][0] == pytest.approx(0.5)
+    table = people_table([row], ["passive", "constant-velocity", "continuous"], "work", goal_error=False)
+    assert "goal error" not in table and "**constant-velocity (+0.5 ± " in table
+
+
+def test_the_continuous_policy_estimates_with_the_online_preset():
+    from comanip.simulation import ScenarioSetup, SyncSettings
+    from comanip.simulation.policies import ContinuousPolicy
+    from comanip.simulation.sync_scenario import policy_context
+
+    with pytest.raises(ValueError, match="online_preset"):
+        SyncSettings(online_preset="no-such-preset")
+    settings = SyncSettings(online_preset="arm")
+    setup = ScenarioSetup(settings)
+    context = policy_context(settings, setup, setup.settled_start(np.zeros(3)))
+    policy = ContinuousPolicy(context)
+    assert policy.estimator.model.name == "arm" and policy.estimator.width == context.online_model.width
+    assert context.model.name != "arm"                                   # the other policies keep the scenario's model

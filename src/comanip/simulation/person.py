@@ -49,7 +49,7 @@ from comanip.planning.planner import Planner
 
 
 #: The sources of a simulated person's intended hand motion (:attr:`PersonParameters.hand_path`).
-HAND_PATHS = ("model", "recorded")
+HAND_PATHS = ("model", "recorded", "recorded-arm")
 
 
 @dataclass(frozen=True)
@@ -80,11 +80,13 @@ class PersonParameters:
     """The person's duration relative to their intended motion's (dimensionless): that motion played over pace
     times its duration, positions unchanged, times × pace, velocities ÷ pace (module docstring). 1: the model's
     own pace (or the recording's); 0.7: 30 % faster; 1.3: 30 % slower."""
-    hand_path: Literal["model", "recorded"] = "model"
+    hand_path: Literal["model", "recorded", "recorded-arm"] = "model"
     """Where the intended hand motion comes from: ``"model"``, the reaching model's plan, re-planned every
-    ``replan_interval``; ``"recorded"``, a recorded person's movement (development split of the cursory
+    ``replan_interval``; ``"recorded"``, a recorded person's mouse movement (development split of the cursory
     recordings, ``pip install -e ".[data]"``) scaled and turned onto the reach and played at its recorded timing
-    (:mod:`comanip.simulation.recorded_person`), with the same arm impedance and no re-planning."""
+    (:mod:`comanip.simulation.recorded_person`), with the same arm impedance and no re-planning;
+    ``"recorded-arm"``, the same with a motion-capture arm reach in 3-D (the scenario setup's ``arm_reaches``
+    folder)."""
 
     def __post_init__(self):
         as_positive("stiffness", self.stiffness, "N/m")

@@ -11,7 +11,7 @@ summarised per goal and policy by its median and interquartile range over the tr
 The same policies also meet people who are not the model (:func:`compare_with_people`: a person at another
 pace, or one whose intended path is a recorded movement; :class:`comanip.simulation.person.PersonParameters`),
 summarised by :func:`people_rows` as the mean and standard deviation over the trials of the goal error and the
-person's force change, with the candidate policy's verdicts against the baselines.
+person's efforts (force change, work beyond holding), with the candidate policy's verdicts against the baselines.
 """
 
 from __future__ import annotations
@@ -71,15 +71,22 @@ def compare_with_people(settings_by_goal: dict[str, SyncSettings], people: dict[
 #: The policy the people comparison's verdicts are about, and the one whose goal error it must beat.
 CANDIDATE, GOAL_ERROR_BASELINE = "continuous", "constant-velocity"
 
+#: The person's efforts the people comparison reports: name -> (key in the trial metrics, heading, unit).
+EFFORTS = {
+    "force_change": ("rms_force_change_N", "RMS force change", "N"),
+    "work": ("person_work_J", "person's work beyond holding", "J"),
+}
+
 
 def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> list[dict]:
     """One row per person and goal (results of :func:`compare_with_people`): the candidate's and the goal-error
-    baseline's mean goal error from t_o to MT (mm) and every policy's RMS force change (N), each as mean and
-    standard deviation over the trials, with the verdicts: ``goal_error_below`` (candidate's mean below the
-    baseline's) and ``force_above`` (the policies whose mean force change is below the candidate's); and, over
-    the trials paired by seed (the same person for every policy), the candidate's goal error minus the
-    baseline's (``goal_error_difference_mm``) and its force change minus each lighter policy's
-    (``force_excess_<policy>_N``), as mean and standard error."""
+    baseline's mean goal error from t_o to MT (mm) and every policy's efforts (:data:`EFFORTS`: RMS force
+    change, N, and the person's work beyond holding, J), each as mean and standard deviation over the trials,
+    with the verdicts: ``goal_error_below`` (candidate's mean below the baseline's) and, per effort,
+    ``<effort>_above`` (the policies whose mean effort is below the candidate's); and, over the trials paired
+    by seed (the same person for every policy), the candidate's goal error minus the baseline's
+    (``goal_error_difference_mm``) and its effort minus each lighter policy's (``<effort>_excess_<policy>_<unit>``),
+    as mean and standard error."""
     rows = []
     for person, by_goal in results.items():
         for goal, by_policy in by_goal.items():
@@ -87,40 +94,49 @@ def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> li
             for name in (CANDIDATE, GOAL_ERROR_BASELINE):
                 if name in by_policy:
                     row[f"goal_error_{name}_mm"] = _mean_std(by_policy[name], "goal_error_mean_m", 1e3)
-            for name, trials in by_policy.items():
-                row[f"force_change_{name}_N"] = _mean_std(trials, "rms_force_change_N", 1.0)
+            for effort, (key, _, unit) in EFFORTS.items():
+                for name, trials in by_policy.items():
+                    row[f"{effort}_{name}_{unit}"] = _mean_std(trials, key, 1.0)
             if CANDIDATE in by_policy:
                 mine = by_policy[CANDIDATE]
                 if GOAL_ERROR_BASELINE in by_policy:
                     row["goal_error_below"] = bool(row[f"goal_error_{CANDIDATE}_mm"][0] < row[f"goal_error_{GOAL_ERROR_BASELINE}_mm"][0])
                     row["goal_error_difference_mm"] = _paired(mine, by_policy[GOAL_ERROR_BASELINE], "goal_error_mean_m", 1e3)
-                row["force_above"] = [name for name in by_policy if name != CANDIDATE
-                                      and row[f"force_change_{name}_N"][0] < row[f"force_change_{CANDIDATE}_N"][0]]
-                for name in row["force_above"]:
-                    row[f"force_excess_{name}_N"] = _paired(mine, by_policy[name], "rms_force_change_N", 1.0)
+                for effort, (key, _, unit) in EFFORTS.items():
+                    row[f"{effort}_above"] = [name for name in by_policy if name != CANDIDATE
+                                              and row[f"{effort}_{name}_{unit}"][0] < row[f"{effort}_{CANDIDATE}_{unit}"][0]]
+                    for name in row[f"{effort}_above"]:
+                        row[f"{effort}_excess_{name}_{unit}"] = _paired(mine, by_policy[name], key, 1.0)
             rows.append(row)
     return rows
 
 
-def people_table(rows: list[dict], policies) -> str:
-    """:func:`people_rows` as a markdown table: cells 'mean ± std' over the trials, paired differences 'mean ±
-    standard error', the verdicts last (each baseline with less force change followed by the candidate's paired
-    excess over it)."""
+def people_table(rows: list[dict], policies, effort: str = "force_change", goal_error: bool = True) -> str:
+    """:func:`people_rows` as a markdown table: the goal errors (unless goal_error=False) and one effort of
+    :data:`EFFORTS` per policy, cells 'mean ± std' over the trials, paired differences 'mean ± standard error',
+    the verdicts last (each baseline with less effort followed by the candidate's paired excess over it)."""
+    _, heading, unit = EFFORTS[effort]
     baselines = [name for name in policies if name != CANDIDATE]
-    headings = (["person", "goal", "n", f"goal error t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)",
-                 "paired difference (mm)", f"RMS force change, {CANDIDATE} (N)"] + [f"… {name} (N)" for name in baselines]
-                + [f"{CANDIDATE} below {GOAL_ERROR_BASELINE}?", f"baselines with less force change than {CANDIDATE}"])
+    headings = ["person", "goal", "n"]
+    if goal_error:
+        headings += [f"goal error t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)", "paired difference (mm)"]
+    headings += [f"{heading}, {CANDIDATE} ({unit})"] + [f"… {name} ({unit})" for name in baselines]
+    if goal_error:
+        headings.append(f"{CANDIDATE} below {GOAL_ERROR_BASELINE}?")
+    headings.append(f"baselines with less {heading} than {CANDIDATE}")
     lines = ["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)]
     for row in rows:
         cells = [row["person"], row["goal"], str(row["trials"])]
-        cells += [_pm(row.get(f"goal_error_{name}_mm")) for name in (CANDIDATE, GOAL_ERROR_BASELINE)]
-        cells.append(_pm(row.get("goal_error_difference_mm"), signed=True))
-        cells += [_pm(row.get(f"force_change_{name}_N")) for name in [CANDIDATE] + baselines]
-        below = row.get("goal_error_below")
-        cells.append("–" if below is None else "yes" if below else "**no**")
-        above = row.get("force_above")
+        if goal_error:
+            cells += [_pm(row.get(f"goal_error_{name}_mm")) for name in (CANDIDATE, GOAL_ERROR_BASELINE)]
+            cells.append(_pm(row.get("goal_error_difference_mm"), signed=True))
+        cells += [_pm(row.get(f"{effort}_{name}_{unit}")) for name in [CANDIDATE] + baselines]
+        if goal_error:
+            below = row.get("goal_error_below")
+            cells.append("–" if below is None else "yes" if below else "**no**")
+        above = row.get(f"{effort}_above")
         cells.append("–" if above is None else "none" if not above else "**" + ", ".join(
-            f"{name} ({_pm(row[f'force_excess_{name}_N'], signed=True)} N)" for name in above) + "**")
+            f"{name} ({_pm(row[f'{effort}_excess_{name}_{unit}'], signed=True)} {unit})" for name in above) + "**")
         lines.append("| " + " | ".join(cells) + " |")
     return "\n".join(lines) + "\n"
 
@@ -199,5 +215,5 @@ def _fmt(value: float) -> str:
     return f"{value:.3g}" if magnitude < 10 else f"{value:.0f}" if magnitude >= 100 else f"{value:.1f}"
 
 
-__all__ = ["CANDIDATE", "COMPARED", "GOAL_ERROR_BASELINE", "POLICIES", "compare_sync_policies", "compare_with_people",
+__all__ = ["CANDIDATE", "COMPARED", "EFFORTS", "GOAL_ERROR_BASELINE", "POLICIES", "compare_sync_policies", "compare_with_people",
            "comparison_rows", "markdown_table", "people_rows", "people_table", "write_comparison"]

@@ -1,17 +1,25 @@
 """A simulated person whose intended hand path is a recorded person's movement, not the model's plan.
 
-A recording (:class:`comanip.recordings.Recording`, d = 2: positions p(t) on a screen or table, m) is mapped
-onto the scenario's reach from the handle's start x_0 (3,) to the goal g (3,), both m:
+A recording (:class:`comanip.recordings.Recording`: positions p(t), m, on a screen or table (d = 2) or in a
+tracker's space (d = 3)) is mapped onto the scenario's reach from the handle's start x_0 (3,) to the goal g
+(3,), both m:
 
-    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2),   0 ≤ t ≤ lead + MT_rec
+    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2 + v(t) e_3),   0 ≤ t ≤ lead + MT_rec
 
-with u(t), w(t) the recorded displacement p(t_0 + t) - p(t_0) along and across the recorded chord
-p_end - p(t_0), D_rec its length, t_0 = onset - lead (:data:`PLAYBACK_LEAD`: the playback begins with the hand
-at rest shortly before the recorded onset, so the intention leaves from rest as a person's does);
-e_1 = (g - x_0) / D_reach the reach's direction (z included: the recording's progress carries the reach's
-height change), e_2 the horizontal unit vector across it, D_reach = ||g - x_0||. So the path starts at x_0,
-ends at g, keeps the recording's timing, speed profile and sideways deviations (scaled), and its x–y direction
-is the recording's turned onto the scenario's.
+with u(t), w(t), v(t) the recorded displacement p(t_0 + t) - p(t_0) along the recorded chord c = p_end - p(t_0),
+across it horizontally (along up × c) and across it upward (along c × (up × c)), with up the recording's
+upward direction (a planar recording lies flat: up = its plane's normal, v = 0); D_rec = |c|;
+t_0 = onset - lead (:data:`PLAYBACK_LEAD`: the playback begins with the hand at rest shortly before the
+recorded onset, so the intention leaves from rest as a person's does). On the scenario's side e_1 =
+(g - x_0) / D_reach is the reach's direction (z included: the recording's progress carries the reach's height
+change), e_2 = z × e_1 (normalised) the horizontal unit vector across it and e_3 = e_1 × e_2, D_reach =
+|g - x_0|. So the path starts at x_0, ends at g, keeps the recording's timing, speed profile and deviations
+from its chord (scaled, sideways ones horizontal, upward ones upward), and a planar recording's x–y
+direction is turned onto the scenario's.
+
+A 3-D recording's upward direction is that of the surface its reaches start and end on
+(:func:`surface_normal`): the normal of the plane through the starts and ends of a set of recordings,
+signed so that the hands rise off it on average (a pointing hand lifts between start and target).
 
 The intention is that path added to where the person held the hand before the reach (the offset between
 intention and the sagging hand carries over, as for the model's person), interpolated by a quintic spline that
@@ -59,52 +67,83 @@ def usable_for_reach(recording: Recording) -> bool:
             and recording.distance >= MIN_DISTANCE and recording.movement_time <= MAX_MOVEMENT_TIME)
 
 
-def recorded_reach(recording: Recording, start, goal) -> tuple[np.ndarray, np.ndarray]:
+def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarray, np.ndarray]:
     """The recording mapped onto the reach from start (3,) m to goal (3,) m (module docstring).
 
-    Returns (t (K,) s from the playback's start, positions (K, 3) m): t[0] = 0 at start, t[-1] =
-    PLAYBACK_LEAD + MT_rec at goal (the recording's onset at PLAYBACK_LEAD, or at 0 when it has no samples
-    that early).
+    up: the recording's upward direction (3,), for a 3-D recording (:func:`surface_normal`); a planar one lies
+    flat and takes none. Returns (t (K,) s from the playback's start, positions (K, 3) m): t[0] = 0 at start,
+    t[-1] = PLAYBACK_LEAD + MT_rec at goal (the recording's onset at PLAYBACK_LEAD, or at 0 when it has no
+    samples that early).
     """
     start, goal = as_vector("start", start, 3, "m"), as_vector("goal", goal, 3, "m")
-    if recording.position.shape[1] != 2:
-        raise ValueError(f"a recorded reach needs a planar recording (K, 2), got {recording.position.shape}")
+    d = recording.position.shape[1]
+    if d == 2:
+        if up is not None:
+            raise ValueError("a planar recording lies flat: give no up direction")
+        up = np.array([0.0, 0.0, 1.0])
+    elif d == 3:
+        if up is None:
+            raise ValueError("a 3-D recording needs its upward direction up (3,) (surface_normal)")
+        up = as_vector("up", up, 3, "direction")
+    else:
+        raise ValueError(f"a recorded reach needs a recording (K, 2) or (K, 3), got {recording.position.shape}")
     reach = goal - start
     distance = float(np.linalg.norm(reach))
     if distance == 0:
         raise ValueError("a recorded reach needs a start away from its goal")
     first = max(recording.onset - PLAYBACK_LEAD, float(recording.t[0]))
     keep = (recording.t >= first - 1e-9) & (recording.t <= recording.end_time + 1e-9)
-    t, recorded = recording.t[keep] - first, recording.position[keep]
-    chord = recorded[-1] - recorded[0]
-    length = float(np.linalg.norm(chord))
+    t, recorded = recording.t[keep] - first, np.pad(recording.position[keep], ((0, 0), (0, 3 - d)))
+    length = float(np.linalg.norm(recorded[-1] - recorded[0]))
     if length == 0:
         raise ValueError(f"recording {recording.name!r} ends where it starts")
-    along = chord / length
-    across = np.array([-along[1], along[0]])
-    e1 = reach / distance
-    e2 = np.cross([0.0, 0.0, 1.0], e1)
-    e2 = e2 / np.linalg.norm(e2) if np.linalg.norm(e2) > 1e-9 else np.array([0.0, 1.0, 0.0])   # a vertical reach
     displacement = recorded - recorded[0]
-    position = start + (distance / length) * (np.outer(displacement @ along, e1) + np.outer(displacement @ across, e2))
+    components = displacement @ _chord_frame(recorded[-1] - recorded[0], up).T        # (K, 3): along, across, upward
+    position = start + (distance / length) * components @ _chord_frame(reach, np.array([0.0, 0.0, 1.0]))
     position[-1] = goal   # equal up to rounding
     return t, position
+
+
+def _chord_frame(chord: np.ndarray, up: np.ndarray) -> np.ndarray:
+    """Rows e_1 = chord / |chord|, e_2 = up × e_1 and e_3 = e_1 × e_2, normalised (3, 3); for a chord along up,
+    e_2 is the y axis projected across the chord."""
+    e1 = chord / np.linalg.norm(chord)
+    e2 = np.cross(up, e1)
+    if np.linalg.norm(e2) < 1e-9:   # a vertical chord
+        e2 = np.array([0.0, 1.0, 0.0]) - e1[1] * e1
+    e2 = e2 / np.linalg.norm(e2)
+    return np.array([e1, e2, np.cross(e1, e2)])
+
+
+def surface_normal(recordings: list[Recording]) -> np.ndarray:
+    """The upward unit direction (3,) of the surface that 3-D recordings start and end on: the normal of the
+    plane fitted (least squares) to their start and end points, signed so that the hands rise off it on
+    average (their displacements from their first samples point along it)."""
+    if not recordings or any(r.position.shape[1] != 3 for r in recordings):
+        raise ValueError("surface_normal needs 3-D recordings (K, 3)")
+    ends = np.array([p for r in recordings for p in (r.position[np.searchsorted(r.t, r.onset)], r.position[-1])])
+    if len(ends) < 3:
+        raise ValueError("surface_normal needs the starts and ends of at least two recordings")
+    normal = np.linalg.svd(ends - ends.mean(axis=0))[2][-1]
+    rise = sum(float(np.mean((r.position - r.position[0]) @ normal)) for r in recordings)
+    return normal if rise >= 0 else -normal
 
 
 class RecordedPerson:
     """One person reaching for the goal along a recorded movement's path, holding the handle (module docstring).
 
     Args:
-        recording: a planar recording (:func:`usable_for_reach` says which play well).
+        recording: a planar or 3-D recording (:func:`usable_for_reach` says which play well).
         parameters: arm impedance; ``pace`` scales the recording's times (1: as recorded).
         start: where the handle starts (3,), m; goal: the person's goal (3,), m.
         load_inertia: M_load (3, 3), kg, for the feedforward when ``parameters.anticipates_inertia``.
+        up: a 3-D recording's upward direction (3,) (:func:`recorded_reach`).
     """
 
-    def __init__(self, recording: Recording, parameters: PersonParameters, start, goal, load_inertia=None):
+    def __init__(self, recording: Recording, parameters: PersonParameters, start, goal, load_inertia=None, up=None):
         self.recording, self.parameters = recording, parameters
         self.goal = as_vector("goal", goal, 3, "m")
-        t, position = recorded_reach(recording, start, goal)
+        t, position = recorded_reach(recording, start, goal, up)
         self.duration = float(t[-1] * parameters.pace)
         """The path's duration (s): the playback's (lead and movement time) times the pace."""
         rest = [(1, np.zeros(3)), (2, np.zeros(3))]

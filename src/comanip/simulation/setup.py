@@ -1,5 +1,6 @@
 """What a scenario builds once and reuses for every trial: the world, the person's planner, the robot's
-planner or estimator, the settled start, the person's first plan and, for recorded people, the recordings.
+planner or estimator, the settled start, the person's first plan and, for recorded people, the recordings
+(mouse movements of the cursory development split, or motion-capture arm reaches from a TAT-HUM data folder).
 
 Building the solvers takes seconds; a trial then takes a fraction of its simulated time. One
 :class:`ScenarioSetup` can serve several runs of the same scenario family (e.g. a near and a far goal):
@@ -9,6 +10,7 @@ everything that depends on the goal is computed per run.
 from __future__ import annotations
 
 from functools import cached_property
+from pathlib import Path
 
 import numpy as np
 
@@ -19,18 +21,24 @@ from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner, SolverOptions
 from comanip.recordings.recording import Recording
 from comanip.simulation.person import PersonParameters, SimulatedPerson, solve_to_convergence
-from comanip.simulation.recorded_person import RECORDING_STRIDE, RecordedPerson, usable_for_reach
+from comanip.simulation.recorded_person import RECORDING_STRIDE, RecordedPerson, surface_normal, usable_for_reach
 from comanip.simulation.scenario import ScenarioSettings, SettledStart, settle
 from comanip.simulation.world import CoManipulationWorld
 
 
 class ScenarioSetup:
-    """Shared, lazily built parts of the scenarios for one set of settings (goal and trial count aside)."""
+    """Shared, lazily built parts of the scenarios for one set of settings (goal and trial count aside).
 
-    def __init__(self, settings: ScenarioSettings):
+    arm_reaches: a TAT-HUM data folder of motion-capture arm reaches (:func:`comanip.recordings.load_tathum`),
+    the intended paths of people with ``hand_path="recorded-arm"``; None: no such people.
+    """
+
+    def __init__(self, settings: ScenarioSettings, arm_reaches: str | Path | None = None):
         if not isinstance(settings, ScenarioSettings):
             raise ValueError(f"settings must be a ScenarioSettings, got {type(settings).__name__}")
         self.settings = settings
+        self.arm_reaches = None if arm_reaches is None else Path(arm_reaches)
+        self._online_models: dict[str, ReachingModel] = {}
         base = presets.cartesian()
         self.model: ReachingModel = base if settings.kappa is None else base.replace(kappa=settings.kappa)
         self.width = self.model.width if settings.width is None else float(settings.width)
@@ -84,14 +92,41 @@ class ScenarioSetup:
 
         return [recording for recording in load_cursory("development") if usable_for_reach(recording)]
 
-    def recording(self, seed: int) -> Recording:
-        """The recording a recorded person with this seed plays (:data:`RECORDING_STRIDE`)."""
-        return self.recordings[seed * RECORDING_STRIDE % len(self.recordings)]
+    @cached_property
+    def arm_recordings(self) -> list[Recording]:
+        """The arm reaches of the ``arm_reaches`` folder that play as a reach (:func:`usable_for_reach`), by
+        participant and trial: the intended paths of people with ``hand_path="recorded-arm"``."""
+        if self.arm_reaches is None:
+            raise ValueError('people with hand_path="recorded-arm" need the setup\'s arm_reaches folder (TAT-HUM layout)')
+        from comanip.recordings import load_tathum
+
+        recordings = [trial.recording() for trial in load_tathum(self.arm_reaches)]
+        return [recording for recording in recordings if usable_for_reach(recording)]
+
+    @cached_property
+    def arm_up(self) -> np.ndarray:
+        """The arm reaches' upward direction (3,) in their tracker's frame (:func:`surface_normal`)."""
+        return surface_normal(self.arm_recordings)
+
+    def recording(self, seed: int, hand_path: str = "recorded") -> Recording:
+        """The recording a recorded person (``hand_path`` "recorded" or "recorded-arm") with this seed plays:
+        number (seed · :data:`RECORDING_STRIDE`) mod N of the N usable ones."""
+        recordings = self.arm_recordings if hand_path == "recorded-arm" else self.recordings
+        return recordings[seed * RECORDING_STRIDE % len(recordings)]
+
+    def online_model(self, preset: str | None) -> ReachingModel:
+        """The reaching model of an online goal estimator: the preset of that name (:mod:`comanip.presets`),
+        built once; None: the scenario's model."""
+        if preset is None:
+            return self.model
+        if preset not in self._online_models:
+            self._online_models[preset] = presets.load(preset)
+        return self._online_models[preset]
 
     def person(self, start: SettledStart, goal, seed: int, first_plan: Plan | None = None,
                parameters: PersonParameters | None = None) -> SimulatedPerson | RecordedPerson:
         """A person reaching from the settled start for goal (3,), m: the model's person with motor noise from
-        seed, or (``parameters.hand_path == "recorded"``) the recording of :meth:`recording` (seed); the load
+        seed, or (``parameters.hand_path`` "recorded" or "recorded-arm") the recording of :meth:`recording`; the load
         they anticipate is the handle's apparent inertia at the start. parameters: None for the settings'."""
         parameters = parameters or self.settings.person
         world = self.world
@@ -99,5 +134,8 @@ class ScenarioSetup:
         load_inertia = world.handle_inertia(world.observe())
         if parameters.hand_path == "recorded":
             return RecordedPerson(self.recording(seed), parameters, start.position, goal, load_inertia=load_inertia)
+        if parameters.hand_path == "recorded-arm":
+            return RecordedPerson(self.recording(seed, "recorded-arm"), parameters, start.position, goal,
+                                  load_inertia=load_inertia, up=self.arm_up)
         return SimulatedPerson(self.planner, parameters, goal, self.width, np.random.default_rng(seed),
                                first_plan, load_inertia=load_inertia)

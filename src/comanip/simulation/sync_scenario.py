@@ -23,6 +23,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
+from comanip import presets
 from comanip.analysis.speed_profile import speed_metrics
 from comanip.arguments import as_positive, as_vector
 from comanip.control.impedance import CartesianImpedanceController, RobotState
@@ -55,11 +56,17 @@ class SyncSettings(ScenarioSettings):
     """The robot policy, a name of :data:`comanip.simulation.policies.POLICIES` (default: the paper's)."""
     update_interval: float = DEFAULT_UPDATE_INTERVAL
     """Time between the predictions of the continuously updating policies (s)."""
+    online_preset: str | None = None
+    """The reaching model of the continuous policy's online goal estimator, a preset name of
+    :mod:`comanip.presets` (e.g. ``"arm"``, a person's arm in 3-D); None: the scenario's model (the Cartesian
+    preset)."""
 
     def __post_init__(self):
         super().__post_init__()
         as_positive("observation_time", self.observation_time, "s")
         check_policy(self.policy)
+        if self.online_preset is not None and self.online_preset not in presets.names():
+            raise ValueError(f"online_preset must be one of {presets.names()} or None, got {self.online_preset!r}")
         as_positive("update_interval", self.update_interval, "s")
         object.__setattr__(self, "prior_goal", tuple(check_workspace(
             as_vector("prior_goal", self.prior_goal, 3, "m, robot base frame"), "prior_goal").tolist()))
@@ -175,8 +182,11 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
 def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledStart) -> PolicyContext:
     """What every policy knows before the reach, for the settings' prior goal (the prior plan is solved here)."""
     prior = np.asarray(settings.prior_goal)
+    online_model = setup.online_model(settings.online_preset)
     return PolicyContext(start=start.state, prior_goal=prior, width=setup.width, observation_time=settings.observation_time,
-                         dt=setup.world.timestep, duration=setup.trial_duration(settings.person), model=setup.model, estimator=setup.estimator,
+                         dt=setup.world.timestep, duration=setup.trial_duration(settings.person), model=setup.model,
+                         online_model=online_model, online_width=setup.width if settings.online_preset is None else online_model.width,
+                         estimator=setup.estimator,
                          prior_plan=setup.person_first_plan(start, prior), update_interval=settings.update_interval)
 
 

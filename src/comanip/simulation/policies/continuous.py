@@ -63,8 +63,8 @@ class ContinuousPolicy:
         self.context = context
         self.update_interval = context.update_interval
         options = options or dataclasses.replace(ROBOT_BELIEF, led_from=context.observation_time)
-        self.estimator = OnlineGoalEstimator(context.model, context.start, prior_goal=context.prior_goal,
-                                             prior_std=prior_std, width=context.width, options=options)
+        self.estimator = OnlineGoalEstimator(context.online_model, context.start, prior_goal=context.prior_goal,
+                                             prior_std=prior_std, width=context.online_width, options=options)
         self._next_observation = context.update_interval
 
     def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:

@@ -42,6 +42,10 @@ class PolicyContext:
     """Simulated time of a trial from the start (s): how far rest motions must reach."""
     model: ReachingModel
     """The reaching model the model-based policies use (the Cartesian preset)."""
+    online_model: ReachingModel
+    """The reaching model of the continuous policy's online goal estimator (``SyncSettings.online_preset``)."""
+    online_width: float
+    """The goal width (m) that estimator assumes: ``width`` with the scenario's model, else the online model's own."""
     estimator: GoalEstimator
     """The one-shot goal estimator (built once per scenario)."""
     prior_plan: Plan
