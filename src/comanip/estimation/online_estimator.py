@@ -107,13 +107,14 @@ class OnlineGoalEstimator:
     def _explanations(self, d: int) -> list[Explanation]:
         """The explanations ``options.timing`` names (module docstring)."""
         if self.options.timing == "model":
-            return [ModelAtOwnPace(self.model, self.options, None)]
+            return [ModelAtOwnPace(self.model, self.options)]
         person_pace = ModelAtPersonPace(PacedModel(self.family), self.options)
         people = self.options.people_model or shipped_people_model("arm" if d == 3 else "mouse")
         if d == 3 and people.kind == "mouse":
             raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: fit one "
                              "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
-        return [HandAtRest(), ModelAtOwnPace(self.model, self.options, person_pace), person_pace, RecordedPeople(people)]
+        recorded = RecordedPeople(people)
+        return [HandAtRest(), ModelAtOwnPace(self.model, self.options, (person_pace, recorded)), person_pace, recorded]
 
     def reset(self, start=None) -> None:
         """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:

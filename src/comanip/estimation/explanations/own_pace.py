@@ -16,22 +16,24 @@ goal's covariance is the Laplace approximation with a 1-D quadrature along the r
 still poorly known (:meth:`~comanip.estimation.map_goal.MapProblem.distance_spread`). Axes someone else moves
 (``OnlineOptions.led_axes``) count for less while they move.
 
-It explains the hand while its whitened misfit stays at most ``OnlineOptions.mismatch_threshold`` and the model's
-reach at the person's pace (:mod:`comanip.estimation.explanations.person_pace`) does not contradict its timing;
-once it does not, it stays out for the rest of the reach. Beyond the reach family's distances or a person's hand
+It explains the hand while its whitened misfit stays at most ``OnlineOptions.mismatch_threshold`` and no other
+explanation contradicts it (the model's reach at the person's pace contradicts its timing,
+:mod:`comanip.estimation.explanations.person_pace`; where recorded people stopped contradicts its goal,
+:mod:`comanip.estimation.explanations.people`); once it does not, it stays out for the rest of the reach. Beyond the reach family's distances or a person's hand
 speeds no other explanation does better, so there it explains the hand whatever its misfit.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from typing import Protocol
 
 import numpy as np
 
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
 from comanip.estimation.explanations.base import Explained, HandTrace, Reach, grid_position
-from comanip.estimation.explanations.person_pace import ModelAtPersonPace
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import observation_covariance
@@ -44,17 +46,26 @@ from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
 COVARIANCE_ROUNDS = 3
 
 
+class Contradicting(Protocol):
+    """An explanation that can contradict another's estimate."""
+
+    def contradiction(self, hand: HandTrace, estimate: Explained) -> str | None:
+        """Why ``estimate`` is contradicted by this explanation of the observations so far, or None."""
+
+
 class ModelAtOwnPace:
     """The reaching model at its own pace (module docstring).
 
     Args:
         model: the point-mass model of the reach family.
-        person_pace: the explanation whose settled fit may contradict this one's timing; None: never checked
-            (``OnlineOptions.timing == "model"``: this explanation always explains the hand).
+        options: the estimator's :class:`~comanip.estimation.online_options.OnlineOptions`.
+        contradicted_by: explanations that may contradict this one (each with ``contradiction(hand, estimate)``,
+            a reason or None), asked in order; empty: this explanation always explains the hand
+            (``OnlineOptions.timing == "model"``).
     """
 
-    def __init__(self, model: ReachingModel, options, person_pace: ModelAtPersonPace | None):
-        self.model, self.options, self.person_pace = model, options, person_pace
+    def __init__(self, model: ReachingModel, options, contradicted_by: Sequence[Contradicting] = ()):
+        self.model, self.options, self.contradicted_by = model, options, tuple(contradicted_by)
         n = model.n
         _, A, _ = linearised_step_function(model.body, model.h)(np.zeros(model.state_size), np.zeros(n))
         self._A = np.asarray(A)
@@ -87,12 +98,9 @@ class ModelAtOwnPace:
         self._add(hand)
         estimate, misfit = self._estimate(hand)
         self._last = estimate
-        if self.person_pace is None or misfit is None or not self._humanlike(hand):
+        if not self.contradicted_by or misfit is None or not self._humanlike(hand) or hand.onset() is None:
             return estimate
-        onset = hand.onset()
-        if onset is None:
-            return estimate
-        contradiction = self.person_pace.contradiction(hand, estimate)
+        contradiction = next((why for check in self.contradicted_by if (why := check.contradiction(hand, estimate))), None)
         if misfit <= self.options.mismatch_threshold and contradiction is None:
             return estimate
         self._ruled_out = contradiction or (f"the model at its own pace does not explain the hand (misfit {misfit:.3g} "
