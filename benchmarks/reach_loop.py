@@ -1,0 +1,227 @@
+"""Recorded arm reaches streamed back to back, with rests, through goal estimation with no reset: the robot's loop.
+
+The development trials of a TAT-HUM folder (motion capture, ``../shared/data/arm_reaches/``) are joined into one
+uninterrupted tracker stream: each trial from ``--rest`` s before its onset (its own recorded rest; a trial
+recorded with less is held at its first position before that) to ``--after`` s past its end, moved so that it
+starts where the previous one ended (the hand rests where it stopped, then reaches again in the recorded
+direction). The stream is delivered as a live tracker would (:meth:`TrackedSamples.stream`: ``--rate`` Hz, raw
+positions, backward-difference velocities, lost samples as NaN) to :class:`comanip.ReachStream` (``--preset``)
+and, with ``--node``, replayed in lock step through the ROS 2 goal node (``ros`` extra; every pose estimated).
+
+Printed, for each: the reaches in the stream, found (one start within ``MATCH_BEFORE`` s before the recorded
+onset to half of its movement time; the goal node's first reach begins at the stream's first pose), missed and
+split; the error / D of the goal estimate at 25/50/75/90 % of
+each found reach's movement time (median [IQR] over reaches); the update time (ms) per tenth of the stream and
+while a reach is under way. Outputs in ``--out``: ``reaches.csv`` (one row per reach) and ``summary.md``.
+
+    python benchmarks/reach_loop.py                     # every development trial, the arm preset
+    python benchmarks/reach_loop.py --limit 40 --node   # the first 40 trials, also through the node
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+import comanip
+from comanip.recordings import load_tathum
+from comanip.recordings.motion_capture import TrackedSamples
+
+ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
+FRACTIONS = (0.25, 0.5, 0.75, 0.9)
+MATCH_BEFORE = 0.3
+"""A reach start found up to this long (s) before a recorded onset belongs to that reach."""
+
+
+@dataclass(frozen=True)
+class RecordedReach:
+    """One reach of the stream, on the stream's clock."""
+
+    name: str
+    onset: float
+    """s."""
+    end_time: float
+    """s."""
+    start: np.ndarray
+    """Position at the onset (3,), m."""
+    end: np.ndarray
+    """Endpoint (3,), m."""
+
+    @property
+    def movement_time(self) -> float:
+        return self.end_time - self.onset
+
+
+def joined_stream(trials, rest: float, after: float) -> tuple[TrackedSamples, list[RecordedReach]]:
+    """The trials joined into one tracked stream (module docstring), and its reaches."""
+    times, positions, reaches = [], [], []
+    clock, anchor = 0.0, None
+    for trial in trials:
+        recording = trial.recording()
+        t = trial.t - trial.first_tracked
+        keep = (t >= recording.onset - rest) & (t <= recording.end_time + after)
+        t, position = t[keep], trial.position[keep]
+        first = np.flatnonzero(np.all(np.isfinite(position), axis=1))[0]
+        step = float(np.median(np.diff(t)))
+        held = np.arange(recording.onset - rest, t[0] - 0.5 * step, step)          # rest the recording lacks
+        t, position = np.r_[held, t], np.r_[np.repeat(position[first:first + 1], len(held), axis=0), position]
+        shift = np.zeros(3) if anchor is None else anchor - position[first]
+        begin = t[0]
+        times.append(clock + t - begin)
+        positions.append(position + shift)
+        onset = clock + recording.onset - begin
+        reaches.append(RecordedReach(trial.name, onset, clock + recording.end_time - begin,
+                                     recording.position[np.searchsorted(recording.t, recording.onset)] + shift,
+                                     recording.end + shift))
+        anchor = recording.end + shift
+        clock = times[-1][-1] + step
+    return TrackedSamples("joined", np.concatenate(times), np.concatenate(positions), {}), reaches
+
+
+def matched_starts(starts: list[float], reaches: list[RecordedReach]) -> list[list[int]]:
+    """For each recorded reach, the indices of the found starts that belong to it (module docstring; the goal
+    node begins its first reach at the stream's first pose, which belongs to the first recorded reach)."""
+    return [[i for i, s in enumerate(starts)
+             if (0.0 if j == 0 else r.onset - MATCH_BEFORE) <= s <= r.onset + 0.5 * r.movement_time]
+            for j, r in enumerate(reaches)]
+
+
+def scored(reaches, matches, t, goals, reach_numbers) -> list[dict]:
+    """Per recorded reach: found / missed / split, and the error / D at FRACTIONS of the estimate of the reach
+    found for it (the latest goal at or before each time while that reach was the one under way)."""
+    rows = []
+    for reach, found in zip(reaches, matches):
+        row = {"reach": reach.name, "distance_m": float(np.linalg.norm(reach.end - reach.start)),
+               "movement_time_s": reach.movement_time, "found": len(found)}
+        for f in FRACTIONS:
+            row[f"error_{f:g}"] = np.nan
+            if len(found) != 1:
+                continue
+            seen = np.flatnonzero((t <= reach.onset + f * reach.movement_time) & (reach_numbers == found[0] + 1))
+            if seen.size and np.all(np.isfinite(goals[seen[-1]])):
+                row[f"error_{f:g}"] = float(np.linalg.norm(goals[seen[-1]] - reach.end)) / row["distance_m"]
+        rows.append(row)
+    return rows
+
+
+def through_stream(preset: str, t, position, velocity):
+    """ReachStream over the samples (the model's reach family built first, as at a robot's startup): its reach
+    starts (s, each reach's clock zero), per sample the goal (3,), reach number, moving, and update time (ms)."""
+    model = comanip.presets.load(preset)
+    comanip.OnlineGoalEstimator(model, np.r_[position[0], np.zeros(model.state_size - model.n)])
+    stream = comanip.ReachStream(model)
+    K = len(t)
+    goals, numbers, moving, times = np.full((K, 3), np.nan), np.zeros(K, dtype=int), np.zeros(K, dtype=bool), np.zeros(K)
+    starts = []
+    for k in range(K):
+        begin = time.perf_counter()
+        latest = stream.update(t[k], position[k], velocity[k])
+        times[k] = 1e3 * (time.perf_counter() - begin)
+        if latest.reach > len(starts):
+            starts.append(latest.reach_start)
+        numbers[k], moving[k] = latest.reach, latest.moving
+        if latest.estimate is not None:
+            goals[k] = latest.estimate.goal
+    return starts, goals, numbers, moving, times
+
+
+def through_node(preset: str, rate: float, t, position, velocity):
+    """The samples replayed through the goal node in lock step: its reach starts (s, each reach's clock zero),
+    per sample the latest goal published (3,) and the reach it belongs to, the latencies (ms) the node's
+    status reports and the wall time per pose (ms)."""
+    from comanip.ros.node_settings import NodeSettings
+    from comanip.ros.replay import BASE_STAMP, Replay
+
+    tracked = np.all(np.isfinite(position), axis=1) & np.all(np.isfinite(velocity), axis=1)
+    with Replay(NodeSettings(preset=preset, estimation_rate=2 * rate), None) as replay:
+        recording = replay.run(t[tracked], np.c_[position, velocity][tracked])
+    values = [v for *_, v in recording.statuses if int(v["reach"]) > 0]
+    starts = sorted({float(v["reach_start_stamp_s"]) - BASE_STAMP for v in values})
+    goal_t = np.array([stamp - BASE_STAMP for stamp, *_ in recording.goals])
+    goal = np.array([g for _, g, _, _ in recording.goals])
+    latest = np.searchsorted(goal_t, t + 1e-9, side="right") - 1
+    goals = np.where((latest >= 0)[:, None], goal[np.maximum(latest, 0)], np.nan)
+    numbers = np.searchsorted(starts, goal_t[np.maximum(latest, 0)] + 1e-9, side="right")
+    latency = 1e3 * np.array([float(v["last_latency_s"]) for v in values if v["last_latency_s"] not in (None, "")], dtype=float)
+    latency = latency[np.isfinite(latency)]
+    return starts, goals, numbers, latency, 1e3 * recording.wall_time / tracked.sum()
+
+
+def error_table(label: str, rows) -> str:
+    cells = []
+    for f in FRACTIONS:
+        errors = np.array([row[f"error_{f:g}"] for row in rows], dtype=float)
+        errors = errors[np.isfinite(errors)]
+        cells.append(f"{np.median(errors):.3f} [{np.percentile(errors, 25):.2f}–{np.percentile(errors, 75):.2f}]"
+                     if errors.size else "–")
+    found = [row["found"] for row in rows]
+    return (f"| {label} | {len(rows)} | {found.count(1)} | {found.count(0)} | {sum(1 for n in found if n > 1)} | "
+            + " | ".join(cells) + " |")
+
+
+def time_table(t, times, moving) -> str:
+    lines = ["| part of the stream | updates | median / p95 / largest (ms) | while a reach is under way: median / p95 (ms) |",
+             "|---|---|---|---|"]
+    edges = np.linspace(t[0], t[-1] + 1e-9, 11)
+    parts = [(f"{low:.0f}–{high:.0f} s", (t >= low) & (t < high)) for low, high in zip(edges[:-1], edges[1:])]
+    for label, part in parts + [("all", np.ones(len(t), dtype=bool))]:
+        reach = part & moving
+        during = f"{np.median(times[reach]):.2f} / {np.percentile(times[reach], 95):.2f}" if reach.any() else "–"
+        lines.append(f"| {label} | {part.sum()} | {np.median(times[part]):.2f} / {np.percentile(times[part], 95):.2f} / "
+                     f"{times[part].max():.1f} | {during} |")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--arms", type=Path, default=ARMS, help="a TAT-HUM 3-D data folder (trajectory_data/, trial_data/)")
+    parser.add_argument("--limit", type=int, default=None, help="at most this many trials")
+    parser.add_argument("--rest", type=float, default=0.5, help="rest before each reach's onset (s)")
+    parser.add_argument("--after", type=float, default=0.2, help="time kept after each reach's end (s)")
+    parser.add_argument("--rate", type=float, default=125.0, help="tracker samples per second (Hz)")
+    parser.add_argument("--preset", default="arm")
+    parser.add_argument("--node", action="store_true", help="also replay the stream through the ROS 2 goal node")
+    parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "reach_loop")
+    args = parser.parse_args(argv)
+    if not args.arms.is_dir():
+        sys.exit(f"no arm reaches at {args.arms}: pass --arms FOLDER (a TAT-HUM data_3d folder)")
+    trials = load_tathum(args.arms)[:args.limit]
+    tracked, reaches = joined_stream(trials, args.rest, args.after)
+    t, position, velocity = tracked.stream(rate_hz=args.rate)
+    print(f"{len(reaches)} recorded arm reaches joined into one {t[-1]:.0f} s stream at {args.rate:g} Hz", file=sys.stderr)
+    starts, goals, numbers, moving, times = through_stream(args.preset, t, position, velocity)
+    rows = scored(reaches, matched_starts(starts, reaches), t, goals, numbers)
+    header = ("| through | reaches | found | missed | split | " + " | ".join(f"error / D at {100 * f:g} % of MT" for f in FRACTIONS)
+              + " |\n|---|---|---|---|---|" + "---|" * len(FRACTIONS))
+    lines = [error_table("ReachStream", rows)]
+    node_line = ""
+    if args.node:
+        node_starts, node_goals, node_numbers, latency, per_pose = through_node(args.preset, args.rate, t, position, velocity)
+        node_rows = scored(reaches, matched_starts(node_starts, reaches), t, node_goals, node_numbers)
+        lines.append(error_table("goal node (replay, lock step)", node_rows))
+        node_line = (f"\n\nThe goal node: latency from a pose's arrival to its goal's publication (as its status reports "
+                     f"it) median {np.median(latency):.2f} ms, p95 {np.percentile(latency, 95):.2f} ms; "
+                     f"{per_pose:.2f} ms of wall time per pose in lock step.")
+        for row, node_row in zip(rows, node_rows):
+            row.update({f"node_{k}": v for k, v in node_row.items() if k.startswith(("found", "error"))})
+    summary = (f"{len(reaches)} recorded arm reaches ({args.arms.name}, development split) back to back with "
+               f"{args.rest:g} s of rest, one {t[-1]:.0f} s stream at {args.rate:g} Hz, `{args.preset}` preset, no reset: "
+               f"reaches found, and error / D, median [IQR] over the found reaches\n\n{header}\n" + "\n".join(lines)
+               + node_line + "\n\nReachStream update times over the stream:\n\n" + time_table(t, times, moving))
+    print(summary)
+    args.out.mkdir(parents=True, exist_ok=True)
+    with open(args.out / "reaches.csv", "w", newline="") as stream:
+        writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
+        writer.writeheader()
+        writer.writerows(rows)
+    (args.out / "summary.md").write_text(summary + "\n")
+
+
+if __name__ == "__main__":
+    main()
