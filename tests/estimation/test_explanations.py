@@ -1,15 +1,10 @@
 """The online estimator composed of explanations: the first that explains the hand gives the estimate, a
 user's own explanation plugs in, and the model-timing estimator is the own-pace explanation alone."""
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-import comanip
-from comanip.estimation import OnlineGoalEstimator, OnlineOptions, ReachStream
-from comanip.estimation.online_options import CORRECTING_PERSON
-from comanip.recordings import load_tathum
+from comanip.estimation import OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.explanations import Explained, HandAtRest, HandTrace, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople
 from comanip.optim import Status
 
@@ -83,24 +78,3 @@ def test_the_hand_trace_grows_past_its_first_block():
     np.testing.assert_array_equal(trace.position[:, 0], np.arange(200))
     np.testing.assert_array_equal(trace.last_observation, [199, -199, 1, 2])
 
-
-ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
-
-
-@pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
-def test_where_people_stop_overrules_the_model_at_its_own_pace_on_recorded_arm_reaches():
-    """Recorded arm reaches streamed from rest and segmented as a robot's loop does, estimated under the belief
-    of a person who corrects deviations (broad enough to take an arm's reach for the model's own): at 90 % of
-    the movement the median error is below 0.1 D, because the model of recorded people contradicts the model at
-    its own pace (without that check it is about 0.24 D)."""
-    model = comanip.presets.arm()
-    errors = []
-    for trial in load_tathum(ARMS)[:12]:
-        recording = trial.recording()
-        begin = max(recording.onset - 0.5, 0.0)
-        t, position, velocity = trial.stream(start=begin, stop=recording.end_time)
-        stream = ReachStream(model, options=CORRECTING_PERSON)
-        for k in np.flatnonzero(t <= recording.onset - begin + 0.9 * recording.movement_time):
-            goal = stream.update(t[k], position[k], velocity[k]).estimate
-        errors.append(np.linalg.norm(goal.goal - recording.end) / recording.distance)
-    assert np.median(errors) < 0.1, np.round(errors, 3)

@@ -17,10 +17,9 @@ def checked_model(model) -> ReachingModel | Planner:
 def estimation_planner(model: ReachingModel | Planner) -> Planner:
     """A new planner for ``model`` (a Planner passed in is returned as it is).
 
-    Its terms are compiled to C (``SolverOptions(compile=True)``, cached on disk; a first build costs
-    2–9 s for a point mass): an estimate evaluates them some fifteen times, and compiled they make a warm
-    Cartesian estimate about a third faster (benchmarks/README.md), where the planner's own default
-    leaves point masses uncompiled for sweeps over many models.
+    Its terms are compiled to C (``SolverOptions(compile=True)``, cached on disk, built once per model): an
+    estimate evaluates them many times, so compiled terms make it faster (docs/results/speed.md), where the
+    planner's own default leaves point masses uncompiled for sweeps over many models.
     """
     if isinstance(checked_model(model), Planner):
         return model

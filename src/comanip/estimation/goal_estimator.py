@@ -231,8 +231,8 @@ class GoalEstimator:
         x_obs, _ = task_space_state(self.planner, observed)
 
         def newton(point: RegretPoint):
-            # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest, and a
-            # multi-threaded BLAS on a busy machine was measured 6x slower (threads waiting for cores).
+            # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest; more
+            # threads wait for cores on a busy machine.
             with self._blas.limit(limits=1, user_api="blas"):
                 return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
                                     tolerance=self.options.tolerance, max_iterations=self._max_iterations,

@@ -23,10 +23,10 @@ import numpy as np
 
 from comanip.objectives.reward import goal_covariance
 
-#: Standard deviation (m) of the default, weak prior.
 DEFAULT_PRIOR_STD = 10.0
-#: The ``prior_std`` value that asks for the paper's weighting (W from the goal width).
+"""Standard deviation (m) of the default, weak prior."""
 PAPER_PRIOR = "width"
+"""The ``prior_std`` value that asks for the paper's weighting (W from the goal width)."""
 
 
 def prior_covariance(prior_std, model, width: float) -> np.ndarray:

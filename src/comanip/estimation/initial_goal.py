@@ -22,8 +22,8 @@ from comanip.estimation.observation import prefix_log_likelihoods
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 
-#: Below this speed (m/s) and displacement (m) the observation shows no movement to extrapolate.
 _AT_REST = 1e-6
+"""Below this speed (m/s) and displacement (m) the observation shows no movement to extrapolate."""
 
 
 def task_space_state(planner: Planner, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -28,12 +28,12 @@ from comanip.arguments import as_matrix, as_positive, as_vector
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
 
-#: Default observation-noise floor: standard deviation of a measured position (m or rad) and velocity
-#: (m/s or rad/s). About what motion capture or joint encoders with differentiated velocity deliver.
 OBSERVATION_STD = (1e-3, 1e-2)
+"""Default observation-noise floor: standard deviation of a measured position (m or rad) and velocity (m/s or
+rad/s). About what motion capture or joint encoders with differentiated velocity deliver."""
 
-#: Relative slack on t/h so that times on the grid are not floored one step early by rounding.
 _GRID_SLACK = 1e-9
+"""Relative slack on t/h so that times on the grid are not floored one step early by rounding."""
 
 
 def observation_step(model: ReachingModel, t_obs, *, allow_start: bool = False, name: str = "t_obs") -> int:

@@ -113,8 +113,7 @@ class OnlineGoalEstimator:
         if d == 3 and people.kind == "mouse":
             raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: fit one "
                              "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
-        recorded = RecordedPeople(people)
-        return [HandAtRest(), ModelAtOwnPace(self.model, self.options, (person_pace, recorded)), person_pace, recorded]
+        return [HandAtRest(), ModelAtOwnPace(self.model, self.options, (person_pace,)), person_pace, RecordedPeople(people)]
 
     def reset(self, start=None) -> None:
         """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:

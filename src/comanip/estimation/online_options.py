@@ -60,10 +60,9 @@ class OnlineOptions:
     person's (the sync robot leads z from t_o)."""
     covariance_scale: float = 1.0
     """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
-    is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time it is not: on
-    reaches sampled from that process most ellipsoids are too wide and about a tenth far too narrow (87–88 %
-    pooled coverage of the 95 % ellipsoid at 0.2–0.8 s); the sync robot's belief uses 3
-    (comanip.simulation.policies.continuous.ROBOT_BELIEF; studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot)."""
+    is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time most
+    ellipsoids are too wide and some far too narrow (docs/results/calibration.md); the sync robot's belief
+    uses 3 (comanip.simulation.policies.continuous.ROBOT_BELIEF)."""
 
     timing: str = "estimated"
     """"model": the reach starts at t = 0 and moves at the model's pace (the estimate above, exact for the

@@ -7,7 +7,7 @@ block of the state (q, qdot, and the activation stages, each (n,)) has a mean u 
 Q Sigma_i(D) Q^T, Q an orthogonal map with Q e_1 = u; the torque is u · tau_i(D). So the plans to the goals
 along one axis, at distances D_1 < ... < D_K (m, geometric), give the plan to any goal: the member at
 |g - x_0| (a cubic spline in log D between members), turned onto u. The spline's error against a real plan
-is measured by tests/estimation/test_online_estimator.py (about 1e-5 m in the mean on the Cartesian preset).
+is checked at build time (``ReachFamily.interpolation_error``).
 
 The derivative of the mean with respect to the goal, which the online estimator needs for its Gauss–Newton
 steps, follows from the same form: d(u a)/dg = a'(D) u u^T + (a(D) / D) (I - u u^T).
@@ -31,9 +31,9 @@ from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 from comanip.planning.starts.reach_library import reflection_onto
 
-#: Largest difference (m, m/s, ...) between an oblique plan and the turned member for the model to count as
-#: rotation-invariant: well above the planner's convergence noise, far below any model asymmetry.
 INVARIANCE_TOLERANCE = 1e-5
+"""Largest difference (m, m/s, ...) between an oblique plan and the turned member for the model to count as
+rotation-invariant: well above the planner's convergence noise, far below any model asymmetry."""
 
 
 @dataclass

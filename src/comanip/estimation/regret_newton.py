@@ -11,9 +11,8 @@ attainable J), so the numbers the solver sees lie in about [-1, 0] for every wid
 
 Minimising J over g as well favours goals that are cheap to reach from the observation, not the goal the
 person is heading to: the reward earned near the start and the shorter remaining reach make a nearby goal
-score better. Observing a planar plan at 0.2 s and solving eq. 11 from the true goal puts the estimate at
-0.5–0.85 of the true distance, and sometimes on the start itself; on the Cartesian preset (observed at
-0.165 s) at 0.07–0.16 of it. The plan to the true goal is not even a stationary point: dJ/dg ≠ 0 there.
+score better: eq. 11 solved from the true goal of an observed plan moves the estimate towards the start.
+The plan to the true goal is not even a stationary point: dJ/dg ≠ 0 there.
 
 **Regret.** Subtract what reaching g costs without the observation, V*(g) = min_tau J(tau, g) (the plan):
 
@@ -289,15 +288,16 @@ def _updated_active_set(active, nu, limits, threshold, excluded) -> tuple[np.nda
     return np.r_[active[keep], added].astype(int), np.r_[nu[keep], np.zeros(len(added))]
 
 
-#: A goal step shorter than this fraction of the goal width means the iteration has stalled.
 _SHORTEST_GOAL_STEP = 1e-7
-#: Relative change of the (normalised) regret below which it no longer tells steps apart.
+"""A goal step shorter than this fraction of the goal width means the iteration has stalled."""
 _ROUNDING = 1e-10
-#: Inner steps (approximate Jacobian) tried: 1, 1/2, ..., 1/32, then 1/64 taken untried.
+"""Relative change of the (normalised) regret below which it no longer tells steps apart."""
 _INNER_STEPS = 6
-#: 'solved_acceptable' (approximate Jacobian): plan stationarity, constraint error (state units), goal step (goal widths).
+"""Inner steps (approximate Jacobian) tried: 1, 1/2, ..., 1/32, then 1/64 taken untried."""
 _ACCEPTABLE_GRADIENT, _ACCEPTABLE_CONSTRAINT_ERROR, _ACCEPTABLE_GOAL_STEP = 1e-3, 1e-4, 1e-2
-#: Limits within this distance of binding at the start (rad, rad/s) are held from the first step.
+"""'solved_acceptable' (approximate Jacobian): plan stationarity, constraint error (state units), goal step (goal
+widths)."""
 _INITIAL_MARGIN = 1e-4
-#: A multiplier below -this leaves the active set; at most this many active-set updates per solve.
+"""Limits within this distance of binding at the start (rad, rad/s) are held from the first step."""
 _MULTIPLIER_TOLERANCE, _ACTIVE_SET_ROUNDS = 1e-9, 5
+"""A multiplier below -this leaves the active set; at most this many active-set updates per solve."""

@@ -17,9 +17,8 @@ still poorly known (:meth:`~comanip.estimation.map_goal.MapProblem.distance_spre
 (``OnlineOptions.led_axes``) count for less while they move.
 
 It explains the hand while its whitened misfit stays at most ``OnlineOptions.mismatch_threshold`` and no other
-explanation contradicts it (the model's reach at the person's pace contradicts its timing,
-:mod:`comanip.estimation.explanations.person_pace`; where recorded people stopped contradicts its goal,
-:mod:`comanip.estimation.explanations.people`); once it does not, it stays out for the rest of the reach. Beyond the reach family's distances or a person's hand
+explanation contradicts it (by default the model's reach at the person's pace, where it contradicts its timing:
+:mod:`comanip.estimation.explanations.person_pace`); once it does not, it stays out for the rest of the reach. Beyond the reach family's distances or a person's hand
 speeds no other explanation does better, so there it explains the hand whatever its misfit.
 """
 
@@ -42,8 +41,8 @@ from comanip.model import ReachingModel
 from comanip.optim import Status
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
 
-#: Whitenings rebuilt per update at most (each at the goal the previous round ended at).
 COVARIANCE_ROUNDS = 3
+"""Whitenings rebuilt per update at most (each at the goal the previous round ended at)."""
 
 
 class Contradicting(Protocol):

@@ -4,11 +4,6 @@ the prior and never lies behind a hand that has moved past it."""
 
 from __future__ import annotations
 
-import math
-
-import numpy as np
-from scipy.stats import chi2
-
 from comanip.estimation.explanations.base import Explained, HandTrace, Reach
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.people_model import PeopleModel
@@ -31,16 +26,3 @@ class RecordedPeople:
             return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
         goal, covariance = reach.landed(predicted.goal, predicted.covariance, hand.position[-1])
         return Explained(goal, covariance, True, Status.PEOPLE_MODEL, "the goal is the people model's")
-
-    def contradiction(self, hand: HandTrace, estimate: Explained) -> str | None:
-        """Why ``estimate`` is contradicted by where recorded people stopped, or None: the people model's goal
-        lies outside the 99.9 % region of the difference of the two (their covariances summed)."""
-        people = self.explain(hand, None)
-        if not people.explains:
-            return None
-        difference = people.goal - estimate.goal
-        distance2 = float(difference @ np.linalg.solve(people.covariance + estimate.covariance, difference))
-        if distance2 <= chi2.ppf(0.999, len(difference)):
-            return None
-        return (f"the model at its own pace is contradicted by where recorded people stopped (their goal lies "
-                f"{math.sqrt(distance2):.3g} standard deviations away)")

@@ -18,12 +18,12 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.paced_model import PacedFit, PacedModel
 from comanip.optim import Status
 
-#: A paced fit whose relative std of the goal's distance is at most this pins the goal.
 SETTLED_SPREAD = 0.1
-#: Observations since the onset a paced fit needs to pin the goal.
+"""A paced fit whose relative std of the goal's distance is at most this pins the goal."""
 SETTLED_OBSERVATIONS = 8
-#: |log pace|, and |onset delay| / MT, beyond which a settled paced fit contradicts the model's own timing.
+"""Observations since the onset a paced fit needs to pin the goal."""
 PACE_TOLERANCE = 0.14
+"""|log pace|, and |onset delay| / MT, beyond which a settled paced fit contradicts the model's own timing."""
 
 
 class ModelAtPersonPace:
