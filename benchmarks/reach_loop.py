@@ -6,7 +6,8 @@ recorded with less is held at its first position before that) to ``--after`` s p
 starts where the previous one ended (the hand rests where it stopped, then reaches again in the recorded
 direction). The stream is delivered as a live tracker would (:meth:`TrackedSamples.stream`: ``--rate`` Hz, raw
 positions, backward-difference velocities, lost samples as NaN) to :class:`comanip.ReachStream` (``--preset``)
-and, with ``--node``, replayed in lock step through the ROS 2 goal node (``ros`` extra; every pose estimated).
+and, with ``--node``, replayed in lock step through the ROS 2 goal node (``ros`` extra; every pose estimated);
+with ``--live S``, its first S seconds published in real time to the node running in its own process.
 
 Printed, for each: the reaches in the stream, found (one start within ``MATCH_BEFORE`` s before the recorded
 onset to half of its movement time; the goal node's first reach begins at the stream's first pose), missed and
@@ -16,6 +17,7 @@ while a reach is under way. Outputs in ``--out``: ``reaches.csv`` (one row per r
 
     python benchmarks/reach_loop.py                     # every development trial, the arm preset
     python benchmarks/reach_loop.py --limit 40 --node   # the first 40 trials, also through the node
+    python benchmarks/reach_loop.py --node --live 60     # and live: the first 60 s to the node in its own process
 """
 
 from __future__ import annotations
@@ -153,6 +155,29 @@ def through_node(preset: str, rate: float, t, position, velocity):
     return starts, goals, numbers, latency, 1e3 * recording.wall_time / tracked.sum()
 
 
+def live(preset: str, rate: float, seconds: float, t, position, velocity):
+    """The first ``seconds`` of the stream published in real time to the goal node running in its own process
+    (``python -m comanip ros``, estimating at ``rate`` Hz), as a robot's tracker would: its reach starts (s),
+    per sample the latest goal received (3,) and the reach it belongs to, and the latencies (ms) from publishing
+    a pose to receiving the goal made from it."""
+    sys.path.insert(0, str(Path(__file__).parent))
+    from ros_node_rate import two_processes
+
+    keep = (t <= seconds) & np.all(np.isfinite(position), axis=1) & np.all(np.isfinite(velocity), axis=1)
+    run = two_processes(rate, t[keep], np.c_[position, velocity][keep], goal=position[keep][-1],
+                        parameters={"preset": preset, "person": "recorded"})
+    begin = run["begin"]
+    starts = sorted({float(v["reach_start_stamp_s"]) - begin for v in run["statuses"] if int(v["reach"]) > 0})
+    stamps = sorted(run["goals"])
+    goal_t = np.array(stamps) - begin
+    goal = np.array([run["goals"][s][1] for s in stamps])
+    latest = np.searchsorted(goal_t, t + 1e-9, side="right") - 1
+    goals = np.where(((latest >= 0) & (t <= seconds))[:, None], goal[np.maximum(latest, 0)], np.nan)
+    numbers = np.searchsorted(starts, goal_t[np.maximum(latest, 0)] + 1e-9, side="right")
+    latency = 1e3 * np.array([run["goals"][s][0] - s for s in stamps])
+    return starts, goals, numbers, latency
+
+
 def error_table(label: str, rows) -> str:
     cells = []
     for f in FRACTIONS:
@@ -187,6 +212,9 @@ def main(argv=None):
     parser.add_argument("--rate", type=float, default=125.0, help="tracker samples per second (Hz)")
     parser.add_argument("--preset", default="arm")
     parser.add_argument("--node", action="store_true", help="also replay the stream through the ROS 2 goal node")
+    parser.add_argument("--live", type=float, default=0.0, help="also publish the first LIVE s of the stream in real time "
+                        "to the goal node in its own process (0: not)")
+    parser.add_argument("--live-rate", type=float, default=50.0, help="the live node's estimation_rate (Hz)")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "reach_loop")
     args = parser.parse_args(argv)
     if not args.arms.is_dir():
@@ -210,6 +238,16 @@ def main(argv=None):
                      f"{per_pose:.2f} ms of wall time per pose in lock step.")
         for row, node_row in zip(rows, node_rows):
             row.update({f"node_{k}": v for k, v in node_row.items() if k.startswith(("found", "error"))})
+    if args.live > 0:
+        live_starts, live_goals, live_numbers, latency = live(args.preset, args.live_rate, args.live, t, position, velocity)
+        within = [k for k, r in enumerate(reaches) if r.end_time <= args.live]
+        live_rows = scored([reaches[k] for k in within], matched_starts(live_starts, [reaches[k] for k in within]), t,
+                           live_goals, live_numbers)
+        lines.append(error_table(f"goal node, live: its own process, real time, {args.live_rate:g} Hz, first {args.live:g} s",
+                                 live_rows))
+        node_line += (f"\n\nLive, the node in its own process fed in real time: latency from publishing a pose to receiving "
+                      f"its goal median {np.median(latency[1:]):.1f} ms, p95 {np.percentile(latency[1:], 95):.1f} ms "
+                      f"({len(latency)} goals).")
     summary = (f"{len(reaches)} recorded arm reaches ({args.arms.name}, development split) back to back with "
                f"{args.rest:g} s of rest, one {t[-1]:.0f} s stream at {args.rate:g} Hz, `{args.preset}` preset, no reset: "
                f"reaches found, and error / D, median [IQR] over the found reaches\n\n{header}\n" + "\n".join(lines)

@@ -66,9 +66,11 @@ def replay_once(settings: NodeSettings, transition: TransitionModel, times, stat
 }
 
 
-def two_processes(rate: float, times, states, src: Path | None = None) -> dict:
+def two_processes(rate: float, times, states, src: Path | None = None, goal=GOAL, parameters: dict | None = None) -> dict:
     """Real time with the node in its own process (``python -m comanip ros``) at ``estimation_rate`` rate; ``src``:
-    the checkout's source folder the node imports (None: this environment's)."""
+    the checkout's source folder the node imports (None: this environment's); ``parameters``: further node
+    parameters (name: value). Also returns ``begin`` (the wall time, s, of time 0 of ``times``), ``goals``
+    (pose stamp s -> (wall time received s, goal (3,) m)) and ``statuses`` (every status's values)."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
@@ -77,7 +79,7 @@ def two_processes(rate: float, times, states, src: Path | None = None) -> dict:
     from comanip.ros.messages import seconds, stamp_of, status_values
 
     params = Path(tempfile.mkdtemp()) / "params.yaml"
-    params.write_text(f"estimation_rate: {rate}\n")
+    params.write_text("".join(f"{name}: {value}\n" for name, value in {"estimation_rate": rate, **(parameters or {})}.items()))
     t0 = time.time()
     domain = private_domain()
     env = {**os.environ, "ROS_DOMAIN_ID": str(domain)}
@@ -122,9 +124,10 @@ def two_processes(rate: float, times, states, src: Path | None = None) -> dict:
     delivered = (len(stamps) - 1) / (stamps[-1] - stamps[0])
     return {"build_s": build, "estimates": len(goals), "rate_hz": delivered, "ratio": delivered / rate,
             "skipped": int(last["skipped"]), "cold_ms": 1e3 * latencies[0], "median_ms": 1e3 * np.median(latencies[1:]),
-            "p95_ms": 1e3 * np.percentile(latencies[1:], 95), "goal_error_mm": 1e3 * np.linalg.norm(goals[stamps[-1]][1] - GOAL),
+            "p95_ms": 1e3 * np.percentile(latencies[1:], 95), "goal_error_mm": 1e3 * np.linalg.norm(goals[stamps[-1]][1] - goal),
             "status_rate_hz": float(last.get("achieved_rate_hz", "nan")),
-            "status_latency_ms": 1e3 * float(last.get("latency_median_s", "nan"))}
+            "status_latency_ms": 1e3 * float(last.get("latency_median_s", "nan")), "begin": begin, "goals": goals,
+            "statuses": statuses}
 
 
 def lock_step(times, states, repeats: int, tracker_rate: float) -> str:
@@ -165,7 +168,7 @@ def main(argv=None) -> None:
             for label, src in codes.items():
                 runs[label].append(two_processes(rate, times, states, src))
         for label, results in runs.items():
-            m = {key: float(np.median([r[key] for r in results])) for key in results[0]}
+            m = {key: float(np.median([r[key] for r in results])) for key in results[0] if key not in ("goals", "statuses")}
             print(f"| real time, two processes | {label} | {rate:g} | {m['estimates']:.0f} | {m['rate_hz']:.2f} | {m['ratio']:.3f} "
                   f"| {m['skipped']:.0f} | {m['median_ms']:.1f} | {m['p95_ms']:.1f} | {m['cold_ms']:.0f} "
                   f"| {_optional(m['status_rate_hz'], 2)} | {_optional(m['status_latency_ms'], 1)} "

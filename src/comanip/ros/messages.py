@@ -142,7 +142,8 @@ def status_values(message: DiagnosticArray) -> dict:
 
 
 def status_text(value) -> str:
-    """A status value as the message carries it: floats to 9 digits, booleans as 'true'/'false'."""
+    """A status value as the message carries it: floats exactly (the shortest text that reads back as the same
+    number: a stamp keeps its nanoseconds), booleans as 'true'/'false'."""
     if isinstance(value, float):
-        return "nan" if math.isnan(value) else f"{value:.9g}"
+        return "nan" if math.isnan(value) else repr(value)
     return str(value).lower() if isinstance(value, bool) else str(value)
