@@ -57,6 +57,9 @@ from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
 COLD_SEARCHES = ("ranked", "all")
+LOCAL_OPTIMUM_TOLERANCE = 1e-6
+"""Relative objective difference below which two converged plans of one cold search count as the same local
+optimum (a point-mass reach library keeps one plan per local optimum)."""
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
 full inverse kinematics (:meth:`Planner._goal_joints`): on 30 chained warm ``franka_rest`` goals 22–120 mm from
@@ -204,10 +207,19 @@ class Planner:
         self._start_threads = StartThreads(self._curvature, threads) \
             if threads > 1 and isinstance(self._curvature, LinearisedCurvature) else None
 
-    def _solve_reach(self, start, goal, width) -> np.ndarray:
-        """The torques (H, n) of a cold solve from the minimum-jerk guesses (a point-mass reach library's entry)."""
+    def _solve_reach(self, start, goal, width) -> list[np.ndarray]:
+        """The distinct converged plans (torques (H, n), lowest objective first) of a cold solve from the
+        minimum-jerk guesses: a point-mass reach library's entry. Plans whose objectives agree to
+        ``LOCAL_OPTIMUM_TOLERANCE`` (relative) count as one."""
         params = ReachParameters(start, goal, width)
-        return self._solve_from(self.starts.searched_guesses(params), params, time.perf_counter(), None).torque
+        with self._blas:
+            results = sorted(self._results_from(self.starts.searched_guesses(params), params, np.inf), key=_rank)
+        kept: list[SolverResult] = []
+        for result in results:
+            if result.status in CONVERGED and result.violation <= LIMIT_TOLERANCE and \
+                    all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
+                kept.append(result)
+        return [result.x for result in kept] or [results[0].x]
 
     @property
     def curvature(self) -> Curvature | None:
@@ -353,11 +365,7 @@ class Planner:
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
         # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
         with self._blas:
-            if until_converged or len(guesses) == 1 or self._curvature is None:
-                results = self._solved_in_turn(guesses, params, deadline, until_converged)
-            else:
-                results = [self._finite(result, guess, params) for guess, result in
-                           zip(guesses, self._searched(guesses, params, deadline))]
+            results = self._results_from(guesses, params, deadline, until_converged)
         # The plan within the limits with the lowest objective wins, whatever its status: a start that stalls short
         # of the tolerances can still be far better than one that converged on the zero-reward plateau (seen on the
         # Panda), and the status then says it did not converge.
@@ -367,6 +375,13 @@ class Planner:
                                solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
         plan.goal_sensitivity = self._sensitivity_of(best)
         return plan
+
+    def _results_from(self, guesses, params: ReachParameters, deadline: float, until_converged: bool = False) -> list[SolverResult]:
+        """One result per guess solved (each (H, n)): in turn, or, when every guess is solved, as the cold search
+        :meth:`_searched` runs them (``until_converged``: :meth:`_solve_from`)."""
+        if until_converged or len(guesses) == 1 or self._curvature is None:
+            return self._solved_in_turn(guesses, params, deadline, until_converged)
+        return [self._finite(result, guess, params) for guess, result in zip(guesses, self._searched(guesses, params, deadline))]
 
     def _solved_in_turn(self, guesses, params: ReachParameters, deadline: float, until_converged: bool) -> list[SolverResult]:
         """The guesses' solves one after another, each to convergence, until the deadline has passed (after the

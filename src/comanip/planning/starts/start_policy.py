@@ -175,12 +175,17 @@ class StartPolicy:
             return self.arm_library_starts(params, goal_q)
         if self.library is None:
             return self.searched_guesses(params, goal_q)
-        guesses = self.cold_guesses(params, self.options.n_starts)
-        if self.narrow(params):  # several local optima compete: the full search's starts
-            return guesses
         motion = start.copy()
         motion[: self.model.n] = 0.0
         moving = bool(np.any(motion))
+        narrow = self.narrow(params)
+        if narrow and not moving:  # several local optima compete: the library's, ranked
+            optima = self.library.local_optima(start, goal, width, solve_missing=not budgeted)
+            if optima:
+                return [min(optima, key=lambda candidate: self.objective(candidate, params))]
+        guesses = self.cold_guesses(params, self.options.n_starts)
+        if narrow:  # the full search's starts
+            return guesses
         objectives = [self.objective(guess, params) for guess in guesses]
         first_best = min(range(len(guesses)), key=objectives.__getitem__)
         best_guess = guesses[first_best]
