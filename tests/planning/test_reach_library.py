@@ -36,9 +36,9 @@ def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
         assert fast.success and reference.success
         # as good as the full search (the cold-search rule allows 1e-4 in 2 % of problems; these four are closer)
         assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
-        motion = np.r_[np.zeros(model.n), start[model.n:]]
-        carried_on = np.any(motion) and ranked.starts.stops(model.full_state(motion)).any()
-        if carried_on and ranked.starts.narrow(ReachParameters(start, goal, width)):  # the full search's starts
+        motion = model.full_state(np.r_[np.zeros(model.n), start[model.n:]])
+        params = ReachParameters(model.full_state(start), goal, width)
+        if ranked.starts.stops(motion).any() and ranked.starts.narrow_after_stops(params, motion):  # the full search's starts
             assert fast.iterations == reference.iterations
         else:  # one solve from a near-optimal start, not every guess
             assert fast.iterations < reference.iterations

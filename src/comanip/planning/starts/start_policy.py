@@ -162,7 +162,8 @@ class StartPolicy:
         body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the candidate of lowest
         objective (evaluating one costs about a hundredth of solving from it) among the minimum-jerk guesses and the
         nearest solved reach of the :class:`ReachLibrary` (from a moving start: :meth:`stopped_reaches`). Where
-        several local optima compete (a goal farther than ``narrow_ratio`` widths) a minimum-jerk guess of lowest
+        several local optima compete (a goal farther than ``narrow_ratio`` widths from the start or from where a stop
+        of its motion ends) a minimum-jerk guess of lowest
         objective can end on a worse one: the candidates are then the library's plans near each local optimum
         (:meth:`ReachLibrary.local_optima`, stopped first from a moving start), which lie close to their optima, so
         that their objectives rank them as their solves would end. The full search stays ``cold_search="all"``;
@@ -180,7 +181,7 @@ class StartPolicy:
         motion = start.copy()
         motion[: self.model.n] = 0.0
         moving = bool(np.any(motion))
-        narrow = self.narrow(params)
+        narrow = self.narrow_after_stops(params, motion)
         if moving and narrow and self.stops(motion).any():
             # a hand carried on by its motion: its local optima are not the library's (on planar and Cartesian
             # goals past narrow_ratio widths, ranking these starts ended up to 3 % worse than the full search)
@@ -231,6 +232,14 @@ class StartPolicy:
         back_at_start = reaches_from(np.zeros(n)) if not stops.any(axis=1).all() else None  # one reach for every such stop
         reaches = [reaches_from(stop) if stop.any() else back_at_start for stop in stops]
         return [reach + brake for found, brake in zip(reaches, brakes) for reach in found]
+
+    def narrow_after_stops(self, params: ReachParameters, motion: np.ndarray) -> bool:
+        """:meth:`narrow`, or the goal farther than ``narrow_ratio`` widths from where a stop of the start's motion
+        ends (:meth:`stops`; ``motion`` (nx,): the start with its position zeroed). A point mass's test for
+        competing local optima."""
+        ends = params.start[: self.model.n] + self.stops(motion)
+        return self.narrow(params) or \
+            bool(np.any(np.linalg.norm(params.goal - ends, axis=1) > self.options.narrow_ratio * params.width))
 
     def stops(self, motion: np.ndarray) -> np.ndarray:
         """Where a point mass's stops from a moving start end (``n_starts``, n), relative to its start position (m):
