@@ -6,10 +6,14 @@ Each case builds its solver once (build time reported apart), runs one cold solv
 warm solves with varied goals (cold cases: `repeats` cold solves to new goals). Add a case by adding to
 CASES a key (used by --only) and a function that returns a Case.
 
-``--compare REF``: REF is another checkout (e.g. a worktree at main); every case runs twice in the same run,
-each in its own process, one with this checkout's src/ and one with REF's (same script, same problems), the
-two processes taking turns solve by solve so that both see the same machine load; the two rows are printed
-one under the other ('new' and 'ref').
+``--compare REF``: REF is another checkout (e.g. a worktree at main), or a git revision of this repository
+(checked out into a temporary worktree for the run); every case runs twice in the same run, each in its own
+process, one with this checkout's src/ and one with REF's (same script, same problems), the two processes taking
+turns solve by solve so that both see the same machine load; the two rows are printed one under the other ('new'
+and 'ref'), or with ``--markdown`` side by side in the speed page's table.
+
+The ``*_workspace_*`` cases solve the preset's sampled workspace set (benchmarks/workspace.py) and list their
+slowest solves.
 """
 
 from __future__ import annotations
@@ -52,6 +56,8 @@ class Case:
     build_time: float
     solve: Callable[[int], Timed]
     paper_time: float | None = None
+    size: int | None = None
+    """Problems in the case's set (its solves stop there), None for a case that draws new problems."""
 
 
 def timed(build: Callable[[], object]) -> tuple[object, float]:
@@ -120,7 +126,7 @@ def cold_case(preset: str, paper_time: float | None = None, distances=(0.1, 0.4)
 def workspace_case(preset: str, warm: bool, moving: bool, paper_time: float | None = None,
                    options: SolverOptions | None = None) -> Callable[[], Case]:
     """The preset's sampled workspace set (benchmarks/workspace.py), its problems at rest or (``moving``) from a
-    moving start, in order (solve k is problem k, wrapping around). Cold: a solve to the problem's goal without a
+    moving start, in order (solve k is problem k). Cold: a solve to the problem's goal without a
     warm start, by a long-lived planner: a point mass's planner has solved the whole set once before (untimed), which
     fills its reach library as a planner's first solves do (its entries: a full search each). Warm: the plan to the
     problem's goal (untimed), then the timed solve to its warm goal (up to 5 cm away), warm-started from that plan."""
@@ -146,7 +152,7 @@ def workspace_case(preset: str, warm: bool, moving: bool, paper_time: float | No
             return Timed(plan.solve_time, plan.success, plan.iterations, f"#{k % len(problems)} {problem.describe()}")
 
         kind = ("warm" if warm else "cold") + (", moving start" if moving else ", at rest")
-        return Case(f"{preset} workspace {kind} (H={model.H}, n={model.n})", build, solve, paper_time)
+        return Case(f"{preset} workspace {kind} (H={model.H}, n={model.n})", build, solve, paper_time, len(problems))
 
     return make
 
@@ -321,7 +327,8 @@ SLOWEST = 3
 def measure_case(key: str, repeats: int) -> dict:
     """The case timed in this process (:func:`summary`)."""
     case = CASES[key]()
-    return summary(case.name, case.build_time, case.paper_time, [case.solve(k) for k in range(repeats)])
+    count = repeats if case.size is None else min(repeats, case.size)
+    return summary(case.name, case.build_time, case.paper_time, [case.solve(k) for k in range(count)])
 
 
 def summary(name: str, build_time: float, paper_time: float | None, runs: list[Timed]) -> dict:
@@ -357,7 +364,7 @@ def markdown_table(rows: list[dict], repeats: int) -> str:
     """The README's speed block: one row per case, medians of ``repeats`` solves; then the slowest solves of the
     workspace cases."""
     lines = [f"Measured by `benchmarks/solve_times.py --markdown --repeats {repeats} --only …` (median and p90 of "
-             f"{repeats} solves per case; successes count plans that reach their goal):", "",
+             f"{repeats} solves per case, or of every problem of a workspace set; successes count plans that reach their goal):", "",
              "| case | median | p90 | iterations, median / p90 | succeeded | paper |", "|---|---|---|---|---|---|"]
     for row in rows:
         iterations = "–" if row["iterations"] is None else f"{row['iterations'][0]:.0f} / {row['iterations'][1]:.0f}"
@@ -372,6 +379,44 @@ def markdown_table(rows: list[dict], repeats: int) -> str:
     return "\n".join(lines)
 
 
+def markdown_comparison(pairs: list[tuple[dict, dict]], repeats: int, reference: str) -> str:
+    """The speed page's side-by-side block: per case this code's row and the reference's (:func:`measure_side_by_side`),
+    then the slowest solves of each."""
+    lines = [f"Measured by `benchmarks/solve_times.py --markdown --repeats {repeats} --compare {reference} --only …` "
+             f"(median and p90 of {repeats} solves per case, or of every problem of a workspace set; this code and the code at {reference} in their own "
+             "processes, taking turns solve by solve; successes count plans that reach their goal):", "",
+             "| case | median | p90 | iterations, median / p90 | succeeded | previous median | previous p90 | "
+             "previous iterations | previous succeeded |", "|---|---|---|---|---|---|---|---|---|"]
+
+    def iterations(row):
+        return "–" if row["iterations"] is None else f"{row['iterations'][0]:.0f} / {row['iterations'][1]:.0f}"
+
+    for new, ref in pairs:
+        lines.append(f"| {new['name']} | {_time(new['median_s'])} | {_time(new['p90_s'])} | {iterations(new)} | "
+                     f"{new['ok']}/{new['runs']} | {_time(ref['median_s'])} | {_time(ref['p90_s'])} | {iterations(ref)} | "
+                     f"{ref['ok']}/{ref['runs']} |")
+    lines += ["", f"The {SLOWEST} slowest solves of each case, this code (D: goal distance, w: width, v0: start speed):", ""]
+    for new, _ in pairs:
+        lines.append(f"- {new['name']}: " + "; ".join(f"{_time(seconds)} ({iterations} it, {problem})"
+                                                     for seconds, iterations, problem in new["slowest"]))
+    return "\n".join(lines)
+
+
+def reference_source(compare: str) -> tuple[Path, Callable[[], None]]:
+    """The ``src`` of the checkout to compare with, and how to clean up after: ``compare`` is a checkout's folder,
+    or else a git revision of this repository, checked out into a temporary worktree for the run."""
+    if Path(compare).is_dir():
+        return Path(compare).resolve() / "src", lambda: None
+    import tempfile
+
+    root = Path(__file__).resolve().parents[1]
+    folder = Path(tempfile.mkdtemp(prefix="comanip-reference-")) / "checkout"
+    subprocess.run(["git", "-C", str(root), "worktree", "add", "--detach", str(folder), compare], check=True,
+                   capture_output=True)
+    return folder / "src", lambda: subprocess.run(["git", "-C", str(root), "worktree", "remove", "--force", str(folder)],
+                                                  check=True, capture_output=True)
+
+
 def measure_side_by_side(sources: list[Path], key: str, repeats: int) -> list[dict]:
     """The case timed once per checkout, each in a fresh process importing comanip from its ``src``; the
     processes take turns solve by solve (solve k of every checkout, then solve k + 1)."""
@@ -380,7 +425,7 @@ def measure_side_by_side(sources: list[Path], key: str, repeats: int) -> list[di
                for src in sources]
     heads = [_reply(worker) for worker in workers]  # each has built its case
     runs = [[] for _ in workers]
-    for k in range(repeats):
+    for k in range(repeats if heads[0]["size"] is None else min(repeats, heads[0]["size"])):
         for worker, run in zip(workers, runs):
             worker.stdin.write(f"{k}\n")
             worker.stdin.flush()
@@ -404,7 +449,8 @@ def _reply(worker: subprocess.Popen):
 def serve(key: str) -> None:
     """Build the case, write its name and build time, then time solve k for every k read from stdin."""
     case = CASES[key]()
-    print(json.dumps({"name": case.name, "build_s": case.build_time, "paper_s": case.paper_time}), flush=True)
+    print(json.dumps({"name": case.name, "build_s": case.build_time, "paper_s": case.paper_time, "size": case.size}),
+          flush=True)
     for line in sys.stdin:
         run = case.solve(int(line))
         print(json.dumps([run.seconds, bool(run.success), run.iterations, run.problem]), flush=True)
@@ -414,8 +460,10 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--repeats", type=int, default=50)
     parser.add_argument("--only", default="", help=f"comma-separated case keys to run, of: {', '.join(CASES)}")
-    parser.add_argument("--compare", type=Path, default=None, help="another checkout to time side by side (its src/)")
-    parser.add_argument("--markdown", action="store_true", help="print the README's markdown table instead (no --compare)")
+    parser.add_argument("--compare", default=None,
+                        help="another checkout to time side by side (its src/), or a git revision of this repository")
+    parser.add_argument("--markdown", action="store_true",
+                        help="print the README's markdown table instead (with --compare: the side-by-side table)")
     parser.add_argument("--serve", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     wanted = [w for w in args.only.split(",") if w]
@@ -425,6 +473,18 @@ def main(argv=None) -> None:
     keys = [key for key in CASES if not wanted or key in wanted]
     if args.serve:
         serve(keys[0])
+        return
+    if args.markdown and args.compare is not None:
+        source, clean_up = reference_source(args.compare)
+        try:
+            pairs = []
+            for key in keys:
+                pairs.append(tuple(measure_side_by_side([Path(__file__).resolve().parents[1] / "src", source], key,
+                                                        args.repeats)))
+                print(text_row(pairs[-1][0]), file=sys.stderr, flush=True)   # progress
+        finally:
+            clean_up()
+        print(markdown_comparison(pairs, args.repeats, args.compare).replace("--only …", "--only " + ",".join(keys)))
         return
     if args.markdown:
         rows = []
@@ -440,11 +500,15 @@ def main(argv=None) -> None:
             print("\n".join([text_row(row)] + slowest_lines(row)), flush=True)
         return
     here = Path(__file__).resolve().parents[1] / "src"
+    source, clean_up = reference_source(args.compare)
     print(f"{'code':<5}{HEADER}")
-    for key in keys:
-        rows = measure_side_by_side([here, args.compare.resolve() / "src"], key, args.repeats)
-        for label, row in zip(("new", "ref"), rows):
-            print("\n".join([f"{label:<5}{text_row(row)}"] + slowest_lines(row)), flush=True)
+    try:
+        for key in keys:
+            rows = measure_side_by_side([here, source], key, args.repeats)
+            for label, row in zip(("new", "ref"), rows):
+                print("\n".join([f"{label:<5}{text_row(row)}"] + slowest_lines(row)), flush=True)
+    finally:
+        clean_up()
 
 
 if __name__ == "__main__":
