@@ -107,16 +107,21 @@ class SolverOptions:
     cold_search: str = "ranked"
     """How a cold solve starts. 'all': from each of the ``n_starts`` minimum-jerk guesses, keeping the best
     converged plan. 'ranked': from the lowest-objective start among those guesses and, for a point mass, a solved
-    reach turned to the goal, for an arm at its ready pose, the nearest plans of its reach library
+    reach turned to the goal (past ``narrow_ratio`` widths: the library's plans near each local optimum), for an arm
+    at its ready pose, the nearest plans of its reach library
     (:meth:`StartPolicy.cold_starts <comanip.planning.starts.StartPolicy.cold_starts>`), about as fast as a warm
-    solve, with second solves where local optima compete (point masses) or the guesses as fallbacks (arms). An arm
+    solve, with every guess solved where a moving hand's local optima compete (point masses) or the guesses as
+    fallbacks (arms). An arm
     without a library, or away from its ready pose, runs every guess as 'all' does. benchmarks/cold_quality.py
     compares 'ranked' with 'all' under the cold-search rule (docs/results/speed.md)."""
     narrow_ratio: float = 20.0
-    """Reach distance over goal width beyond which a 'ranked' cold solve solves from every minimum-jerk guess:
-    far, narrow goals of the planar preset have several local optima (the lowest-objective start alone ended 0.7 %
-    worse on 1 of 200 random problems, at 54 widths, and with the best guess beside it 0.12 % worse on another, at
-    31 widths; none below 20 widths on any point-mass preset)."""
+    """Reach distance over goal width beyond which local optima compete in a point mass's 'ranked' cold solve: it
+    starts from the reach library's plans near each of them (:meth:`ReachLibrary.local_optima
+    <comanip.planning.starts.reach_library.ReachLibrary.local_optima>`) instead of the nearest solved reach, or,
+    from a start whose motion carries the hand on, solves from every minimum-jerk guess. The distance counts from
+    the start and from where a stop of its motion ends. Far, narrow goals of the planar preset have several local
+    optima (the lowest-objective minimum-jerk start ended 0.7 % worse on 1 of 200 random problems, at 54 widths;
+    none below 20 widths on any point-mass preset)."""
     far_warm_start: float = 3.0
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it. For

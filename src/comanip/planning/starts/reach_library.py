@@ -12,6 +12,12 @@ D_k/w_0 on a geometric grid), each solved on first use and kept for the planner'
 from the nearest one needs three to four Newton iterations instead of the seven of the best minimum-jerk
 guess (benchmarks/README.md). Deterministic: an entry depends on its grid point only, not on the order of
 the solves that asked for it.
+
+Far, narrow reaches (beyond the planner's ``narrow_ratio`` widths) have several local optima, which differ in the
+step where the hand brakes; which one is lowest changes between grid points. An entry therefore keeps every
+distinct plan its full search converged to, and :meth:`ReachLibrary.local_optima` offers all those of the two
+entries around a goal, each also run a little faster and slower (:func:`at_pace`): near-converged starts whose
+objectives rank them as their solves end.
 """
 
 from __future__ import annotations
