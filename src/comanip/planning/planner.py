@@ -221,7 +221,8 @@ class Planner:
             results = sorted(self._results_from(self.starts.searched_guesses(params), params, np.inf), key=_rank)
         kept: list[SolverResult] = []
         for result in results:
-            if result.status in CONVERGED and result.violation <= LIMIT_TOLERANCE and \
+            within_limits = not result.violation > LIMIT_TOLERANCE  # IPOPT reports no violation (NaN)
+            if result.status in CONVERGED and within_limits and \
                     all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
                 kept.append(result)
         return [result.x for result in kept] or [results[0].x]

@@ -36,8 +36,9 @@ query's width is at most √2 times off its entry's (with one width for all, a 5
 took three times the iterations)."""
 PACES = (0.9, 0.95, 1.0, 1.05, 1.1)
 """Paces at which :meth:`ReachLibrary.local_optima` also runs each entry's plans: the local optima of a far, narrow
-reach differ in the step at which the hand brakes, and the best one's step moves between grid points (on 171 random
-planar goals 20–160 widths away, ranking these starts by objective matched or beat the full search's plan in all)."""
+reach differ in the step at which the hand brakes, and the best one's step moves between grid points (with the
+entries' plans at their own pace only, the ranked start missed the full search's optimum on some planar goals;
+benchmarks/cold_quality.py --workspace checks these paces)."""
 SYMMETRY_TOLERANCE = 1e-9
 """Relative objective difference under a random turn and shift below which a model counts as symmetric."""
 

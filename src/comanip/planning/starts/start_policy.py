@@ -163,10 +163,11 @@ class StartPolicy:
         objective (evaluating one costs about a hundredth of solving from it) among the minimum-jerk guesses and the
         nearest solved reach of the :class:`ReachLibrary` (from a moving start: :meth:`stopped_reaches`). Where
         several local optima compete (a goal farther than ``narrow_ratio`` widths from the start or from where a stop
-        of its motion ends) a minimum-jerk guess of lowest
-        objective can end on a worse one: the candidates are then the library's plans near each local optimum
-        (:meth:`ReachLibrary.local_optima`, stopped first from a moving start), which lie close to their optima, so
-        that their objectives rank them as their solves would end. The full search stays ``cold_search="all"``;
+        of its motion ends) a minimum-jerk guess of lowest objective can end on a worse one: the candidates are then
+        the library's plans near each local optimum (:meth:`ReachLibrary.local_optima`, superposed on a stop from a
+        moving start that its damping stops in place), which lie close to their optima, so that their objectives
+        rank them as their solves would end; from a start whose motion carries the hand on, every minimum-jerk
+        guess. The full search stays ``cold_search="all"``;
         benchmarks/cold_quality.py checks the ranked starts against it under the cold-search rule (within 1e-4 of
         its objective in at least 98 % of random problems, never 1e-3 worse, as many successes).
         A ``budgeted`` solve (max_wall_time given) uses only library reaches solved before: solving a new one is a
@@ -183,8 +184,8 @@ class StartPolicy:
         moving = bool(np.any(motion))
         narrow = self.narrow_after_stops(params, motion)
         if moving and narrow and self.stops(motion).any():
-            # a hand carried on by its motion: its local optima are not the library's (on planar and Cartesian
-            # goals past narrow_ratio widths, ranking these starts ended up to 3 % worse than the full search)
+            # a hand carried on by its motion: its local optima are not the library's (ranked starts built from them
+            # ended above the full search on planar goals: benchmarks/results/solver_speed_runs.md)
             return self.cold_guesses(params, self.options.n_starts)
         if moving:
             candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)
