@@ -3,12 +3,14 @@
     .venv/bin/python benchmarks/cold_quality.py [--problems 200] [--presets planar,cartesian,human,human_cartesian]
                                                 [--compare /path/to/worktree-at-main]
     .venv/bin/python benchmarks/cold_quality.py --presets franka_rest,franka   # the Panda: minutes per problem set
+    .venv/bin/python benchmarks/cold_quality.py --workspace [--presets planar]   # the sampled workspace sets
 
 Problems (the same for both sides, seeded): point masses: goals 0.1–0.4 m from the start in uniformly drawn
 directions, widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per
 axis); arms: from the ready pose, goals 0.15–0.3 m from its hand, widths log-uniform over 2.5–10 cm, every
 tenth start in motion (±0.3 rad/s per joint; the reach library's plans then start with braking moves
-superposed).
+superposed). ``--workspace``: the problems of each preset's sampled workspace set instead (benchmarks/workspace.py:
+point masses' goals 0.05–0.8 m away, starts moving at up to 1 m/s; arms' goals 0.1–0.3 m away; widths 5–50 mm).
 The reference is the code of another checkout (``--compare``: its src/ is imported in a separate process)
 or, without it, this code with ``SolverOptions(cold_search="all")`` (every minimum-jerk guess solved to
 convergence, the best kept). Each side runs in its own process, the presets alternating between them.
@@ -73,8 +75,17 @@ def arm_problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.
     return out
 
 
-def worker(preset: str, count: int, cold_search: str | None, seed: int = 0) -> None:
-    """Solve the preset's problems with the comanip on sys.path; one JSON line per problem on stdout."""
+def workspace_problems(preset: str, count: int) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """(start, goal, width) of the first ``count`` problems of the preset's sampled workspace set."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import workspace
+
+    return [(p.start, p.goal, p.width) for p in workspace.load(preset)[:count]]
+
+
+def worker(preset: str, count: int, cold_search: str | None, seed: int = 0, sampled: bool = False) -> None:
+    """Solve the preset's problems (``sampled``: its workspace set's) with the comanip on sys.path; one JSON line per
+    problem on stdout."""
     import comanip
     from comanip.planning.planner import SolverOptions
 
@@ -84,30 +95,32 @@ def worker(preset: str, count: int, cold_search: str | None, seed: int = 0) -> N
     rest = np.r_[model.body.home_position, np.zeros(model.n)]
     hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     planner.solve(rest, hand + 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
-    for start, goal, width in problems(model, count, seed):
+    for start, goal, width in (workspace_problems(preset, count) if sampled else problems(model, count, seed)):
         plan = planner.solve(start, goal, width)
         print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
                           "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal - hand) / width),
                           "moving": bool(np.any(start[model.n:]))}), flush=True)
 
 
-def run_side(src: Path, cold_search: str | None, preset: str, count: int, seed: int = 0) -> list[dict]:
+def run_side(src: Path, cold_search: str | None, preset: str, count: int, seed: int = 0, sampled: bool = False) -> list[dict]:
     """The worker's rows for one preset, run in a fresh process importing comanip from ``src``."""
     env = {**os.environ, "PYTHONPATH": str(src)}
     command = [sys.executable, __file__, "--worker", preset, "--problems", str(count), "--seed", str(seed)]
     if cold_search:
         command += ["--cold-search", cold_search]
+    if sampled:
+        command += ["--workspace"]
     done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
     return [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
 
 
 HEADER = (f"{'preset':<16} {'start':<7} {'worse':>6} {'better':>7} {'equal':>6} {'ok new':>7} {'ok ref':>7} "
-          f"{'new ms':>8} {'ref ms':>8} {'new p90':>8} {'ref p90':>8} {'new it':>7} {'ref it':>7}")
+          f"{'new ms':>8} {'ref ms':>8} {'new p90':>8} {'ref p90':>8} {'new it':>7} {'ref it':>7} {'new it90':>8} {'ref it90':>8}")
 
 
 def summary(rows: list[dict]) -> list[str]:
     """Table lines: per preset and start (rest, moving, all), the verdict counts, successes, median and p90
-    times and median iterations of both sides."""
+    times and median and p90 iterations of both sides."""
     lines = [HEADER]
     for preset in dict.fromkeys(row["preset"] for row in rows):
         for start, keep in (("rest", False), ("moving", True), ("all", None)):
@@ -115,10 +128,11 @@ def summary(rows: list[dict]) -> list[str]:
             counts = {v: sum(r["verdict"] == v for r in part) for v in ("worse", "better", "equal")}
             t_new, t_ref = (np.array([float(r[key]) for r in part]) for key in ("new_ms", "ref_ms"))
             it_new, it_ref = (np.median([int(r[key]) for r in part]) for key in ("new_iterations", "ref_iterations"))
+            it90_new, it90_ref = (np.percentile([int(r[key]) for r in part], 90) for key in ("new_iterations", "ref_iterations"))
             ok_new, ok_ref = (sum(r[key] for r in part) for key in ("new_success", "ref_success"))
             lines.append(f"{preset:<16} {start:<7} {counts['worse']:>6} {counts['better']:>7} {counts['equal']:>6} {ok_new:>7} {ok_ref:>7} "
                          f"{np.median(t_new):8.2f} {np.median(t_ref):8.2f} {np.percentile(t_new, 90):8.2f} "
-                         f"{np.percentile(t_ref, 90):8.2f} {it_new:7.0f} {it_ref:7.0f}")
+                         f"{np.percentile(t_ref, 90):8.2f} {it_new:7.0f} {it_ref:7.0f} {it90_new:8.0f} {it90_ref:8.0f}")
     return lines
 
 
@@ -157,11 +171,12 @@ def main(argv=None) -> None:
     parser.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "results" / "cold_quality.csv",
                         help="the CSV of every problem's row (default: %(default)s)")
     parser.add_argument("--summarise", type=Path, default=None, help="print the table of a CSV written before, solve nothing")
+    parser.add_argument("--workspace", action="store_true", help="the sampled workspace sets' problems (benchmarks/workspace.py)")
     parser.add_argument("--worker", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--cold-search", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
-        worker(args.worker, args.problems, args.cold_search, args.seed)
+        worker(args.worker, args.problems, args.cold_search, args.seed, args.workspace)
         return
     if args.summarise:
         rows = read_rows(args.summarise)
@@ -173,8 +188,8 @@ def main(argv=None) -> None:
     print(f"reference: {label}; {args.problems} problems per preset; equal = within {RELATIVE:g} relative", flush=True)
     rows = []
     for preset in args.presets.split(","):
-        new = run_side(here, None, preset, args.problems, args.seed)
-        ref = run_side(*reference, preset, args.problems, args.seed)
+        new = run_side(here, None, preset, args.problems, args.seed, args.workspace)
+        ref = run_side(*reference, preset, args.problems, args.seed, args.workspace)
         for k, (a, b) in enumerate(zip(new, ref)):
             relative = (a["objective"] - b["objective"]) / abs(b["objective"])
             verdict = "worse" if relative > RELATIVE else "better" if relative < -RELATIVE else "equal"

@@ -1,11 +1,13 @@
 """Point-mass solves against CasADi + IPOPT on the same problems, with another checkout's code in the same run.
 
-    PYTHONPATH=src .venv/bin/python benchmarks/point_mass_vs_ipopt.py --compare ../main [--presets planar] [--repeats 40]
+    PYTHONPATH=src .venv/bin/python benchmarks/point_mass_vs_ipopt.py --compare ../main [--presets planar] [--repeats 100]
 
-Per preset, two cases: warm (goals drawn uniformly within ±5 cm per axis of 0.3 m along x from the home position,
-each solve warm-started from the same solver's previous plan) and cold (from rest, no warm start, goals 0.1–0.4 m
-away in random directions; the planner fills its reach library as it goes, as in a user's first plans). Both at
-the model's width, the problems seeded (the same for every solver and every checkout).
+Per preset, the problems of its sampled workspace set (benchmarks/workspace.py: goals 0.05–0.8 m away in every
+direction, widths 5–50 mm, half the starts moving at up to 1 m/s), in three cases: warm (each problem's plan to its
+goal, untimed, then the timed solve to its warm goal up to 5 cm away, warm-started from that plan by the same
+solver), cold (the problems at rest, no warm start) and cold_moving (the problems from a moving start). Cold solves
+are a long-lived planner's: each planner has solved the cold problems once before, untimed, which fills its reach
+library as its first solves would. The same problems for every solver and every checkout.
 
 Each checkout runs in its own process (its ``src`` first on PYTHONPATH) holding two planners for the model: the
 structured Newton method, compiled (``SolverOptions(compile=True)``), and the reference, IPOPT on the same
@@ -35,7 +37,10 @@ from pathlib import Path
 
 import numpy as np
 
-CASES = ("warm", "cold")
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import workspace  # noqa: E402  (the sampled problem sets beside this script)
+
+CASES = ("warm", "cold", "cold_moving")
 SOLVERS = ("newton", "ipopt")
 GAP = 1e-8
 """Objective gap (relative) within which two plans count as the same optimum."""
@@ -51,25 +56,21 @@ class Problems:
         model = self.model = comanip.presets.load(preset)
         self.planners = {"newton": comanip.Planner(model, SolverOptions(compile=True)),
                          "ipopt": comanip.Planner(model, SolverOptions(method="ipopt"))}
-        self.start = np.zeros(model.state_size)
-        self.base = np.eye(model.d)[0] * 0.3
-        self.previous = {name: planner.solve(self.start, self.base, model.width) for name, planner in self.planners.items()}
-        for planner in self.planners.values():  # any one-off work of a cold solve, untimed
-            planner.solve(self.start, 0.2 * np.eye(model.d)[1 % model.d], model.width)
-
-    def goal(self, case: str, k: int) -> np.ndarray:
-        rng = np.random.default_rng([0 if case == "warm" else 1, k])
-        if case == "warm":
-            return self.base + rng.uniform(-0.05, 0.05, self.model.d)
-        direction = rng.normal(size=self.model.d)
-        return rng.uniform(0.1, 0.4) * direction / np.linalg.norm(direction)
+        problems = workspace.load(preset)
+        self.problems = {"warm": problems, "cold": [p for p in problems if not p.moving],
+                         "cold_moving": [p for p in problems if p.moving]}
+        for planner in self.planners.values():  # one-off work, and the reach library a long-lived planner has
+            for problem in problems:
+                planner.solve(problem.start, problem.goal, problem.width)
 
     def solve(self, solver: str, case: str, k: int) -> list:
-        """Problem k of the case by the solver ('newton' or 'ipopt'): [seconds, J, success]."""
-        warm = self.previous[solver] if case == "warm" else None
-        plan = self.planners[solver].solve(self.start, self.goal(case, k), self.model.width, warm_start=warm)
+        """Problem k of the case (wrapping around) by the solver ('newton' or 'ipopt'): [seconds, J, success]."""
+        planner, problem = self.planners[solver], self.problems[case][k % len(self.problems[case])]
         if case == "warm":
-            self.previous[solver] = plan
+            first = planner.solve(problem.start, problem.goal, problem.width)
+            plan = planner.solve(problem.start, problem.warm_goal, problem.width, warm_start=first)
+        else:
+            plan = planner.solve(problem.start, problem.goal, problem.width)
         return [plan.solve_time, plan.objective, bool(plan.success)]
 
 
@@ -127,7 +128,7 @@ def rows(preset: str, sources: dict[str, Path], repeats: int, block: int, blas_t
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--presets", default="planar", help="comma-separated point-mass presets (default: %(default)s)")
-    parser.add_argument("--repeats", type=int, default=40, help="problems per case (default: %(default)s)")
+    parser.add_argument("--repeats", type=int, default=100, help="problems per case (default: %(default)s)")
     parser.add_argument("--block", type=int, default=10, help="consecutive problems per solver and turn (default: %(default)s)")
     parser.add_argument("--blas-threads", type=int, default=1, help="OpenBLAS and OpenMP threads of the processes (default: %(default)s)")
     parser.add_argument("--compare", type=Path, default=None, help="another checkout to run side by side (its src/)")

@@ -48,6 +48,9 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
                "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,planar_cold_moving,"
                "cartesian_cold_moving,franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
+    "speed-workspace": ("solve times over the sampled workspace sets, this code beside the code before them, taking turns (about 20 min)",
+                        ["benchmarks/solve_times.py", "--markdown", "--repeats", "100", "--compare", "323f41c", "--only",
+                         "planar_workspace_cold,planar_workspace_cold_moving,planar_workspace_warm,planar_workspace_warm_moving,cartesian_workspace_cold,cartesian_workspace_cold_moving,cartesian_workspace_warm,cartesian_workspace_warm_moving,human_workspace_cold,human_workspace_cold_moving,human_workspace_warm,human_workspace_warm_moving,human_cartesian_workspace_cold,human_cartesian_workspace_cold_moving,human_cartesian_workspace_warm,human_cartesian_workspace_warm_moving,franka_workspace_cold,franka_workspace_cold_moving,franka_workspace_warm,franka_workspace_warm_moving,franka_rest_workspace_cold,franka_rest_workspace_cold_moving,franka_rest_workspace_warm,franka_rest_workspace_warm_moving"]),
     "real-people-development": ("goal prediction on recorded people, development split, 400 movements (about 20 min)",
                                 ["benchmarks/real_people.py", "--markdown", "--limit", "400", "--figure",
                                  "docs/figures/real_people_development.png"]),
@@ -92,6 +95,7 @@ PAGES: dict[str, tuple[Path, ...]] = {
     "policy-people": (RESULTS / "policy_comparison.md",),
     "speed": (RESULTS / "speed.md", ROOT / "benchmarks" / "README.md"),
     "online-estimation-speed": (RESULTS / "speed.md",),
+    "speed-workspace": (RESULTS / "speed.md",),
 }
 
 

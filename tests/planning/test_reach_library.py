@@ -36,10 +36,41 @@ def test_ranked_cold_solve_is_as_good_as_the_full_search(preset, seed):
         assert fast.success and reference.success
         # as good as the full search (the cold-search rule allows 1e-4 in 2 % of problems; these four are closer)
         assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
-        if ranked.starts.narrow(ReachParameters(start, goal, width)):  # local optima compete: the full search's starts
+        motion = model.full_state(np.r_[np.zeros(model.n), start[model.n:]])
+        params = ReachParameters(model.full_state(start), goal, width)
+        if ranked.starts.stops(motion).any() and ranked.starts.narrow_after_stops(params, motion):  # the full search's starts
             assert fast.iterations == reference.iterations
         else:  # one solve from a near-optimal start, not every guess
             assert fast.iterations < reference.iterations
+
+
+@pytest.mark.parametrize("preset, seed", [("planar", 6), ("human", 7)])
+def test_far_narrow_goals_from_rest_start_from_the_library_local_optima(preset, seed):
+    """Past narrow_ratio widths local optima compete (they differ in the step where the hand brakes): the ranked
+    start among the library entries' optima, at several paces, ends as good as the full search or better, in one
+    solve instead of every guess's."""
+    model = comanip.presets.load(preset)
+    ranked, full = comanip.Planner(model), comanip.Planner(model, SolverOptions(cold_search="all"))
+    rng = np.random.default_rng(seed)
+    for _ in range(4):
+        width = float(np.exp(rng.uniform(np.log(0.005), np.log(0.02))))
+        distance = rng.uniform(25, 120) * width
+        direction = rng.normal(size=model.d)
+        start, goal = np.zeros(2 * model.n), distance * direction / np.linalg.norm(direction)
+        assert ranked.starts.narrow(ReachParameters(model.full_state(start), goal, width))
+        fast, reference = ranked.solve(start, goal, width), full.solve(start, goal, width)
+        assert fast.success and reference.success
+        assert (fast.objective - reference.objective) / abs(reference.objective) <= RELATIVE
+        assert fast.iterations < reference.iterations / 2
+
+
+def test_a_reach_at_half_pace_pushes_with_a_quarter_of_the_force_and_at_pace_one_is_unchanged():
+    from comanip.planning.starts.reach_library import at_pace
+
+    torque = np.random.default_rng(8).normal(size=(30, 2))
+    np.testing.assert_array_equal(at_pace(torque, 1.0), torque)
+    slower = at_pace(np.ones((30, 2)), 0.5)  # a constant push run at half speed: a quarter of the force
+    np.testing.assert_allclose(slower, 0.25)
 
 
 def test_library_entries_do_not_depend_on_the_order_of_the_solves():

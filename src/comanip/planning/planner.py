@@ -57,6 +57,9 @@ from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
 COLD_SEARCHES = ("ranked", "all")
+LOCAL_OPTIMUM_TOLERANCE = 1e-6
+"""Relative objective difference below which two converged plans of one cold search count as the same local
+optimum (a point-mass reach library keeps one plan per local optimum)."""
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
 full inverse kinematics (:meth:`Planner._goal_joints`): on 30 chained warm ``franka_rest`` goals 22–120 mm from
@@ -104,16 +107,21 @@ class SolverOptions:
     cold_search: str = "ranked"
     """How a cold solve starts. 'all': from each of the ``n_starts`` minimum-jerk guesses, keeping the best
     converged plan. 'ranked': from the lowest-objective start among those guesses and, for a point mass, a solved
-    reach turned to the goal, for an arm at its ready pose, the nearest plans of its reach library
+    reach turned to the goal (past ``narrow_ratio`` widths: the library's plans near each local optimum), for an arm
+    at its ready pose, the nearest plans of its reach library
     (:meth:`StartPolicy.cold_starts <comanip.planning.starts.StartPolicy.cold_starts>`), about as fast as a warm
-    solve, with second solves where local optima compete (point masses) or the guesses as fallbacks (arms). An arm
+    solve, with every guess solved where a moving hand's local optima compete (point masses) or the guesses as
+    fallbacks (arms). An arm
     without a library, or away from its ready pose, runs every guess as 'all' does. benchmarks/cold_quality.py
     compares 'ranked' with 'all' under the cold-search rule (docs/results/speed.md)."""
     narrow_ratio: float = 20.0
-    """Reach distance over goal width beyond which a 'ranked' cold solve solves from every minimum-jerk guess:
-    far, narrow goals of the planar preset have several local optima (the lowest-objective start alone ended 0.7 %
-    worse on 1 of 200 random problems, at 54 widths, and with the best guess beside it 0.12 % worse on another, at
-    31 widths; none below 20 widths on any point-mass preset)."""
+    """Reach distance over goal width beyond which local optima compete in a point mass's 'ranked' cold solve: it
+    starts from the reach library's plans near each of them (:meth:`ReachLibrary.local_optima
+    <comanip.planning.starts.reach_library.ReachLibrary.local_optima>`) instead of the nearest solved reach, or,
+    from a start whose motion carries the hand on, solves from every minimum-jerk guess. The distance counts from
+    the start and from where a stop of its motion ends. Far, narrow goals of the planar preset have several local
+    optima (the lowest-objective minimum-jerk start ended 0.7 % worse on 1 of 200 random problems, at 54 widths;
+    none below 20 widths on any point-mass preset)."""
     far_warm_start: float = 3.0
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it. For
@@ -204,10 +212,20 @@ class Planner:
         self._start_threads = StartThreads(self._curvature, threads) \
             if threads > 1 and isinstance(self._curvature, LinearisedCurvature) else None
 
-    def _solve_reach(self, start, goal, width) -> np.ndarray:
-        """The torques (H, n) of a cold solve from the minimum-jerk guesses (a point-mass reach library's entry)."""
+    def _solve_reach(self, start, goal, width) -> list[np.ndarray]:
+        """The distinct converged plans (torques (H, n), lowest objective first) of a cold solve from the
+        minimum-jerk guesses: a point-mass reach library's entry. Plans whose objectives agree to
+        ``LOCAL_OPTIMUM_TOLERANCE`` (relative) count as one."""
         params = ReachParameters(start, goal, width)
-        return self._solve_from(self.starts.searched_guesses(params), params, time.perf_counter(), None).torque
+        with self._blas:
+            results = sorted(self._results_from(self.starts.searched_guesses(params), params, np.inf), key=_rank)
+        kept: list[SolverResult] = []
+        for result in results:
+            within_limits = not result.violation > LIMIT_TOLERANCE  # IPOPT reports no violation (NaN)
+            if result.status in CONVERGED and within_limits and \
+                    all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
+                kept.append(result)
+        return [result.x for result in kept] or [results[0].x]
 
     @property
     def curvature(self) -> Curvature | None:
@@ -353,11 +371,7 @@ class Planner:
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
         # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
         with self._blas:
-            if until_converged or len(guesses) == 1 or self._curvature is None:
-                results = self._solved_in_turn(guesses, params, deadline, until_converged)
-            else:
-                results = [self._finite(result, guess, params) for guess, result in
-                           zip(guesses, self._searched(guesses, params, deadline))]
+            results = self._results_from(guesses, params, deadline, until_converged)
         # The plan within the limits with the lowest objective wins, whatever its status: a start that stalls short
         # of the tolerances can still be far better than one that converged on the zero-reward plateau (seen on the
         # Panda), and the status then says it did not converge.
@@ -367,6 +381,13 @@ class Planner:
                                solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
         plan.goal_sensitivity = self._sensitivity_of(best)
         return plan
+
+    def _results_from(self, guesses, params: ReachParameters, deadline: float, until_converged: bool = False) -> list[SolverResult]:
+        """One result per guess solved (each (H, n)): in turn, or, when every guess is solved, as the cold search
+        :meth:`_searched` runs them (``until_converged``: :meth:`_solve_from`)."""
+        if until_converged or len(guesses) == 1 or self._curvature is None:
+            return self._solved_in_turn(guesses, params, deadline, until_converged)
+        return [self._finite(result, guess, params) for guess, result in zip(guesses, self._searched(guesses, params, deadline))]
 
     def _solved_in_turn(self, guesses, params: ReachParameters, deadline: float, until_converged: bool) -> list[SolverResult]:
         """The guesses' solves one after another, each to convergence, until the deadline has passed (after the

@@ -12,6 +12,12 @@ D_k/w_0 on a geometric grid), each solved on first use and kept for the planner'
 from the nearest one needs three to four Newton iterations instead of the seven of the best minimum-jerk
 guess (benchmarks/README.md). Deterministic: an entry depends on its grid point only, not on the order of
 the solves that asked for it.
+
+Far, narrow reaches (beyond the planner's ``narrow_ratio`` widths) have several local optima, which differ in the
+step where the hand brakes; which one is lowest changes between grid points. An entry therefore keeps every
+distinct plan its full search converged to, and :meth:`ReachLibrary.local_optima` offers all those of the two
+entries around a goal, each also run a little faster and slower (:func:`at_pace`): near-converged starts whose
+objectives rank them as their solves end.
 """
 
 from __future__ import annotations
@@ -28,6 +34,11 @@ WIDTH_RATIO = 2.0
 """Ratio of successive entries' widths: the scaling is only nearly exact (the effort does not scale), and a
 query's width is at most √2 times off its entry's (with one width for all, a 5 mm query from a 50 mm entry
 took three times the iterations)."""
+PACES = (0.9, 0.95, 1.0, 1.05, 1.1)
+"""Paces at which :meth:`ReachLibrary.local_optima` also runs each entry's plans: the local optima of a far, narrow
+reach differ in the step at which the hand brakes, and the best one's step moves between grid points (with the
+entries' plans at their own pace only, the ranked start missed the full search's optimum on some planar goals;
+benchmarks/cold_quality.py --workspace checks these paces)."""
 SYMMETRY_TOLERANCE = 1e-9
 """Relative objective difference under a random turn and shift below which a model counts as symmetric."""
 
@@ -42,6 +53,13 @@ def reflection_onto(direction: np.ndarray) -> np.ndarray:
     if norm2 < 1e-24:
         return np.eye(d)
     return np.eye(d) - 2.0 * np.outer(v, v) / norm2
+
+
+def at_pace(torque: np.ndarray, pace: float) -> np.ndarray:
+    """Torques (H, n) of the same reach run ``pace`` times as fast: tau'(t) = pace² tau(pace t), which moves an
+    undamped mass along the same path in 1/pace of the time; interpolated between steps, zero past the horizon."""
+    steps = np.arange(torque.shape[0]) + 0.5
+    return pace**2 * np.stack([np.interp(pace * steps, steps, column, right=0.0) for column in torque.T], axis=1)
 
 
 def is_symmetric(problem: ReachProblem, seed: int = 0) -> bool:
@@ -71,32 +89,59 @@ def is_symmetric(problem: ReachProblem, seed: int = 0) -> bool:
 class ReachLibrary:
     """Rest-to-goal reaches of one symmetric point-mass model, solved on demand (module docstring).
 
+    An entry keeps every distinct plan its cold search converged to, lowest objective first: past
+    ``narrow_ratio`` widths several local optima compete, and which is lowest changes between grid points.
+
     Args:
-        solve: (start (state_size,), goal (n,), width) -> torques (H, n): the planner's cold search.
+        solve: (start (state_size,), goal (n,), width) -> the converged plans (each torques (H, n)) of the
+            planner's cold search, lowest objective first.
         n: dimension of the point mass (= d).
         state_size: length of the model's state (2n plus any activation states).
         width: w_0 (m), the width grid's anchor (the model's default).
     """
 
-    def __init__(self, solve: Callable[[np.ndarray, np.ndarray, float], np.ndarray], n: int, state_size: int, width: float):
+    def __init__(self, solve: Callable[[np.ndarray, np.ndarray, float], list[np.ndarray]], n: int, state_size: int,
+                 width: float):
         self._solve, self.n, self.state_size, self.width = solve, n, state_size, float(width)
-        self._entries: dict[tuple[int, int], np.ndarray] = {}
+        self._entries: dict[tuple[int, int], list[np.ndarray]] = {}
 
     def guess(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> np.ndarray | None:
-        """Torques (H, n) of the nearest entry turned towards goal (n,) and scaled to its distance from the
-        start's position, for the start at rest there (a moving start adds its own correction); None when the
+        """Torques (H, n) of the nearest entry's best plan turned towards goal (n,) and scaled to its distance from
+        the start's position, for the start at rest there (a moving start adds its own correction); None when the
         goal is at the start (or its distance overflows), or when the entry is not solved yet and not ``solve_missing``."""
+        found = self._near_entries(start, goal, width, solve_missing, bracket=False)
+        return found[0] if found else None
+
+    def local_optima(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> list[np.ndarray]:
+        """Every plan of the two entries whose D/w bracket the goal's (at the nearest width), turned and scaled as
+        :meth:`guess` does, each also run at the other :data:`PACES`: torques (H, n) near each local optimum the
+        goal's problem has where several compete. Empty when the goal is at the start, or an entry is not solved
+        yet and not ``solve_missing``."""
+        plans = self._near_entries(start, goal, width, solve_missing, bracket=True)
+        return [plan if pace == 1.0 else at_pace(plan, pace) for plan in plans for pace in PACES]
+
+    def _near_entries(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool,
+                      bracket: bool) -> list[np.ndarray]:
+        """The plans (H, n) of the nearest entry (its best only), or of both bracketing entries (all of them), turned
+        and scaled onto the goal; empty as :meth:`local_optima` says."""
         offset = np.asarray(goal, dtype=float) - start[: self.n]
         with np.errstate(over="ignore"):
             distance = float(np.linalg.norm(offset))
         if not 0.0 < distance < np.inf:  # at the start, or so far that the distance overflows: no entry
-            return None
-        key = (int(np.round(np.log(distance / width) / np.log(GRID_RATIO))),
-               int(np.round(np.log(width / self.width) / np.log(WIDTH_RATIO))))
-        entry_width = WIDTH_RATIO**key[1] * self.width
-        entry_distance = GRID_RATIO**key[0] * entry_width
-        if key not in self._entries:
-            if not solve_missing:
-                return None
-            self._entries[key] = self._solve(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
-        return (distance / entry_distance) * self._entries[key] @ reflection_onto(offset / distance).T
+            return []
+        ratio_index = np.log(distance / width) / np.log(GRID_RATIO)
+        width_index = int(np.round(np.log(width / self.width) / np.log(WIDTH_RATIO)))
+        ratio_indices = sorted({int(np.floor(ratio_index)), int(np.ceil(ratio_index))}) if bracket \
+            else [int(np.round(ratio_index))]
+        turn = reflection_onto(offset / distance).T
+        plans = []
+        for key in ((index, width_index) for index in ratio_indices):
+            entry_width = WIDTH_RATIO**key[1] * self.width
+            entry_distance = GRID_RATIO**key[0] * entry_width
+            if key not in self._entries:
+                if not solve_missing:
+                    return []
+                self._entries[key] = self._solve(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
+            kept = self._entries[key] if bracket else self._entries[key][:1]
+            plans += [(distance / entry_distance) * torque @ turn for torque in kept]
+        return plans

@@ -159,46 +159,59 @@ class StartPolicy:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
         An arm at the ready pose of its reach library: :meth:`arm_library_starts`. 'all', or another nonlinear
-        body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the
-        candidate of lowest objective (evaluating one costs about a hundredth of solving from it) among the
-        minimum-jerk guesses and the nearest solved reach of the :class:`ReachLibrary` (from a moving
-        start: :meth:`stopped_reaches`). Where several local optima compete the lowest-objective start can end on
-        a worse one: a goal farther than ``narrow_ratio`` widths runs every minimum-jerk guess instead, as the full
-        search does. The full search stays ``cold_search="all"``; benchmarks/cold_quality.py checks
-        the ranked starts against it under the cold-search rule (within 1e-4 of its objective in at least 98 % of
-        random problems, never 1e-3 worse, as many successes).
-        A ``budgeted`` solve (max_wall_time given) uses only library reaches solved
-        before: solving a new one is a whole cold search outside the budget (about 0.1 s on the Cartesian preset).
+        body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the candidate of lowest
+        objective (evaluating one costs about a hundredth of solving from it) among the minimum-jerk guesses and the
+        nearest solved reach of the :class:`ReachLibrary` (from a moving start: :meth:`stopped_reaches`). Where
+        several local optima compete (a goal farther than ``narrow_ratio`` widths from the start or from where a stop
+        of its motion ends) a minimum-jerk guess of lowest objective can end on a worse one: the candidates are then
+        the library's plans near each local optimum (:meth:`ReachLibrary.local_optima`, superposed on a stop from a
+        moving start that its damping stops in place), which lie close to their optima, so that their objectives
+        rank them as their solves would end; from a start whose motion carries the hand on, every minimum-jerk
+        guess. The full search stays ``cold_search="all"``;
+        benchmarks/cold_quality.py checks the ranked starts against it under the cold-search rule (within 1e-4 of
+        its objective in at least 98 % of random problems, never 1e-3 worse, as many successes).
+        A ``budgeted`` solve (max_wall_time given) uses only library reaches solved before: solving a new one is a
+        whole cold search outside the budget (about 0.1 s on the Cartesian preset); without them a narrow goal
+        runs every minimum-jerk guess.
         """
         start, goal, width = params.start, params.goal, params.width
         if self.from_arm_library(start):
             return self.arm_library_starts(params, goal_q)
         if self.library is None:
             return self.searched_guesses(params, goal_q)
-        guesses = self.cold_guesses(params, self.options.n_starts)
-        if self.narrow(params):  # several local optima compete: the full search's starts
-            return guesses
         motion = start.copy()
         motion[: self.model.n] = 0.0
         moving = bool(np.any(motion))
-        objectives = [self.objective(guess, params) for guess in guesses]
-        first_best = min(range(len(guesses)), key=objectives.__getitem__)
-        best_guess = guesses[first_best]
+        narrow = self.narrow_after_stops(params, motion)
+        if moving and narrow and self.stops(motion).any():
+            # a hand carried on by its motion: its local optima are not the library's (ranked starts built from them
+            # ended above the full search on planar goals: benchmarks/results/solver_speed_runs.md)
+            return self.cold_guesses(params, self.options.n_starts)
         if moving:
-            candidates = self.stopped_reaches(params, motion, budgeted)
+            candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)
+        elif narrow:
+            candidates = self.library.local_optima(start, goal, width, solve_missing=not budgeted)
         else:
             turned = self.library.guess(start, goal, width, solve_missing=not budgeted)
             candidates = [] if turned is None else [turned]
+        if narrow:
+            return [self.lowest_objective(candidates, params)] if candidates else self.cold_guesses(params, self.options.n_starts)
+        guesses = self.cold_guesses(params, self.options.n_starts)
+        objectives = [self.objective(guess, params) for guess in guesses]
+        first_best = min(range(len(guesses)), key=objectives.__getitem__)
+        best_guess = guesses[first_best]
         if not candidates:  # the goal at the start, or a budgeted solve without the entry: as without a library
             return [best_guess]
         scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
             [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
         return [min(scored, key=lambda pair: pair[0])[1]]
 
-    def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, budgeted: bool = False) -> list[np.ndarray]:
+    def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, budgeted: bool = False,
+                        every_optimum: bool = False) -> list[np.ndarray]:
         """A point mass's starts (H, n) from a moving start: for each minimum-jerk duration T, a stop from the start's
         velocity v0 superposed on the library's reach from where the stop ends to the goal (the mean is affine in the
-        torques and the start, so the sum ends at the goal at rest). A lightly damped hand stops v0·T/2 on, where a
+        torques and the start, so the sum ends at the goal at rest); ``every_optimum``: on each of the library's plans
+        near a local optimum (:meth:`ReachLibrary.local_optima`) instead. A lightly damped hand stops v0·T/2 on, where a
         minimum-jerk stop with a free end comes to rest (the quintic's t⁵ term vanishes); one whose damping alone
         would stop it sooner (D⁻¹ M v0 on) is braked back to its start position, the stop that serves strongly
         damped hands better (benchmarks/cold_quality.py). Stops whose reach the library does not have for a
@@ -206,19 +219,40 @@ class StartPolicy:
         model, start = self.model, params.start
         n = model.n
         durations = guess_durations(model.duration, self.options.n_starts)
+        stops = self.stops(motion)
+        brakes = minimum_jerk_torques(model.body, model.h, model.H, motion, stops[:, None, :], durations, self.linear_dynamics)
+        at_rest = np.zeros(model.state_size - n)
+
+        def reaches_from(stop) -> list[np.ndarray]:
+            stopped = np.r_[start[:n] + stop, at_rest]
+            if every_optimum:
+                return self.library.local_optima(stopped, params.goal, params.width, solve_missing=not budgeted)
+            reach = self.library.guess(stopped, params.goal, params.width, solve_missing=not budgeted)
+            return [] if reach is None else [reach]
+
+        back_at_start = reaches_from(np.zeros(n)) if not stops.any(axis=1).all() else None  # one reach for every such stop
+        reaches = [reaches_from(stop) if stop.any() else back_at_start for stop in stops]
+        return [reach + brake for found, brake in zip(reaches, brakes) for reach in found]
+
+    def narrow_after_stops(self, params: ReachParameters, motion: np.ndarray) -> bool:
+        """:meth:`narrow`, or the goal farther than ``narrow_ratio`` widths from where a stop of the start's motion
+        ends (:meth:`stops`; ``motion`` (nx,): the start with its position zeroed). A point mass's test for
+        competing local optima."""
+        ends = params.start[: self.model.n] + self.stops(motion)
+        return self.narrow(params) or \
+            bool(np.any(np.linalg.norm(params.goal - ends, axis=1) > self.options.narrow_ratio * params.width))
+
+    def stops(self, motion: np.ndarray) -> np.ndarray:
+        """Where a point mass's stops from a moving start end (``n_starts``, n), relative to its start position (m):
+        v0·T/2 on for each minimum-jerk duration T, or zero (back at the start) where its damping alone would stop
+        it sooner (:meth:`stopped_reaches`). ``motion`` (nx,): the start with its position zeroed."""
+        n = self.model.n
+        durations = guess_durations(self.model.duration, self.options.n_starts)
         velocity = motion[n:2 * n]
         stops = 0.5 * durations[:, None] * velocity
         drift = np.inf if self.damped_drift is None else np.linalg.norm(self.damped_drift @ velocity)
         stops[np.linalg.norm(stops, axis=1) > drift] = 0.0
-        brakes = minimum_jerk_torques(model.body, model.h, model.H, motion, stops[:, None, :], durations, self.linear_dynamics)
-        at_rest = np.zeros(model.state_size - n)
-
-        def reach_from(stop):
-            return self.library.guess(np.r_[start[:n] + stop, at_rest], params.goal, params.width, solve_missing=not budgeted)
-
-        back_at_start = reach_from(np.zeros(n)) if not stops.any(axis=1).all() else None  # one reach for every such stop
-        reaches = [reach_from(stop) if stop.any() else back_at_start for stop in stops]
-        return [reach + brake for reach, brake in zip(reaches, brakes) if reach is not None]
+        return stops
 
     def arm_library_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """An arm's cold starts from its ready pose (:mod:`comanip.planning.starts.arm_reach_library`): first the
