@@ -62,9 +62,8 @@ LOCAL_OPTIMUM_TOLERANCE = 1e-6
 optimum (a point-mass reach library keeps one plan per local optimum)."""
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
-full inverse kinematics (:meth:`Planner._goal_joints`): on 30 chained warm ``franka_rest`` goals 22–120 mm from
-the previous plan's final hand position, one step left up to 18 mm, two 0.3 mm, three 1e-4 mm
-(benchmarks/franka_witness_steps.py)."""
+full inverse kinematics (:meth:`Planner._goal_joints`); how close each step lands:
+studies/how_many_steps_does_the_arm_reachability_witness_need/."""
 
 
 @dataclass(frozen=True)
@@ -89,18 +88,13 @@ class SolverOptions:
     ``arm_tolerance`` applies instead, unless it is None."""
     arm_tolerance: float | None = 1e-6
     """The convergence tolerance for nonlinear bodies (None: ``tolerance``). Their approximate Hessian converges
-    linearly, and the iterations from 1e-6 to 1e-8 only polish the gradient: on 16 cold and 16 warm
-    ``franka_rest`` problems, stopping at 1e-6 changed J by at most 1.1e-9 relative and the mean hand paths by at
-    most 0.004 mm, and took a sixth fewer iterations (benchmarks/franka_solver_options.py). 1e-5 saves about as
-    many again on ``franka_rest`` (J within 1e-7), but the paper's ``franka`` plans lie on a flat valley where it
-    stopped one warm plan 2e-3 above the previous solver's J (benchmarks/README.md, "Franka warm solves")."""
+    linearly, and the iterations from 1e-6 to 1e-8 only polish the gradient; a looser tolerance stops the paper's
+    ``franka`` plans early on their flat valley (studies/which_newton_options_suit_the_arm/)."""
     hessian_refresh: int = 3
     """Nonlinear bodies: the approximate Hessian is assembled every this many Newton iterations, and after any step
     the line search shortened or taken with a limit in the working set; in between it is kept with its secant
     corrections updated (:func:`comanip.optim.active_set_newton.newton_minimize`). 1: every iteration. Point masses (exact
-    Hessian) assemble theirs as before whatever this says. On the ``franka_rest`` problems above (tolerance 1e-8),
-    3 took as many iterations as 1 (447 against 454), 62 % of the assemblies and ended at the same plans (J within
-    1.6e-9); at tolerance 1e-6, 2 and 4 were slower than 3 (benchmarks/franka_solver_options.py)."""
+    Hessian) assemble theirs as before whatever this says (the trade: studies/which_newton_options_suit_the_arm/)."""
     n_starts: int = 3
     """Minimum-jerk initial guesses of a cold solve (durations spread over the horizon). A warm-started
     solve uses the warm start only."""
@@ -133,8 +127,8 @@ class SolverOptions:
     abandon_after: int = 100
     """Newton iterations after which a 'ranked' cold search that runs every start (an arm without a reach library, a
     point mass's narrow goal) abandons a start that has not converged, when a start that has converged within the
-    limits by then has a lower objective than it has there. On the Panda long starts crawl along a joint limit and
-    seldom end best (benchmarks/franka_abandon.py); 'all' runs every start to the end."""
+    limits by then has a lower objective than it has there: on the Panda long starts crawl along a joint limit and
+    seldom end best (studies/may_an_arm_cold_search_abandon_long_starts/); 'all' runs every start to the end."""
     threads: int | None = None
     """Threads that solve a nonlinear body's cold starts side by side when every start is solved (an arm without a
     reach library, or ``cold_search="all"``): a Newton iteration on an arm spends most of its time in
