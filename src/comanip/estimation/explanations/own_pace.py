@@ -48,6 +48,9 @@ COVARIANCE_ROUNDS = 3
 class Contradicting(Protocol):
     """An explanation that can contradict another's estimate."""
 
+    def reset(self, reach: Reach) -> None:
+        """Start a new reach."""
+
     def contradiction(self, hand: HandTrace, estimate: Explained) -> str | None:
         """Why ``estimate`` is contradicted by this explanation of the observations so far, or None."""
 
@@ -78,8 +81,11 @@ class ModelAtOwnPace:
         self._deviation_times[np.ix_(led_steps, list(options.led_axes))] = options.led_deviation_time
 
     def reset(self, reach: Reach) -> None:
+        """Start a new reach (the explanations that may contradict this one too)."""
         H, n = self.model.H, self.model.n
         self.reach = reach
+        for check in self.contradicted_by:
+            check.reset(reach)
         self._counts = np.zeros(H + 1)
         self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations
         self._sums = np.zeros((H + 1, 2 * n))
