@@ -63,7 +63,7 @@ def test_background_compile_skips_a_collected_owner_and_builds_for_a_live_one(tm
         function = ca.Function("background_test", [x], [ca.exp(x) * x[0]])
 
     kept, dropped = Owner(), Owner()
-    with compiled_module.COMPILERS.turn:  # as if another build were running: both wait their turn
+    with compiled_module.compilers().turn:  # as if another build were running: both wait their turn
         gone = compile_in_background(dropped, lambda owner: [owner.function])
         built = compile_in_background(kept, lambda owner: [owner.function])
         del dropped  # collected before its turn
@@ -77,11 +77,11 @@ def test_a_compiler_running_at_exit_is_stopped_and_its_scratch_removed(tmp_path)
     scratch = tmp_path / "scratch"
     scratch.mkdir()
     process = subprocess.Popen(["sleep", "60"])
-    compiled_module.COMPILERS.running[process] = str(scratch)
+    compiled_module.compilers().running[process] = str(scratch)
     try:
-        compiled_module.COMPILERS.stop_running()
+        compiled_module.compilers().stop_running()
     finally:
-        compiled_module.COMPILERS.running.pop(process, None)
+        compiled_module.compilers().running.pop(process, None)
     assert process.poll() is not None and not scratch.exists()
 
 

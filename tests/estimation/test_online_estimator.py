@@ -442,8 +442,8 @@ def test_a_batch_of_recordings_gets_the_estimates_of_streaming_them(online, cart
     for k, goal in enumerate(([0.25, 0.1, 0.0], [-0.1, 0.3, 0.1])):
         plan = cartesian_planner.solve(np.zeros(6), goal)
         recordings.append(Recording(f"r{k}", plan.t[:12] + 1.0, plan.mean[:12, :3], plan.mean[:12, 3:], 1.0, 1.6))
-    from comanip.estimation.model_families import DEFAULT_FAMILIES
-    batch = estimate_recordings(online.planner, recordings, cache=DEFAULT_FAMILIES)
+    from comanip.estimation.model_families import default_families
+    batch = estimate_recordings(online.planner, recordings, cache=default_families())
     for recording, estimates in zip(recordings, batch):
         by_hand = fresh(online)
         for k, estimate in enumerate(estimates):

@@ -28,6 +28,7 @@ from itertools import product
 import numpy as np
 from scipy.stats import linregress
 
+from comanip.caching.process_caches import PROCESS_CACHES
 from comanip.analysis.fitts import FittsFit, fit_fitts, trend_fraction
 from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, open_loop_grid
 from comanip.arguments import as_count
@@ -202,8 +203,7 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
             results[task[-1][1]].append(_run_condition(planners, *task))
             bar.update(1)
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn"),
-                                 initializer=_start_worker) as pool:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=get_context("spawn")) as pool:
             futures = {pool.submit(_run_condition_in_worker, *task): task[-1][1] for task in tasks}
             for future in as_completed(futures):
                 results[futures[future]].append(future.result())
@@ -212,19 +212,15 @@ def run_calibration(base: ReachingModel, configurations: list[Configuration], di
     return [measure_grid(results[i], c, c.model(base).goal_covariance) for i, c in enumerate(configurations)]
 
 
-_worker_planners: PlannerCache | None = None
-"""A pool worker's planners, made by :func:`_start_worker` (the pool's initializer); None in other processes."""
-
-
-def _start_worker() -> None:
-    """Give this pool worker its planner cache. It keeps one planner: conditions are submitted configuration
-    by configuration, so a worker reuses it for a run of conditions, and one bounds the memory a worker holds."""
-    global _worker_planners
-    _worker_planners = PlannerCache(size=1)
+def _worker_planners() -> PlannerCache:
+    """A pool worker's planner cache (its process's, :data:`comanip.caching.process_caches.PROCESS_CACHES`). It keeps
+    one planner: conditions are submitted configuration by configuration, so a worker reuses it for a run of
+    conditions, and one bounds the memory a worker holds."""
+    return PROCESS_CACHES.get("calibration planners", lambda: PlannerCache(size=1))
 
 
 def _run_condition_in_worker(*task) -> ReachOutcome:
-    return _run_condition(_worker_planners, *task)
+    return _run_condition(_worker_planners(), *task)
 
 
 def _run_condition(planners: PlannerCache, base_config: dict, configuration: Configuration, distance: float,

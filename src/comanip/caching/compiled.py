@@ -42,6 +42,7 @@ from typing import Callable
 import casadi as ca
 
 from comanip.caching.module_imports import PACKAGE, import_closure, module_files, names_imported_from
+from comanip.caching.process_caches import PROCESS_CACHES
 from comanip.progress import elapsed
 
 COMPILE_FLAGS = ("-O1", "-fPIC", "-shared")
@@ -134,7 +135,7 @@ def compiling_modules(package: Path = PACKAGE) -> set[str]:
             if __name__ in path.read_text() and set(BUILDERS) & names_imported_from(path, __name__)}
 
 
-@functools.cache
+@functools.lru_cache(maxsize=4)
 def _source_fingerprint(package: Path = PACKAGE) -> str:
     """SHA-256 of the source of :func:`compiling_modules` and every module they import in ``package``, and of the
     versions of :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint): editing a
@@ -198,10 +199,20 @@ class Compilers:
             shutil.rmtree(scratch, ignore_errors=True)
 
 
-COMPILERS = Compilers()
-"""This process's compilers (stopped at exit)."""
-atexit.register(COMPILERS.stop_running)
-compile_in_background = COMPILERS.in_background
+def _started_compilers() -> Compilers:
+    made = Compilers()
+    atexit.register(made.stop_running)
+    return made
+
+
+def compilers() -> Compilers:
+    """This process's compilers (:data:`comanip.caching.process_caches.PROCESS_CACHES`; stopped at exit)."""
+    return PROCESS_CACHES.get("compilers", _started_compilers)
+
+
+def compile_in_background(owner: object, functions_of: Callable[[object], list[ca.Function]], tag: str | None = None) -> Future:
+    """:meth:`Compilers.in_background` of this process's compilers."""
+    return compilers().in_background(owner, functions_of, tag)
 
 
 def _build(source: str, compiler: list[str], library: Path) -> None:
@@ -213,11 +224,11 @@ def _build(source: str, compiler: list[str], library: Path) -> None:
         built = Path(scratch) / library.name
         process = subprocess.Popen([*compiler, *COMPILE_FLAGS, str(c_file), "-o", str(built), "-lm"],
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-        COMPILERS.running[process] = scratch
+        compilers().running[process] = scratch
         try:
             output, errors = process.communicate()
         finally:
-            COMPILERS.running.pop(process, None)
+            compilers().running.pop(process, None)
         if process.returncode != 0:
             raise subprocess.CalledProcessError(process.returncode, process.args, output, errors)
         os.replace(built, library)

@@ -51,6 +51,7 @@ from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
+from comanip.caching.process_caches import PROCESS_CACHES
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import GoalPrior, prior_covariance
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
@@ -364,8 +365,10 @@ class EstimatorCache(ModelCache[GoalEstimator]):
         return self.get(checked_model(model))
 
 
-DEFAULT_CACHE = EstimatorCache()
-"""The cache :func:`estimate_goal` and :func:`comanip.goal_posterior` use when given none."""
+def default_estimators() -> EstimatorCache:
+    """The estimator cache of this process (:data:`comanip.caching.process_caches.PROCESS_CACHES`), which
+    :func:`estimate_goal` and :func:`comanip.goal_posterior` use when given none."""
+    return PROCESS_CACHES.get("goal estimators", EstimatorCache)
 
 
 def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observed, t_obs, prior_goal=None,
@@ -373,10 +376,10 @@ def estimate_goal(model: ReachingModel | Planner | GoalEstimator, start, observe
     """Estimate a reach's goal from a state observed at t_obs; see :meth:`GoalEstimator.estimate`.
 
     ``model`` may be a ReachingModel or a Planner (its estimator is built on first use and kept in
-    ``cache``, :data:`DEFAULT_CACHE` when None), or a GoalEstimator. ``options`` go to
+    ``cache``, :func:`default_estimators` when None), or a GoalEstimator. ``options`` go to
     :meth:`GoalEstimator.estimate` (method, warm_start, max_wall_time).
     """
-    estimator = (cache or DEFAULT_CACHE).estimator(model)
+    estimator = (cache or default_estimators()).estimator(model)
     return estimator.estimate(start, observed, t_obs, prior_goal, width, **options)
 
 

@@ -26,7 +26,7 @@ import numpy as np
 from scipy.special import logsumexp
 
 from comanip.arguments import as_matrix, as_optional_positive
-from comanip.estimation.goal_estimator import DEFAULT_CACHE, EstimatorCache
+from comanip.estimation.goal_estimator import EstimatorCache, default_estimators
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observed_sequence, prefix_log_likelihoods
 from comanip.optim import Status
 from comanip.planning.plan import Plan
@@ -114,12 +114,12 @@ def goal_posterior(model, start, observed_states, times, candidate_goals, width:
             (a new observation costs no solve); otherwise they warm-start the new plans.
         max_wall_time: planning budget (s) per candidate; a late plan is used as it stands.
         cache: where the planner is kept between calls; None: the package's default cache
-            (:data:`comanip.estimation.goal_estimator.DEFAULT_CACHE`).
+            (:func:`comanip.estimation.goal_estimator.default_estimators`).
 
     Returns:
         A :class:`GoalPosterior`; ``probabilities[k]`` is the posterior after observations 0..k.
     """
-    estimator = (cache or DEFAULT_CACHE).estimator(model)
+    estimator = (cache or default_estimators()).estimator(model)
     planner, model = estimator.planner, estimator.model
     t_begin = time.perf_counter()
     start, _, width = planner.check_inputs(start, np.zeros(model.d), width)

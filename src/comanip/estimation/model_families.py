@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from comanip.caching.model_cache import ModelCache
+from comanip.caching.process_caches import PROCESS_CACHES
 from comanip.estimation.estimation_planner import checked_model, estimation_planner
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.reach_family import ReachFamily
@@ -38,5 +39,7 @@ class FamilyCache(ModelCache[ModelFamilies]):
         return self.get(checked_model(model))
 
 
-DEFAULT_FAMILIES = FamilyCache()
-"""The cache :class:`OnlineGoalEstimator` uses when given none."""
+def default_families() -> FamilyCache:
+    """The reach-family cache of this process (:data:`comanip.caching.process_caches.PROCESS_CACHES`), which an
+    online estimator given none uses."""
+    return PROCESS_CACHES.get("reach families", FamilyCache)

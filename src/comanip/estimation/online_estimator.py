@@ -47,7 +47,7 @@ from comanip.estimation.explanations.base import grid_position
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.hand_rest import lost_sample
-from comanip.estimation.model_families import DEFAULT_FAMILIES, FamilyCache
+from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.people_model import shipped_people_model
@@ -72,8 +72,9 @@ class OnlineGoalEstimator:
             or "width" (the paper's W from the width); :mod:`comanip.estimation.goal_prior`.
         width: goal width w (m); the model's default when None.
         options: :class:`~comanip.estimation.online_options.OnlineOptions`.
-        cache: where the model's reach family is kept (:data:`~comanip.estimation.model_families.DEFAULT_FAMILIES`
-            when None). Building it takes a second or so once per model and width, in the constructor.
+        cache: where the model's reach family is kept (the process's,
+            :func:`~comanip.estimation.model_families.default_families`, when None). Building it takes a second
+            or so once per model and width, in the constructor.
         explanations: the explanations asked in order (module docstring); None: those ``options.timing`` names.
     """
 
@@ -88,7 +89,7 @@ class OnlineGoalEstimator:
         if not body.is_linear:
             raise ValueError(f"OnlineGoalEstimator needs a point-mass model (linear dynamics), got the {body.name!r} body; "
                              "use comanip.estimate_goal for arms")
-        families = (cache or DEFAULT_FAMILIES).families(model)
+        families = (cache or default_families()).families(model)
         self.planner = families.planner
         self.model = model = self.planner.model
         n, d = model.n, model.d

@@ -40,6 +40,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
+from comanip.caching.process_caches import PROCESS_CACHES
 from comanip.estimation.endpoint_baselines import MOVING_SPEED, EndpointPrediction
 from comanip.estimation.hand_rest import has_left, resting_position
 from comanip.estimation.profile_fit import onset_index
@@ -282,7 +283,9 @@ def _samples(recordings):
 
 
 def shipped_people_model(kind: str = "mouse") -> PeopleModel:
-    """The model of ``kind`` (a key of :data:`KINDS`) fitted to recorded people that ships with comanip."""
+    """The model of ``kind`` (a key of :data:`KINDS`) fitted to recorded people that ships with comanip, read once
+    per process (:data:`comanip.caching.process_caches.PROCESS_CACHES`)."""
     if kind not in KINDS:
         raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
-    return PeopleModel.load(resources.files("comanip") / "data" / f"people_endpoint_{kind}.npz")
+    return PROCESS_CACHES.get(f"{kind} people model", lambda: PeopleModel.load(resources.files("comanip") / "data" /
+                                                                              f"people_endpoint_{kind}.npz"))

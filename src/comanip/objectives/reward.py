@@ -133,7 +133,7 @@ class GoalReward:
         return (2 * np.pi * goal_variance(float(width), self.goal_covariance_form, self.effective_k)) ** (-self.d / 2)
 
 
-@lru_cache(maxsize=None)
+@lru_cache(maxsize=8)
 def _hit_function(d: int) -> ca.Function:
     """``(e (d,), Sigma_x (d, d), w) -> E[K]`` of the flat-topped hit kernel (module docstring)."""
     m = HIT_KERNEL_ORDER
