@@ -9,8 +9,8 @@ order and takes the first that explains the hand (:mod:`comanip.estimation.onlin
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Protocol
+from dataclasses import dataclass, replace
+from typing import NamedTuple, Protocol
 
 import numpy as np
 
@@ -101,18 +101,20 @@ class Reach:
                                    mixed=np.zeros((H + 1, nx // model.n)))
         return self.family.prediction(self.start_position, goal, order=order, covariance=covariance)
 
-    def landed(self, goal: np.ndarray, covariance: np.ndarray, hand: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """A goal (d,) m with covariance (d, d) m² fitted to the hand's movement, as an estimate: moved along the
-        line from the start through it up to the ``hand``'s projection on that line when the hand is farther
-        along (a hand that has moved on is not heading for a goal behind it), and combined with the prior."""
+    def landed(self, fitted: "Explained", hand: np.ndarray) -> "Explained":
+        """``fitted``, a goal and covariance fitted to the hand's movement, as an estimate: its goal moved along the
+        line from the start through it up to the ``hand``'s (d,) m projection on that line when the hand is
+        farther along (a hand that has moved on is not heading for a goal behind it), and combined with the
+        prior."""
+        goal, covariance = fitted.goal, fitted.covariance
         offset = goal - self.start_position
         distance = float(np.linalg.norm(offset))
         if distance > 0:
             along = float((hand - self.start_position) @ offset) / distance
             goal = goal + max(along - distance, 0.0) * offset / distance
-        precision = np.linalg.inv(covariance) + self.prior_precision
-        combined = np.linalg.inv(precision)
-        return combined @ (np.linalg.solve(covariance, goal) + self.prior_precision @ self.prior_mean), combined
+        combined = np.linalg.inv(np.linalg.inv(covariance) + self.prior_precision)
+        goal = combined @ (np.linalg.solve(covariance, goal) + self.prior_precision @ self.prior_mean)
+        return replace(fitted, goal=goal, covariance=combined)
 
 
 @dataclass(frozen=True)
@@ -131,6 +133,8 @@ class Explained:
     """What it found: why it explains the hand, or why not."""
     iterations: int = 0
     """Newton iterations spent."""
+    misfit: float | None = None
+    """How far the hand is from this explanation, in its own measure (None: not measured)."""
 
 
 class Explanation(Protocol):
@@ -144,9 +148,17 @@ class Explanation(Protocol):
         estimate (None before the first)."""
 
 
-def grid_position(time_s: float, h: float, H: int) -> tuple[int, float]:
-    """Where time_s (s, ≥ 0) falls on the grid of step h (s): the step i ≤ H at or before it and the fraction
-    of a step (in [0, 1]) it lies after t_i; times at or after the horizon H·h read as (H, 0)."""
+class GridPosition(NamedTuple):
+    """Where a time falls on the planning grid."""
+
+    step: int
+    """The step i ≤ H at or before it."""
+    fraction: float
+    """The fraction of a step (in [0, 1]) it lies after t_i."""
+
+
+def grid_position(time_s: float, h: float, H: int) -> GridPosition:
+    """Where time_s (s, ≥ 0) falls on the grid of step h (s); times at or after the horizon H·h read as (H, 0)."""
     grid = time_s / h
     before = min(H, int(math.floor(grid * (1 + 1e-9))))
-    return before, (0.0 if before == H else min(max(grid - before, 0.0), 1.0))
+    return GridPosition(before, 0.0 if before == H else min(max(grid - before, 0.0), 1.0))

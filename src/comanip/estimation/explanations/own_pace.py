@@ -25,6 +25,7 @@ speeds no other explanation does better, so there it explains the hand whatever 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from collections.abc import Sequence
 from typing import Protocol
 
@@ -101,7 +102,8 @@ class ModelAtOwnPace:
         if self._ruled_out is not None:
             return Explained(self.reach.prior_mean, self.reach.prior_cov, False, Status.FAILED, self._ruled_out)
         self._add(hand)
-        estimate, misfit = self._estimate(hand)
+        estimate = self._estimate(hand)
+        misfit = estimate.misfit
         self._last = estimate
         if not self.contradicted_by or misfit is None or not self._humanlike(hand) or hand.onset() is None:
             return estimate
@@ -110,7 +112,7 @@ class ModelAtOwnPace:
             return estimate
         self._ruled_out = contradiction or (f"the model at its own pace does not explain the hand (misfit {misfit:.3g} "
                                             "per observed number)")
-        return Explained(estimate.goal, estimate.covariance, False, estimate.status, self._ruled_out)
+        return replace(estimate, explains=False, message=self._ruled_out)
 
     def _add(self, hand: HandTrace) -> None:
         """Average the observations not yet added into their grid steps."""
@@ -133,8 +135,8 @@ class ModelAtOwnPace:
         return bool(np.sqrt((offset * offset).sum(axis=1)).max() <= self.reach.family.distances[-1]
                     and np.sqrt((velocity * velocity).sum(axis=1)).max() <= MAX_HUMAN_HAND_SPEED_M_S)
 
-    def _estimate(self, hand: HandTrace) -> tuple[Explained, float | None]:
-        """The MAP estimate (module docstring) and its misfit (mean squared whitened residual per observed
+    def _estimate(self, hand: HandTrace) -> Explained:
+        """The MAP estimate (module docstring) with its misfit (mean squared whitened residual per observed
         number; None when nothing was fitted or the timing is the model's)."""
         reach, options = self.reach, self.options
         steps = np.flatnonzero(self._counts)
@@ -148,7 +150,7 @@ class ModelAtOwnPace:
                 goal = problem.cold_goal(hand.last_observation, options.observation_std, self._R[None] / counts[:, None, None])
                 if goal is None:
                     return Explained(reach.prior_mean, reach.prior_cov, True, Status.UNINFORMATIVE,
-                                     "no observation shows movement: the estimate is the prior"), None
+                                     "no observation shows movement: the estimate is the prior")
             else:
                 goal = previous.goal
             iterations = 0
@@ -168,8 +170,8 @@ class ModelAtOwnPace:
             self._whitening = None
             goal, covariance = (reach.prior_mean, reach.prior_cov) if previous is None else (previous.goal, previous.covariance)
             return Explained(goal, covariance, True, Status.FAILED, f"the Newton iteration failed ({error}); "
-                             "the previous estimate is kept"), math.inf
-        return Explained(goal, 0.5 * (covariance + covariance.T), True, solved.status, solved.message, iterations), misfit
+                             "the previous estimate is kept", misfit=math.inf)
+        return Explained(goal, 0.5 * (covariance + covariance.T), True, solved.status, solved.message, iterations, misfit)
 
     def _stale(self, goal: np.ndarray, observations: int) -> bool:
         """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance, or

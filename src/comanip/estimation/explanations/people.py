@@ -24,5 +24,5 @@ class RecordedPeople:
         predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
         if predicted is None:
             return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
-        goal, covariance = reach.landed(predicted.goal, predicted.covariance, hand.position[-1])
-        return Explained(goal, covariance, True, Status.PEOPLE_MODEL, "the goal is the people model's")
+        return reach.landed(Explained(predicted.goal, predicted.covariance, True, Status.PEOPLE_MODEL,
+                                      "the goal is the people model's"), hand.position[-1])

@@ -63,11 +63,11 @@ class ModelAtPersonPace:
         fitted = self.fit(hand, None if latest is None else latest.goal)
         if fitted.misfit > self.options.paced_threshold or not self.settled(fitted):
             return Explained(fitted.goal, fitted.covariance, False, Status.FAILED,
-                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})")
+                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})", misfit=fitted.misfit)
         landing = reach.prediction(fitted.goal, order=0).cov[-1, :reach.model.n, :reach.model.n]
-        goal, covariance = reach.landed(fitted.goal, fitted.covariance + landing, hand.position[-1])
-        return Explained(goal, covariance, True, Status.SOLVED, f"the model's reach at the person's pace "
-                         f"(×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does")
+        return reach.landed(Explained(fitted.goal, fitted.covariance + landing, True, Status.SOLVED, "the model's reach "
+                                      f"at the person's pace (×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does",
+                                      misfit=fitted.misfit), hand.position[-1])
 
     def settled(self, fitted: PacedFit) -> bool:
         """Whether a paced fit pins the goal's distance: its relative std along the reach at most
