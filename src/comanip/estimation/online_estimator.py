@@ -132,7 +132,7 @@ class OnlineGoalEstimator:
         self.start = start
         self.start_position = start[:n].copy()
         self.prior_mean = self.start_position.copy() if self.prior_goal is None else self.prior_goal
-        self.reach = Reach(self.family, start, self.prior_mean, self.prior_cov, self.options)
+        self.reach = Reach(self.family, start, self.prior_mean, self.prior_cov)
         for explanation in self.explanations:
             explanation.reset(self.reach)
         self._hand = HandTrace(model.d)

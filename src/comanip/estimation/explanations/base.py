@@ -17,7 +17,6 @@ import numpy as np
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_rest import has_left
-from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.optim import Status
@@ -31,6 +30,7 @@ class HandTrace:
         self.count = 0
         """Observations so far."""
         self.d = d
+        self._onset: tuple[int, float | None] = (0, None)    # (count, onset) of the last onset found
 
     def append(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
         if self.count == len(self._rows):
@@ -63,8 +63,10 @@ class HandTrace:
 
     def onset(self) -> float | None:
         """The first time (s) the hand's speed exceeds :data:`~comanip.estimation.endpoint_baselines.MOVING_SPEED`, or None."""
-        velocity = self.velocity
-        return detected_onset(self.t, np.sqrt((velocity * velocity).sum(axis=1)), MOVING_SPEED)
+        if self._onset[0] != self.count:
+            velocity = self.velocity
+            self._onset = (self.count, detected_onset(self.t, np.sqrt((velocity * velocity).sum(axis=1)), MOVING_SPEED))
+        return self._onset[1]
 
     def has_left(self, start_position: np.ndarray) -> bool:
         """Whether the hand has left its start (:func:`comanip.estimation.hand_rest.has_left`)."""
@@ -78,12 +80,10 @@ class Reach:
         family: the model's reach family for the goal width.
         start: the state at the start (nx,), at rest.
         prior_mean: g_bar (d,) m; prior_cov: P0 (d, d) m².
-        options: the estimator's options.
     """
 
-    def __init__(self, family: ReachFamily, start: np.ndarray, prior_mean: np.ndarray, prior_cov: np.ndarray,
-                 options: OnlineOptions):
-        self.family, self.model, self.options = family, family.model, options
+    def __init__(self, family: ReachFamily, start: np.ndarray, prior_mean: np.ndarray, prior_cov: np.ndarray):
+        self.family, self.model = family, family.model
         self.start = start
         self.start_position = start[:family.model.n].copy()
         self.prior_mean, self.prior_cov = prior_mean, prior_cov
