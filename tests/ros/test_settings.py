@@ -19,6 +19,7 @@ from comanip.ros.node_settings import NodeSettings
     ({"hand_pose_topic": ""}, "hand_pose_topic must be a non-empty string"),
     ({"equilibrium_orientation": [1, 1, 0, 0]}, "equilibrium_orientation must be a unit quaternion"),
     ({"estimation_rat": 3}, "unknown parameter(s) ['estimation_rat']"),
+    ({"person": "mouse"}, "person must be one of ('recorded', 'correcting'), got 'mouse'"),
 ])
 def test_a_bad_setting_is_a_value_error_naming_it(values, message):
     with pytest.raises(ValueError) as error:
