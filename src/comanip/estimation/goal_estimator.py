@@ -59,6 +59,7 @@ from comanip.estimation.regret_newton import newton_solve
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.estimation_planner import checked_model, estimation_planner
 from comanip.model import ReachingModel
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import CONVERGED, Status
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
@@ -257,7 +258,7 @@ class GoalEstimator:
         plan = self.planner.solve(start, prior.mean, width, warm_start=warm_start, max_wall_time=max_wall_time)
         message = (f"the observation at t_obs = {t_obs:g} s falls on step 0, the start itself, and says nothing about the goal: "
                    f"the estimate is the prior goal and the trajectory its plan (plan status '{plan.status}')")
-        plan = replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
+        plan = replace(plan, success=False, status=EstimateStatus.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
         return GoalEstimate.of(plan, t_obs=t_obs, observed_step=0, observed_state=observed,
                                observation_residual=plan.mean[0] - observed, prior_goal=prior.mean, method=method,
                                plan_status=plan.status, goal_covariance=prior.covariance.copy())

@@ -2,11 +2,9 @@
 
     min f(x)  subject to  lb ≤ x ≤ ub  and  c(x) ≤ 0.
 
-The planner's problem has a few hundred unknowns, a dense Hessian that is cheap to assemble from per-step
-pieces (:mod:`comanip.planning.curvature`), and constraints (torque bounds, joint limits on the mean path)
-that bind at a handful of steps at most. A general NLP solver spends more per iteration on its own
-machinery than the Hessian costs (IPOPT with MUMPS: about 1 ms per iteration for 150 unknowns), so the
-iteration is written out here:
+It is meant for problems with a few hundred unknowns, a dense Hessian that is cheap to assemble, and
+constraints that bind at a handful of rows at most, where a general NLP solver spends more per iteration on its
+own machinery than the Hessian costs; so the iteration is written out here:
 
 Solver quantities are named as in ``docs/notation.md``: ``hessian`` (∇²f, not the horizon H), the
 ``working`` set of constraint rows (not the goal covariance W), ``merit_weight`` (not the mean mu) and
@@ -28,21 +26,19 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
 - Secant correction (``secant=True``, for approximate Hessians): C is updated after every step s with
   the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (hessian + C) s, y the change of gradient, and
   hessian + C is used in its place. It learns the curvature the approximation misses along the directions
-  the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md). Where
-  hessian + C needs a shift delta ≥ 0.1 (``CORRECTED_SHIFT_LIMIT``), C is dropped (reset to zero) and the hessian
-  alone is factored, shifted as it needs: the shift such a C needed (up to a hundred times s on the Panda) shrinks
-  only a third per iteration and held the steps short long after.
+  the iteration actually moves in (the iterations saved: docs/results/speed.md). Where hessian + C needs a
+  shift delta ≥ 0.1 (``CORRECTED_SHIFT_LIMIT``), C is dropped (reset to zero) and the hessian alone is factored,
+  shifted as it needs: a large shift shrinks only a third per iteration and would hold the steps short long after.
 - Chord steps (exact Hessians, ``secant=False``): while no constraint is in the working set and the last step
   cut max |∇f| at least tenfold, the next step reuses that step's factorisation instead of evaluating and
   factoring a new Hessian (Kelley 2003, sec. 5.4: the chord method); a step that cuts it less, or fails the
-  line search, brings a fresh Hessian back. On warm point-mass solves it saves one Hessian and factorisation
-  of about four, for one more cheap iteration (benchmarks/README.md); the optimum is the same (J to ~1e-11).
+  line search, brings a fresh Hessian back. It trades Hessians and factorisations for cheap iterations; the
+  optimum is the same.
 - Lazy assembly (approximate Hessians, ``hessian_refresh`` k > 1): the hessian is assembled only every k-th
   iteration, and whenever the last step was shortened by the line search or taken with constraints in the
-  working set (there the model had been wrong, or the iterate follows a limit: on the Panda's reaches along a
-  joint limit keeping the hessian then ended 1e-4 to 6e-3 worse); in between the last one is kept and the
-  secant corrections, updated against it, carry the change of curvature (an update costs about a twentieth of
-  an assembly on the Panda). The Cholesky factor of the last factored matrix then takes those rank-one updates
+  working set (there the model had been wrong, or the iterate follows a limit, where a kept hessian ends the
+  solve at a worse point); in between the last one is kept and the secant corrections, updated against it,
+  carry the change of curvature (an update costs far less than an assembly). The Cholesky factor of the last factored matrix then takes those rank-one updates
   by the Woodbury identity, when it needed no shift and stays positive definite (checked by the inertia of the small
   capacitance matrix), instead of a new factorisation. The gradient is evaluated at every iterate, so the
   convergence test and the optimum are those of k = 1.
@@ -50,13 +46,12 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
   the violated constraints' linearisation is taken if it halves the violation.
 - Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
   recomputed with delta ≥ 1e-3, then 1e-2, 1e-1 (turning it towards steepest descent), before giving up.
-  With the working-set and merit rules above it took failed closed-loop Panda replans from 11 in 40 to 1.
 - Convergence: max |∇f + A_Wᵀ lambda| ≤ tolerance with every constraint violated by at most
   ``constraint_tolerance`` ('solved'). If the merit cannot be decreased any more in floating point, the
   point is 'solved_acceptable' when the constraints are met and that gradient is below 1e-4 (or 100 ×
   tolerance, if larger). It is 'solved_acceptable' too when f has decreased by less than 1e-8 |f| over the
   last five iterations with the gradient below 1e-4 and the constraints met: along the nearly flat
-  directions of a redundant arm an approximate Hessian converges linearly and slowly, while the plan
+  directions of a nearly singular problem an approximate Hessian converges linearly and slowly, while the iterate
   stopped changing long before.
 
 f must be finite at x0; a trial point where f is not finite is treated as a failed trial.
@@ -217,7 +212,7 @@ class ActiveSetNewton:
 
     def converged(self, state: SQPState) -> Stop | None:
         """With no constraint in the working set the Lagrangian's gradient is the gradient, and a converged
-        point needs no Hessian (a warm point-mass solve's last of about five)."""
+        point needs no Hessian (the last iteration of a warm solve)."""
         state.free = state.point.largest <= -self.margin
         state.optimality = state.point.steepest if state.free else np.inf
         return self._converged(state) if state.free else None
@@ -320,8 +315,8 @@ class ActiveSetNewton:
 
         Trials are evaluated value-only (``value``) and the accepted one then with its gradient, except the full
         step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
-        working set: that trial is evaluated with its gradient at once, saving the value-only call (a fifth of
-        an evaluation on the Panda) on most iterations for a wasted gradient on the few whose full step fails."""
+        working set: that trial is evaluated with its gradient at once, saving the value-only call on most iterations
+        for a wasted gradient on the few whose full step fails."""
         penalty = self._penalty(point)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
@@ -336,7 +331,7 @@ class ActiveSetNewton:
             if len(working) and self._penalty(trial) > penalty:
                 # second-order correction: the step broke the curved constraints; pull it back onto their
                 # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
-                # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
+                # backtrack: along a limit the iterate follows for many steps, the shorter steps break it too.
                 corrected = self._trial(trial.x + correct(trial.c[working]))
                 if corrected is not None and corrected.f + merit_weight * self._penalty(corrected) <= bound:
                     trial = corrected

@@ -123,10 +123,9 @@ class SecantHessian(_Regularised):
         ``CORRECTED_SHIFT_LIMIT``; where that needs more, the corrections are dropped and the assembled Hessian alone
         is factored, with the shifts it needs.
 
-        Such corrections learnt curvature from steps the model does not hold along: on the Panda they put the
-        matrix's smallest eigenvalue tens of times its largest diagonal entry below zero while the assembled Hessian
-        was positive definite, and the shift that cured it, shrinking a third per iteration, held the steps short for
-        the next ten. Smaller shifts stay: along joint limits the corrections supply curvature the assembled Hessian
+        Such corrections learnt curvature from steps the model does not hold along: they can make the matrix
+        strongly indefinite while the assembled Hessian is positive definite, and the shift that cures it, shrinking
+        a third per iteration, would hold the steps short for many iterations. Smaller shifts stay: along joint limits the corrections supply curvature the assembled Hessian
         lacks, and without them the steps crawl."""
         if self.correction.any():
             factor, shift = self._factored(self.assembled + self.correction, recoveries, below=CORRECTED_SHIFT_LIMIT)
@@ -168,8 +167,8 @@ class UpdatedFactor:
     """Solves with a regularised hessian M = F + U S Uᵀ: F's Cholesky factor (from
     :func:`~comanip.optim.shifted_cholesky`, with its relative ``shift``), and the secant updates made since it was
     factored, U = [u_1 ... u_m] (N, m) with signs S = diag(±1), by the Woodbury identity
-    M⁻¹ b = F⁻¹ b - F⁻¹U C⁻¹ Uᵀ F⁻¹ b, C = S⁻¹ + Uᵀ F⁻¹ U (m, m): two triangular solves per update (about
-    0.1 ms for the Panda's 350 unknowns) instead of a factorisation (1.1 ms)."""
+    M⁻¹ b = F⁻¹ b - F⁻¹U C⁻¹ Uᵀ F⁻¹ b, C = S⁻¹ + Uᵀ F⁻¹ U (m, m): two triangular solves per update instead of
+    a factorisation."""
 
     def __init__(self, cholesky: tuple, shift: float, vectors: np.ndarray | None = None, signs: np.ndarray | None = None):
         self.cholesky, self.shift = cholesky, shift

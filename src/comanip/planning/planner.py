@@ -48,7 +48,7 @@ from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_solve
 from comanip.optim.newton_loop import never
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
-from comanip.planning.plan import Plan, with_reach_check
+from comanip.planning.plan import Plan, PlanStatus, with_reach_check
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.start_threads import StartThreads, usable_cores
@@ -341,7 +341,7 @@ class Planner:
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
-        return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
+        return self._make_plan(torque, params, status=PlanStatus.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
     def _sensitivity_of(self, result: SolverResult) -> GoalSensitivity | None:

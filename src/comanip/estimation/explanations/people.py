@@ -7,6 +7,7 @@ from __future__ import annotations
 from comanip.estimation.explanations.base import Explained, HandTrace, Reach
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.people_model import PeopleModel
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 
 
@@ -25,4 +26,4 @@ class RecordedPeople:
         if predicted is None:
             return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
         goal, covariance = reach.landed(predicted.goal, predicted.covariance, hand.position[-1])
-        return Explained(goal, covariance, True, Status.PEOPLE_MODEL, "the goal is the people model's")
+        return Explained(goal, covariance, True, EstimateStatus.PEOPLE_MODEL, "the goal is the people model's")
