@@ -55,7 +55,7 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import GoalPrior, prior_covariance
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
-from comanip.estimation.regret_newton import newton_solve
+from comanip.estimation.regret_newton import minimize_regret
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.estimation_planner import checked_model, estimation_planner
 from comanip.model import ReachingModel
@@ -235,7 +235,7 @@ class GoalEstimator:
             # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest; more
             # threads wait for cores on a busy machine.
             with self._blas.limit(limits=1, user_api="blas"):
-                return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
+                return minimize_regret(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
                                     tolerance=self.options.tolerance, max_iterations=self._max_iterations,
                                     step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
 

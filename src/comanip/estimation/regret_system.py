@@ -26,7 +26,7 @@ import numpy as np
 import scipy.linalg
 
 from comanip.estimation.goal_prior import GoalPrior
-from comanip.optim import decade_shifts, shifted_cholesky
+from comanip.optim import CholeskyFactor, decade_shifts, shifted_cholesky
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
@@ -231,9 +231,9 @@ class Linearisation:
         return stationarity, max(np.abs(self.F2).max(initial=0.0), np.abs(self.F5).max(initial=0.0))
 
     @cached_property
-    def _cholesky(self) -> tuple[tuple | None, tuple | None]:
+    def _cholesky(self) -> tuple[CholeskyFactor | None, CholeskyFactor | None]:
         """Cholesky factors of H_c and H_s (shifted if ``regularise``), None where one is not positive definite."""
-        return tuple(shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))[0]
+        return tuple(shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))
                      for H in (self.H_c, self.H_s))
 
     @cached_property
@@ -312,7 +312,7 @@ class Linearisation:
         return True, ""
 
 
-def _kkt_solve(H: np.ndarray, factor, A: np.ndarray, right: np.ndarray, right_constraints: np.ndarray) -> np.ndarray:
+def _kkt_solve(H: np.ndarray, factor: CholeskyFactor | None, A: np.ndarray, right: np.ndarray, right_constraints: np.ndarray) -> np.ndarray:
     """[[H, A^T], [A, 0]]^-1 [right; right_constraints], by block elimination on H's Cholesky factor
     (``factor``, None when H is not positive definite: then by LU of the whole matrix)."""
     m = A.shape[0]
@@ -320,7 +320,7 @@ def _kkt_solve(H: np.ndarray, factor, A: np.ndarray, right: np.ndarray, right_co
         K = np.block([[H, A.T], [A, np.zeros((m, m))]])
         return np.linalg.solve(K, np.vstack([right, right_constraints]))
     k = right.shape[1]
-    solved = scipy.linalg.cho_solve(factor, np.column_stack([right, A.T]), check_finite=False)
+    solved = factor.solve(np.column_stack([right, A.T]))
     if m == 0:
         return solved
     # H x + A^T y = r, A x = r_c  =>  (A H^-1 A^T) y = A H^-1 r - r_c,  x = H^-1 r - H^-1 A^T y
@@ -329,7 +329,7 @@ def _kkt_solve(H: np.ndarray, factor, A: np.ndarray, right: np.ndarray, right_co
     return np.vstack([x_right - x_At @ y, y])
 
 
-def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
+def _positive_on_null_space(H: np.ndarray, factor: CholeskyFactor | None, A: np.ndarray) -> bool:
     """H positive definite on the null space of A (H itself positive definite is enough)."""
     if factor is not None:
         return True
@@ -337,9 +337,9 @@ def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
     return _cholesky_or_none(Z.T @ H @ Z) is not None
 
 
-def _cholesky_or_none(matrix: np.ndarray):
-    """scipy's Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
-    return shifted_cholesky(_symmetric_part(matrix), (0.0,))[0]
+def _cholesky_or_none(matrix: np.ndarray) -> CholeskyFactor | None:
+    """The Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
+    return shifted_cholesky(_symmetric_part(matrix), (0.0,))
 
 
 def _symmetric_part(matrix: np.ndarray) -> np.ndarray:

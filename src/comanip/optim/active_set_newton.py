@@ -66,11 +66,11 @@ from typing import Any, Callable
 import numpy as np
 
 from comanip.arguments import as_count
-from comanip.optim.factorisation import cholesky_solve
+from comanip.optim.factorisation import CholeskyFactor
 from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, restoration_step
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import backtrack
-from comanip.optim.newton_loop import NewtonSolve, Stop, never
+from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, never
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import Status
 
@@ -85,7 +85,7 @@ _BUDGET = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
 
 def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
                     hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
-                    max_iterations: int, **options) -> SolverResult[np.ndarray]:
+                    max_iterations: int, **options) -> SolverResult[np.ndarray, LocalModel]:
     """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0, in at most ``max_iterations`` iterations (each evaluates
     the Hessian, except a last one that only finds the point converged); the arguments and the result are those of
     :func:`newton_solve`."""
@@ -158,8 +158,8 @@ class SQPState:
     """The last line search took the full step: evaluate the next full step with its gradient."""
     model_held: bool = False
     """The last step was a full step with no constraint in the working set."""
-    stepped_with: tuple | None = None
-    """The factorisation of the last step taken."""
+    stepped_with: CholeskyFactor | None = None
+    """The factorisation of the last step taken (None when its matrix had secant updates since it was factored)."""
     free: bool = True
     """No constraint in the working set at the iterate."""
     optimality: float = np.inf
@@ -176,13 +176,14 @@ class SQPDirection:
     working: np.ndarray
     correct: Callable | None
     """c_W -> the least-H-norm move back onto the working set's linearisation (second-order correction)."""
-    factor: tuple | None
+    factor: CholeskyFactor | None
+    """The factorisation the step was computed with (None when its matrix had secant updates since)."""
     chord: bool = False
     """Taken with an earlier iteration's factor."""
 
 
 @dataclass
-class ActiveSetNewton:
+class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
     """The method of the module docstring for one problem: the hooks :func:`newton_iterate` calls."""
 
     evaluate: Callable
@@ -222,12 +223,12 @@ class ActiveSetNewton:
         if state.free:
             chord = self.hessians.chord_factor(state.optimality, state.recoveries)
             if chord is not None:
-                return SQPDirection(-cholesky_solve(chord, point.g), NO_ROWS, None, chord, chord=True)
+                return SQPDirection(-chord.solve(point.g), NO_ROWS, None, chord, chord=True)
         factored = self.hessians.factor(point, state.recoveries, state.model_held)
-        if isinstance(factored, str):
+        if isinstance(factored, Stop):
             state.optimality = np.inf
-            return Stop(Status.FAILED, factored)
-        solve, factor = factored
+            return factored
+        solve, factor = factored.solve, factored.factor
         if state.free:  # the Newton step; its optimality was tested in converged()
             step, multipliers, working, correct = -solve(point.g), NO_MULTIPLIERS, NO_ROWS, None
         else:
@@ -235,13 +236,15 @@ class ActiveSetNewton:
                                                                    self.constraint_tolerance)
             lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
             state.optimality = float(np.abs(lagrangian_gradient).max())
-            converged = self._converged(state)
-            if converged is not None:
-                return converged
         self.hessians.stepped(factor, state.optimality, state.free)
         if len(multipliers):
             state.merit_weight = max(state.merit_weight, 2 * float(np.max(multipliers)))
         return SQPDirection(step, working, correct, factor)
+
+    def solved_along(self, state: SQPState, direction: SQPDirection) -> Stop | None:
+        """With constraints in the working set, the Lagrangian's gradient is known once the direction has found the
+        multipliers: the test of :meth:`converged` on it."""
+        return None if state.free else self._converged(state)
 
     def globalise(self, state: SQPState, direction: SQPDirection) -> bool:
         """Armijo's rule on the l1 merit along the step; where it fails while a constraint is violated, the
@@ -275,7 +278,7 @@ class ActiveSetNewton:
             return None
         return self._final_status(state)
 
-    def result(self, state: SQPState, stop: Stop) -> SolverResult[np.ndarray]:
+    def result(self, state: SQPState, stop: Stop) -> SolverResult[np.ndarray, LocalModel]:
         point = state.point
         optimality = np.inf if stop.status in _BUDGET else state.optimality
         return SolverResult(point.x, point.f, stop.status, stop.message, state.iterations, optimality, point.violation,

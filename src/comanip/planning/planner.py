@@ -41,7 +41,7 @@ from comanip.arguments import as_bounded_vector, as_count, as_goal_width, as_opt
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.curvature import ReachCurvature
-from comanip.optim import CONVERGED, NewtonSolve, SolverResult, Status
+from comanip.optim import CONVERGED, LocalModel, NewtonSolve, SolverResult, Status
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
@@ -442,7 +442,7 @@ class Planner:
         return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
                                       objective=f * curvature.normaliser(width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
+    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
         fun the normalised objective."""
         if self._curvature is None:
@@ -460,12 +460,12 @@ class Planner:
                             constraint_tolerance=LIMIT_TOLERANCE, value=value,
                             expired=(lambda: time.perf_counter() > deadline) if deadline < np.inf else never)
 
-    def _as_torques(self, result: SolverResult) -> SolverResult[np.ndarray]:
+    def _as_torques(self, result: SolverResult[np.ndarray, LocalModel]) -> SolverResult[np.ndarray, LocalModel]:
         """The result with x as torques (H, n)."""
         result.x = result.x.reshape(self.model.H, self.model.n)
         return result
 
-    def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
+    def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
         solver = self._ipopt
         self._deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params.vector)
