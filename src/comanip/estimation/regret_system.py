@@ -108,9 +108,10 @@ class RegretSystem:
     def derivatives(self, tau: np.ndarray, goal: np.ndarray, start: np.ndarray, width: float) -> Derivatives:
         """Normalised J and its first and second derivatives in (tau, g) at torques tau (H·n,) and goal g (d,)."""
         curvature = self.curvature
-        f, grad, data = curvature.evaluate(np.asarray(tau, dtype=float), ReachParameters(start, goal, width))
-        grad_g, cross, hess_gg = curvature.goal_derivatives(data)
-        return Derivatives(f, grad, grad_g, curvature.hessian(data), cross, hess_gg, data)
+        evaluation = curvature.evaluate(np.asarray(tau, dtype=float), ReachParameters(start, goal, width))
+        data = evaluation.data
+        goal = curvature.goal_derivatives(data)
+        return Derivatives(evaluation.f, evaluation.gradient, goal.gradient, curvature.hessian(data), goal.cross, goal.hessian, data)
 
     def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> tuple[np.ndarray, np.ndarray]:
         """(mu_no (2n,), A = dmu_no/dtau (2n, H·n)) at torques tau; ``data`` from the same evaluation."""
@@ -141,12 +142,13 @@ class RegretSystem:
         params = ReachParameters(start, point.goal, width)
         for tau, active, mu, observe in ((point.tau_c, point.active_c, weights[0], True),
                                          (point.tau_s, point.active_s, weights[1], False)):
-            f, data = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
+            evaluation = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
+            data = evaluation.data
             violation = np.abs(self.limits(tau, data, _NO_INDICES)[0][active]).sum()
             if observe:
                 mean = self.observed_mean(n_o, tau, start, data)[0] if self.linear else self.curvature.mean_path(data)[n_o]
                 violation += np.abs((mean - observed)[observed_rows]).sum()
-            total += f + mu * violation
+            total += evaluation.f + mu * violation
         return total
 
     def limits_at_step(self, step: int) -> np.ndarray:

@@ -66,8 +66,9 @@ from typing import Any, Callable
 import numpy as np
 
 from comanip.arguments import as_count
-from comanip.optim.factorisation import CholeskyFactor
 from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, restoration_step
+from comanip.optim.evaluation import Evaluation
+from comanip.optim.factorisation import CholeskyFactor
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import backtrack
 from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, never
@@ -83,7 +84,7 @@ _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 _BUDGET = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
 
 
-def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
+def newton_minimize(evaluate: Callable[[np.ndarray], Evaluation],
                     hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
                     max_iterations: int, **options) -> SolverResult[np.ndarray, LocalModel]:
     """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0, in at most ``max_iterations`` iterations (each evaluates
@@ -92,19 +93,20 @@ def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, An
     return newton_solve(evaluate, hessian, x0, lb, ub, **options).advance(max_iterations)
 
 
-def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
+def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
                  hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
                  tolerance: float, secant: bool = False,
                  constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
                  constraint_tolerance: float = 1e-6, margin: float = 1e-3,
                  expired: Callable[[], bool] = never,
-                 value: Callable[[np.ndarray], tuple[float, Any]] | None = None,
+                 value: Callable[[np.ndarray], Evaluation] | None = None,
                  hessian_refresh: int = 1) -> NewtonSolve[SQPState]:
     """The solve of f over the box [lb, ub] and c(x) ≤ 0 from x0, to run in stages (:class:`NewtonSolve`: its
     ``advance(max_iterations)`` gives the result); f is evaluated at x0 here.
 
     Args:
-        evaluate: x (N,) -> (f, grad f (N,), data); ``data`` is handed to ``hessian`` and ``constraints``.
+        evaluate: x (N,) -> its :class:`~comanip.optim.Evaluation` (f, grad f (N,), data); ``data`` is handed to
+            ``hessian`` and ``constraints``.
         hessian: data -> ∇²f (N, N), symmetric (the solver does not modify it).
         x0: start (N,), projected onto the box; lb, ub: bounds (N,), ±inf allowed.
         tolerance: on max |gradient of the Lagrangian|.
@@ -114,7 +116,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]]
         constraint_tolerance: largest violation a solution may keep (units of c).
         margin: constraints with c > -margin are in the working set.
         expired: called between evaluations; True stops with status 'max_wall_time'.
-        value: x -> (f, data) without the gradient, for line-search trials when that is much cheaper than
+        value: x -> its Evaluation without the gradient, for line-search trials when that is much cheaper than
             ``evaluate`` (``data`` then only needs what ``constraints`` reads); ``evaluate`` runs once a trial
             is accepted. None: trials use ``evaluate``.
         hessian_refresh: with ``secant``, assemble ``hessian`` every this many iterations (and after any step that
@@ -136,8 +138,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]]
     method = ActiveSetNewton(evaluate, hessians, ConstraintSet(lb, ub, constraints), value, tolerance=tolerance,
                              constraint_tolerance=constraint_tolerance, margin=margin)
     x = np.array(x0, dtype=float) if method.problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
-    f, g, data = evaluate(x)
-    point = method.finite_point(x, f, g, data)
+    point = method.finite_point(x, evaluate(x))
     if point is None:
         return NewtonSolve(None, None, final=SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
     return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
@@ -194,14 +195,14 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
     constraint_tolerance: float
     margin: float
 
-    def at(self, x, f, g, data) -> Iterate:
-        return Iterate(x, f, g, data, *self.problem(x, data))
+    def at(self, x: np.ndarray, evaluation: Evaluation) -> Iterate:
+        return Iterate(x, evaluation.f, evaluation.gradient, evaluation.data, *self.problem(x, evaluation.data))
 
-    def finite_point(self, x, f, g, data) -> Iterate | None:
-        """The iterate at x, or None where f or an entry of g (if evaluated) is not finite."""
-        if not math.isfinite(f):
+    def finite_point(self, x: np.ndarray, evaluation: Evaluation) -> Iterate | None:
+        """The iterate at x, or None where f or an entry of its gradient (if evaluated) is not finite."""
+        if not math.isfinite(evaluation.f):
             return None
-        point = self.at(x, f, g, data)
+        point = self.at(x, evaluation)
         return point if point.finite else None
 
     def iterations(self, state: SQPState) -> int:
@@ -341,7 +342,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
             if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
             if trial.g is None:  # a trial evaluated with its gradient was checked finite by _trial
-                return self.finite_point(trial.x, *self.evaluate(trial.x))
+                return self.finite_point(trial.x, self.evaluate(trial.x))
             return trial
 
         alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
@@ -350,11 +351,8 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
     def _trial(self, x: np.ndarray, with_gradient: bool = False) -> Iterate | None:
         """The point x evaluated (value only when a cheaper ``value`` is given, unless ``with_gradient``); None where
         not finite."""
-        if self.value is None or with_gradient:
-            f, g, data = self.evaluate(x)
-        else:
-            (f, data), g = self.value(x), None
-        return self.finite_point(x, f, g, data)
+        evaluate = self.evaluate if self.value is None or with_gradient else self.value
+        return self.finite_point(x, evaluate(x))
 
     def _restore(self, point: Iterate) -> Iterate | None:
         """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over
@@ -362,9 +360,9 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         step = restoration_step(point)
         for alpha in (1.0, 0.5, 0.25, 0.125):
             x = point.x + alpha * step
-            f, g, data = self.evaluate(x)
-            if np.isfinite(f) and np.all(np.isfinite(g)):
-                trial = self.at(x, f, g, data)
+            evaluation = self.evaluate(x)
+            if np.isfinite(evaluation.f) and np.all(np.isfinite(evaluation.gradient)):
+                trial = self.at(x, evaluation)
                 if trial.violation < 0.5 * point.violation:
                     return trial
         return None

@@ -41,7 +41,7 @@ from comanip.arguments import as_bounded_vector, as_count, as_goal_width, as_opt
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.curvature import ReachCurvature
-from comanip.optim import CONVERGED, LocalModel, NewtonSolve, SolverResult, Status
+from comanip.optim import CONVERGED, Evaluation, LocalModel, NewtonSolve, SolverResult, Status
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
@@ -370,7 +370,7 @@ class Planner:
         # of the tolerances can still be far better than one that converged on the zero-reward plateau (seen on the
         # Panda), and the status then says it did not converge.
         best = min(results, key=_rank)
-        evaluation = None if best.local_model is None else (best.fun, best.local_model.data)
+        evaluation = None if best.local_model is None else Evaluation(best.fun, None, best.local_model.data)
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
         plan.goal_sensitivity = self._sensitivity_of(best)
@@ -427,20 +427,20 @@ class Planner:
         """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
         plan can rest on the zero-reward plateau instead)."""
         model, curvature = self.model, self._curvature
-        q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params)[1])[-1, : model.n]
+        q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params).data)[-1, : model.n]
         end = np.asarray(model.body.kinematics_function(q_end)[0]).ravel()
         return bool(np.linalg.norm(end - params.goal) <= params.width)
 
-    def _make_plan(self, torque, params: ReachParameters, evaluation: tuple | None = None, **fields) -> Plan:
-        """The Plan of torques (H, n); ``evaluation`` = (f, data): the Newton method's own evaluation at them, from
-        which an arm's belief is taken without evaluating again (about 4 ms of a Panda solve)."""
+    def _make_plan(self, torque, params: ReachParameters, evaluation: Evaluation | None = None, **fields) -> Plan:
+        """The Plan of torques (H, n); ``evaluation``: the Newton method's own evaluation at them (its f and data),
+        from which an arm's belief is taken without evaluating again."""
         start, goal, width = params.start, params.goal, params.width
         curvature = self._curvature
         if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
             return self.problem.make_plan(torque, start, goal, width, **fields)
-        f, data = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)[::2]
-        return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
-                                      objective=f * curvature.normaliser(width), **fields)
+        evaluation = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)
+        return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(evaluation.data),
+                                      objective=evaluation.f * curvature.normaliser(width), **fields)
 
     def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),

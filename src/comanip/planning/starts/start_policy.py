@@ -152,8 +152,8 @@ class StartPolicy:
         curvature = self.curvature
         if curvature is None or not curvature.carries_belief or not self.limits.active:
             return False, self.objective(torque, params)
-        f, data = curvature.value_and_data(np.ravel(torque), params)
-        return self.limits.violation(curvature.mean_path(data)) > LIMIT_TOLERANCE, f
+        evaluation = curvature.value_and_data(np.ravel(torque), params)
+        return self.limits.violation(curvature.mean_path(evaluation.data)) > LIMIT_TOLERANCE, evaluation.f
 
     def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
@@ -271,7 +271,7 @@ class StartPolicy:
         velocity = params.start[model.n:2 * model.n]
         for entry_goal, torque in library.nearest(goal, entries):
             entry_params = ReachParameters(library.start, entry_goal, library.width)
-            mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params)[1])
+            mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params).data)
             moved = self.retargeted(torque, mean, entry_goal, goal)
             if np.any(velocity):
                 moved = [braked for candidate in moved for braked in
