@@ -112,7 +112,7 @@ def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
 def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite_one(rng):
     """The Woodbury solve after secant updates equals a direct solve with F + Σ sign_j u_j u_jᵀ, and an update
     that makes the matrix indefinite (eigenvalues checked directly) gives None."""
-    from comanip.optim.hessian_models import UpdatedFactor
+    from comanip.optim.hessian_models import RankOneUpdate, UpdatedFactor
 
     size = 30
     root = rng.normal(size=(size, size))
@@ -121,7 +121,7 @@ def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite
     matrix = F.copy()
     for sign in (1.0, -1.0):
         u = rng.normal(size=size)
-        factor = factor.updated((u, sign))
+        factor = factor.updated(RankOneUpdate(u, sign))
         matrix += sign * np.outer(u, u)
         assert np.linalg.eigvalsh(matrix)[0] > 0 and factor is not None
         b = rng.normal(size=(size, 3))
@@ -129,5 +129,5 @@ def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite
     eigenvalues, vectors = np.linalg.eigh(matrix)
     breaking = vectors[:, 0] * np.sqrt(2 * eigenvalues[0])  # subtracting it leaves eigenvalue -eigenvalues[0]
     assert np.linalg.eigvalsh(matrix - np.outer(breaking, breaking))[0] < 0
-    assert factor.updated((breaking, -1.0)) is None
+    assert factor.updated(RankOneUpdate(breaking, -1.0)) is None
     assert factor.updated(None) is factor

@@ -63,6 +63,7 @@ from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import CONVERGED, Status
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
 from comanip.planning.planner import Planner
 
@@ -179,8 +180,8 @@ class GoalEstimator:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
                                                                    observed, n_o, rows, prior, width, remaining_time())
             details = {}
-        plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
-                                      success=status in CONVERGED, message=message,
+        plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), ReachParameters(start, point.goal, width),
+                                      status=status, success=status in CONVERGED, message=message,
                                       solve_time=time.perf_counter() - t_begin, iterations=iterations)
         return self._estimate_of(plan, point, checked, float(t_obs), method, details)
 

@@ -302,7 +302,7 @@ class MapNewton(NewtonMethod[MapState, np.ndarray]):
             trial = MapState(goal, self.problem.terms(self.whitening, goal))
             return trial if trial.terms.objective <= bound + rounding else None
 
-        _, accepted = backtrack(attempt, objective, 0.0, max_trials=BACKTRACKS)
+        accepted = backtrack(attempt, objective, 0.0, max_trials=BACKTRACKS).accepted
         if accepted is None:
             return False
         state.goal, state.terms = accepted.goal, accepted.terms

@@ -247,13 +247,13 @@ class RegretNewton(NewtonMethod[RegretState, RegretPoint | None]):
             trial = self.system.merits(point.plus(step, alpha), *fixed)
             return True if np.isfinite(trial) and trial <= bound else None
 
-        return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS)[0]
+        return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS).alpha
 
 
 def _minimum_checked(stop: Stop, linearisation: Linearisation, exact: bool) -> Stop:
     """``stop`` at a point that meets the convergence test, or 'not_a_minimum' where the second-order check fails."""
-    is_minimum, why = linearisation.is_strict_minimum(exact)
-    return stop if is_minimum else Stop(Status.NOT_A_MINIMUM, why)
+    why = linearisation.not_a_minimum(exact)
+    return stop if why is None else Stop(Status.NOT_A_MINIMUM, why)
 
 
 def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
@@ -269,8 +269,7 @@ def _acceptable_without_exact_jacobian(linearisation: Linearisation, point: Regr
     """Stop criterion for an approximate Jacobian (module docstring): both plans stationary and their
     constraints met to acceptable levels, and either the Newton goal step is short or the trust region has
     shrunk below that length (no longer goal step lowers the regret as far as the approximation can tell)."""
-    stationarity, constraints = linearisation.inner_residuals
-    if stationarity > _ACCEPTABLE_GRADIENT or constraints > _ACCEPTABLE_CONSTRAINT_ERROR:
+    if linearisation.stationarity > _ACCEPTABLE_GRADIENT or linearisation.constraint_error > _ACCEPTABLE_CONSTRAINT_ERROR:
         return False
     short = _ACCEPTABLE_GOAL_STEP * width
     return radius <= short or np.linalg.norm(linearisation.step(np.inf, point).goal) <= short

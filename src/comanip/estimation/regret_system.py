@@ -227,16 +227,27 @@ class Linearisation:
         return float(max(np.abs(F).max(initial=0.0) for F in (self.F1, self.F2, self.F3, self.F4, self.F5)))
 
     @property
-    def inner_residuals(self) -> tuple[float, float, float]:
-        """(max |F1|, |F3|: the plans' stationarity; max |F2|, |F5|: their constraints)."""
-        stationarity = max(np.abs(self.F1).max(), np.abs(self.F3).max())
-        return stationarity, max(np.abs(self.F2).max(initial=0.0), np.abs(self.F5).max(initial=0.0))
+    def stationarity(self) -> float:
+        """max |F1|, |F3|: the plans' stationarity."""
+        return max(np.abs(self.F1).max(), np.abs(self.F3).max())
+
+    @property
+    def constraint_error(self) -> float:
+        """max |F2|, |F5|: the plans' constraints."""
+        return max(np.abs(self.F2).max(initial=0.0), np.abs(self.F5).max(initial=0.0))
 
     @cached_property
-    def _cholesky(self) -> tuple[CholeskyFactor | None, CholeskyFactor | None]:
-        """Cholesky factors of H_c and H_s (shifted if ``regularise``), None where one is not positive definite."""
-        return tuple(shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))
-                     for H in (self.H_c, self.H_s))
+    def _factor_c(self) -> CholeskyFactor | None:
+        """The Cholesky factor of H_c (shifted if ``regularise``), None where it is not positive definite."""
+        return self._factored(self.H_c)
+
+    @cached_property
+    def _factor_s(self) -> CholeskyFactor | None:
+        """The Cholesky factor of H_s, as :attr:`_factor_c`."""
+        return self._factored(self.H_s)
+
+    def _factored(self, H: np.ndarray) -> CholeskyFactor | None:
+        return shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))
 
     @cached_property
     def _solves(self) -> tuple[np.ndarray, np.ndarray]:
@@ -244,7 +255,7 @@ class Linearisation:
         plans' KKT matrices: the torques' (and multipliers') sensitivity to the goal (first d columns) and
         their Newton step at a fixed goal (last column). Raises LinAlgError when a system is singular."""
         d = self.Hc_gg.shape[0]
-        factor_c, factor_s = self._cholesky
+        factor_c, factor_s = self._factor_c, self._factor_s
         Xc = _kkt_solve(self.H_c, factor_c, self.A_c, np.column_stack([self.Hc_tau_g, self.F1]),
                         np.column_stack([np.zeros((len(self.F2), d)), self.F2]))
         Xs = _kkt_solve(self.H_s, factor_s, self.A_s, np.column_stack([self.Hs_tau_g, self.F3]),
@@ -298,20 +309,21 @@ class Linearisation:
         reduced = (self.Hc_gg - self.Hc_tau_g.T @ Xc[:Hn, :d]) - (self.Hs_gg - self.Hs_tau_g.T @ Xs[:Hn, :d]) + 2 * self.P
         return 0.5 * (reduced + reduced.T)
 
-    def is_strict_minimum(self, exact: bool = True) -> tuple[bool, str]:
-        """Second-order check: the plan, the constrained plan and the regret all have positive curvature.
+    def not_a_minimum(self, exact: bool = True) -> str | None:
+        """Second-order check: None when the plan, the constrained plan and the regret all have positive curvature,
+        else which does not, in words.
 
         With approximate Hessians (``exact`` False) only the regret's d×d curvature is checked: the plans'
         Hessians are then approximations that may be indefinite at a minimum (the planner does not check them).
         """
-        factor_c, factor_s = self._cholesky
+        factor_c, factor_s = self._factor_c, self._factor_s
         if exact and not _positive_on_null_space(self.H_s, factor_s, self.A_s):
-            return False, "the plan to the estimated goal is not a minimum of J"
+            return "the plan to the estimated goal is not a minimum of J"
         if exact and not _positive_on_null_space(self.H_c, factor_c, self.A_c):
-            return False, "the trajectory through the observation is not a minimum of J"
+            return "the trajectory through the observation is not a minimum of J"
         if _cholesky_or_none(self.reduced_hessian()) is None:
-            return False, "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
-        return True, ""
+            return "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
+        return None
 
 
 def _kkt_solve(H: np.ndarray, factor: CholeskyFactor | None, A: np.ndarray, right: np.ndarray, right_constraints: np.ndarray) -> np.ndarray:

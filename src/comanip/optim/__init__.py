@@ -11,12 +11,12 @@ and the online estimator's MAP goal (:mod:`comanip.estimation.map_goal`) are bui
 
 from comanip.optim.evaluation import Evaluation
 from comanip.optim.factorisation import CholeskyFactor, decade_shifts, growing_shifts, shifted_cholesky
-from comanip.optim.line_search import ARMIJO, backtrack
+from comanip.optim.line_search import ARMIJO, Backtracked, backtrack
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import CONVERGED, Status
 from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, newton_iterate
 from comanip.optim.active_set_newton import newton_minimize, newton_solve
 
-__all__ = ["ARMIJO", "CONVERGED", "CholeskyFactor", "Evaluation", "LocalModel", "NewtonMethod", "NewtonSolve", "SolverResult", "Status", "Stop", "backtrack",
+__all__ = ["ARMIJO", "Backtracked", "CONVERGED", "CholeskyFactor", "Evaluation", "LocalModel", "NewtonMethod", "NewtonSolve", "SolverResult", "Status", "Stop", "backtrack",
            "decade_shifts", "growing_shifts", "newton_iterate", "newton_minimize", "newton_solve",
            "shifted_cholesky"]

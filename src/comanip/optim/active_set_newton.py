@@ -70,7 +70,7 @@ from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Ite
 from comanip.optim.evaluation import Evaluation
 from comanip.optim.factorisation import CholeskyFactor
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
-from comanip.optim.line_search import backtrack
+from comanip.optim.line_search import Backtracked, backtrack
 from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, never
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import Status
@@ -82,6 +82,8 @@ _RECOVERIES = 3
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
 _BUDGET = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
+_NO_STEP = Backtracked(0.0, None)
+"""A line search that accepted no step length."""
 
 
 def newton_minimize(evaluate: Callable[[np.ndarray], Evaluation],
@@ -251,8 +253,9 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         """Armijo's rule on the l1 merit along the step; where it fails while a constraint is violated, the
         restoration step."""
         point = state.point
-        alpha, accepted = self._line_search(point, direction.step, direction.working, direction.correct,
-                                            state.merit_weight, state.full_steps)
+        searched = self._line_search(point, direction.step, direction.working, direction.correct,
+                                     state.merit_weight, state.full_steps)
+        alpha, accepted = searched.alpha, searched.accepted
         state.full_steps = alpha == 1.0
         if not direction.chord:
             state.model_held = alpha == 1.0 and len(direction.working) == 0
@@ -313,9 +316,9 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         return float(np.maximum(point.c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: Iterate, step: np.ndarray, working: np.ndarray, correct,
-                     merit_weight: float, full_step_likely: bool) -> tuple[float, Iterate | None]:
-        """(alpha, the accepted point alpha·``step`` away) by Armijo's rule on the l1 merit, with second-order
-        corrections; (0, None) when no step length is accepted.
+                     merit_weight: float, full_step_likely: bool) -> Backtracked[Iterate]:
+        """alpha and the accepted point alpha·``step`` away by Armijo's rule on the l1 merit, with second-order
+        corrections; alpha 0 and no point when no step length is accepted.
 
         Trials are evaluated value-only (``value``) and the accepted one then with its gradient, except the full
         step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
@@ -325,7 +328,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
         if not slope < -1e-16 * max(1.0, abs(merit)):
-            return 0.0, None
+            return _NO_STEP
 
         def attempt(alpha: float, bound: float) -> Iterate | None:
             trial = self._trial(point.x + step if alpha == 1.0 else point.x + alpha * step,
@@ -345,8 +348,8 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
                 return self.finite_point(trial.x, self.evaluate(trial.x))
             return trial
 
-        alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
-        return (alpha, accepted) if accepted is not None else (0.0, None)
+        searched = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
+        return searched if searched.accepted is not None else _NO_STEP
 
     def _trial(self, x: np.ndarray, with_gradient: bool = False) -> Iterate | None:
         """The point x evaluated (value only when a cheaper ``value`` is given, unless ``with_gradient``); None where

@@ -8,6 +8,7 @@ IPOPT's growing shifts, more strongly after a failed line search."""
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
@@ -152,18 +153,28 @@ def _not_factored(hessian: np.ndarray) -> Stop:
                 "no positive definite regularised Hessian")
 
 
-def symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float] | None:
+@dataclass(frozen=True)
+class RankOneUpdate:
+    """A symmetric rank-one change sign·u uᵀ of a matrix."""
+
+    u: np.ndarray
+    """(N,)."""
+    sign: float
+    """±1."""
+
+
+def symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> RankOneUpdate | None:
     """correction += r rᵀ / (rᵀ s), r = y - (H + correction) s, in place; skipped when rᵀ s is tiny
     (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|). correction and H (N, N), s and y (N,).
 
-    Returns the update as (u (N,), sign ±1), correction's change being sign·u uᵀ; None when skipped."""
+    Returns correction's change; None when skipped."""
     r = y - H @ s - correction @ s
     denominator = r @ s
     if abs(denominator) > 1e-8 * np.linalg.norm(r) * np.linalg.norm(s):
         u = r / np.sqrt(abs(denominator))  # u_i u_j = u_j u_i: the correction stays exactly symmetric
         sign = float(np.sign(denominator))
         correction += np.outer(u, sign * u)
-        return u, sign
+        return RankOneUpdate(u, sign)
     return None
 
 
@@ -194,15 +205,13 @@ class UpdatedFactor:
             return x
         return x - self._solved @ np.linalg.solve(self._capacitance, self._solved.T @ b)
 
-    def updated(self, update: tuple[np.ndarray, float] | None) -> "UpdatedFactor | None":
-        """The factor of M + sign·u uᵀ (``update`` as :func:`symmetric_rank_one_update` returns it; None: M
-        itself), or None when that matrix is not safely positive definite. By Haynsworth's inertia additivity
+    def updated(self, update: RankOneUpdate | None) -> "UpdatedFactor | None":
+        """The factor of M + sign·u uᵀ (``update``; None: M itself), or None when that matrix is not safely positive definite. By Haynsworth's inertia additivity
         M + U S Uᵀ is positive definite exactly when C has as many negative eigenvalues as S has negative signs;
         C nearly singular counts as not."""
         if update is None:
             return self
-        u, sign = update
-        factor = UpdatedFactor(self.cholesky, np.column_stack([self.vectors, u]), np.append(self.signs, sign))
+        factor = UpdatedFactor(self.cholesky, np.column_stack([self.vectors, update.u]), np.append(self.signs, update.sign))
         eigenvalues = np.linalg.eigvalsh(factor._capacitance)
         if np.sum(eigenvalues < 0) != np.sum(factor.signs < 0) or np.min(np.abs(eigenvalues)) <= 1e-8 * np.max(np.abs(eigenvalues)):
             return None

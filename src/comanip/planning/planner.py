@@ -434,13 +434,12 @@ class Planner:
     def _make_plan(self, torque, params: ReachParameters, evaluation: Evaluation | None = None, **fields) -> Plan:
         """The Plan of torques (H, n); ``evaluation``: the Newton method's own evaluation at them (its f and data),
         from which an arm's belief is taken without evaluating again."""
-        start, goal, width = params.start, params.goal, params.width
         curvature = self._curvature
         if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
-            return self.problem.make_plan(torque, start, goal, width, **fields)
+            return self.problem.make_plan(torque, params, **fields)
         evaluation = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)
-        return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(evaluation.data),
-                                      objective=evaluation.f * curvature.normaliser(width), **fields)
+        return self.problem.make_plan(torque, params, belief=curvature.trajectory(evaluation.data),
+                                      objective=evaluation.f * curvature.normaliser(params.width), **fields)
 
     def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),

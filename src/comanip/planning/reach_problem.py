@@ -18,6 +18,7 @@ from comanip.objectives.reach_objective import reach_objective, velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.plan import Plan
+from comanip.planning.reach_parameters import ReachParameters
 
 
 class ReachProblem:
@@ -96,14 +97,15 @@ class ReachProblem:
         ee_cov (d, d·(H+1)), J."""
         return dict(zip(self._trajectory_outputs, self._trajectory(np.ravel(torque), start, goal, width)))
 
-    def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
+    def make_plan(self, torque, params: ReachParameters, *, status: str, success: bool, message: str,
                   solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
-        """A :class:`Plan` for torques (H, n): rolls the belief out and fills every field.
+        """A :class:`Plan` for torques (H, n) of the reach ``params``: rolls the belief out and fills every field.
 
         ``belief`` = (mean (H+1, 2n), cov (H+1, 2n, 2n)) and ``objective`` (J) already computed for these
         torques skip the rollout (for the Panda the expanded rollout costs about 9 ms).
         """
         model = self.model
+        start, goal, width = params.start, params.goal, params.width  # the compiled rollouts take them apart
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
         if belief is None and self._plan_rollout is not None:
@@ -128,5 +130,5 @@ class ReachProblem:
             solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),
             mean=mean, cov=cov, torque=torque,
             ee_mean=ee_mean, ee_cov=ee_cov, ee_velocity=ee_velocity,
-            start=np.asarray(start, dtype=float), goal=np.asarray(goal, dtype=float), width=float(width),
+            start=start, goal=goal, width=width,
             model_name=model.name, extras=extras or {})
