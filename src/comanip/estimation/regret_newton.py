@@ -195,7 +195,8 @@ class RegretNewton(NewtonMethod[RegretState, RegretPoint | None]):
         shrink the radius to a quarter of the step tried."""
         if step is None:
             return False
-        trial, trial_linearisation = self.moved(state.point, step)
+        trial = state.point.plus(step)
+        trial_linearisation = self.linearise_moved(trial)
         length, ceiling = np.linalg.norm(step.goal), min(state.radius, self.ceiling_at(state.point))
         if not _acceptable(state.linearisation, trial_linearisation):
             state.radius = 0.25 * length
@@ -212,7 +213,8 @@ class RegretNewton(NewtonMethod[RegretState, RegretPoint | None]):
             return Stop(Status.FAILED, "the Newton iteration stalled (no goal step lowers the regret)")
         inner_step = state.linearisation.step(0.0, state.point)
         scale = 1.0 if self.system.exact else self.inner_step_length(state.point, inner_step, state.linearisation)
-        inner, inner_linearisation = self.moved(state.point, inner_step, scale)
+        inner = state.point.plus(inner_step, scale)
+        inner_linearisation = self.linearise_moved(inner)
         if np.isfinite(inner_linearisation.residual):
             state.point, state.linearisation = inner, inner_linearisation
         return None
@@ -225,10 +227,10 @@ class RegretNewton(NewtonMethod[RegretState, RegretPoint | None]):
     def linearise(self, at: RegretPoint) -> Linearisation:
         return self.system.linearise(at, self.start, self.observed, self.n_o, self.observed_rows, self.prior, self.width)
 
-    def moved(self, base: RegretPoint, step: RegretPoint, scale: float = 1.0) -> tuple[RegretPoint, Linearisation]:
+    def linearise_moved(self, at: RegretPoint) -> Linearisation:
+        """The linearisation at a point the iteration moved to, counted as an iteration."""
         self.count += 1
-        at = base.plus(step, scale)
-        return at, self.linearise(at)
+        return self.linearise(at)
 
     def inner_step_length(self, point: RegretPoint, step: RegretPoint, linearisation: Linearisation) -> float:
         """Step length alpha in (0, 1] for the plans' Newton step at a fixed goal (approximate Jacobian): the

@@ -81,6 +81,23 @@ class Derivatives:
     """What the curvature's ``evaluate`` returned (for further terms of the same point)."""
 
 
+@dataclass(frozen=True)
+class ObservedMean:
+    """The plan's mean state at the observed step, mu_no (2n,), and its Jacobian A = dmu_no/dtau (2n, H·n)."""
+
+    mean: np.ndarray
+    jacobian: np.ndarray
+
+
+@dataclass(frozen=True)
+class LimitRows:
+    """The path limits at torques tau: c (all of them, flattened; ≤ 0 where they hold) and the rows dc/dtau of the
+    active ones (len(active), H·n)."""
+
+    values: np.ndarray
+    rows: np.ndarray
+
+
 class RegretSystem:
     """The derivatives Newton's method on F needs, from the planner's own Newton terms (built once per model).
 
@@ -113,11 +130,11 @@ class RegretSystem:
         goal = curvature.goal_derivatives(data)
         return Derivatives(evaluation.f, evaluation.gradient, goal.gradient, curvature.hessian(data), goal.cross, goal.hessian, data)
 
-    def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> tuple[np.ndarray, np.ndarray]:
-        """(mu_no (2n,), A = dmu_no/dtau (2n, H·n)) at torques tau; ``data`` from the same evaluation."""
+    def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> ObservedMean:
+        """mu_no and its Jacobian at torques tau; ``data`` from the same evaluation."""
         if not self.linear:
             A = self.curvature.mean_sensitivities(data)[n_o].reshape(2 * self.n, -1)
-            return self.curvature.mean_path(data)[n_o], A
+            return ObservedMean(self.curvature.mean_path(data)[n_o], A)
         if n_o not in self._observed:
             p = self.problem
             tau_symbol = ca.vec(p.tau)
@@ -125,14 +142,14 @@ class RegretSystem:
             # a linear body's mean is affine in tau: its Jacobian is a constant matrix
             self._observed[n_o] = (BufferedFunction(mean), np.asarray(ca.evalf(ca.jacobian(p.means[n_o], tau_symbol))))
         mean, A = self._observed[n_o]
-        return mean(tau, start)[0].ravel(), A
+        return ObservedMean(mean(tau, start)[0].ravel(), A)
 
-    def limits(self, tau: np.ndarray, data, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(c (all path limits, flattened; ≤ 0 when they hold), rows dc/dtau of the ``active`` ones (len, H·n))."""
+    def limits(self, tau: np.ndarray, data, active: np.ndarray) -> LimitRows:
+        """The path limits at torques tau, with the rows of the ``active`` ones."""
         if self._limits is None:
-            return np.zeros(0), np.zeros((0, self.H * self.n))
+            return LimitRows(np.zeros(0), np.zeros((0, self.H * self.n)))
         c, rows = self._limits(tau, data)
-        return c, (rows(active) if len(active) else np.zeros((0, self.H * self.n)))
+        return LimitRows(c, rows(active) if len(active) else np.zeros((0, self.H * self.n)))
 
     def merits(self, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, width: float,
                weights: tuple[float, float]) -> float:
@@ -144,9 +161,9 @@ class RegretSystem:
                                          (point.tau_s, point.active_s, weights[1], False)):
             evaluation = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
             data = evaluation.data
-            violation = np.abs(self.limits(tau, data, _NO_INDICES)[0][active]).sum()
+            violation = np.abs(self.limits(tau, data, _NO_INDICES).values[active]).sum()
             if observe:
-                mean = self.observed_mean(n_o, tau, start, data)[0] if self.linear else self.curvature.mean_path(data)[n_o]
+                mean = self.observed_mean(n_o, tau, start, data).mean if self.linear else self.curvature.mean_path(data)[n_o]
                 violation += np.abs((mean - observed)[observed_rows]).sum()
             total += evaluation.f + mu * violation
         return total
@@ -170,20 +187,20 @@ class RegretSystem:
         plan must meet; ``prior`` (a :class:`GoalPrior`) None drops the regulariser."""
         c = self.derivatives(point.tau_c, point.goal, start, width)
         s = self.derivatives(point.tau_s, point.goal, start, width)
-        mu, A_observed = self.observed_mean(n_o, point.tau_c, start, c.data)
-        limits_c, rows_c = self.limits(point.tau_c, c.data, point.active_c)
-        limits_s, rows_s = self.limits(point.tau_s, s.data, point.active_s)
-        A_c = np.vstack([A_observed[observed_rows], rows_c])
+        observed_mean = self.observed_mean(n_o, point.tau_c, start, c.data)
+        limits_c = self.limits(point.tau_c, c.data, point.active_c)
+        limits_s = self.limits(point.tau_s, s.data, point.active_s)
+        A_c = np.vstack([observed_mean.jacobian[observed_rows], limits_c.rows])
         P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(prior, width)
         pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior.mean)
         regulariser = 0.0 if prior is None else float((point.goal - prior.mean) @ P @ (point.goal - prior.mean))
         return Linearisation(
             J_c=c.f, J_s=s.f, regulariser=regulariser, grad_c=c.grad, grad_s=s.grad, H_c=c.hess, H_s=s.hess,
             F1=c.grad + A_c.T @ np.r_[point.lam, point.nu_c],
-            F2=np.r_[(mu - observed)[observed_rows], limits_c[point.active_c]],
-            F3=s.grad + rows_s.T @ point.nu_s, F5=limits_s[point.active_s],
+            F2=np.r_[(observed_mean.mean - observed)[observed_rows], limits_c.values[point.active_c]],
+            F3=s.grad + limits_s.rows.T @ point.nu_s, F5=limits_s.values[point.active_s],
             F4=c.grad_g - s.grad_g + pull, Hc_tau_g=c.cross, Hs_tau_g=s.cross, Hc_gg=c.hess_gg, Hs_gg=s.hess_gg,
-            P=P, A_c=A_c, A_s=rows_s, limits_c=limits_c, limits_s=limits_s, regularise=not self.exact)
+            P=P, A_c=A_c, A_s=limits_s.rows, limits_c=limits_c.values, limits_s=limits_s.values, regularise=not self.exact)
 
 
 @dataclass
