@@ -44,7 +44,7 @@ from comanip.planning.curvature import _noise_second_derivatives, _reward_deriva
 from comanip.optim import Evaluation
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
-from comanip.planning.terms import ArmPieces, ArmTerms, GoalDerivatives, Rollout
+from comanip.planning.terms import ArmPieces, ArmTerms, GoalDerivatives, Rollout, StateBelief
 
 
 class LinearisedCurvature:
@@ -316,10 +316,10 @@ class LinearisedCurvature:
         half = cross + 0.5 * (gram[:, :, None] * scale).reshape(H, H * n)
         return (scale[:, :, None] * half[:, None, :]).reshape(H * n, H * n)
 
-    def trajectory(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray]:
-        """Mean (H+1, 2n) and covariance (H+1, 2n, 2n) of the evaluated torques."""
+    def trajectory(self, data: ArmTerms) -> StateBelief:
+        """The belief along the evaluated torques: mean (H+1, 2n) and covariance (H+1, 2n, 2n)."""
         n2, H = 2 * self.model.n, self.model.H
-        return data.mean.T.copy(), data.cov.reshape(n2, H + 1, n2).transpose(1, 0, 2).copy()
+        return StateBelief(data.mean.T.copy(), data.cov.reshape(n2, H + 1, n2).transpose(1, 0, 2).copy())
 
 
 _PIECE_FIELDS = ["A", "B", "J", "phi_hess", "phi_grad", "kinematic_hessian", "dvech"]

@@ -19,6 +19,7 @@ from comanip.objectives.reward import GoalReward
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
+from comanip.planning.terms import StateBelief
 
 
 class ReachProblem:
@@ -98,11 +99,12 @@ class ReachProblem:
         return dict(zip(self._trajectory_outputs, self._trajectory(np.ravel(torque), start, goal, width)))
 
     def make_plan(self, torque, params: ReachParameters, *, status: str, success: bool, message: str,
-                  solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
+                  solve_time: float, iterations: int, extras: dict | None = None, belief: StateBelief | None = None,
+                  objective=None) -> Plan:
         """A :class:`Plan` for torques (H, n) of the reach ``params``: rolls the belief out and fills every field.
 
-        ``belief`` = (mean (H+1, 2n), cov (H+1, 2n, 2n)) and ``objective`` (J) already computed for these
-        torques skip the rollout (for the Panda the expanded rollout costs about 9 ms).
+        ``belief`` and ``objective`` (J) already computed for these torques skip the rollout (for an arm the
+        expanded rollout is costly).
         """
         model = self.model
         start, goal, width = params.start, params.goal, params.width  # the compiled rollouts take them apart
@@ -120,7 +122,7 @@ class ReachProblem:
                 ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
                 mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
             else:
-                mean, cov = belief
+                mean, cov = belief.mean, belief.cov
                 ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
                 J = np.asarray(objective, dtype=float)
             ee_mean, ee_cov = ee_mean.T, ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2)

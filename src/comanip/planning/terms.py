@@ -23,6 +23,16 @@ from comanip.planning.reach_parameters import ReachParameters
 
 
 @dataclass(frozen=True, eq=False)
+class StateBelief:
+    """The state's belief along a plan."""
+
+    mean: np.ndarray
+    """Mean states (H+1, nx)."""
+    cov: np.ndarray
+    """Their covariances (H+1, nx, nx)."""
+
+
+@dataclass(frozen=True, eq=False)
 class GoalDerivatives:
     """The objective's derivatives in the goal g (d,), m, at one evaluation at torques x (H·n,)."""
 
