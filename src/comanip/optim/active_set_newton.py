@@ -77,6 +77,8 @@ from comanip.optim.status import Status
 
 _BACKTRACKS = 30
 """Step lengths tried by one line search."""
+_RESTORATION_TRIALS = 4
+"""Step lengths tried by a restoration step (1 to 1/8)."""
 _RECOVERIES = 3
 """Attempts after a failed line search (each with a stronger shift, :mod:`comanip.optim.hessian_models`)."""
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
@@ -361,11 +363,14 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over
         the violated rows V, halved until the largest violation shrinks; None if it does not."""
         step = restoration_step(point)
-        for alpha in (1.0, 0.5, 0.25, 0.125):
+
+        def attempt(alpha: float, bound: float) -> Iterate | None:
+            # the violation must halve: the merit's bound does not apply
             x = point.x + alpha * step
             evaluation = self.evaluate(x)
-            if np.isfinite(evaluation.f) and np.all(np.isfinite(evaluation.gradient)):
-                trial = self.at(x, evaluation)
-                if trial.violation < 0.5 * point.violation:
-                    return trial
-        return None
+            if not (np.isfinite(evaluation.f) and np.all(np.isfinite(evaluation.gradient))):
+                return None
+            trial = self.at(x, evaluation)
+            return trial if trial.violation < 0.5 * point.violation else None
+
+        return backtrack(attempt, point.violation, 0.0, max_trials=_RESTORATION_TRIALS).accepted
