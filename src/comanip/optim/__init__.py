@@ -1,12 +1,11 @@
 """The numerical pieces every solver in comanip shares: one Newton iteration (:func:`newton_iterate`, over a
-:class:`NewtonMethod`'s hooks), one vocabulary of solver outcomes (:class:`Status`), one result type (:class:`SolverResult`),
-one regularised factorisation (:func:`shifted_cholesky`, giving a :class:`CholeskyFactor`) and one Armijo line search on an l1 merit
-(:func:`backtrack`).
+:class:`NewtonMethod`'s hooks), one vocabulary of solver outcomes (:class:`Status`), one evaluation type
+(:class:`Evaluation`), one result type (:class:`SolverResult`), one regularised factorisation
+(:func:`shifted_cholesky`, giving a :class:`CholeskyFactor`) and one Armijo line search (:func:`backtrack`).
 
-The planner's active-set Newton method (:func:`newton_minimize`, :mod:`comanip.optim.active_set_newton`), the
-goal estimator's Newton iteration on the regret's first-order conditions (:mod:`comanip.estimation.regret_newton`)
-and the online estimator's MAP goal (:mod:`comanip.estimation.map_goal`) are built from them. Names of solver quantities follow ``docs/notation.md`` (``hessian``, ``shift``, ``merit_weight``,
-``working``, ``multipliers``), so they never collide with the paper's H, W, mu and nu.
+The active-set Newton method (:func:`newton_minimize`, :mod:`comanip.optim.active_set_newton`) is built from them, and
+so is every solver of the layers above. Names of solver quantities follow ``docs/notation.md`` (``hessian``,
+``shift``, ``merit_weight``, ``working``, ``multipliers``), so they never collide with the paper's H, W, mu and nu.
 """
 
 from comanip.optim.evaluation import Evaluation

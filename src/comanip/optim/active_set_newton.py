@@ -7,7 +7,7 @@ constraints that bind at a handful of rows at most, where a general NLP solver s
 own machinery than the Hessian costs; so the iteration is written out here:
 
 Solver quantities are named as in ``docs/notation.md``: ``hessian`` (∇²f, not the horizon H), the
-``working`` set of constraint rows (not the goal covariance W), ``merit_weight`` (not the mean mu) and
+``working`` set of constraint rows (not the covariance W), ``merit_weight`` (not the mean mu) and
 ``multipliers`` (not the effort weight nu). The factorisation, line search, status and result are those
 of :mod:`comanip.optim`; the iteration is :func:`comanip.optim.newton_loop.newton_iterate`, the
 Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`comanip.optim.active_set`.

@@ -1,6 +1,5 @@
-"""The one Newton iteration every solver in comanip runs: the planner's active-set SQP
-(:mod:`comanip.optim.active_set_newton`), the goal estimate's root finding on the regret's first-order conditions
-(:mod:`comanip.estimation.regret_newton`) and the online estimator's MAP goal (:mod:`comanip.estimation.map_goal`).
+"""The one Newton iteration every solver in comanip runs, the active-set SQP of
+:mod:`comanip.optim.active_set_newton` among them.
 
 One pass of :func:`newton_iterate`:
 
@@ -21,7 +20,7 @@ One pass of :func:`newton_iterate`:
    regularisation, a fresh Hessian), or the :class:`Stop` that ends the solve.
 
 ``method.result(state, stop)`` turns the state into the :class:`~comanip.optim.SolverResult`. What differs between the
-solvers (the working set of constraints, secant corrections, trust regions, the goal's projection onto a
+solvers (the working set of constraints, secant corrections, trust regions, a projection onto a feasible
 range) lives in their methods, never in this loop. A method that subclasses :class:`NewtonMethod` inherits the
 stages it does not need: ``settle`` keeps the stop, ``solved_along`` finds nothing.
 """

@@ -31,21 +31,21 @@ class SolverResult(Generic[X, M]):
     type of what the solver knows of the objective at it."""
 
     x: X
-    """The best point found: an array (N,) for the planner, a RegretPoint for the goal estimate."""
+    """The best point found (an array (N,), or the solver's own point type)."""
     fun: float
-    """The objective there (normalised J for the planner, the normalised regret for the goal estimate)."""
+    """The objective there."""
     status: Status
     message: str
     """The status in words."""
     nit: int
-    """Iterations: Hessian evaluations (planner) or linearisations (goal estimate)."""
+    """Iterations, as the solver counts them (Hessian evaluations, linearisations)."""
     optimality: float
-    """First-order optimality at x: max |gradient of the Lagrangian| (planner) or max |F| (goal estimate)."""
+    """First-order optimality at x: max |gradient of the Lagrangian|, or max |F| for a root finder."""
     violation: float = 0.0
     """Largest constraint violation at x (units of the constraints)."""
     local_model: M | None = None
     """What the solver knows of the objective at and around x, for callers that build on it (the active-set Newton
-    method: a :class:`LocalModel`; the online estimator's MAP: its terms); None when it has nothing."""
+    method: a :class:`LocalModel`); None when it has nothing."""
 
     @property
     def success(self) -> bool:

@@ -1,6 +1,5 @@
 """How a solver ends: the outcomes every solver in :mod:`comanip.optim` reports. The layers that build on the
-solvers add the outcomes that speak of their own problems (:class:`comanip.planning.plan.PlanStatus`,
-:class:`comanip.estimation.estimate_status.EstimateStatus`), with the same string values in every result."""
+solvers define the outcomes of their own problems beside them, as ``str`` enums too."""
 
 from __future__ import annotations
 
