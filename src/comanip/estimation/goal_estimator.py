@@ -64,7 +64,7 @@ from comanip.optim import CONVERGED, Status
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
-from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
+from comanip.planning.ipopt_status import IpoptDeadline, IpoptSolver, ipopt_status
 from comanip.planning.planner import Planner
 
 METHODS = ("regret", "paper")
@@ -122,7 +122,7 @@ class GoalEstimator:
         self.step_jacobians = linearised_step_function(self.model.body, self.model.h)
         """The body's linearised step ``(s, tau) -> (f, A, B)`` (:func:`comanip.belief.linearised_step_function`)."""
         self._blas = ThreadpoolController()
-        self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
+        self._paper_solvers: dict[int, IpoptSolver] = {}
 
     def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, prior_std=None,
                  method: str = "regret", warm_start: Plan | None = None, max_wall_time: float | None = None) -> GoalEstimate:
@@ -304,7 +304,7 @@ class GoalEstimator:
         tau = plan.torque.ravel()
         return RegretPoint(tau.copy(), np.zeros(n_rows), tau.copy(), np.asarray(goal, dtype=float).copy())
 
-    def _paper_solver(self, n_o: int, rows: np.ndarray) -> tuple[ca.Function, IpoptDeadline]:
+    def _paper_solver(self, n_o: int, rows: np.ndarray) -> IpoptSolver:
         """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1, P0^-1 (d, d));
         the constraint holds the observed ``rows`` (fixed by n_o) of the state."""
         if n_o not in self._paper_solvers:
@@ -321,11 +321,12 @@ class GoalEstimator:
             solver = ca.nlpsol(f"goal_estimate_eq11_{n_o}", "ipopt",
                                {"x": x, "p": params, "f": objective, "g": (p.means[n_o] - observed)[rows.tolist()]},
                                {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
-            self._paper_solvers[n_o] = (solver, deadline)
+            self._paper_solvers[n_o] = IpoptSolver(solver, deadline)
         return self._paper_solvers[n_o]
 
     def _paper_solve(self, point: RegretPoint, start, observed, n_o, rows, prior, width, budget):
-        solver, deadline = self._paper_solver(n_o, rows)
+        paper = self._paper_solver(n_o, rows)
+        solver, deadline = paper.function, paper.deadline
         deadline.time = math.inf if budget is None else time.perf_counter() + budget
         d = self.model.d
         params = np.r_[start, observed, np.zeros(d) if prior is None else prior.mean, width, prior is not None,

@@ -42,7 +42,7 @@ from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.curvature import ReachCurvature
 from comanip.optim import CONVERGED, Evaluation, LocalModel, NewtonSolve, SolverResult, Status
-from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
+from comanip.planning.ipopt_status import IpoptDeadline, IpoptSolver, ipopt_status
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_solve
@@ -198,7 +198,7 @@ class Planner:
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
         self._blas = _SingleThreadBlas()
-        self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
+        self._ipopt = self._ipopt_solver() if self.options.method == "ipopt" else None
         self.starts = StartPolicy(self.model, self.options, problem, self._curvature, self._limits, self._solve_reach)
         """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`)."""
         self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
@@ -247,9 +247,8 @@ class Planner:
             return ReachCurvature(self.problem, compile=compile)
         return LinearisedCurvature(self.problem, compile=compile is not False)
 
-    def _ipopt_solver(self) -> tuple[ca.Function, IpoptDeadline]:
-        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian, and the deadline its
-        iteration callback watches (set before each solve)."""
+    def _ipopt_solver(self) -> IpoptSolver:
+        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian."""
         problem = self.problem
         params = ca.vertcat(problem.s0, problem.goal, problem.width)
         ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
@@ -258,7 +257,7 @@ class Planner:
         solver = ca.nlpsol("planner", "ipopt",
                            {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
                            {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
-        return solver, deadline
+        return IpoptSolver(solver, deadline)
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (nx,), goal (d,), width) or ValueError naming the argument (:func:`reach_inputs`)."""
@@ -465,11 +464,11 @@ class Planner:
         return result
 
     def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
-        solver = self._ipopt
-        self._deadline.time = deadline
+        solver = self._ipopt.function
+        self._ipopt.deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params.vector)
         stats = solver.stats()
-        status = ipopt_status(stats, self._deadline)
+        status = ipopt_status(stats, self._ipopt.deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
 
