@@ -55,7 +55,8 @@ def measure(preset: str, compile: bool) -> dict:
     goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + np.asarray(reach)[:model.d]
     plan = planner.solve(start, goal, model.width)
     x, params = plan.torque.ravel(), ReachParameters(start, goal, model.width)
-    _, gradient, data = curvature.evaluate(x, params)
+    evaluated = curvature.evaluate(x, params)
+    gradient, data = evaluated.gradient, evaluated.data
 
     def hessian():
         if curvature.carries_belief:

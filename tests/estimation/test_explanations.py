@@ -6,6 +6,7 @@ import pytest
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.explanations import Explained, HandAtRest, HandTrace, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 
 
@@ -54,7 +55,7 @@ def test_the_first_explanation_that_explains_gives_the_estimate(planner):
 def test_no_explanation_leaves_the_prior(planner):
     estimator = OnlineGoalEstimator(planner, np.zeros(6), prior_goal=[0.1, 0.2, 0.3], explanations=[FixedGoal([1.0, 0, 0], False)])
     estimate = estimator.update(0.05, np.array([0.01, 0.0, 0.0]), np.array([0.3, 0.0, 0.0]))
-    assert estimate.status == Status.UNINFORMATIVE
+    assert estimate.status == EstimateStatus.UNINFORMATIVE
     np.testing.assert_array_equal(estimate.goal, [0.1, 0.2, 0.3])
 
 

@@ -1,4 +1,4 @@
-"""Newton's method on the regret (comanip.estimation.regret_newton.newton_solve) on the planar point mass, against the
+"""Newton's method on the regret (comanip.estimation.regret_newton.minimize_regret) on the planar point mass, against the
 regret evaluated by brute force: R(g) = Jc(g) - V*(g), both plans solved by IPOPT on the reach problem's CasADi
 expressions, Jc held to the observed state."""
 
@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from comanip.estimation.observation import observed_rows
-from comanip.estimation.regret_newton import newton_solve
+from comanip.estimation.regret_newton import minimize_regret
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.optim import Status
 
@@ -44,7 +44,7 @@ def _solve(reach, observed, from_goal):
     rows = observed_rows(model, OBSERVED_STEP)
     tau = planner.solve(start, from_goal, WIDTH).torque.ravel()
     point = RegretPoint(tau.copy(), np.zeros(len(rows)), tau.copy(), np.asarray(from_goal, dtype=float))
-    return newton_solve(system, point, start, observed, OBSERVED_STEP, rows, None, WIDTH, observed_position=observed[:model.n],
+    return minimize_regret(system, point, start, observed, OBSERVED_STEP, rows, None, WIDTH, observed_position=observed[:model.n],
                         tolerance=1e-9, max_iterations=60, step_fraction=0.5, expired=lambda: False)
 
 
@@ -61,7 +61,7 @@ def test_an_exact_observation_of_a_plan_gives_back_its_goal(reach):
 
 
 def test_the_regret_at_the_solution_is_the_brute_force_regret_and_a_local_minimum_of_it(reach, rng):
-    """A perturbed observation (no plan passes through it): the regret newton_solve reports equals IPOPT's
+    """A perturbed observation (no plan passes through it): the regret minimize_regret reports equals IPOPT's
     Jc - V* at its goal, and IPOPT's regret 2 mm away along either axis is no lower."""
     _, _, _, goal, plan, regret = reach
     observed = plan.mean[OBSERVED_STEP][:4] + np.r_[rng.normal(scale=0.004, size=2), rng.normal(scale=0.02, size=2)]

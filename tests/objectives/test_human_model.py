@@ -98,7 +98,8 @@ def test_structured_hessian_is_exact_with_the_extensions(changes, rng):
     for _ in range(2):
         tau = rng.normal(scale=3.0, size=x.numel())
         p = ReachParameters(model.full_state(rng.normal(scale=0.1, size=4)), rng.uniform(0.05, 0.15, 2), 0.03)
-        value, _, data = curvature.evaluate(tau, p)
+        evaluation = curvature.evaluate(tau, p)
+        value, data = evaluation.f, evaluation.data
         H_exact, f_exact = (np.asarray(v) for v in exact(tau, p.start, p.goal, p.width))
         assert value == pytest.approx(f_exact.item(), rel=1e-12)
         np.testing.assert_allclose(curvature.hessian(data), H_exact, rtol=1e-8, atol=1e-10 * np.abs(H_exact).max())

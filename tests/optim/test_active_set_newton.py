@@ -5,13 +5,14 @@ import numpy as np
 import pytest
 import scipy.optimize
 
+from comanip.optim import Evaluation
 from comanip.optim.active_set_newton import newton_minimize
 
 
 def test_newton_matches_scipy_on_a_bounded_rosenbrock():
     """An independent check of the method: the bounded Rosenbrock minimiser found by L-BFGS-B."""
     def evaluate(x):
-        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
 
     lb, ub = np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5]
     result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(6, -1.2), lb, ub, tolerance=1e-8, max_iterations=200)
@@ -29,7 +30,7 @@ def test_hessian_refresh_reaches_the_same_minimiser_with_fewer_assemblies():
     with a bound active; without bounds it assembles at most one Hessian per two iterations (a short step or a
     constraint in the working set brings an assembly back sooner)."""
     def evaluate(x):
-        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
 
     def approximate_hessian(x):
         assemblies.append(x)
@@ -59,7 +60,7 @@ def test_hessian_refresh_reaches_the_same_minimiser_with_fewer_assemblies():
                                                    (2, False, "without secant")])
 def test_hessian_refresh_is_checked(refresh, secant, word):
     def evaluate(x):
-        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
 
     with pytest.raises(ValueError, match="hessian_refresh") as error:
         newton_minimize(evaluate, scipy.optimize.rosen_hess, np.zeros(3), np.full(3, -1.0), np.full(3, 1.0),
@@ -72,7 +73,7 @@ def test_newton_stops_at_the_deadline():
 
     def evaluate(x):
         calls.append(1)
-        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
 
     result = newton_minimize(evaluate, scipy.optimize.rosen_hess, np.full(4, -1.2), np.full(4, -np.inf), np.full(4, np.inf),
                              tolerance=1e-12, max_iterations=100, expired=lambda: len(calls) > 3)
@@ -87,7 +88,7 @@ def test_a_solve_paused_and_resumed_takes_the_iterates_of_one_run(secant):
     from comanip.optim import Status, newton_solve
 
     def evaluate(x):
-        return float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
 
     hessian = (lambda x: 0.5 * (scipy.optimize.rosen_hess(x) + np.diag(np.diag(scipy.optimize.rosen_hess(x))))) if secant \
         else scipy.optimize.rosen_hess

@@ -6,9 +6,10 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-import scipy.linalg
 
+from comanip.optim import shifted_cholesky
 from comanip.optim.hessian_models import CORRECTED_SHIFT_LIMIT, SecantHessian
+from comanip.optim.newton_loop import Stop
 
 
 def _corrected(assembled: np.ndarray, negative_curvature: float) -> tuple[SecantHessian, np.ndarray]:
@@ -18,12 +19,12 @@ def _corrected(assembled: np.ndarray, negative_curvature: float) -> tuple[Secant
     hessians = SecantHessian(lambda data: assembled, refresh=1)
     size = len(assembled)
     first = SimpleNamespace(x=np.zeros(size), g=np.zeros(size), data=None)
-    assert not isinstance(hessians.factor(first, 0, False), str)
+    assert not isinstance(hessians.factor(first, 0, False), Stop)
     step = np.eye(size)[0]
     second = SimpleNamespace(x=step, g=-negative_curvature * step, data=None)
     factored = hessians.factor(second, 0, False)
-    assert not isinstance(factored, str)
-    return hessians, factored[0]
+    assert not isinstance(factored, Stop)
+    return hessians, factored.solve
 
 
 @pytest.fixture
@@ -52,7 +53,7 @@ def test_corrections_needing_a_small_shift_are_kept(assembled, rng):
     hessians, solve = _corrected(assembled, 1e-3 * scale)
     corrected = assembled + hessians.correction
     assert hessians.correction[0, 0] == pytest.approx(-assembled[0, 0] - 1e-3 * scale)
-    shift = hessians.updated.shift
+    shift = hessians.updated.cholesky.shift
     assert 0 < shift < CORRECTED_SHIFT_LIMIT
     b = rng.normal(size=len(assembled))
     np.testing.assert_allclose(solve(b), np.linalg.solve(corrected + shift * scale * np.eye(len(b)), b), rtol=1e-10)
@@ -70,10 +71,10 @@ def test_a_hessian_with_a_nan_or_inf_is_refused(assembled, entry, value, model):
         return ExactHessian(lambda data: matrix) if model == "exact" else SecantHessian(lambda data: matrix, refresh=1)
 
     point = SimpleNamespace(x=np.zeros(len(assembled)), g=np.zeros(len(assembled)), data=None)
-    assert not isinstance(hessians(assembled).factor(point, 0, False), str)
+    assert not isinstance(hessians(assembled).factor(point, 0, False), Stop)
     broken = assembled.copy()
     broken[entry] = broken[entry[::-1]] = value
-    assert hessians(broken).factor(point, 0, False) == "Hessian not finite"
+    assert hessians(broken).factor(point, 0, False).message == "Hessian not finite"
 
 
 @pytest.mark.parametrize("gradient, finite", [([0.0, -2.0], True), ([0.0, np.nan], False), ([np.inf, 1.0], False),
@@ -111,16 +112,16 @@ def test_symmetric_rank_one_update_meets_the_secant_equation(rng):
 def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite_one(rng):
     """The Woodbury solve after secant updates equals a direct solve with F + Σ sign_j u_j u_jᵀ, and an update
     that makes the matrix indefinite (eigenvalues checked directly) gives None."""
-    from comanip.optim.hessian_models import UpdatedFactor
+    from comanip.optim.hessian_models import RankOneUpdate, UpdatedFactor
 
     size = 30
     root = rng.normal(size=(size, size))
     F = root @ root.T + size * np.eye(size)
-    factor = UpdatedFactor(scipy.linalg.cho_factor(F), 0.0)
+    factor = UpdatedFactor(shifted_cholesky(F, (0.0,)))
     matrix = F.copy()
     for sign in (1.0, -1.0):
         u = rng.normal(size=size)
-        factor = factor.updated((u, sign))
+        factor = factor.updated(RankOneUpdate(u, sign))
         matrix += sign * np.outer(u, u)
         assert np.linalg.eigvalsh(matrix)[0] > 0 and factor is not None
         b = rng.normal(size=(size, 3))
@@ -128,5 +129,5 @@ def test_updated_factor_solves_with_the_updated_matrix_and_refuses_an_indefinite
     eigenvalues, vectors = np.linalg.eigh(matrix)
     breaking = vectors[:, 0] * np.sqrt(2 * eigenvalues[0])  # subtracting it leaves eigenvalue -eigenvalues[0]
     assert np.linalg.eigvalsh(matrix - np.outer(breaking, breaking))[0] < 0
-    assert factor.updated((breaking, -1.0)) is None
+    assert factor.updated(RankOneUpdate(breaking, -1.0)) is None
     assert factor.updated(None) is factor

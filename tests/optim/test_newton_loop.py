@@ -6,7 +6,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from comanip.optim import SolverResult, Status
-from comanip.optim.newton_loop import Stop, newton_iterate
+from comanip.optim.newton_loop import NewtonMethod, Stop, newton_iterate
 
 
 @dataclass
@@ -17,7 +17,7 @@ class _State:
 
 
 @dataclass
-class _CubeRoot:
+class _CubeRoot(NewtonMethod[_State, float]):
     tolerance: float = 1e-12
     failures: int = 0
     """Line searches that fail before one succeeds."""
@@ -76,3 +76,24 @@ def test_failed_steps_are_recovered_and_then_end_the_solve():
 def test_an_expired_budget_stops_with_max_wall_time():
     result = newton_iterate(_CubeRoot(), _State(1.0), max_iterations=50, expired=lambda: True)
     assert result.status == Status.MAX_WALL_TIME and result.nit == 0
+
+
+@dataclass
+class _ShiftedCubeRoot(_CubeRoot):
+    """Settles a converged root of x³ - 2 by moving to x + 1 once: the loop tests the moved iterate again and goes on
+    iterating from it, to the same root."""
+
+    moved: bool = False
+
+    def settle(self, state, stop):
+        if self.moved:
+            return stop
+        self.moved, state.x = True, state.x + 1.0
+        return None
+
+
+def test_a_settling_stage_that_moves_the_iterate_is_followed_by_more_iterations():
+    plain = newton_iterate(_CubeRoot(), _State(1.0), max_iterations=50)
+    settled = newton_iterate(_ShiftedCubeRoot(), _State(1.0), max_iterations=50)
+    assert settled.status == Status.SOLVED and abs(settled.x - np.cbrt(2)) < 1e-12
+    assert settled.nit > plain.nit

@@ -33,7 +33,8 @@ def test_structured_hessian_equals_casadi_exact_hessian(preset, noise, rng):
     for _ in range(3):
         tau = rng.normal(scale=3.0, size=x.numel())
         p = ReachParameters(rng.normal(scale=0.1, size=2 * model.n), rng.uniform(0.1, 0.3, model.d), rng.uniform(0.01, 0.05))
-        value, gradient, data = curvature.evaluate(tau, p)
+        evaluation = curvature.evaluate(tau, p)
+        value, gradient, data = evaluation.f, evaluation.gradient, evaluation.data
         H_exact, g_exact, f_exact = (np.asarray(v) for v in exact(tau, p.start, p.goal, p.width))
         assert value == pytest.approx(f_exact.item(), rel=1e-12)
         np.testing.assert_allclose(gradient, g_exact.ravel(), rtol=1e-10, atol=1e-12 * np.abs(g_exact).max())

@@ -46,7 +46,8 @@ def test_gradient_and_mean_sensitivities_are_exact(short_franka, rng):
     independent construction), and d mu_i / d tau against CasADi's Jacobian of the mean rollout."""
     model, problem, curvature = short_franka
     tau, p = _point(model, rng)
-    f, g, data = curvature.evaluate(tau, p)
+    evaluation = curvature.evaluate(tau, p)
+    f, g, data = evaluation.f, evaluation.gradient, evaluation.data
     J = lambda x: problem.objective_value(x, p.start, p.goal, p.width) / curvature.normaliser(p.width)  # noqa: E731
     assert f == pytest.approx(J(tau), rel=1e-12)
     eps = 1e-6
@@ -69,7 +70,7 @@ def test_structured_hessian_is_close_to_the_exact_one(short_franka, rng):
     for _ in range(2):
         tau, p = _point(model, rng)
         H_exact = np.asarray(exact(tau, p.start, p.goal, p.width))
-        H = curvature.hessian(curvature.evaluate(tau, p)[2])
+        H = curvature.hessian(curvature.evaluate(tau, p).data)
         assert np.linalg.norm(H - H_exact, 2) < 0.1 * np.linalg.norm(H_exact, 2)
 
 
@@ -83,7 +84,7 @@ def test_condensed_hessian_equals_the_sum_over_steps(noise, rng):
     model = comanip.presets.load("franka").replace(H=6, noise=noise)
     curvature = LinearisedCurvature(ReachProblem(model), compile=False)
     tau, p = _point(model, rng)
-    data = curvature.evaluate(tau, p)[2]
+    data = curvature.evaluate(tau, p).data
     n, d, H = 7, 3, model.H
     pieces = curvature.pieces(data)
     J, Q, phi_grad, W, dvech = pieces.J, pieces.phi_hess, pieces.phi_grad, pieces.kinematic_hessian, pieces.dvech
@@ -136,7 +137,8 @@ def test_speed_cost_value_and_gradient_are_exact(short_franka_rest, rng):
 
     model, problem, curvature, bare = short_franka_rest
     tau, p = _point(model, rng)
-    f, g, _ = curvature.evaluate(tau, p)
+    evaluation = curvature.evaluate(tau, p)
+    f, g = evaluation.f, evaluation.gradient
     J = lambda x: problem.objective_value(x, p.start, p.goal, p.width) / curvature.normaliser(p.width)  # noqa: E731
     assert f == pytest.approx(J(tau), rel=1e-12)
     mean, cov = propagate_belief(model.body, model.h, model.kappa, p.start, tau.reshape(model.H, 7), model.noise)
@@ -169,8 +171,8 @@ def test_speed_cost_hessian_is_the_gauss_newton_term_and_close_to_the_exact_one(
     exact = ca.Function("speed_hessian", [x, problem.s0], [ca.hessian(cost, x)[0]])
     for _ in range(3):
         tau, p = _point(model, rng)
-        data = curvature.evaluate(tau, p)[2]
-        share = curvature.hessian(data) - bare.hessian(bare.evaluate(tau, p)[2])
+        data = curvature.evaluate(tau, p).data
+        share = curvature.hessian(data) - bare.hessian(bare.evaluate(tau, p).data)
         Tv = curvature.mean_sensitivities(data)[:, n:].reshape(H + 1, n, H * n)
         expected = sum(2 * c[i] * Tv[i].T @ Tv[i] for i in range(H + 1))
         for k in range(H):

@@ -23,11 +23,11 @@ def test_point_mass_goal_derivatives_match_finite_differences(request, preset, g
     tau = planner.solve(start, goal + 0.02).torque.ravel()
 
     def terms(g):
-        f, grad, data = curvature.evaluate(tau, ReachParameters(start, g, model.width))
-        return f, grad, curvature.goal_derivatives(data)[0]
+        evaluation = curvature.evaluate(tau, ReachParameters(start, g, model.width))
+        return evaluation.f, evaluation.gradient, curvature.goal_derivatives(evaluation.data).gradient
 
-    _, _, data = curvature.evaluate(tau, ReachParameters(start, goal, model.width))
-    grad_g, cross, hess_gg = curvature.goal_derivatives(data)
+    derivatives = curvature.goal_derivatives(curvature.evaluate(tau, ReachParameters(start, goal, model.width)).data)
+    grad_g, cross, hess_gg = derivatives.gradient, derivatives.cross, derivatives.hessian
     eps = 1e-6
     differences = [[(a - b) / (2 * eps) for a, b in zip(terms(goal + eps * e), terms(goal - eps * e))] for e in np.eye(model.d)]
     fd_grad_g = np.array([row[0] for row in differences])
@@ -48,8 +48,8 @@ def test_panda_goal_derivatives_against_casadi(rng):
     start = np.r_[model.body.home_position + rng.normal(scale=0.1, size=7), rng.normal(scale=0.2, size=7)]
     tau = rng.normal(scale=2.0, size=7 * model.H)
     goal = np.asarray(model.body.kinematics_function(start[:7])[0]).ravel() + rng.uniform(-0.03, 0.03, 3)
-    _, _, data = curvature.evaluate(tau, ReachParameters(start, goal, model.width))
-    grad_g, cross, hess_gg = curvature.goal_derivatives(data)
+    derivatives = curvature.goal_derivatives(curvature.evaluate(tau, ReachParameters(start, goal, model.width)).data)
+    grad_g, cross, hess_gg = derivatives.gradient, derivatives.cross, derivatives.hessian
 
     x = ca.vertcat(ca.vec(problem.tau), problem.goal)
     hessian, gradient = ca.hessian(problem.objective / -problem.best_objective, x)

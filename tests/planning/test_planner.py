@@ -16,7 +16,7 @@ def test_objective_gradient_matches_finite_differences(planar_planner, rng):
     problem, curvature = planar_planner.problem, planar_planner.curvature
     p = ReachParameters(np.zeros(4), [0.3, 0.0], 0.02)
     x = planar_planner.solve(np.zeros(4), [0.3, 0.0], 0.02).torque.ravel() + rng.normal(scale=0.5, size=60)
-    _, g, _ = curvature.evaluate(x, p)
+    g = curvature.evaluate(x, p).gradient
     J = lambda v: problem.objective_value(v, p.start, p.goal, p.width) / curvature.normaliser(p.width)  # noqa: E731
     eps = 1e-6
     fd = np.array([(J(x + eps * e) - J(x - eps * e)) / (2 * eps) for e in np.eye(60)])

@@ -56,14 +56,16 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import GoalPrior, prior_covariance
 from comanip.estimation.initial_goal import search_along_observed_direction, task_space_state
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state
-from comanip.estimation.regret_newton import newton_solve
+from comanip.estimation.regret_newton import minimize_regret
 from comanip.estimation.regret_system import RegretPoint, RegretSystem
 from comanip.estimation.estimation_planner import checked_model, estimation_planner
 from comanip.model import ReachingModel
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import CONVERGED, Status
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
-from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
+from comanip.planning.reach_parameters import ReachParameters
+from comanip.planning.ipopt_status import IpoptDeadline, IpoptSolver, ipopt_status
 from comanip.planning.planner import Planner
 
 METHODS = ("regret", "paper")
@@ -121,7 +123,7 @@ class GoalEstimator:
         self.step_jacobians = linearised_step_function(self.model.body, self.model.h)
         """The body's linearised step ``(s, tau) -> (f, A, B)`` (:func:`comanip.belief.linearised_step_function`)."""
         self._blas = ThreadpoolController()
-        self._paper_solvers: dict[int, tuple[ca.Function, IpoptDeadline]] = {}
+        self._paper_solvers: dict[int, IpoptSolver] = {}
 
     def estimate(self, start, observed, t_obs, prior_goal=None, width: float | None = None, *, prior_std=None,
                  method: str = "regret", warm_start: Plan | None = None, max_wall_time: float | None = None) -> GoalEstimate:
@@ -179,8 +181,8 @@ class GoalEstimator:
             point, status, message, iterations = self._paper_solve(point if point is not None else cold_point(), start,
                                                                    observed, n_o, rows, prior, width, remaining_time())
             details = {}
-        plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), start, point.goal, width, status=status,
-                                      success=status in CONVERGED, message=message,
+        plan = self.problem.make_plan(point.tau_c.reshape(model.H, model.n), ReachParameters(start, point.goal, width),
+                                      status=status, success=status in CONVERGED, message=message,
                                       solve_time=time.perf_counter() - t_begin, iterations=iterations)
         return self._estimate_of(plan, point, checked, float(t_obs), method, details)
 
@@ -235,7 +237,7 @@ class GoalEstimator:
             # The Newton systems are a few hundred unknowns: one BLAS thread solves them fastest; more
             # threads wait for cores on a busy machine.
             with self._blas.limit(limits=1, user_api="blas"):
-                return newton_solve(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
+                return minimize_regret(self._regret, point, start, observed, n_o, rows, prior, width, observed_position=x_obs,
                                     tolerance=self.options.tolerance, max_iterations=self._max_iterations,
                                     step_fraction=self.options.step_fraction, expired=lambda: time.perf_counter() > deadline)
 
@@ -258,7 +260,7 @@ class GoalEstimator:
         plan = self.planner.solve(start, prior.mean, width, warm_start=warm_start, max_wall_time=max_wall_time)
         message = (f"the observation at t_obs = {t_obs:g} s falls on step 0, the start itself, and says nothing about the goal: "
                    f"the estimate is the prior goal and the trajectory its plan (plan status '{plan.status}')")
-        plan = replace(plan, success=False, status=Status.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
+        plan = replace(plan, success=False, status=EstimateStatus.UNINFORMATIVE, message=message, solve_time=time.perf_counter() - t_begin)
         return GoalEstimate.of(plan, t_obs=t_obs, observed_step=0, observed_state=observed,
                                observation_residual=plan.mean[0] - observed, prior_goal=prior.mean, method=method,
                                plan_status=plan.status, goal_covariance=prior.covariance.copy())
@@ -303,7 +305,7 @@ class GoalEstimator:
         tau = plan.torque.ravel()
         return RegretPoint(tau.copy(), np.zeros(n_rows), tau.copy(), np.asarray(goal, dtype=float).copy())
 
-    def _paper_solver(self, n_o: int, rows: np.ndarray) -> tuple[ca.Function, IpoptDeadline]:
+    def _paper_solver(self, n_o: int, rows: np.ndarray) -> IpoptSolver:
         """IPOPT on eq. 11 as printed: x = (tau, g), p = (s_0, s_o, g_bar, w, prior weight 0 or 1, P0^-1 (d, d));
         the constraint holds the observed ``rows`` (fixed by n_o) of the state."""
         if n_o not in self._paper_solvers:
@@ -320,11 +322,12 @@ class GoalEstimator:
             solver = ca.nlpsol(f"goal_estimate_eq11_{n_o}", "ipopt",
                                {"x": x, "p": params, "f": objective, "g": (p.means[n_o] - observed)[rows.tolist()]},
                                {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
-            self._paper_solvers[n_o] = (solver, deadline)
+            self._paper_solvers[n_o] = IpoptSolver(solver, deadline)
         return self._paper_solvers[n_o]
 
     def _paper_solve(self, point: RegretPoint, start, observed, n_o, rows, prior, width, budget):
-        solver, deadline = self._paper_solver(n_o, rows)
+        paper = self._paper_solver(n_o, rows)
+        solver, deadline = paper.function, paper.deadline
         deadline.time = math.inf if budget is None else time.perf_counter() + budget
         d = self.model.d
         params = np.r_[start, observed, np.zeros(d) if prior is None else prior.mean, width, prior is not None,

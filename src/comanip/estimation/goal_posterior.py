@@ -28,6 +28,7 @@ from scipy.special import logsumexp
 from comanip.arguments import as_matrix, as_optional_positive
 from comanip.estimation.goal_estimator import EstimatorCache, default_estimators
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observed_sequence, prefix_log_likelihoods
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
@@ -65,9 +66,9 @@ class GoalPosterior:
         return all(plan.converged for plan in self.plans)
 
     @property
-    def status(self) -> Status:
+    def status(self) -> Status | EstimateStatus:
         """'solved' when every candidate's plan converged, else 'plans_not_converged' (:attr:`message` says which)."""
-        return Status.SOLVED if self.success else Status.PLANS_NOT_CONVERGED
+        return Status.SOLVED if self.success else EstimateStatus.PLANS_NOT_CONVERGED
 
     @property
     def message(self) -> str:

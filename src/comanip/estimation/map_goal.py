@@ -9,23 +9,23 @@ whitened under a fixed belief (:class:`~comanip.estimation.observation_whitening
 :class:`MapProblem` gives its value, gradient and Hessian (Newton's, or the Gauss–Newton matrix where that is not
 positive definite), a cold start, and the spread of the distance along the reach; :class:`MapNewton` minimises
 it with the one Newton iteration (:func:`comanip.optim.newton_loop.newton_iterate`): a step no longer than
-``step_fraction`` of the goal's distance, halved until -log p does not rise, stopping once the Newton decrement
-falls below ``DECREMENT``.
+``step_fraction`` of the goal's distance, halved until -log p does not rise (:func:`comanip.optim.backtrack`),
+converged once the Newton decrement falls below ``DECREMENT``, and settled by taking that last Newton step.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
-from scipy.linalg import lapack
 
 from comanip.estimation.observation_whitening import ObservationWhitening
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
-from comanip.optim import SolverResult, Status
-from comanip.optim.newton_loop import Stop, newton_iterate
+from comanip.optim import CholeskyFactor, SolverResult, Status, backtrack, shifted_cholesky
+from comanip.optim.newton_loop import NewtonMethod, Stop, newton_iterate
 
 MOVEMENT_SIGMAS = 3.0
 """Observed speed and displacement beyond this many noise standard deviations count as movement."""
@@ -51,14 +51,30 @@ class MapTerms:
     descent: np.ndarray
     """Minus the gradient (d,)."""
 
+    @cached_property
+    def factor(self) -> CholeskyFactor:
+        """The Cholesky factor of the Hessian when it is positive definite, else of the Gauss–Newton matrix.
+        Raises numpy's LinAlgError when neither is."""
+        factor = shifted_cholesky(self.hessian, (0.0,), lower=True)
+        if factor is None:
+            factor = shifted_cholesky(self.gauss_newton, (0.0,), lower=True)
+            if factor is None:
+                raise np.linalg.LinAlgError("the Gauss–Newton matrix is not positive definite")
+        return factor
+
+    @cached_property
     def step(self) -> np.ndarray:
-        """The Newton step (:func:`_factor`'s matrix)."""
-        return lapack.dpotrs(_factor(self.hessian, self.gauss_newton), self.descent, lower=1)[0]
+        """The Newton step (d,) m, with :attr:`factor`'s matrix."""
+        return self.factor.solve(self.descent)
+
+    @property
+    def decrement(self) -> float:
+        """The decrease of -log p the Newton step predicts (nats)."""
+        return 0.5 * float(self.step @ self.descent)
 
     def covariance(self) -> np.ndarray:
-        """The Laplace covariance: the inverse of the Hessian (:func:`_factor`'s matrix)."""
-        inverse, _ = lapack.dpotri(_factor(self.hessian, self.gauss_newton), lower=1)
-        return np.tril(inverse) + np.tril(inverse, -1).T
+        """The Laplace covariance: the inverse of :attr:`factor`'s matrix (d, d), m²."""
+        return self.factor.inverse()
 
 
 @dataclass
@@ -219,16 +235,15 @@ class MapProblem:
 
 @dataclass
 class MapState:
-    """The MAP iteration's iterate: the goal (d,) m, -log p's terms there, and the Newton step from it."""
+    """The MAP iteration's iterate: the goal (d,) m and -log p's terms there."""
 
     goal: np.ndarray
     terms: MapTerms
     iterations: int = 0
-    step: np.ndarray | None = None
 
 
 @dataclass
-class MapNewton:
+class MapNewton(NewtonMethod[MapState, np.ndarray]):
     """Newton's method on -log p under a fixed whitening (module docstring): the hooks of
     :func:`~comanip.optim.newton_loop.newton_iterate`."""
 
@@ -241,7 +256,7 @@ class MapNewton:
     width: float
     """Goal width w (m)."""
 
-    def solve(self, goal: np.ndarray, max_iterations: int) -> SolverResult[np.ndarray]:
+    def solve(self, goal: np.ndarray, max_iterations: int) -> SolverResult[np.ndarray, MapTerms]:
         """The MAP goal from ``goal``: x the goal (d,) m, fun -log p, local_model the :class:`MapTerms` at the last
         iterate (its :meth:`MapTerms.covariance` is the Laplace covariance). Raises numpy's LinAlgError when the
         Gauss–Newton matrix is singular."""
@@ -256,55 +271,53 @@ class MapNewton:
         state.iterations += 1
 
     def converged(self, state: MapState) -> Stop | None:
-        """The Newton step would lower -log p by less than DECREMENT (or is shorter than the tolerance): it is
-        taken and the iteration stops."""
-        step = state.terms.step()
-        state.step = step
-        if 0.5 * float(step @ state.terms.descent) > DECREMENT and math.sqrt(float(step @ step)) > self.tolerance:
+        """The Newton step would lower -log p by less than DECREMENT, or is shorter than the tolerance."""
+        step = state.terms.step
+        if state.terms.decrement > DECREMENT and math.sqrt(float(step @ step)) > self.tolerance:
             return None
-        state.goal = self.problem.projected(state.goal + step)
-        if self.problem.at_range_end(state.goal):
-            return Stop(Status.MAX_ITERATIONS, self.problem.range_message())
         return Stop(Status.SOLVED, f"converged in {state.iterations} Newton iterations")
 
+    def settle(self, state: MapState, stop: Stop) -> Stop:
+        """The last Newton step, taken whole (the terms stay those it was computed from); at the family's largest
+        distance the estimate is not a solution."""
+        state.goal = self.problem.projected(state.goal + state.terms.step)
+        if self.problem.at_range_end(state.goal):
+            return Stop(Status.MAX_ITERATIONS, self.problem.range_message())
+        return stop
+
     def direction(self, state: MapState) -> np.ndarray:
+        step = state.terms.step
         offset = state.goal - self.problem.start_position
         limit = self.step_fraction * max(math.sqrt(float(offset @ offset)), self.width)
-        length = math.sqrt(float(state.step @ state.step))
-        return state.step * (limit / length) if length > limit else state.step
+        length = math.sqrt(float(step @ step))
+        return step * (limit / length) if length > limit else step
 
     def globalise(self, state: MapState, step: np.ndarray) -> bool:
         """Halve the step until -log p does not rise (to rounding)."""
         objective = state.terms.objective
-        for _ in range(BACKTRACKS):
-            trial = self.problem.projected(state.goal + step)
-            trial_terms = self.problem.terms(self.whitening, trial)
-            if trial_terms.objective <= objective + 1e-12 * abs(objective):
-                state.goal, state.terms = trial, trial_terms
-                return True
-            step = 0.5 * step
-        return False
+        rounding = 1e-12 * abs(objective)
+
+        def attempt(alpha: float, bound: float) -> MapState | None:
+            goal = self.problem.projected(state.goal + alpha * step)
+            trial = MapState(goal, self.problem.terms(self.whitening, goal))
+            return trial if trial.terms.objective <= bound + rounding else None
+
+        accepted = backtrack(attempt, objective, 0.0, max_trials=BACKTRACKS).accepted
+        if accepted is None:
+            return False
+        state.goal, state.terms = accepted.goal, accepted.terms
+        return True
 
     def recover(self, state: MapState, step: np.ndarray) -> Stop:
         """No step lowers -log p: converged to rounding when the decrement is that small, else failed."""
         if self.problem.at_range_end(state.goal):
             return Stop(Status.MAX_ITERATIONS, self.problem.range_message())
-        decrement = 0.5 * float(state.step @ state.terms.descent)
+        decrement = state.terms.decrement
         if decrement <= ACCEPTABLE_DECREMENT * max(1.0, abs(state.terms.objective)):
             return Stop(Status.SOLVED_ACCEPTABLE, f"no Newton step lowers the objective any more (decrement {decrement:.2g})")
         return Stop(Status.FAILED, f"no Newton step lowers the objective, though it predicts a decrease of {decrement:.2g}")
 
-    def result(self, state: MapState, stop: Stop) -> SolverResult[np.ndarray]:
+    def result(self, state: MapState, stop: Stop) -> SolverResult[np.ndarray, MapTerms]:
         return SolverResult(state.goal, state.terms.objective, stop.status, stop.message, state.iterations,
                             float(np.abs(state.terms.descent).max()), local_model=state.terms)
 
-
-def _factor(newton: np.ndarray, gauss_newton: np.ndarray) -> np.ndarray:
-    """Cholesky factor of the Hessian when it is positive definite, else of the Gauss–Newton matrix (positive
-    definite by construction). LAPACK directly: numpy's wrappers cost more than these d×d solves."""
-    factor, info = lapack.dpotrf(newton, lower=1)
-    if info != 0:
-        factor, info = lapack.dpotrf(gauss_newton, lower=1)
-        if info != 0:
-            raise np.linalg.LinAlgError("the Gauss–Newton matrix is not positive definite")
-    return factor

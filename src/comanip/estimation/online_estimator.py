@@ -52,7 +52,7 @@ from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.people_model import shipped_people_model
 from comanip.model import ReachingModel
-from comanip.optim import CONVERGED, Status
+from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
@@ -180,7 +180,7 @@ class OnlineGoalEstimator:
             # a sample the tracker lost: skipped, the estimate stands until the next good one
             if self.latest is None:
                 self._last_time = time_s
-                return self._result(Explained(self.prior_mean, self.prior_cov, True, Status.UNINFORMATIVE,
+                return self._result(Explained(self.prior_mean, self.prior_cov, True, EstimateStatus.UNINFORMATIVE,
                                               "no tracked sample yet: the estimate is the prior"), t_begin)
             return self.latest
         position = as_vector("position", position, model.d, "hand position, m")
@@ -225,7 +225,7 @@ class OnlineGoalEstimator:
             if explained.explains:
                 return self._result(explained, t_begin, reasons)
             reasons.append(explained.message)
-        return self._result(Explained(self.prior_mean, self.prior_cov, True, Status.UNINFORMATIVE,
+        return self._result(Explained(self.prior_mean, self.prior_cov, True, EstimateStatus.UNINFORMATIVE,
                                       "the estimate is the prior"), t_begin, reasons)
 
     def _result(self, explained: Explained, t_begin: float, reasons: Sequence[str] = ()) -> GoalEstimate:
@@ -237,7 +237,7 @@ class OnlineGoalEstimator:
         before, fraction = grid_position(self._last_time, model.h, model.H)
         predicted = (1 - fraction) * prediction.mean[before, :2 * n] + fraction * prediction.mean[min(before + 1, model.H), :2 * n]
         observed = self._hand.last_observation
-        plan = Plan(success=status in CONVERGED, status=status, message="; ".join([*reasons, explained.message]),
+        plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),
                     objective=prediction.objective, solve_time=time.perf_counter() - t_begin, iterations=explained.iterations,
                     t=model.h * np.arange(model.H + 1), mean=prediction.mean, cov=prediction.cov, torque=prediction.torque,
                     ee_mean=prediction.mean[:, :n].copy(), ee_cov=prediction.cov[:, :n, :n].copy(),

@@ -44,7 +44,7 @@ provides its starting point. Block elimination reduces each Newton step to a d×
 goal whose matrix is the regret's Hessian d²R/dg²; where that is not positive definite (far from the
 optimum) its eigenvalues are mirrored so the step still descends. A trust region on the goal step, judged
 by the regret the inner problems' quadratic models predict, keeps the iteration from overshooting where
-the regret is flat (:func:`newton_solve`). The returned point is checked to be a strict local minimum.
+the regret is flat (:func:`minimize_regret`). The returned point is checked to be a strict local minimum.
 
 **Arms.** The Panda's Hessian of J is an approximation (:mod:`comanip.planning.linearised_curvature`), so
 F's Jacobian is too, and the iteration converges linearly. Indefinite plan Hessians are shifted by a
@@ -67,14 +67,14 @@ import numpy as np
 
 from comanip.estimation.goal_prior import GoalPrior
 from comanip.estimation.regret_system import Linearisation, RegretPoint, RegretSystem
-from comanip.optim import SolverResult, Status, backtrack
-from comanip.optim.newton_loop import Stop, newton_iterate
+from comanip.optim import CONVERGED, SolverResult, Status, backtrack
+from comanip.optim.newton_loop import NewtonMethod, Stop, newton_iterate
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 
 
-def newton_solve(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, prior,
+def minimize_regret(system: RegretSystem, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, prior,
                  width: float, *, observed_position: np.ndarray, tolerance: float, max_iterations: int, step_fraction: float,
-                 expired) -> SolverResult[RegretPoint]:
+                 expired) -> SolverResult[RegretPoint, None]:
     """Newton's method on F from ``point`` until max |F| ≤ tolerance, then the second-order check.
 
     Globalised by a trust region on the goal step, judged by the regret itself: a trial point is kept when
@@ -116,9 +116,9 @@ class RegretState:
 
 
 @dataclass
-class RegretNewton:
+class RegretNewton(NewtonMethod[RegretState, RegretPoint | None]):
     """One estimate's fixed data (start, observation, prior, width), the linearisations made so far, and the
-    hooks of :func:`~comanip.optim.newton_loop.newton_iterate` (:func:`newton_solve`)."""
+    hooks of :func:`~comanip.optim.newton_loop.newton_iterate` (:func:`minimize_regret`)."""
 
     system: RegretSystem
     start: np.ndarray
@@ -156,24 +156,32 @@ class RegretNewton:
         """Iterations are linearisations, counted where they are made."""
 
     def converged(self, state: RegretState) -> Stop | None:
-        """Converged (max |F| ≤ tolerance, or the approximate Jacobian's test), after at most
-        ``_ACTIVE_SET_ROUNDS`` updates of the plans' active sets, and checked to be a strict minimum."""
-        while True:
-            linearisation, point = state.linearisation, state.point
-            if not np.isfinite(linearisation.residual):
-                return Stop(Status.FAILED, "J is not finite at the starting point")
-            converged = Status.SOLVED if linearisation.residual <= self.tolerance else None
-            if converged is None and not self.system.exact and \
-                    _acceptable_without_exact_jacobian(linearisation, point, self.width, state.radius):
-                converged = Status.SOLVED_ACCEPTABLE
-            if converged is None:
-                return None
-            updated = _updated_active_sets(point, linearisation, self.excluded_c, threshold=LIMIT_TOLERANCE)
-            if updated is None or state.active_set_rounds >= _ACTIVE_SET_ROUNDS or self.count >= self.max_iterations:
-                return _converged_stop(converged, linearisation, self.system.exact)
-            state.active_set_rounds += 1
-            state.point, state.linearisation = updated, self.linearise(updated)
-            state.radius = self.ceiling_at(updated)
+        """Converged: max |F| ≤ tolerance, or the approximate Jacobian's test (module docstring); failed where F is
+        not finite."""
+        linearisation = state.linearisation
+        if not np.isfinite(linearisation.residual):
+            return Stop(Status.FAILED, "J is not finite at the starting point")
+        if linearisation.residual <= self.tolerance:
+            return Stop(Status.SOLVED, "converged")
+        if not self.system.exact and \
+                _acceptable_without_exact_jacobian(linearisation, state.point, self.width, state.radius):
+            return Stop(Status.SOLVED_ACCEPTABLE, "the goal step fell below 1e-2 goal widths, or no longer one lowers "
+                                                  "the regret (approximate Jacobian)")
+        return None
+
+    def settle(self, state: RegretState, stop: Stop) -> Stop | None:
+        """The active-set round at a converged point: the plans' active sets updated to the limits binding there
+        and the point linearised anew (None: to be tested again), at most ``_ACTIVE_SET_ROUNDS`` times; once they
+        stay, the point checked to be a strict minimum."""
+        if stop.status not in CONVERGED:
+            return stop
+        updated = _updated_active_sets(state.point, state.linearisation, self.excluded_c, threshold=LIMIT_TOLERANCE)
+        if updated is None or state.active_set_rounds >= _ACTIVE_SET_ROUNDS or self.count >= self.max_iterations:
+            return _minimum_checked(stop, state.linearisation, self.system.exact)
+        state.active_set_rounds += 1
+        state.point, state.linearisation = updated, self.linearise(updated)
+        state.radius = self.ceiling_at(updated)
+        return None
 
     def direction(self, state: RegretState) -> RegretPoint | None:
         """The trust-region step on the goal, or None when the goal has settled: with an approximate Jacobian,
@@ -187,7 +195,8 @@ class RegretNewton:
         shrink the radius to a quarter of the step tried."""
         if step is None:
             return False
-        trial, trial_linearisation = self.moved(state.point, step)
+        trial = state.point.plus(step)
+        trial_linearisation = self.linearise_moved(trial)
         length, ceiling = np.linalg.norm(step.goal), min(state.radius, self.ceiling_at(state.point))
         if not _acceptable(state.linearisation, trial_linearisation):
             state.radius = 0.25 * length
@@ -204,12 +213,13 @@ class RegretNewton:
             return Stop(Status.FAILED, "the Newton iteration stalled (no goal step lowers the regret)")
         inner_step = state.linearisation.step(0.0, state.point)
         scale = 1.0 if self.system.exact else self.inner_step_length(state.point, inner_step, state.linearisation)
-        inner, inner_linearisation = self.moved(state.point, inner_step, scale)
+        inner = state.point.plus(inner_step, scale)
+        inner_linearisation = self.linearise_moved(inner)
         if np.isfinite(inner_linearisation.residual):
             state.point, state.linearisation = inner, inner_linearisation
         return None
 
-    def result(self, state: RegretState, stop: Stop) -> SolverResult[RegretPoint]:
+    def result(self, state: RegretState, stop: Stop) -> SolverResult[RegretPoint, None]:
         linearisation = state.linearisation
         return SolverResult(state.point, linearisation.J_c - linearisation.J_s, stop.status, stop.message, self.count,
                             linearisation.residual)
@@ -217,10 +227,10 @@ class RegretNewton:
     def linearise(self, at: RegretPoint) -> Linearisation:
         return self.system.linearise(at, self.start, self.observed, self.n_o, self.observed_rows, self.prior, self.width)
 
-    def moved(self, base: RegretPoint, step: RegretPoint, scale: float = 1.0) -> tuple[RegretPoint, Linearisation]:
+    def linearise_moved(self, at: RegretPoint) -> Linearisation:
+        """The linearisation at a point the iteration moved to, counted as an iteration."""
         self.count += 1
-        at = base.plus(step, scale)
-        return at, self.linearise(at)
+        return self.linearise(at)
 
     def inner_step_length(self, point: RegretPoint, step: RegretPoint, linearisation: Linearisation) -> float:
         """Step length alpha in (0, 1] for the plans' Newton step at a fixed goal (approximate Jacobian): the
@@ -239,15 +249,13 @@ class RegretNewton:
             trial = self.system.merits(point.plus(step, alpha), *fixed)
             return True if np.isfinite(trial) and trial <= bound else None
 
-        return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS)[0]
+        return backtrack(attempt, merit, min(slope, 0.0), max_trials=_INNER_STEPS).alpha
 
 
-def _converged_stop(converged: Status, linearisation: Linearisation, exact: bool) -> Stop:
-    """The stop at a point that meets the convergence test ``converged``, after the second-order check."""
-    is_minimum, why = linearisation.is_strict_minimum(exact)
-    message = "converged" if converged == Status.SOLVED else \
-        "the goal step fell below 1e-2 goal widths, or no longer one lowers the regret (approximate Jacobian)"
-    return Stop(converged, message) if is_minimum else Stop(Status.NOT_A_MINIMUM, why)
+def _minimum_checked(stop: Stop, linearisation: Linearisation, exact: bool) -> Stop:
+    """``stop`` at a point that meets the convergence test, or 'not_a_minimum' where the second-order check fails."""
+    why = linearisation.not_a_minimum(exact)
+    return stop if why is None else Stop(Status.NOT_A_MINIMUM, why)
 
 
 def _acceptable(current: Linearisation, trial: Linearisation) -> bool:
@@ -263,8 +271,7 @@ def _acceptable_without_exact_jacobian(linearisation: Linearisation, point: Regr
     """Stop criterion for an approximate Jacobian (module docstring): both plans stationary and their
     constraints met to acceptable levels, and either the Newton goal step is short or the trust region has
     shrunk below that length (no longer goal step lowers the regret as far as the approximation can tell)."""
-    stationarity, constraints = linearisation.inner_residuals
-    if stationarity > _ACCEPTABLE_GRADIENT or constraints > _ACCEPTABLE_CONSTRAINT_ERROR:
+    if linearisation.stationarity > _ACCEPTABLE_GRADIENT or linearisation.constraint_error > _ACCEPTABLE_CONSTRAINT_ERROR:
         return False
     short = _ACCEPTABLE_GOAL_STEP * width
     return radius <= short or np.linalg.norm(linearisation.step(np.inf, point).goal) <= short

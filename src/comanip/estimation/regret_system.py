@@ -26,7 +26,7 @@ import numpy as np
 import scipy.linalg
 
 from comanip.estimation.goal_prior import GoalPrior
-from comanip.optim import decade_shifts, shifted_cholesky
+from comanip.optim import CholeskyFactor, decade_shifts, shifted_cholesky
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.path_limits import PathLimits
@@ -81,6 +81,23 @@ class Derivatives:
     """What the curvature's ``evaluate`` returned (for further terms of the same point)."""
 
 
+@dataclass(frozen=True)
+class ObservedMean:
+    """The plan's mean state at the observed step, mu_no (2n,), and its Jacobian A = dmu_no/dtau (2n, H·n)."""
+
+    mean: np.ndarray
+    jacobian: np.ndarray
+
+
+@dataclass(frozen=True)
+class LimitRows:
+    """The path limits at torques tau: c (all of them, flattened; ≤ 0 where they hold) and the rows dc/dtau of the
+    active ones (len(active), H·n)."""
+
+    values: np.ndarray
+    rows: np.ndarray
+
+
 class RegretSystem:
     """The derivatives Newton's method on F needs, from the planner's own Newton terms (built once per model).
 
@@ -108,15 +125,16 @@ class RegretSystem:
     def derivatives(self, tau: np.ndarray, goal: np.ndarray, start: np.ndarray, width: float) -> Derivatives:
         """Normalised J and its first and second derivatives in (tau, g) at torques tau (H·n,) and goal g (d,)."""
         curvature = self.curvature
-        f, grad, data = curvature.evaluate(np.asarray(tau, dtype=float), ReachParameters(start, goal, width))
-        grad_g, cross, hess_gg = curvature.goal_derivatives(data)
-        return Derivatives(f, grad, grad_g, curvature.hessian(data), cross, hess_gg, data)
+        evaluation = curvature.evaluate(np.asarray(tau, dtype=float), ReachParameters(start, goal, width))
+        data = evaluation.data
+        goal = curvature.goal_derivatives(data)
+        return Derivatives(evaluation.f, evaluation.gradient, goal.gradient, curvature.hessian(data), goal.cross, goal.hessian, data)
 
-    def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> tuple[np.ndarray, np.ndarray]:
-        """(mu_no (2n,), A = dmu_no/dtau (2n, H·n)) at torques tau; ``data`` from the same evaluation."""
+    def observed_mean(self, n_o: int, tau: np.ndarray, start: np.ndarray, data) -> ObservedMean:
+        """mu_no and its Jacobian at torques tau; ``data`` from the same evaluation."""
         if not self.linear:
             A = self.curvature.mean_sensitivities(data)[n_o].reshape(2 * self.n, -1)
-            return self.curvature.mean_path(data)[n_o], A
+            return ObservedMean(self.curvature.mean_path(data)[n_o], A)
         if n_o not in self._observed:
             p = self.problem
             tau_symbol = ca.vec(p.tau)
@@ -124,14 +142,14 @@ class RegretSystem:
             # a linear body's mean is affine in tau: its Jacobian is a constant matrix
             self._observed[n_o] = (BufferedFunction(mean), np.asarray(ca.evalf(ca.jacobian(p.means[n_o], tau_symbol))))
         mean, A = self._observed[n_o]
-        return mean(tau, start)[0].ravel(), A
+        return ObservedMean(mean(tau, start)[0].ravel(), A)
 
-    def limits(self, tau: np.ndarray, data, active: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(c (all path limits, flattened; ≤ 0 when they hold), rows dc/dtau of the ``active`` ones (len, H·n))."""
+    def limits(self, tau: np.ndarray, data, active: np.ndarray) -> LimitRows:
+        """The path limits at torques tau, with the rows of the ``active`` ones."""
         if self._limits is None:
-            return np.zeros(0), np.zeros((0, self.H * self.n))
+            return LimitRows(np.zeros(0), np.zeros((0, self.H * self.n)))
         c, rows = self._limits(tau, data)
-        return c, (rows(active) if len(active) else np.zeros((0, self.H * self.n)))
+        return LimitRows(c, rows(active) if len(active) else np.zeros((0, self.H * self.n)))
 
     def merits(self, point: RegretPoint, start, observed, n_o: int, observed_rows: np.ndarray, width: float,
                weights: tuple[float, float]) -> float:
@@ -141,12 +159,13 @@ class RegretSystem:
         params = ReachParameters(start, point.goal, width)
         for tau, active, mu, observe in ((point.tau_c, point.active_c, weights[0], True),
                                          (point.tau_s, point.active_s, weights[1], False)):
-            f, data = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
-            violation = np.abs(self.limits(tau, data, _NO_INDICES)[0][active]).sum()
+            evaluation = self.curvature.value_and_data(np.asarray(tau, dtype=float), params)
+            data = evaluation.data
+            violation = np.abs(self.limits(tau, data, _NO_INDICES).values[active]).sum()
             if observe:
-                mean = self.observed_mean(n_o, tau, start, data)[0] if self.linear else self.curvature.mean_path(data)[n_o]
+                mean = self.observed_mean(n_o, tau, start, data).mean if self.linear else self.curvature.mean_path(data)[n_o]
                 violation += np.abs((mean - observed)[observed_rows]).sum()
-            total += f + mu * violation
+            total += evaluation.f + mu * violation
         return total
 
     def limits_at_step(self, step: int) -> np.ndarray:
@@ -168,20 +187,20 @@ class RegretSystem:
         plan must meet; ``prior`` (a :class:`GoalPrior`) None drops the regulariser."""
         c = self.derivatives(point.tau_c, point.goal, start, width)
         s = self.derivatives(point.tau_s, point.goal, start, width)
-        mu, A_observed = self.observed_mean(n_o, point.tau_c, start, c.data)
-        limits_c, rows_c = self.limits(point.tau_c, c.data, point.active_c)
-        limits_s, rows_s = self.limits(point.tau_s, s.data, point.active_s)
-        A_c = np.vstack([A_observed[observed_rows], rows_c])
+        observed_mean = self.observed_mean(n_o, point.tau_c, start, c.data)
+        limits_c = self.limits(point.tau_c, c.data, point.active_c)
+        limits_s = self.limits(point.tau_s, s.data, point.active_s)
+        A_c = np.vstack([observed_mean.jacobian[observed_rows], limits_c.rows])
         P = np.zeros((self.d, self.d)) if prior is None else self.prior_weight(prior, width)
         pull = np.zeros(self.d) if prior is None else 2 * P @ (point.goal - prior.mean)
         regulariser = 0.0 if prior is None else float((point.goal - prior.mean) @ P @ (point.goal - prior.mean))
         return Linearisation(
             J_c=c.f, J_s=s.f, regulariser=regulariser, grad_c=c.grad, grad_s=s.grad, H_c=c.hess, H_s=s.hess,
             F1=c.grad + A_c.T @ np.r_[point.lam, point.nu_c],
-            F2=np.r_[(mu - observed)[observed_rows], limits_c[point.active_c]],
-            F3=s.grad + rows_s.T @ point.nu_s, F5=limits_s[point.active_s],
+            F2=np.r_[(observed_mean.mean - observed)[observed_rows], limits_c.values[point.active_c]],
+            F3=s.grad + limits_s.rows.T @ point.nu_s, F5=limits_s.values[point.active_s],
             F4=c.grad_g - s.grad_g + pull, Hc_tau_g=c.cross, Hs_tau_g=s.cross, Hc_gg=c.hess_gg, Hs_gg=s.hess_gg,
-            P=P, A_c=A_c, A_s=rows_s, limits_c=limits_c, limits_s=limits_s, regularise=not self.exact)
+            P=P, A_c=A_c, A_s=limits_s.rows, limits_c=limits_c.values, limits_s=limits_s.values, regularise=not self.exact)
 
 
 @dataclass
@@ -225,16 +244,27 @@ class Linearisation:
         return float(max(np.abs(F).max(initial=0.0) for F in (self.F1, self.F2, self.F3, self.F4, self.F5)))
 
     @property
-    def inner_residuals(self) -> tuple[float, float, float]:
-        """(max |F1|, |F3|: the plans' stationarity; max |F2|, |F5|: their constraints)."""
-        stationarity = max(np.abs(self.F1).max(), np.abs(self.F3).max())
-        return stationarity, max(np.abs(self.F2).max(initial=0.0), np.abs(self.F5).max(initial=0.0))
+    def stationarity(self) -> float:
+        """max |F1|, |F3|: the plans' stationarity."""
+        return max(np.abs(self.F1).max(), np.abs(self.F3).max())
+
+    @property
+    def constraint_error(self) -> float:
+        """max |F2|, |F5|: the plans' constraints."""
+        return max(np.abs(self.F2).max(initial=0.0), np.abs(self.F5).max(initial=0.0))
 
     @cached_property
-    def _cholesky(self) -> tuple[tuple | None, tuple | None]:
-        """Cholesky factors of H_c and H_s (shifted if ``regularise``), None where one is not positive definite."""
-        return tuple(shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))[0]
-                     for H in (self.H_c, self.H_s))
+    def _factor_c(self) -> CholeskyFactor | None:
+        """The Cholesky factor of H_c (shifted if ``regularise``), None where it is not positive definite."""
+        return self._factored(self.H_c)
+
+    @cached_property
+    def _factor_s(self) -> CholeskyFactor | None:
+        """The Cholesky factor of H_s, as :attr:`_factor_c`."""
+        return self._factored(self.H_s)
+
+    def _factored(self, H: np.ndarray) -> CholeskyFactor | None:
+        return shifted_cholesky(_symmetric_part(H), decade_shifts() if self.regularise else (0.0,))
 
     @cached_property
     def _solves(self) -> tuple[np.ndarray, np.ndarray]:
@@ -242,7 +272,7 @@ class Linearisation:
         plans' KKT matrices: the torques' (and multipliers') sensitivity to the goal (first d columns) and
         their Newton step at a fixed goal (last column). Raises LinAlgError when a system is singular."""
         d = self.Hc_gg.shape[0]
-        factor_c, factor_s = self._cholesky
+        factor_c, factor_s = self._factor_c, self._factor_s
         Xc = _kkt_solve(self.H_c, factor_c, self.A_c, np.column_stack([self.Hc_tau_g, self.F1]),
                         np.column_stack([np.zeros((len(self.F2), d)), self.F2]))
         Xs = _kkt_solve(self.H_s, factor_s, self.A_s, np.column_stack([self.Hs_tau_g, self.F3]),
@@ -296,23 +326,24 @@ class Linearisation:
         reduced = (self.Hc_gg - self.Hc_tau_g.T @ Xc[:Hn, :d]) - (self.Hs_gg - self.Hs_tau_g.T @ Xs[:Hn, :d]) + 2 * self.P
         return 0.5 * (reduced + reduced.T)
 
-    def is_strict_minimum(self, exact: bool = True) -> tuple[bool, str]:
-        """Second-order check: the plan, the constrained plan and the regret all have positive curvature.
+    def not_a_minimum(self, exact: bool = True) -> str | None:
+        """Second-order check: None when the plan, the constrained plan and the regret all have positive curvature,
+        else which does not, in words.
 
         With approximate Hessians (``exact`` False) only the regret's d×d curvature is checked: the plans'
         Hessians are then approximations that may be indefinite at a minimum (the planner does not check them).
         """
-        factor_c, factor_s = self._cholesky
+        factor_c, factor_s = self._factor_c, self._factor_s
         if exact and not _positive_on_null_space(self.H_s, factor_s, self.A_s):
-            return False, "the plan to the estimated goal is not a minimum of J"
+            return "the plan to the estimated goal is not a minimum of J"
         if exact and not _positive_on_null_space(self.H_c, factor_c, self.A_c):
-            return False, "the trajectory through the observation is not a minimum of J"
+            return "the trajectory through the observation is not a minimum of J"
         if _cholesky_or_none(self.reduced_hessian()) is None:
-            return False, "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
-        return True, ""
+            return "the regret has no minimum at the estimated goal (a saddle or a flat direction)"
+        return None
 
 
-def _kkt_solve(H: np.ndarray, factor, A: np.ndarray, right: np.ndarray, right_constraints: np.ndarray) -> np.ndarray:
+def _kkt_solve(H: np.ndarray, factor: CholeskyFactor | None, A: np.ndarray, right: np.ndarray, right_constraints: np.ndarray) -> np.ndarray:
     """[[H, A^T], [A, 0]]^-1 [right; right_constraints], by block elimination on H's Cholesky factor
     (``factor``, None when H is not positive definite: then by LU of the whole matrix)."""
     m = A.shape[0]
@@ -320,7 +351,7 @@ def _kkt_solve(H: np.ndarray, factor, A: np.ndarray, right: np.ndarray, right_co
         K = np.block([[H, A.T], [A, np.zeros((m, m))]])
         return np.linalg.solve(K, np.vstack([right, right_constraints]))
     k = right.shape[1]
-    solved = scipy.linalg.cho_solve(factor, np.column_stack([right, A.T]), check_finite=False)
+    solved = factor.solve(np.column_stack([right, A.T]))
     if m == 0:
         return solved
     # H x + A^T y = r, A x = r_c  =>  (A H^-1 A^T) y = A H^-1 r - r_c,  x = H^-1 r - H^-1 A^T y
@@ -329,7 +360,7 @@ def _kkt_solve(H: np.ndarray, factor, A: np.ndarray, right: np.ndarray, right_co
     return np.vstack([x_right - x_At @ y, y])
 
 
-def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
+def _positive_on_null_space(H: np.ndarray, factor: CholeskyFactor | None, A: np.ndarray) -> bool:
     """H positive definite on the null space of A (H itself positive definite is enough)."""
     if factor is not None:
         return True
@@ -337,9 +368,9 @@ def _positive_on_null_space(H: np.ndarray, factor, A: np.ndarray) -> bool:
     return _cholesky_or_none(Z.T @ H @ Z) is not None
 
 
-def _cholesky_or_none(matrix: np.ndarray):
-    """scipy's Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
-    return shifted_cholesky(_symmetric_part(matrix), (0.0,))[0]
+def _cholesky_or_none(matrix: np.ndarray) -> CholeskyFactor | None:
+    """The Cholesky factor of the symmetric part of ``matrix``, or None if it is not positive definite."""
+    return shifted_cholesky(_symmetric_part(matrix), (0.0,))
 
 
 def _symmetric_part(matrix: np.ndarray) -> np.ndarray:

@@ -1,21 +1,21 @@
 """The numerical pieces every solver in comanip shares: one Newton iteration (:func:`newton_iterate`, over a
-:class:`NewtonMethod`'s hooks), one status vocabulary (:class:`Status`), one result type (:class:`SolverResult`),
-one regularised factorisation (:func:`shifted_cholesky`) and one Armijo line search on an l1 merit
-(:func:`backtrack`).
+:class:`NewtonMethod`'s hooks), one vocabulary of solver outcomes (:class:`Status`), one evaluation type
+(:class:`Evaluation`), one result type (:class:`SolverResult`), one regularised factorisation
+(:func:`shifted_cholesky`, giving a :class:`CholeskyFactor`) and one Armijo line search (:func:`backtrack`).
 
-The planner's active-set Newton method (:func:`newton_minimize`, :mod:`comanip.optim.active_set_newton`), the
-goal estimator's Newton iteration on the regret's first-order conditions (:mod:`comanip.estimation.regret_newton`)
-and the online estimator's MAP goal (:mod:`comanip.estimation.map_goal`) are built from them. Names of solver quantities follow ``docs/notation.md`` (``hessian``, ``shift``, ``merit_weight``,
-``working``, ``multipliers``), so they never collide with the paper's H, W, mu and nu.
+The active-set Newton method (:func:`newton_minimize`, :mod:`comanip.optim.active_set_newton`) is built from them, and
+so is every solver of the layers above. Names of solver quantities follow ``docs/notation.md`` (``hessian``,
+``shift``, ``merit_weight``, ``working``, ``multipliers``), so they never collide with the paper's H, W, mu and nu.
 """
 
-from comanip.optim.factorisation import cholesky_solve, decade_shifts, growing_shifts, shifted_cholesky
-from comanip.optim.line_search import ARMIJO, backtrack
+from comanip.optim.evaluation import Evaluation
+from comanip.optim.factorisation import CholeskyFactor, decade_shifts, growing_shifts, shifted_cholesky
+from comanip.optim.line_search import ARMIJO, Backtracked, backtrack
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import CONVERGED, Status
 from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, newton_iterate
 from comanip.optim.active_set_newton import newton_minimize, newton_solve
 
-__all__ = ["ARMIJO", "CONVERGED", "LocalModel", "NewtonMethod", "NewtonSolve", "SolverResult", "Status", "Stop", "backtrack",
-           "cholesky_solve", "decade_shifts", "growing_shifts", "newton_iterate", "newton_minimize", "newton_solve",
+__all__ = ["ARMIJO", "Backtracked", "CONVERGED", "CholeskyFactor", "Evaluation", "LocalModel", "NewtonMethod", "NewtonSolve", "SolverResult", "Status", "Stop", "backtrack",
+           "decade_shifts", "growing_shifts", "newton_iterate", "newton_minimize", "newton_solve",
            "shifted_cholesky"]

@@ -99,9 +99,9 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     A(indices) gives the constraints' Jacobian rows. Working rows: c_j > -margin; a row with a negative
     multiplier is dropped and the step recomputed unless it is violated by more than ``tolerance`` (then
     the step must restore it), or it is past its limit already and the step without it would move it further
-    (then it is kept). (Keeping a row met to within the tolerance, say at 3e-8 past a joint limit,
-    held the Panda's plans on the limit while the objective pulled them off it: the step vanished and
-    the solve stalled with a large Lagrangian gradient.) Returns (step,
+    (then it is kept). (Keeping a row met to within the tolerance but just past its limit holds the
+    iterate on the limit while the objective pulls it off: the step vanishes and the solve stalls with a large
+    Lagrangian gradient.) Returns (step,
     multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
     """
     Hg = solve(g)
@@ -122,9 +122,8 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
         else:
             multipliers, step = np.zeros(0), -Hg
         # rows dropped together can push one another out: a dropped row already past its limit (within the
-        # tolerance) that the step would drive further out returns to the working set for good (on the Panda's
-        # reaches along a joint limit such rows made the merit rise at first order along every step, and the
-        # solve ended 'failed' at a gradient of 2e-4)
+        # tolerance) that the step would drive further out returns to the working set for good (otherwise such
+        # rows make the merit rise at first order along every step, and the solve fails short of convergence)
         if len(working) == len(near):
             break
         dropped = np.setdiff1d(near, working, assume_unique=True)

@@ -2,14 +2,12 @@
 
     min f(x)  subject to  lb ≤ x ≤ ub  and  c(x) ≤ 0.
 
-The planner's problem has a few hundred unknowns, a dense Hessian that is cheap to assemble from per-step
-pieces (:mod:`comanip.planning.curvature`), and constraints (torque bounds, joint limits on the mean path)
-that bind at a handful of steps at most. A general NLP solver spends more per iteration on its own
-machinery than the Hessian costs (IPOPT with MUMPS: about 1 ms per iteration for 150 unknowns), so the
-iteration is written out here:
+It is meant for problems with a few hundred unknowns, a dense Hessian that is cheap to assemble, and
+constraints that bind at a handful of rows at most, where a general NLP solver spends more per iteration on its
+own machinery than the Hessian costs; so the iteration is written out here:
 
 Solver quantities are named as in ``docs/notation.md``: ``hessian`` (∇²f, not the horizon H), the
-``working`` set of constraint rows (not the goal covariance W), ``merit_weight`` (not the mean mu) and
+``working`` set of constraint rows (not the covariance W), ``merit_weight`` (not the mean mu) and
 ``multipliers`` (not the effort weight nu). The factorisation, line search, status and result are those
 of :mod:`comanip.optim`; the iteration is :func:`comanip.optim.newton_loop.newton_iterate`, the
 Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`comanip.optim.active_set`.
@@ -28,21 +26,19 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
 - Secant correction (``secant=True``, for approximate Hessians): C is updated after every step s with
   the symmetric rank-one formula C += r rᵀ / (rᵀ s), r = y - (hessian + C) s, y the change of gradient, and
   hessian + C is used in its place. It learns the curvature the approximation misses along the directions
-  the iteration actually moves in (on the Panda: five times fewer iterations, benchmarks/README.md). Where
-  hessian + C needs a shift delta ≥ 0.1 (``CORRECTED_SHIFT_LIMIT``), C is dropped (reset to zero) and the hessian
-  alone is factored, shifted as it needs: the shift such a C needed (up to a hundred times s on the Panda) shrinks
-  only a third per iteration and held the steps short long after.
+  the iteration actually moves in (the iterations saved: docs/results/speed.md). Where hessian + C needs a
+  shift delta ≥ 0.1 (``CORRECTED_SHIFT_LIMIT``), C is dropped (reset to zero) and the hessian alone is factored,
+  shifted as it needs: a large shift shrinks only a third per iteration and would hold the steps short long after.
 - Chord steps (exact Hessians, ``secant=False``): while no constraint is in the working set and the last step
   cut max |∇f| at least tenfold, the next step reuses that step's factorisation instead of evaluating and
   factoring a new Hessian (Kelley 2003, sec. 5.4: the chord method); a step that cuts it less, or fails the
-  line search, brings a fresh Hessian back. On warm point-mass solves it saves one Hessian and factorisation
-  of about four, for one more cheap iteration (benchmarks/README.md); the optimum is the same (J to ~1e-11).
+  line search, brings a fresh Hessian back. It trades Hessians and factorisations for cheap iterations; the
+  optimum is the same.
 - Lazy assembly (approximate Hessians, ``hessian_refresh`` k > 1): the hessian is assembled only every k-th
   iteration, and whenever the last step was shortened by the line search or taken with constraints in the
-  working set (there the model had been wrong, or the iterate follows a limit: on the Panda's reaches along a
-  joint limit keeping the hessian then ended 1e-4 to 6e-3 worse); in between the last one is kept and the
-  secant corrections, updated against it, carry the change of curvature (an update costs about a twentieth of
-  an assembly on the Panda). The Cholesky factor of the last factored matrix then takes those rank-one updates
+  working set (there the model had been wrong, or the iterate follows a limit, where a kept hessian ends the
+  solve at a worse point); in between the last one is kept and the secant corrections, updated against it,
+  carry the change of curvature (an update costs far less than an assembly). The Cholesky factor of the last factored matrix then takes those rank-one updates
   by the Woodbury identity, when it needed no shift and stays positive definite (checked by the inertia of the small
   capacitance matrix), instead of a new factorisation. The gradient is evaluated at every iterate, so the
   convergence test and the optimum are those of k = 1.
@@ -50,13 +46,12 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
   the violated constraints' linearisation is taken if it halves the violation.
 - Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
   recomputed with delta ≥ 1e-3, then 1e-2, 1e-1 (turning it towards steepest descent), before giving up.
-  With the working-set and merit rules above it took failed closed-loop Panda replans from 11 in 40 to 1.
 - Convergence: max |∇f + A_Wᵀ lambda| ≤ tolerance with every constraint violated by at most
   ``constraint_tolerance`` ('solved'). If the merit cannot be decreased any more in floating point, the
   point is 'solved_acceptable' when the constraints are met and that gradient is below 1e-4 (or 100 ×
   tolerance, if larger). It is 'solved_acceptable' too when f has decreased by less than 1e-8 |f| over the
   last five iterations with the gradient below 1e-4 and the constraints met: along the nearly flat
-  directions of a redundant arm an approximate Hessian converges linearly and slowly, while the plan
+  directions of a nearly singular problem an approximate Hessian converges linearly and slowly, while the iterate
   stopped changing long before.
 
 f must be finite at x0; a trial point where f is not finite is treated as a failed trial.
@@ -71,45 +66,51 @@ from typing import Any, Callable
 import numpy as np
 
 from comanip.arguments import as_count
-from comanip.optim.factorisation import cholesky_solve
 from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, restoration_step
+from comanip.optim.evaluation import Evaluation
+from comanip.optim.factorisation import CholeskyFactor
 from comanip.optim.hessian_models import ExactHessian, SecantHessian
-from comanip.optim.line_search import backtrack
-from comanip.optim.newton_loop import NewtonSolve, Stop, never
+from comanip.optim.line_search import Backtracked, backtrack
+from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, never
 from comanip.optim.result import LocalModel, SolverResult
 from comanip.optim.status import Status
 
 _BACKTRACKS = 30
 """Step lengths tried by one line search."""
+_RESTORATION_TRIALS = 4
+"""Step lengths tried by a restoration step (1 to 1/8)."""
 _RECOVERIES = 3
 """Attempts after a failed line search (each with a stronger shift, :mod:`comanip.optim.hessian_models`)."""
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
 _BUDGET = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
+_NO_STEP = Backtracked(0.0, None)
+"""A line search that accepted no step length."""
 
 
-def newton_minimize(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
+def newton_minimize(evaluate: Callable[[np.ndarray], Evaluation],
                     hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
-                    max_iterations: int, **options) -> SolverResult[np.ndarray]:
+                    max_iterations: int, **options) -> SolverResult[np.ndarray, LocalModel]:
     """Minimise f over the box [lb, ub] and c(x) ≤ 0 from x0, in at most ``max_iterations`` iterations (each evaluates
     the Hessian, except a last one that only finds the point converged); the arguments and the result are those of
     :func:`newton_solve`."""
     return newton_solve(evaluate, hessian, x0, lb, ub, **options).advance(max_iterations)
 
 
-def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]],
+def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
                  hessian: Callable[[Any], np.ndarray], x0: np.ndarray, lb: np.ndarray, ub: np.ndarray, *,
                  tolerance: float, secant: bool = False,
                  constraints: Callable[[np.ndarray, Any], tuple[np.ndarray, Callable]] | None = None,
                  constraint_tolerance: float = 1e-6, margin: float = 1e-3,
                  expired: Callable[[], bool] = never,
-                 value: Callable[[np.ndarray], tuple[float, Any]] | None = None,
+                 value: Callable[[np.ndarray], Evaluation] | None = None,
                  hessian_refresh: int = 1) -> NewtonSolve[SQPState]:
     """The solve of f over the box [lb, ub] and c(x) ≤ 0 from x0, to run in stages (:class:`NewtonSolve`: its
     ``advance(max_iterations)`` gives the result); f is evaluated at x0 here.
 
     Args:
-        evaluate: x (N,) -> (f, grad f (N,), data); ``data`` is handed to ``hessian`` and ``constraints``.
+        evaluate: x (N,) -> its :class:`~comanip.optim.Evaluation` (f, grad f (N,), data); ``data`` is handed to
+            ``hessian`` and ``constraints``.
         hessian: data -> ∇²f (N, N), symmetric (the solver does not modify it).
         x0: start (N,), projected onto the box; lb, ub: bounds (N,), ±inf allowed.
         tolerance: on max |gradient of the Lagrangian|.
@@ -119,7 +120,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]]
         constraint_tolerance: largest violation a solution may keep (units of c).
         margin: constraints with c > -margin are in the working set.
         expired: called between evaluations; True stops with status 'max_wall_time'.
-        value: x -> (f, data) without the gradient, for line-search trials when that is much cheaper than
+        value: x -> its Evaluation without the gradient, for line-search trials when that is much cheaper than
             ``evaluate`` (``data`` then only needs what ``constraints`` reads); ``evaluate`` runs once a trial
             is accepted. None: trials use ``evaluate``.
         hessian_refresh: with ``secant``, assemble ``hessian`` every this many iterations (and after any step that
@@ -141,8 +142,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], tuple[float, np.ndarray, Any]]
     method = ActiveSetNewton(evaluate, hessians, ConstraintSet(lb, ub, constraints), value, tolerance=tolerance,
                              constraint_tolerance=constraint_tolerance, margin=margin)
     x = np.array(x0, dtype=float) if method.problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
-    f, g, data = evaluate(x)
-    point = method.finite_point(x, f, g, data)
+    point = method.finite_point(x, evaluate(x))
     if point is None:
         return NewtonSolve(None, None, final=SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
     return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
@@ -163,8 +163,8 @@ class SQPState:
     """The last line search took the full step: evaluate the next full step with its gradient."""
     model_held: bool = False
     """The last step was a full step with no constraint in the working set."""
-    stepped_with: tuple | None = None
-    """The factorisation of the last step taken."""
+    stepped_with: CholeskyFactor | None = None
+    """The factorisation of the last step taken (None when its matrix had secant updates since it was factored)."""
     free: bool = True
     """No constraint in the working set at the iterate."""
     optimality: float = np.inf
@@ -181,13 +181,14 @@ class SQPDirection:
     working: np.ndarray
     correct: Callable | None
     """c_W -> the least-H-norm move back onto the working set's linearisation (second-order correction)."""
-    factor: tuple | None
+    factor: CholeskyFactor | None
+    """The factorisation the step was computed with (None when its matrix had secant updates since)."""
     chord: bool = False
     """Taken with an earlier iteration's factor."""
 
 
 @dataclass
-class ActiveSetNewton:
+class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
     """The method of the module docstring for one problem: the hooks :func:`newton_iterate` calls."""
 
     evaluate: Callable
@@ -198,14 +199,14 @@ class ActiveSetNewton:
     constraint_tolerance: float
     margin: float
 
-    def at(self, x, f, g, data) -> Iterate:
-        return Iterate(x, f, g, data, *self.problem(x, data))
+    def at(self, x: np.ndarray, evaluation: Evaluation) -> Iterate:
+        return Iterate(x, evaluation.f, evaluation.gradient, evaluation.data, *self.problem(x, evaluation.data))
 
-    def finite_point(self, x, f, g, data) -> Iterate | None:
-        """The iterate at x, or None where f or an entry of g (if evaluated) is not finite."""
-        if not math.isfinite(f):
+    def finite_point(self, x: np.ndarray, evaluation: Evaluation) -> Iterate | None:
+        """The iterate at x, or None where f or an entry of its gradient (if evaluated) is not finite."""
+        if not math.isfinite(evaluation.f):
             return None
-        point = self.at(x, f, g, data)
+        point = self.at(x, evaluation)
         return point if point.finite else None
 
     def iterations(self, state: SQPState) -> int:
@@ -217,7 +218,7 @@ class ActiveSetNewton:
 
     def converged(self, state: SQPState) -> Stop | None:
         """With no constraint in the working set the Lagrangian's gradient is the gradient, and a converged
-        point needs no Hessian (a warm point-mass solve's last of about five)."""
+        point needs no Hessian (the last iteration of a warm solve)."""
         state.free = state.point.largest <= -self.margin
         state.optimality = state.point.steepest if state.free else np.inf
         return self._converged(state) if state.free else None
@@ -227,12 +228,12 @@ class ActiveSetNewton:
         if state.free:
             chord = self.hessians.chord_factor(state.optimality, state.recoveries)
             if chord is not None:
-                return SQPDirection(-cholesky_solve(chord, point.g), NO_ROWS, None, chord, chord=True)
+                return SQPDirection(-chord.solve(point.g), NO_ROWS, None, chord, chord=True)
         factored = self.hessians.factor(point, state.recoveries, state.model_held)
-        if isinstance(factored, str):
+        if isinstance(factored, Stop):
             state.optimality = np.inf
-            return Stop(Status.FAILED, factored)
-        solve, factor = factored
+            return factored
+        solve, factor = factored.solve, factored.factor
         if state.free:  # the Newton step; its optimality was tested in converged()
             step, multipliers, working, correct = -solve(point.g), NO_MULTIPLIERS, NO_ROWS, None
         else:
@@ -240,20 +241,23 @@ class ActiveSetNewton:
                                                                    self.constraint_tolerance)
             lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
             state.optimality = float(np.abs(lagrangian_gradient).max())
-            converged = self._converged(state)
-            if converged is not None:
-                return converged
         self.hessians.stepped(factor, state.optimality, state.free)
         if len(multipliers):
             state.merit_weight = max(state.merit_weight, 2 * float(np.max(multipliers)))
         return SQPDirection(step, working, correct, factor)
 
+    def solved_along(self, state: SQPState, direction: SQPDirection) -> Stop | None:
+        """With constraints in the working set, the Lagrangian's gradient is known once the direction has found the
+        multipliers: the test of :meth:`converged` on it."""
+        return None if state.free else self._converged(state)
+
     def globalise(self, state: SQPState, direction: SQPDirection) -> bool:
         """Armijo's rule on the l1 merit along the step; where it fails while a constraint is violated, the
         restoration step."""
         point = state.point
-        alpha, accepted = self._line_search(point, direction.step, direction.working, direction.correct,
-                                            state.merit_weight, state.full_steps)
+        searched = self._line_search(point, direction.step, direction.working, direction.correct,
+                                     state.merit_weight, state.full_steps)
+        alpha, accepted = searched.alpha, searched.accepted
         state.full_steps = alpha == 1.0
         if not direction.chord:
             state.model_held = alpha == 1.0 and len(direction.working) == 0
@@ -280,7 +284,7 @@ class ActiveSetNewton:
             return None
         return self._final_status(state)
 
-    def result(self, state: SQPState, stop: Stop) -> SolverResult[np.ndarray]:
+    def result(self, state: SQPState, stop: Stop) -> SolverResult[np.ndarray, LocalModel]:
         point = state.point
         optimality = np.inf if stop.status in _BUDGET else state.optimality
         return SolverResult(point.x, point.f, stop.status, stop.message, state.iterations, optimality, point.violation,
@@ -314,19 +318,19 @@ class ActiveSetNewton:
         return float(np.maximum(point.c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: Iterate, step: np.ndarray, working: np.ndarray, correct,
-                     merit_weight: float, full_step_likely: bool) -> tuple[float, Iterate | None]:
-        """(alpha, the accepted point alpha·``step`` away) by Armijo's rule on the l1 merit, with second-order
-        corrections; (0, None) when no step length is accepted.
+                     merit_weight: float, full_step_likely: bool) -> Backtracked[Iterate]:
+        """alpha and the accepted point alpha·``step`` away by Armijo's rule on the l1 merit, with second-order
+        corrections; alpha 0 and no point when no step length is accepted.
 
         Trials are evaluated value-only (``value``) and the accepted one then with its gradient, except the full
         step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
-        working set: that trial is evaluated with its gradient at once, saving the value-only call (a fifth of
-        an evaluation on the Panda) on most iterations for a wasted gradient on the few whose full step fails."""
+        working set: that trial is evaluated with its gradient at once, saving the value-only call on most iterations
+        for a wasted gradient on the few whose full step fails."""
         penalty = self._penalty(point)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
         if not slope < -1e-16 * max(1.0, abs(merit)):
-            return 0.0, None
+            return _NO_STEP
 
         def attempt(alpha: float, bound: float) -> Iterate | None:
             trial = self._trial(point.x + step if alpha == 1.0 else point.x + alpha * step,
@@ -336,37 +340,37 @@ class ActiveSetNewton:
             if len(working) and self._penalty(trial) > penalty:
                 # second-order correction: the step broke the curved constraints; pull it back onto their
                 # linearisation at the trial point (Nocedal & Wright 2006, sec. 18.3). Tried at every
-                # backtrack: along a limit the arm follows for many steps, the shorter steps break it too.
+                # backtrack: along a limit the iterate follows for many steps, the shorter steps break it too.
                 corrected = self._trial(trial.x + correct(trial.c[working]))
                 if corrected is not None and corrected.f + merit_weight * self._penalty(corrected) <= bound:
                     trial = corrected
             if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
             if trial.g is None:  # a trial evaluated with its gradient was checked finite by _trial
-                return self.finite_point(trial.x, *self.evaluate(trial.x))
+                return self.finite_point(trial.x, self.evaluate(trial.x))
             return trial
 
-        alpha, accepted = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
-        return (alpha, accepted) if accepted is not None else (0.0, None)
+        searched = backtrack(attempt, merit, slope, max_trials=_BACKTRACKS)
+        return searched if searched.accepted is not None else _NO_STEP
 
     def _trial(self, x: np.ndarray, with_gradient: bool = False) -> Iterate | None:
         """The point x evaluated (value only when a cheaper ``value`` is given, unless ``with_gradient``); None where
         not finite."""
-        if self.value is None or with_gradient:
-            f, g, data = self.evaluate(x)
-        else:
-            (f, data), g = self.value(x), None
-        return self.finite_point(x, f, g, data)
+        evaluate = self.evaluate if self.value is None or with_gradient else self.value
+        return self.finite_point(x, evaluate(x))
 
     def _restore(self, point: Iterate) -> Iterate | None:
         """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over
         the violated rows V, halved until the largest violation shrinks; None if it does not."""
         step = restoration_step(point)
-        for alpha in (1.0, 0.5, 0.25, 0.125):
+
+        def attempt(alpha: float, bound: float) -> Iterate | None:
+            # the violation must halve: the merit's bound does not apply
             x = point.x + alpha * step
-            f, g, data = self.evaluate(x)
-            if np.isfinite(f) and np.all(np.isfinite(g)):
-                trial = self.at(x, f, g, data)
-                if trial.violation < 0.5 * point.violation:
-                    return trial
-        return None
+            evaluation = self.evaluate(x)
+            if not (np.isfinite(evaluation.f) and np.all(np.isfinite(evaluation.gradient))):
+                return None
+            trial = self.at(x, evaluation)
+            return trial if trial.violation < 0.5 * point.violation else None
+
+        return backtrack(attempt, point.violation, 0.0, max_trials=_RESTORATION_TRIALS).accepted

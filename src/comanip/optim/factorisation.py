@@ -4,19 +4,47 @@ until it is positive definite, with the shift schedule a policy of the caller.""
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Iterable, Iterator
 
 import numpy as np
-from scipy.linalg.lapack import dpotrf as _potrf, dpotrs as _potrs
+from scipy.linalg.lapack import dpotrf as _potrf, dpotri as _potri, dpotrs as _potrs
 
 
-def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple | None, float]:
-    """(Cholesky factor of matrix + delta·s·I as scipy.linalg.cho_factor gives it, delta) for the first relative
-    shift delta in ``shifts`` that gives a positive definite matrix, s = max |diag matrix| (so delta is
-    relative); (None, nan) if none. Solve with the factor by :func:`cholesky_solve`.
+@dataclass(frozen=True)
+class CholeskyFactor:
+    """The Cholesky factor of a symmetric positive definite matrix M (N, N), as LAPACK's potrf leaves it."""
 
-    ``matrix`` (N, N) is read as symmetric (its upper triangle); delta = 0 factors it as it is. A matrix with a NaN
-    or inf never gives a factor: it fails the factorisation or reaches the factor's diagonal, which is checked.
+    triangle: np.ndarray
+    """(N, N): R with Rᵀ R = M in its upper triangle, or L with L Lᵀ = M in its lower one (``lower``); the other
+    triangle holds whatever the factored matrix held there."""
+    lower: bool = False
+    shift: float = 0.0
+    """The relative shift delta the matrix was factored with (:func:`shifted_cholesky`)."""
+
+    def solve(self, b: np.ndarray) -> np.ndarray:
+        """M⁻¹ b for b (N,) or (N, k)."""
+        x, info = _potrs(self.triangle, b, lower=self.lower)
+        if info != 0:
+            raise ValueError(f"LAPACK potrs rejected argument {-info} (factor {self.triangle.shape}, right-hand side {np.shape(b)})")
+        return x
+
+    def inverse(self) -> np.ndarray:
+        """M⁻¹ (N, N), symmetric."""
+        inverse, info = _potri(self.triangle, lower=self.lower)
+        if info != 0:
+            raise np.linalg.LinAlgError(f"LAPACK potri failed (info {info}, factor {self.triangle.shape})")
+        triangle = np.tril if self.lower else np.triu
+        return triangle(inverse) + triangle(inverse, -1 if self.lower else 1).T
+
+
+def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float], lower: bool = False) -> CholeskyFactor | None:
+    """The Cholesky factor of matrix + delta·s·I for the first relative shift delta in ``shifts`` that gives a
+    positive definite matrix, s = max |diag matrix| (so delta is relative); None if none does.
+
+    ``matrix`` (N, N) is read as symmetric (its upper triangle, or its lower one when ``lower``); delta = 0 factors
+    it as it is. A matrix with a NaN or inf never gives a factor: it fails the factorisation or reaches the factor's
+    diagonal, which is checked.
     """
     shifted, diagonal, scale = None, None, None
     for delta in shifts:
@@ -29,22 +57,13 @@ def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float]) -> tuple[tuple
                 shifted = matrix.copy()
             np.fill_diagonal(shifted, diagonal + delta * scale)
             candidate = shifted
-        # LAPACK directly: scipy.linalg.cho_factor's checks and wrappers cost as much as factoring a point
-        # mass's 60 x 60 Hessian
-        factor, info = _potrf(candidate, lower=False, clean=False, overwrite_a=False)
+        # LAPACK directly: scipy.linalg.cho_factor's checks and wrappers cost as much as factoring a 60 x 60 matrix
+        factor, info = _potrf(candidate, lower=lower, clean=False, overwrite_a=False)
         if info == 0 and math.isfinite(np.trace(factor)):
-            return (factor, False), delta
+            return CholeskyFactor(factor, lower, delta)
         if info < 0:
             raise ValueError(f"LAPACK potrf rejected argument {-info} (matrix {matrix.shape})")
-    return None, np.nan
-
-
-def cholesky_solve(factor: tuple, b: np.ndarray) -> np.ndarray:
-    """x with (R^T R) x = b for a factor (R, lower) from :func:`shifted_cholesky`; b (N,) or (N, k)."""
-    x, info = _potrs(factor[0], b, lower=factor[1])
-    if info != 0:
-        raise ValueError(f"LAPACK potrs rejected argument {-info} (factor {factor[0].shape}, right-hand side {np.shape(b)})")
-    return x
+    return None
 
 
 def growing_shifts(last: float, least: float = 0.0) -> Iterator[float]:

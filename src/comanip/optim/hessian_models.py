@@ -8,11 +8,14 @@ IPOPT's growing shifts, more strongly after a failed line search."""
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-from comanip.optim.factorisation import cholesky_solve, growing_shifts, shifted_cholesky
+from comanip.optim.factorisation import CholeskyFactor, growing_shifts, shifted_cholesky
+from comanip.optim.newton_loop import Stop
+from comanip.optim.status import Status
 
 RECOVERY_SHIFT = 1e-3
 """The least relative shift delta after the first failed line search (ten times more after each further one)."""
@@ -28,16 +31,16 @@ class _Regularised:
 
     shift_last = 0.0
 
-    def _factored(self, matrix: np.ndarray, recoveries: int, below: float = np.inf) -> tuple[tuple | None, float]:
+    def _factored(self, matrix: np.ndarray, recoveries: int, below: float = np.inf) -> CholeskyFactor | None:
         """The factor of matrix with the first shift of the schedule that makes it positive definite, among the
-        shifts ``below`` this one; (None, nan) if none does."""
+        shifts ``below`` this one; None if none does."""
         # after a failed line search, a stronger shift turns the step towards steepest descent
         least = RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
-        factor, shift = shifted_cholesky(matrix, itertools.takewhile(lambda delta: delta < below,
-                                                                     growing_shifts(self.shift_last, least)))
-        if factor is not None and shift > 0:
-            self.shift_last = shift
-        return factor, shift
+        factor = shifted_cholesky(matrix, itertools.takewhile(lambda delta: delta < below,
+                                                              growing_shifts(self.shift_last, least)))
+        if factor is not None and factor.shift > 0:
+            self.shift_last = factor.shift
+        return factor
 
 
 class ExactHessian(_Regularised):
@@ -50,23 +53,23 @@ class ExactHessian(_Regularised):
         self.kept = None
         """The factor of the last free step and the optimality where it was taken, for chord steps."""
 
-    def chord_factor(self, optimality: float, recoveries: int) -> tuple | None:
+    def chord_factor(self, optimality: float, recoveries: int) -> CholeskyFactor | None:
         """The kept factor when a chord step from a free point of this ``optimality`` may use it, else None."""
         if recoveries == 0 and self.kept is not None and optimality <= REUSE_RATIO * self.kept[1]:
             self.kept = (self.kept[0], optimality)
             return self.kept[0]
         return None
 
-    def factor(self, point, recoveries: int, model_held: bool) -> tuple[Callable, tuple] | str:
-        """(solve(b), factor) of the regularised Hessian at ``point``, or why there is none."""
+    def factor(self, point, recoveries: int, model_held: bool) -> UpdatedFactor | Stop:
+        """The regularised Hessian at ``point``, factored (with no updates), or why there is none."""
         self.kept = None
         hessian = self.hessian(point.data)
-        factor, _ = self._factored(hessian, recoveries)
+        factor = self._factored(hessian, recoveries)
         if factor is None:
-            return _why_not_factored(hessian)
-        return (lambda b: cholesky_solve(factor, b)), factor
+            return _not_factored(hessian)
+        return UpdatedFactor(factor)
 
-    def stepped(self, factor: tuple, optimality: float, free: bool) -> None:
+    def stepped(self, factor: CholeskyFactor, optimality: float, free: bool) -> None:
         """A step was computed with ``factor`` at a point of this ``optimality``; a free one may be reused."""
         if free:
             self.kept = (factor, optimality)
@@ -94,9 +97,10 @@ class SecantHessian(_Regularised):
         """Never: the secant corrections change the matrix at every step."""
         return None
 
-    def factor(self, point, recoveries: int, model_held: bool) -> tuple[Callable, tuple | None] | str:
-        """(solve(b), factor or None when the matrix had updates since it was factored), or why there is none.
-        ``model_held``: the last step was a full one with no constraint in the working set."""
+    def factor(self, point, recoveries: int, model_held: bool) -> UpdatedFactor | Stop:
+        """The regularised, corrected Hessian at ``point`` as a factor with the secant updates since it was
+        factored, or why there is none. ``model_held``: the last step was a full one with no constraint in the
+        working set."""
         reused = self.assembled is not None and self.age < self.refresh and model_held
         if not reused:
             self.assembled, self.age = self.hessian(point.data), 0
@@ -109,29 +113,28 @@ class SecantHessian(_Regularised):
         self.previous = (point.x, point.g)
         # between assemblies the last factor takes the secant updates (Woodbury), unless it was shifted or
         # an update leaves the matrix indefinite: then the matrix is factored anew, with the shifts
-        reusable = reused and not recoveries and self.updated.shift == 0
+        reusable = reused and not recoveries and self.updated.cholesky.shift == 0
         self.updated = self.updated.updated(update) if reusable else None
         if self.updated is None:
-            factor, shift = self._corrected_factor(recoveries)
+            factor = self._corrected_factor(recoveries)
             if factor is None:
-                return _why_not_factored(self.assembled)
-            self.updated = UpdatedFactor(factor, shift)
-        return self.updated.solve, self.updated.factor
+                return _not_factored(self.assembled)
+            self.updated = UpdatedFactor(factor)
+        return self.updated
 
-    def _corrected_factor(self, recoveries: int) -> tuple[tuple | None, float]:
+    def _corrected_factor(self, recoveries: int) -> CholeskyFactor | None:
         """The factor of the assembled Hessian with the secant corrections, shifted by less than
         ``CORRECTED_SHIFT_LIMIT``; where that needs more, the corrections are dropped and the assembled Hessian alone
         is factored, with the shifts it needs.
 
-        Such corrections learnt curvature from steps the model does not hold along: on the Panda they put the
-        matrix's smallest eigenvalue tens of times its largest diagonal entry below zero while the assembled Hessian
-        was positive definite, and the shift that cured it, shrinking a third per iteration, held the steps short for
-        the next ten. Smaller shifts stay: along joint limits the corrections supply curvature the assembled Hessian
+        Such corrections learnt curvature from steps the model does not hold along: they can make the matrix
+        strongly indefinite while the assembled Hessian is positive definite, and the shift that cures it, shrinking
+        a third per iteration, would hold the steps short for many iterations. Smaller shifts stay: along joint limits the corrections supply curvature the assembled Hessian
         lacks, and without them the steps crawl."""
         if self.correction.any():
-            factor, shift = self._factored(self.assembled + self.correction, recoveries, below=CORRECTED_SHIFT_LIMIT)
+            factor = self._factored(self.assembled + self.correction, recoveries, below=CORRECTED_SHIFT_LIMIT)
             if factor is not None:
-                return factor, shift
+                return factor
             self.correction = np.zeros_like(self.assembled)
         return self._factored(self.assembled, recoveries)
 
@@ -144,62 +147,71 @@ class SecantHessian(_Regularised):
         self.correction, self.previous, self.assembled = None, None, None
 
 
-def _why_not_factored(hessian: np.ndarray) -> str:
-    """Why no shift of the schedule gave a factor of ``hessian``, in words."""
-    return "Hessian not finite" if not np.isfinite(hessian).all() else "no positive definite regularised Hessian"
+def _not_factored(hessian: np.ndarray) -> Stop:
+    """The failure when no shift of the schedule gave a factor of ``hessian``, with why in words."""
+    return Stop(Status.FAILED, "Hessian not finite" if not np.isfinite(hessian).all() else
+                "no positive definite regularised Hessian")
 
 
-def symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, float] | None:
+@dataclass(frozen=True)
+class RankOneUpdate:
+    """A symmetric rank-one change sign·u uᵀ of a matrix."""
+
+    u: np.ndarray
+    """(N,)."""
+    sign: float
+    """±1."""
+
+
+def symmetric_rank_one_update(correction: np.ndarray, H: np.ndarray, s: np.ndarray, y: np.ndarray) -> RankOneUpdate | None:
     """correction += r rᵀ / (rᵀ s), r = y - (H + correction) s, in place; skipped when rᵀ s is tiny
     (the usual safeguard: |rᵀ s| ≥ 1e-8 |r| |s|). correction and H (N, N), s and y (N,).
 
-    Returns the update as (u (N,), sign ±1), correction's change being sign·u uᵀ; None when skipped."""
+    Returns correction's change; None when skipped."""
     r = y - H @ s - correction @ s
     denominator = r @ s
     if abs(denominator) > 1e-8 * np.linalg.norm(r) * np.linalg.norm(s):
         u = r / np.sqrt(abs(denominator))  # u_i u_j = u_j u_i: the correction stays exactly symmetric
         sign = float(np.sign(denominator))
         correction += np.outer(u, sign * u)
-        return u, sign
+        return RankOneUpdate(u, sign)
     return None
 
 
 class UpdatedFactor:
     """Solves with a regularised hessian M = F + U S Uᵀ: F's Cholesky factor (from
-    :func:`~comanip.optim.shifted_cholesky`, with its relative ``shift``), and the secant updates made since it was
-    factored, U = [u_1 ... u_m] (N, m) with signs S = diag(±1), by the Woodbury identity
-    M⁻¹ b = F⁻¹ b - F⁻¹U C⁻¹ Uᵀ F⁻¹ b, C = S⁻¹ + Uᵀ F⁻¹ U (m, m): two triangular solves per update (about
-    0.1 ms for the Panda's 350 unknowns) instead of a factorisation (1.1 ms)."""
+    :func:`~comanip.optim.shifted_cholesky`), and the secant updates made since it was factored (none for an exact
+    Hessian), U = [u_1 ... u_m] (N, m) with signs S = diag(±1), by the Woodbury identity
+    M⁻¹ b = F⁻¹ b - F⁻¹U C⁻¹ Uᵀ F⁻¹ b, C = S⁻¹ + Uᵀ F⁻¹ U (m, m): two triangular solves per update instead of
+    a factorisation."""
 
-    def __init__(self, cholesky: tuple, shift: float, vectors: np.ndarray | None = None, signs: np.ndarray | None = None):
-        self.cholesky, self.shift = cholesky, shift
-        self.vectors = np.zeros((len(cholesky[0]), 0)) if vectors is None else vectors
+    def __init__(self, cholesky: CholeskyFactor, vectors: np.ndarray | None = None, signs: np.ndarray | None = None):
+        self.cholesky = cholesky
+        self.vectors = np.zeros((len(cholesky.triangle), 0)) if vectors is None else vectors
         self.signs = np.zeros(0) if signs is None else signs
         if len(self.signs):
-            self._solved = cholesky_solve(cholesky, self.vectors)  # F⁻¹ U
+            self._solved = cholesky.solve(self.vectors)  # F⁻¹ U
             self._capacitance = np.diag(self.signs) + self.vectors.T @ self._solved  # S⁻¹ = S for signs ±1
 
     @property
-    def factor(self) -> tuple | None:
+    def factor(self) -> CholeskyFactor | None:
         """M's Cholesky factor when no update was made since it was factored (M = F), else None."""
         return None if len(self.signs) else self.cholesky
 
     def solve(self, b: np.ndarray) -> np.ndarray:
         """M⁻¹ b for b (N,) or (N, k)."""
-        x = cholesky_solve(self.cholesky, b)
+        x = self.cholesky.solve(b)
         if not len(self.signs):
             return x
         return x - self._solved @ np.linalg.solve(self._capacitance, self._solved.T @ b)
 
-    def updated(self, update: tuple[np.ndarray, float] | None) -> "UpdatedFactor | None":
-        """The factor of M + sign·u uᵀ (``update`` as :func:`symmetric_rank_one_update` returns it; None: M
-        itself), or None when that matrix is not safely positive definite. By Haynsworth's inertia additivity
+    def updated(self, update: RankOneUpdate | None) -> "UpdatedFactor | None":
+        """The factor of M + sign·u uᵀ (``update``; None: M itself), or None when that matrix is not safely positive definite. By Haynsworth's inertia additivity
         M + U S Uᵀ is positive definite exactly when C has as many negative eigenvalues as S has negative signs;
         C nearly singular counts as not."""
         if update is None:
             return self
-        u, sign = update
-        factor = UpdatedFactor(self.cholesky, self.shift, np.column_stack([self.vectors, u]), np.append(self.signs, sign))
+        factor = UpdatedFactor(self.cholesky, np.column_stack([self.vectors, update.u]), np.append(self.signs, update.sign))
         eigenvalues = np.linalg.eigvalsh(factor._capacitance)
         if np.sum(eigenvalues < 0) != np.sum(factor.signs < 0) or np.min(np.abs(eigenvalues)) <= 1e-8 * np.max(np.abs(eigenvalues)):
             return None

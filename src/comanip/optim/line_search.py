@@ -4,7 +4,8 @@ merit m(alpha) = f + merit_weight·|c|_1 along a step."""
 
 from __future__ import annotations
 
-from typing import Callable, TypeVar
+from dataclasses import dataclass
+from typing import Callable, Generic, TypeVar
 
 T = TypeVar("T")
 
@@ -12,8 +13,18 @@ ARMIJO = 1e-4
 """Fraction of the linearly predicted decrease of the merit a step must achieve."""
 
 
+@dataclass(frozen=True)
+class Backtracked(Generic[T]):
+    """Where a backtracking line search ended."""
+
+    alpha: float
+    """The accepted step length; the next, untried one when none was accepted."""
+    accepted: T | None
+    """The accepted trial; None when none was."""
+
+
 def backtrack(attempt: Callable[[float, float], T | None], merit: float, slope: float, *,
-              max_trials: int) -> tuple[float, T | None]:
+              max_trials: int) -> Backtracked[T]:
     """The first step length alpha in 1, 1/2, 1/4, ... (at most ``max_trials``) that ``attempt`` accepts.
 
     Args:
@@ -24,12 +35,12 @@ def backtrack(attempt: Callable[[float, float], T | None], merit: float, slope: 
         max_trials: step lengths tried.
 
     Returns:
-        (alpha, trial) for the accepted trial; (the next, untried alpha, None) when none was accepted.
+        alpha and the accepted trial; the next, untried alpha and None when none was accepted.
     """
     alpha = 1.0
     for _ in range(max_trials):
         accepted = attempt(alpha, merit + ARMIJO * alpha * slope)
         if accepted is not None:
-            return alpha, accepted
+            return Backtracked(alpha, accepted)
         alpha *= 0.5
-    return alpha, None
+    return Backtracked(alpha, None)

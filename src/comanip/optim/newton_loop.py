@@ -1,23 +1,28 @@
-"""The one Newton iteration every solver in comanip runs: the planner's active-set SQP
-(:mod:`comanip.optim.active_set_newton`), the goal estimate's root finding on the regret's first-order conditions
-(:mod:`comanip.estimation.regret_newton`) and the online estimator's MAP goal (:mod:`comanip.estimation.map_newton`).
+"""The one Newton iteration every solver in comanip runs, the active-set SQP of
+:mod:`comanip.optim.active_set_newton` among them.
 
 One pass of :func:`newton_iterate`:
 
-1. when the budget is spent (``max_iterations``) or ``expired()``: stop, as a solution if ``method.converged``
-   finds the iterate is one, else with status ``max_iterations`` or ``max_wall_time``;
+1. when the budget is spent (``max_iterations``) or ``expired()``: stop, as a solution if the iterate is one
+   (step 3), else with status ``max_iterations`` or ``max_wall_time``;
 2. ``method.begin(state)``: count the iteration (a method that counts something else, such as linearisations, does
    nothing here);
-3. ``method.converged(state)``: a :class:`Stop` when the iterate is a solution (the test that needs no step);
+3. ``method.converged(state)``: a :class:`Stop` when the iterate is a solution (the test that needs no step); a
+   solution then goes through ``method.settle(state, stop)``, the method's last stage at a solution (a last
+   Newton step, a new active set): the final :class:`Stop`, or None when the stage moved the iterate, which is
+   then tested again;
 4. ``method.direction(state)``: the Newton direction at the iterate, or a :class:`Stop` found while computing it
-   (a converged constrained point, a Hessian that cannot be factored);
-5. ``method.globalise(state, direction)``: a line search or a trust region; True when the iterate moved;
-6. otherwise ``method.recover(state, direction)``: None to try again from the same iterate (a stronger
+   (a Hessian that cannot be factored);
+5. ``method.solved_along(state, direction)``: a :class:`Stop` when what the direction computed shows the iterate
+   is a solution (a constrained point's multipliers), settled as in step 3;
+6. ``method.globalise(state, direction)``: a line search or a trust region; True when the iterate moved;
+7. otherwise ``method.recover(state, direction)``: None to try again from the same iterate (a stronger
    regularisation, a fresh Hessian), or the :class:`Stop` that ends the solve.
 
 ``method.result(state, stop)`` turns the state into the :class:`~comanip.optim.SolverResult`. What differs between the
-solvers (the working set of constraints, secant corrections, trust regions, the goal's projection onto a
-range) lives in their methods, never in this loop.
+solvers (the working set of constraints, secant corrections, trust regions, a projection onto a feasible
+range) lives in their methods, never in this loop. A method that subclasses :class:`NewtonMethod` inherits the
+stages it does not need: ``settle`` keeps the stop, ``solved_along`` finds nothing.
 """
 
 from __future__ import annotations
@@ -51,10 +56,19 @@ class NewtonMethod(Protocol[S, D]):
         """Called once per pass, after the budget checks."""
 
     def converged(self, state: S) -> Stop | None:
-        """A stop when the iterate is a solution, before any direction is computed."""
+        """A stop when the iterate is a solution, before any direction is computed; only tests."""
+
+    def settle(self, state: S, stop: Stop) -> Stop | None:
+        """The last stage at an iterate ``converged`` or ``solved_along`` stopped at: the final stop, or None after
+        moving the iterate (to be tested again)."""
+        return stop
 
     def direction(self, state: S) -> D | Stop:
         """The step to try from the iterate, or why the solve ends."""
+
+    def solved_along(self, state: S, direction: D) -> Stop | None:
+        """A stop when what ``direction`` computed shows the iterate is a solution; only tests."""
+        return None
 
     def globalise(self, state: S, direction: D) -> bool:
         """Move the iterate along ``direction`` (line search or trust region); False when it did not move."""
@@ -78,22 +92,36 @@ def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
         spent = method.iterations(state) >= max_iterations
         if spent or expired():
             # the iterate the budget ends on may be a solution: then it is reported as one
-            stop = method.converged(state) or (
+            stop = _solution(method, state) or (
                 Stop(Status.MAX_ITERATIONS, f"no convergence in {max_iterations} Newton iterations") if spent else
                 Stop(Status.MAX_WALL_TIME, "the wall-time budget ran out"))
             return method.result(state, stop)
         method.begin(state)
-        stop = method.converged(state)
+        stop = _solution(method, state)
         if stop is None:
             direction = method.direction(state)
             if isinstance(direction, Stop):
                 stop = direction
+            elif (solved := method.solved_along(state, direction)) is not None:
+                stop = method.settle(state, solved)
+                if stop is None:
+                    continue
             elif method.globalise(state, direction):
                 continue
             else:
                 stop = method.recover(state, direction)
         if stop is not None:
             return method.result(state, stop)
+
+
+def _solution(method: NewtonMethod[S, D], state: S) -> Stop | None:
+    """The stop at the iterate when it is a solution (``converged``, then ``settle`` until it leaves the iterate
+    where it is), else None."""
+    while (stop := method.converged(state)) is not None:
+        settled = method.settle(state, stop)
+        if settled is not None:
+            return settled
+    return None
 
 
 class NewtonSolve(Generic[S]):

@@ -3,44 +3,49 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any, Generic, TypeVar
+from typing import Generic, TypeVar
 
+from comanip.optim.factorisation import CholeskyFactor
 from comanip.optim.status import CONVERGED, Status
 
 X = TypeVar("X")
+D = TypeVar("D")
+M = TypeVar("M")
 
 
 @dataclass(frozen=True)
-class LocalModel:
-    """What the active-set Newton method knows of the objective at its result: the Cholesky factor of the
-    (regularised, corrected) Hessian of the last step taken (as :func:`~comanip.optim.shifted_cholesky` gives it;
-    None if no step was taken or its matrix had secant updates since it was factored) and the evaluation's data
-    at the result."""
+class LocalModel(Generic[D]):
+    """What the active-set Newton method knows of the objective at its result, D the type of the caller's
+    evaluation data."""
 
-    factor: tuple | None
-    data: Any
+    factor: CholeskyFactor | None
+    """The Cholesky factor of the (regularised, corrected) Hessian of the last step taken; None if no step was
+    taken or its matrix had secant updates since it was factored."""
+    data: D
+    """The evaluation's data at the result."""
 
 
 @dataclass
-class SolverResult(Generic[X]):
-    """Where a solver stopped and why; never an exception for an unconverged solve."""
+class SolverResult(Generic[X, M]):
+    """Where a solver stopped and why; never an exception for an unconverged solve. X is the point's type, M the
+    type of what the solver knows of the objective at it."""
 
     x: X
-    """The best point found: an array (N,) for the planner, a RegretPoint for the goal estimate."""
+    """The best point found (an array (N,), or the solver's own point type)."""
     fun: float
-    """The objective there (normalised J for the planner, the normalised regret for the goal estimate)."""
+    """The objective there."""
     status: Status
     message: str
     """The status in words."""
     nit: int
-    """Iterations: Hessian evaluations (planner) or linearisations (goal estimate)."""
+    """Iterations, as the solver counts them (Hessian evaluations, linearisations)."""
     optimality: float
-    """First-order optimality at x: max |gradient of the Lagrangian| (planner) or max |F| (goal estimate)."""
+    """First-order optimality at x: max |gradient of the Lagrangian|, or max |F| for a root finder."""
     violation: float = 0.0
     """Largest constraint violation at x (units of the constraints)."""
-    local_model: Any = None
+    local_model: M | None = None
     """What the solver knows of the objective at and around x, for callers that build on it (the active-set Newton
-    method: a :class:`LocalModel`; the online estimator's MAP: its terms); None when it has nothing."""
+    method: a :class:`LocalModel`); None when it has nothing."""
 
     @property
     def success(self) -> bool:

@@ -35,9 +35,10 @@ from comanip.objectives.reward import GoalReward
 from comanip.model import model_key
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.caching.compiled import cached_compiled, compile_in_background, compiled_or_cached
+from comanip.optim import Evaluation
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
-from comanip.planning.terms import ReachTerms
+from comanip.planning.terms import GoalDerivatives, ReachTerms
 
 
 class ReachCurvature:
@@ -170,22 +171,22 @@ class ReachCurvature:
         """|J_best(w)|: the objective is divided by it."""
         return self.problem.normaliser(width)
 
-    def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ReachTerms]:
-        """(f, grad f (H·n,), data for :meth:`hessian`) at torques x (H·n,) and parameters p."""
+    def evaluate(self, x: np.ndarray, params: ReachParameters) -> Evaluation[ReachTerms]:
+        """f, grad f (H·n,) and the data for :meth:`hessian` at torques x (H·n,) and parameters p."""
         if self._compiling is not None and self._compiling.done():
             self._use_compiled_when_built()
         out = self._terms.vector(x, params.vector)
         ends, (hessians, gradients) = self._term_ends, self._reduced_shapes
-        return float(out[0]), out[1:ends[0]], ReachTerms(x, params.width, out[ends[0]:ends[1]].reshape(hessians),
-                                                         out[ends[1]:ends[2]].reshape(gradients))
+        return Evaluation(float(out[0]), out[1:ends[0]], ReachTerms(x, params.width, out[ends[0]:ends[1]].reshape(hessians),
+                                                                    out[ends[1]:ends[2]].reshape(gradients)))
 
     def value(self, x: np.ndarray, params: ReachParameters) -> float:
         """f at torques x (H·n,) alone."""
         return float(self._value.vector(x, params.vector)[0])
 
-    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> tuple[float, None]:
-        """(f, None) at torques x: a point mass has no path limits, so a line-search trial needs no data."""
-        return self.value(x, params), None
+    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> Evaluation[None]:
+        """f at torques x, without data: a point mass has no path limits, so a line-search trial needs none."""
+        return Evaluation(self.value(x, params), None, None)
 
     def final_position_change(self, torque_change: np.ndarray) -> np.ndarray:
         """How far (d,) m the mean end-effector position at step H moves for a change of the torques (H, n) (exact:
@@ -209,8 +210,8 @@ class ReachCurvature:
             hessian += self._velocity_hessian
         return hessian
 
-    def goal_derivatives(self, data: ReachTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned, exact.
+    def goal_derivatives(self, data: ReachTerms) -> GoalDerivatives:
+        """∂f/∂g (d,), ∂²f/∂x∂g (H·n, d) and ∂²f/∂g² (d, d) from the data :meth:`evaluate` returned, exact.
 
         phi_i depends on the goal only through mu_x,i - g (the reward is a density of their difference), so
         ∂phi_i/∂g = -∂phi_i/∂mu_x,i, ∂²phi_i/∂z_i∂g = -∂²phi_i/∂z_i∂mu_x,i and ∂²phi_i/∂g² = ∂²phi_i/∂mu_x,i²:
@@ -218,7 +219,8 @@ class ReachCurvature:
         ∂²f/∂x∂g = Σ_i Z_iᵀ ∂²phi_i/∂z_i∂g and ∂²f/∂g² = Σ_i ∂²phi_i/∂g² (the effort does not depend on g).
         """
         d = self.model.d
-        return -data.phi_grad[:, :d].sum(axis=0), self.goal_cross_derivative(data), data.phi_hess[:, :d, :d].sum(axis=0)
+        return GoalDerivatives(-data.phi_grad[:, :d].sum(axis=0), self.goal_cross_derivative(data),
+                               data.phi_hess[:, :d, :d].sum(axis=0))
 
     def goal_cross_derivative(self, data: ReachTerms) -> np.ndarray:
         """∂²f/∂x∂g (H·n, d) of :meth:`goal_derivatives` alone (what the tangential predictor needs)."""

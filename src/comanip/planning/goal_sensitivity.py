@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from comanip.optim import cholesky_solve
+from comanip.optim import CholeskyFactor
 
 
 class GoalSensitivity:
@@ -20,7 +20,7 @@ class GoalSensitivity:
         single_thread: a context in which the BLAS runs on one thread (the planner's).
     """
 
-    def __init__(self, curvature, factor: tuple, data, single_thread):
+    def __init__(self, curvature, factor: CholeskyFactor, data, single_thread):
         self._curvature, self._factor, self._data, self._single_thread = curvature, factor, data, single_thread
         self._matrix: np.ndarray | None = None
 
@@ -32,7 +32,7 @@ class GoalSensitivity:
         """d tau*/d goal (H·n, d)."""
         if self._matrix is None:
             with self._single_thread:
-                self._matrix = -cholesky_solve(self._factor, self._curvature.goal_cross_derivative(self._data))
+                self._matrix = -self._factor.solve(self._curvature.goal_cross_derivative(self._data))
             self._factor = self._data = None
         return self._matrix
 

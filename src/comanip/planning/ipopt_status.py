@@ -1,4 +1,5 @@
-"""What IPOPT says, in comanip's terms: its return status mapped to a plan status, and a wall-time deadline.
+"""What IPOPT says, in comanip's terms: its return status mapped to a solver status, a wall-time deadline, and a
+solver built with that deadline (:class:`IpoptSolver`).
 
 Shared by every problem comanip hands to IPOPT (the planner's reference solver, the paper's eq. 11 goal
 estimate).
@@ -7,6 +8,7 @@ estimate).
 from __future__ import annotations
 
 import time
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
@@ -60,3 +62,11 @@ class IpoptDeadline(ca.Callback):
 
     def eval(self, arg):
         return [1 if self.expired else 0]
+
+
+@dataclass(frozen=True)
+class IpoptSolver:
+    """An IPOPT solver built once, and the deadline its iteration callback watches (set before each solve)."""
+
+    function: ca.Function
+    deadline: IpoptDeadline

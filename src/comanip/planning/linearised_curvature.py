@@ -41,9 +41,10 @@ from comanip.model import model_key
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.caching.compiled import compiled_or_cached
 from comanip.planning.curvature import _noise_second_derivatives, _reward_derivatives_function
+from comanip.optim import Evaluation
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
-from comanip.planning.terms import ArmPieces, ArmTerms, Rollout
+from comanip.planning.terms import ArmPieces, ArmTerms, GoalDerivatives, Rollout, StateBelief
 
 
 class LinearisedCurvature:
@@ -136,11 +137,11 @@ class LinearisedCurvature:
                                                      for buffered in (self._gradient, self._pieces, self._value))
         return twin
 
-    def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ArmTerms]:
-        """(f, grad f (H·n,), data for :meth:`hessian` and :meth:`trajectory`) at torques x and parameters p."""
+    def evaluate(self, x: np.ndarray, params: ReachParameters) -> Evaluation[ArmTerms]:
+        """f, grad f (H·n,) and the data for :meth:`hessian` and :meth:`trajectory` at torques x and parameters p."""
         goal = params.goal
         f, grad, mean, cov = self._gradient(x, params.start, goal, params.width, *self._speed_weights)
-        return float(f.item()), grad.ravel(), ArmTerms(np.array(x, dtype=float), goal.copy(), params.width, mean, cov)
+        return Evaluation(float(f.item()), grad.ravel(), ArmTerms(np.array(x, dtype=float), goal.copy(), params.width, mean, cov))
 
     def pieces(self, data: ArmTerms) -> ArmPieces:
         """The Hessian's per-step pieces at the evaluation ``data``, computed on first request and kept in
@@ -150,12 +151,12 @@ class LinearisedCurvature:
         return data.pieces
 
     def value(self, x: np.ndarray, params: ReachParameters) -> float:
-        return self.value_and_data(x, params)[0]
+        return self.value_and_data(x, params).f
 
-    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> tuple[float, Rollout]:
-        """(f, data for :meth:`mean_path`) at torques x: the forward rollout alone, without derivatives."""
+    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> Evaluation[Rollout]:
+        """f and the data for :meth:`mean_path` at torques x: the forward rollout alone, without derivatives."""
         f, means = self._value(x, params.start, params.goal, params.width, *self._speed_weights)
-        return float(f.item()), Rollout(np.array(x, dtype=float), params.width, means)
+        return Evaluation(float(f.item()), None, Rollout(np.array(x, dtype=float), params.width, means))
 
     @staticmethod
     def mean_path(data: ArmTerms | Rollout) -> np.ndarray:
@@ -245,8 +246,8 @@ class LinearisedCurvature:
         c[-1] += stop
         return c
 
-    def goal_derivatives(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)) from the data :meth:`evaluate` returned.
+    def goal_derivatives(self, data: ArmTerms) -> GoalDerivatives:
+        """∂f/∂g (d,), ∂²f/∂x∂g (H·n, d) and ∂²f/∂g² (d, d) from the data :meth:`evaluate` returned.
 
         phi_i depends on the goal only through x_ee(q_i) - g, so ∂phi_i/∂g = -∂phi_i/∂mu_x,i and
         ∂²phi_i/∂z_i∂g = -∂²phi_i/∂z_i∂mu_x,i (columns of the per-step derivatives), and
@@ -275,7 +276,7 @@ class LinearisedCurvature:
         S = S.reshape(H, n, d, n).transpose(0, 1, 3, 2).reshape(H, n * n, d)
         E = np.einsum("jlrs,kl->kjrs", self._noise_hessian, x.reshape(H, n)).reshape(H, n, n * n)
         cross += (E @ S).reshape(H * n, d)
-        return -phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0)
+        return GoalDerivatives(-phi_grad[:d].sum(axis=1), cross, Q[:, :d, :d].sum(axis=0))
 
     def _noise_rows(self, G: np.ndarray, tau: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
         """The noise rows N_i = d vech Sigma_x,i / d tau through the noise injected at each step (A, B held), in
@@ -315,10 +316,10 @@ class LinearisedCurvature:
         half = cross + 0.5 * (gram[:, :, None] * scale).reshape(H, H * n)
         return (scale[:, :, None] * half[:, None, :]).reshape(H * n, H * n)
 
-    def trajectory(self, data: ArmTerms) -> tuple[np.ndarray, np.ndarray]:
-        """Mean (H+1, 2n) and covariance (H+1, 2n, 2n) of the evaluated torques."""
+    def trajectory(self, data: ArmTerms) -> StateBelief:
+        """The belief along the evaluated torques: mean (H+1, 2n) and covariance (H+1, 2n, 2n)."""
         n2, H = 2 * self.model.n, self.model.H
-        return data.mean.T.copy(), data.cov.reshape(n2, H + 1, n2).transpose(1, 0, 2).copy()
+        return StateBelief(data.mean.T.copy(), data.cov.reshape(n2, H + 1, n2).transpose(1, 0, 2).copy())
 
 
 _PIECE_FIELDS = ["A", "B", "J", "phi_hess", "phi_grad", "kinematic_hessian", "dvech"]

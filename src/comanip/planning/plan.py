@@ -5,18 +5,26 @@ from __future__ import annotations
 import csv
 import json
 from dataclasses import dataclass, field, replace
+from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from comanip.optim import CONVERGED, Status
+from comanip.optim import CONVERGED
 
 if TYPE_CHECKING:  # the planner makes it; a plan only carries it
     from comanip.planning.goal_sensitivity import GoalSensitivity
 
 
-#: statuses of a solver that converged (to its tolerance, or to an acceptable level)
+class PlanStatus(StrEnum):
+    """How a plan ended when the solver's outcome (:class:`comanip.optim.Status`) does not say it. A ``str``, like
+    :class:`comanip.optim.Status`."""
+
+    GOAL_NOT_REACHED = "goal_not_reached"
+    """The solver converged but the plan's mean end effector ends farther than the goal width from the goal."""
+    UNREACHABLE = "unreachable"
+    """The goal is out of the arm's reach; nothing was solved."""
 
 
 @dataclass
@@ -94,7 +102,7 @@ class Plan:
     @property
     def converged(self) -> bool:
         """True when the solver converged, whether or not the plan reaches the goal (see ``success``)."""
-        return self.status in CONVERGED or self.status == Status.GOAL_NOT_REACHED
+        return self.status in CONVERGED or self.status == PlanStatus.GOAL_NOT_REACHED
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (arrays as nested lists)."""
@@ -144,5 +152,5 @@ def with_reach_check(plan: Plan) -> Plan:
         return plan
     message = (f"the plan ends {plan.final_error:.4g} m from the goal, beyond the goal width {plan.width:g} m "
                f"(solver: {plan.status}, {plan.message})")
-    return replace(plan, success=False, status=Status.GOAL_NOT_REACHED, message=message,
+    return replace(plan, success=False, status=PlanStatus.GOAL_NOT_REACHED, message=message,
                    extras={**plan.extras, "solver_status": plan.status})

@@ -41,14 +41,14 @@ from comanip.arguments import as_bounded_vector, as_count, as_goal_width, as_opt
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.planning.curvature import ReachCurvature
-from comanip.optim import CONVERGED, NewtonSolve, SolverResult, Status
-from comanip.planning.ipopt_status import IpoptDeadline, ipopt_status
+from comanip.optim import CONVERGED, Evaluation, LocalModel, NewtonSolve, SolverResult, Status
+from comanip.planning.ipopt_status import IpoptDeadline, IpoptSolver, ipopt_status
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.optim.active_set_newton import newton_solve
 from comanip.optim.newton_loop import never
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
-from comanip.planning.plan import Plan, with_reach_check
+from comanip.planning.plan import Plan, PlanStatus, with_reach_check
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.start_threads import StartThreads, usable_cores
@@ -198,7 +198,7 @@ class Planner:
         self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
         self._limits = PathLimits.of(self.model)
         self._blas = _SingleThreadBlas()
-        self._ipopt, self._deadline = self._ipopt_solver() if self.options.method == "ipopt" else (None, None)
+        self._ipopt = self._ipopt_solver() if self.options.method == "ipopt" else None
         self.starts = StartPolicy(self.model, self.options, problem, self._curvature, self._limits, self._solve_reach)
         """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`)."""
         self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
@@ -247,9 +247,8 @@ class Planner:
             return ReachCurvature(self.problem, compile=compile)
         return LinearisedCurvature(self.problem, compile=compile is not False)
 
-    def _ipopt_solver(self) -> tuple[ca.Function, IpoptDeadline]:
-        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian, and the deadline its
-        iteration callback watches (set before each solve)."""
+    def _ipopt_solver(self) -> IpoptSolver:
+        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian."""
         problem = self.problem
         params = ca.vertcat(problem.s0, problem.goal, problem.width)
         ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
@@ -258,7 +257,7 @@ class Planner:
         solver = ca.nlpsol("planner", "ipopt",
                            {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
                            {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
-        return solver, deadline
+        return IpoptSolver(solver, deadline)
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (nx,), goal (d,), width) or ValueError naming the argument (:func:`reach_inputs`)."""
@@ -341,7 +340,7 @@ class Planner:
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
-        return self._make_plan(torque, params, status=Status.UNREACHABLE, success=False, message=message,
+        return self._make_plan(torque, params, status=PlanStatus.UNREACHABLE, success=False, message=message,
                                solve_time=time.perf_counter() - t_begin, iterations=0)
 
     def _sensitivity_of(self, result: SolverResult) -> GoalSensitivity | None:
@@ -370,7 +369,7 @@ class Planner:
         # of the tolerances can still be far better than one that converged on the zero-reward plateau (seen on the
         # Panda), and the status then says it did not converge.
         best = min(results, key=_rank)
-        evaluation = None if best.local_model is None else (best.fun, best.local_model.data)
+        evaluation = None if best.local_model is None else Evaluation(best.fun, None, best.local_model.data)
         plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
                                solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
         plan.goal_sensitivity = self._sensitivity_of(best)
@@ -427,22 +426,21 @@ class Planner:
         """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
         plan can rest on the zero-reward plateau instead)."""
         model, curvature = self.model, self._curvature
-        q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params)[1])[-1, : model.n]
+        q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params).data)[-1, : model.n]
         end = np.asarray(model.body.kinematics_function(q_end)[0]).ravel()
         return bool(np.linalg.norm(end - params.goal) <= params.width)
 
-    def _make_plan(self, torque, params: ReachParameters, evaluation: tuple | None = None, **fields) -> Plan:
-        """The Plan of torques (H, n); ``evaluation`` = (f, data): the Newton method's own evaluation at them, from
-        which an arm's belief is taken without evaluating again (about 4 ms of a Panda solve)."""
-        start, goal, width = params.start, params.goal, params.width
+    def _make_plan(self, torque, params: ReachParameters, evaluation: Evaluation | None = None, **fields) -> Plan:
+        """The Plan of torques (H, n); ``evaluation``: the Newton method's own evaluation at them (its f and data),
+        from which an arm's belief is taken without evaluating again."""
         curvature = self._curvature
         if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
-            return self.problem.make_plan(torque, start, goal, width, **fields)
-        f, data = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)[::2]
-        return self.problem.make_plan(torque, start, goal, width, belief=curvature.trajectory(data),
-                                      objective=f * curvature.normaliser(width), **fields)
+            return self.problem.make_plan(torque, params, **fields)
+        evaluation = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)
+        return self.problem.make_plan(torque, params, belief=curvature.trajectory(evaluation.data),
+                                      objective=evaluation.f * curvature.normaliser(params.width), **fields)
 
-    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
+    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
         """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
         fun the normalised objective."""
         if self._curvature is None:
@@ -460,17 +458,17 @@ class Planner:
                             constraint_tolerance=LIMIT_TOLERANCE, value=value,
                             expired=(lambda: time.perf_counter() > deadline) if deadline < np.inf else never)
 
-    def _as_torques(self, result: SolverResult) -> SolverResult[np.ndarray]:
+    def _as_torques(self, result: SolverResult[np.ndarray, LocalModel]) -> SolverResult[np.ndarray, LocalModel]:
         """The result with x as torques (H, n)."""
         result.x = result.x.reshape(self.model.H, self.model.n)
         return result
 
-    def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray]:
-        solver = self._ipopt
-        self._deadline.time = deadline
+    def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
+        solver = self._ipopt.function
+        self._ipopt.deadline.time = deadline
         result = solver(x0=np.ravel(guess), p=params.vector)
         stats = solver.stats()
-        status = ipopt_status(stats, self._deadline)
+        status = ipopt_status(stats, self._ipopt.deadline)
         torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
         return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
 

@@ -18,6 +18,8 @@ from comanip.objectives.reach_objective import reach_objective, velocity_cost
 from comanip.objectives.reward import GoalReward
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.planning.plan import Plan
+from comanip.planning.reach_parameters import ReachParameters
+from comanip.planning.terms import StateBelief
 
 
 class ReachProblem:
@@ -96,14 +98,16 @@ class ReachProblem:
         ee_cov (d, d·(H+1)), J."""
         return dict(zip(self._trajectory_outputs, self._trajectory(np.ravel(torque), start, goal, width)))
 
-    def make_plan(self, torque, start, goal, width, *, status: str, success: bool, message: str,
-                  solve_time: float, iterations: int, extras: dict | None = None, belief=None, objective=None) -> Plan:
-        """A :class:`Plan` for torques (H, n): rolls the belief out and fills every field.
+    def make_plan(self, torque, params: ReachParameters, *, status: str, success: bool, message: str,
+                  solve_time: float, iterations: int, extras: dict | None = None, belief: StateBelief | None = None,
+                  objective=None) -> Plan:
+        """A :class:`Plan` for torques (H, n) of the reach ``params``: rolls the belief out and fills every field.
 
-        ``belief`` = (mean (H+1, 2n), cov (H+1, 2n, 2n)) and ``objective`` (J) already computed for these
-        torques skip the rollout (for the Panda the expanded rollout costs about 9 ms).
+        ``belief`` and ``objective`` (J) already computed for these torques skip the rollout (for an arm the
+        expanded rollout is costly).
         """
         model = self.model
+        start, goal, width = params.start, params.goal, params.width  # the compiled rollouts take them apart
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
         if belief is None and self._plan_rollout is not None:
@@ -118,7 +122,7 @@ class ReachProblem:
                 ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
                 mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
             else:
-                mean, cov = belief
+                mean, cov = belief.mean, belief.cov
                 ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
                 J = np.asarray(objective, dtype=float)
             ee_mean, ee_cov = ee_mean.T, ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2)
@@ -128,5 +132,5 @@ class ReachProblem:
             solve_time=solve_time, iterations=iterations, t=model.h * np.arange(H + 1),
             mean=mean, cov=cov, torque=torque,
             ee_mean=ee_mean, ee_cov=ee_cov, ee_velocity=ee_velocity,
-            start=np.asarray(start, dtype=float), goal=np.asarray(goal, dtype=float), width=float(width),
+            start=start, goal=goal, width=width,
             model_name=model.name, extras=extras or {})

@@ -18,7 +18,30 @@ from typing import Protocol
 
 import numpy as np
 
+from comanip.optim import Evaluation
 from comanip.planning.reach_parameters import ReachParameters
+
+
+@dataclass(frozen=True, eq=False)
+class StateBelief:
+    """The state's belief along a plan."""
+
+    mean: np.ndarray
+    """Mean states (H+1, nx)."""
+    cov: np.ndarray
+    """Their covariances (H+1, nx, nx)."""
+
+
+@dataclass(frozen=True, eq=False)
+class GoalDerivatives:
+    """The objective's derivatives in the goal g (d,), m, at one evaluation at torques x (H·n,)."""
+
+    gradient: np.ndarray
+    """∂f/∂g (d,)."""
+    cross: np.ndarray
+    """∂²f/∂x∂g (H·n, d)."""
+    hessian: np.ndarray
+    """∂²f/∂g² (d, d)."""
 
 
 @dataclass(eq=False, slots=True)
@@ -112,17 +135,17 @@ class Curvature(Protocol):
     def normaliser(self, width: float) -> float:
         """|J_best(w)| for width w (m)."""
 
-    def evaluate(self, x: np.ndarray, params: ReachParameters) -> tuple[float, np.ndarray, ReachTerms]:
-        """(f, ∇f (H·n,), data) at torques x (H·n,) and parameters p."""
+    def evaluate(self, x: np.ndarray, params: ReachParameters) -> Evaluation[ReachTerms | ArmTerms]:
+        """f, ∇f (H·n,) and the data at torques x (H·n,) and parameters p."""
 
     def value(self, x: np.ndarray, params: ReachParameters) -> float:
         """f at torques x."""
 
-    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> tuple[float, ReachTerms | Rollout]:
-        """(f, data enough for the path limits) at torques x, as cheaply as the curvature can."""
+    def value_and_data(self, x: np.ndarray, params: ReachParameters) -> Evaluation[Rollout | None]:
+        """f and data enough for the path limits (no gradient) at torques x, as cheaply as the curvature can."""
 
     def hessian(self, data: ReachTerms) -> np.ndarray:
         """∇²f (H·n, H·n), exact or approximate (see :attr:`exact`)."""
 
-    def goal_derivatives(self, data: ReachTerms) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d))."""
+    def goal_derivatives(self, data: ReachTerms) -> GoalDerivatives:
+        """∂f/∂g (d,), ∂²f/∂x∂g (H·n, d), ∂²f/∂g² (d, d)."""

@@ -10,7 +10,7 @@ from __future__ import annotations
 from comanip.estimation.explanations.base import Explained, HandTrace, Reach
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_rest import REST_RADIUS_M
-from comanip.optim import Status
+from comanip.estimation.estimate_status import EstimateStatus
 
 
 class HandAtRest:
@@ -22,6 +22,6 @@ class HandAtRest:
     def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
         reach = self.reach
         resting = not hand.has_left(reach.start_position)
-        return Explained(reach.prior_mean, reach.prior_cov, resting, Status.UNINFORMATIVE,
+        return Explained(reach.prior_mean, reach.prior_cov, resting, EstimateStatus.UNINFORMATIVE,
                          f"the hand has not left its start (within {1e3 * REST_RADIUS_M:g} mm): the estimate is the prior"
                          if resting else "the hand has left its start")

@@ -19,6 +19,7 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_rest import has_left
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 
 
@@ -127,7 +128,7 @@ class Explained:
     """Its covariance (d, d), m²."""
     explains: bool
     """Whether this explanation explains the hand (else the next one is asked)."""
-    status: Status
+    status: Status | EstimateStatus
     """The estimate's status when this explanation gives it."""
     message: str
     """What it found: why it explains the hand, or why not."""

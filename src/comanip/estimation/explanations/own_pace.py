@@ -39,6 +39,7 @@ from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
 from comanip.model import ReachingModel
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
 
@@ -146,10 +147,10 @@ class ModelAtOwnPace:
                              self._sums[steps] / counts[:, None], self._weights[steps] / counts[:, None])
         previous = self._last
         try:
-            if previous is None or previous.status in (Status.UNINFORMATIVE, Status.FAILED):
+            if previous is None or previous.status in (EstimateStatus.UNINFORMATIVE, Status.FAILED):
                 goal = problem.cold_goal(hand.last_observation, options.observation_std, self._R[None] / counts[:, None, None])
                 if goal is None:
-                    return Explained(reach.prior_mean, reach.prior_cov, True, Status.UNINFORMATIVE,
+                    return Explained(reach.prior_mean, reach.prior_cov, True, EstimateStatus.UNINFORMATIVE,
                                      "no observation shows movement: the estimate is the prior")
             else:
                 goal = previous.goal

@@ -7,6 +7,7 @@ from __future__ import annotations
 from comanip.estimation.explanations.base import Explained, HandTrace, Reach
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.people_model import PeopleModel
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 
 
@@ -24,5 +25,5 @@ class RecordedPeople:
         predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
         if predicted is None:
             return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
-        return reach.landed(Explained(predicted.goal, predicted.covariance, True, Status.PEOPLE_MODEL,
+        return reach.landed(Explained(predicted.goal, predicted.covariance, True, EstimateStatus.PEOPLE_MODEL,
                                       "the goal is the people model's"), hand.position[-1])

@@ -8,6 +8,7 @@ the solver where the reward is felt; the duration selects among the local optima
 from __future__ import annotations
 
 import functools
+from dataclasses import dataclass
 
 import casadi as ca
 import numpy as np
@@ -77,12 +78,12 @@ def _quintic(x0, v0, x1, times: _QuinticTimes, positions: bool = True) -> tuple[
 
 
 def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q: np.ndarray, duration,
-                         linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+                         linear_dynamics: LinearDynamics | None = None) -> np.ndarray:
     """Commands (H, n) that make the mean follow a joint-space minimum-jerk reach from start (nx,) to goal_q (n,)
     (through the body's activation stages, if it has them); for durations (m,), one per duration (m, H, n), to
     goal_q (n,) or to a goal per duration (m, 1, n).
 
-    ``linear_dynamics``: a linear body's constant (M (n, n), G (n,)) from :func:`linear_dynamics_of`, evaluated
+    ``linear_dynamics``: a linear body's constant M and G from :func:`linear_dynamics_of`, evaluated
     once by a caller that makes many guesses; None evaluates them here."""
     durations = np.asarray(duration, dtype=float)
     q, qdot, qddot = _quintic(start[: body.n], start[body.n:2 * body.n], goal_q,
@@ -90,8 +91,8 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
     if not durations.ndim:
         q, qdot, qddot = None if q is None else q[0], qdot[0], qddot[0]
     if body.is_linear:  # constant M and G: inverse dynamics of all steps (and durations) at once
-        M, G = linear_dynamics or linear_dynamics_of(body)
-        force = qddot @ M.T + qdot @ body.damping.T + G
+        dynamics = linear_dynamics or linear_dynamics_of(body)
+        force = qddot @ dynamics.mass.T + qdot @ body.damping.T + dynamics.gravity
         return np.array([body.command_for_force(f, h) for f in force]) if force.ndim == 3 else body.command_for_force(force, h)
     if q.ndim == 3:
         return np.array([_arm_torques(body, h, H, *profile) for profile in zip(q, qdot, qddot)])
@@ -106,15 +107,25 @@ def _arm_torques(body: Body, h: float, H: int, q, qdot, qddot) -> np.ndarray:
     return body.command_for_force(np.einsum("irs,is->ir", M, qddot) + qdot @ body.damping.T + G, h)
 
 
-def linear_dynamics_of(body: Body) -> tuple[np.ndarray, np.ndarray]:
-    """(M (n, n), G (n,)) of a linear body: the same at every q."""
+@dataclass(frozen=True)
+class LinearDynamics:
+    """A linear body's mass matrix and gravity, the same at every q."""
+
+    mass: np.ndarray
+    """M (n, n)."""
+    gravity: np.ndarray
+    """G (n,)."""
+
+
+def linear_dynamics_of(body: Body) -> LinearDynamics:
+    """The constant M and G of a linear body."""
     q = np.zeros(body.n)
-    return np.asarray(body.mass_matrix_function(q)), np.asarray(body.gravity_function(q)).ravel()
+    return LinearDynamics(np.asarray(body.mass_matrix_function(q)), np.asarray(body.gravity_function(q)).ravel())
 
 
 def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q: np.ndarray, durations,
                        mean: np.ndarray | None = None,
-                       linear_dynamics: tuple[np.ndarray, np.ndarray] | None = None) -> list[np.ndarray]:
+                       linear_dynamics: LinearDynamics | None = None) -> list[np.ndarray]:
     """A plan's torques (H, n) with a rest-to-rest minimum-jerk move by shift_q (n,) superposed, one result
     per duration (s): delta tau = M(q_i) delta qddot_i + D delta qdot_i along the plan's mean (H+1, 2n).
 
@@ -125,7 +136,7 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
     :func:`minimum_jerk_torques`.
     """
     if body.is_linear:
-        inertia = np.broadcast_to((linear_dynamics or linear_dynamics_of(body))[0], (H, body.n, body.n))
+        inertia = np.broadcast_to((linear_dynamics or linear_dynamics_of(body)).mass, (H, body.n, body.n))
     elif mean is None:
         raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
     else:

@@ -22,8 +22,8 @@ from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
-from comanip.planning.starts.initial_guess import (brake_durations, braked_torques, guess_durations, linear_dynamics_of,
-                                                   minimum_jerk_torques, retargeted_torques)
+from comanip.planning.starts.initial_guess import (LinearDynamics, brake_durations, braked_torques, guess_durations,
+                                                   linear_dynamics_of, minimum_jerk_torques, retargeted_torques)
 from comanip.planning.starts.reach_library import ReachLibrary, is_symmetric
 from comanip.planning.terms import Curvature
 
@@ -152,8 +152,8 @@ class StartPolicy:
         curvature = self.curvature
         if curvature is None or not curvature.carries_belief or not self.limits.active:
             return False, self.objective(torque, params)
-        f, data = curvature.value_and_data(np.ravel(torque), params)
-        return self.limits.violation(curvature.mean_path(data)) > LIMIT_TOLERANCE, f
+        evaluation = curvature.value_and_data(np.ravel(torque), params)
+        return self.limits.violation(curvature.mean_path(evaluation.data)) > LIMIT_TOLERANCE, evaluation.f
 
     def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
@@ -271,7 +271,7 @@ class StartPolicy:
         velocity = params.start[model.n:2 * model.n]
         for entry_goal, torque in library.nearest(goal, entries):
             entry_params = ReachParameters(library.start, entry_goal, library.width)
-            mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params)[1])
+            mean = self.curvature.mean_path(self.curvature.value_and_data(np.ravel(torque), entry_params).data)
             moved = self.retargeted(torque, mean, entry_goal, goal)
             if np.any(velocity):
                 moved = [braked for candidate in moved for braked in
@@ -307,12 +307,12 @@ class StartPolicy:
         return self.problem.objective_value(torque, params.start, params.goal, params.width)
 
 
-def _damped_drift(body, linear_dynamics) -> np.ndarray | None:
+def _damped_drift(body, linear_dynamics: LinearDynamics | None) -> np.ndarray | None:
     """D⁻¹ M (n, n) of a linear body with mass matrix M and damping D (M v' = -D v carries it D⁻¹ M v0 from a start
     velocity v0); None without linear dynamics or when D is singular (the damping alone does not stop it)."""
     if linear_dynamics is None:
         return None
-    mass, damping = linear_dynamics[0], np.asarray(body.damping, dtype=float)
+    mass, damping = linear_dynamics.mass, np.asarray(body.damping, dtype=float)
     if np.linalg.matrix_rank(damping) < len(damping):
         return None
     return np.linalg.solve(damping, mass)
