@@ -14,6 +14,8 @@ the sub-movements of one reach only rarely exceeds.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 REST_RADIUS_M = 0.005
@@ -37,15 +39,24 @@ def has_left(position: np.ndarray, start: np.ndarray, radius: float = REST_RADIU
     return bool(np.any((offset * offset).sum(axis=1) > radius * radius))
 
 
-def fitted_velocity(t: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, float]:
+class FittedVelocity(NamedTuple):
+    """The velocity of a straight line fitted to positions."""
+
+    velocity: np.ndarray
+    """(d,) m/s."""
+    standard_error: float
+    """Per axis (m/s), from the positions' scatter about the line (pooled over the axes)."""
+
+
+def fitted_velocity(t: np.ndarray, position: np.ndarray) -> FittedVelocity:
     """The velocity (d,) m/s of a straight line fitted to positions (K, d) m at times (K,) s (K ≥ 3), and its
-    standard error per axis (m/s) from the positions' scatter about the line (pooled over the axes)."""
+    standard error."""
     times = t - t.mean()
     offset = position - position.mean(axis=0)
     spread = float(times @ times)
     slope = times @ offset / spread
     residual = offset - np.outer(times, slope)
-    return slope, float(np.sqrt(float((residual * residual).sum()) / max(len(times) - 2, 1) / spread))
+    return FittedVelocity(slope, float(np.sqrt(float((residual * residual).sum()) / max(len(times) - 2, 1) / spread)))
 
 
 def resting_position(t: np.ndarray, position: np.ndarray, window: float = REST_WINDOW_S, radius: float = REST_RADIUS_M,

@@ -15,6 +15,8 @@ velocity (for a point mass starting at rest, the very line of the reach) at dist
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from scipy.optimize import minimize_scalar
 
@@ -26,15 +28,32 @@ _AT_REST = 1e-6
 """Below this speed (m/s) and displacement (m) the observation shows no movement to extrapolate."""
 
 
-def task_space_state(planner: Planner, state: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """End-effector position (d,) m and velocity J(q) qdot (d,) m/s of a state [q; qdot; ...] (2n or nx,)."""
+class TaskSpaceState(NamedTuple):
+    """Where the hand is and how it moves."""
+
+    position: np.ndarray
+    """End-effector position (d,), m."""
+    velocity: np.ndarray
+    """J(q) qdot (d,), m/s."""
+
+
+class FoundGoal(NamedTuple):
+    """A goal found along the observed direction, with its plan."""
+
+    goal: np.ndarray
+    """(d,), m."""
+    plan: Plan
+
+
+def task_space_state(planner: Planner, state: np.ndarray) -> TaskSpaceState:
+    """The end effector's position and velocity of a state [q; qdot; ...] (2n or nx,)."""
     n = planner.model.n
     x, J = (np.asarray(v) for v in planner.model.body.kinematics_function(state[:n]))
-    return x.ravel(), J @ state[n:2 * n]
+    return TaskSpaceState(x.ravel(), J @ state[n:2 * n])
 
 
 def search_along_observed_direction(planner: Planner, start, observed, n_o: int, prior, width: float, R: np.ndarray,
-                                    distances: tuple[float, float], step_jacobians, remaining_time) -> tuple[np.ndarray, Plan] | None:
+                                    distances: tuple[float, float], step_jacobians, remaining_time) -> FoundGoal | None:
     """The goal x_o + D u, u the observed direction, whose plan makes the observed state most likely.
 
     With a prior (a :class:`GoalPrior`) the score is the posterior: the log-likelihood plus log N(g; g_bar, P0),
@@ -76,4 +95,4 @@ def search_along_observed_direction(planner: Planner, start, observed, n_o: int,
     low, high = np.log(distances[0]), np.log(distances[1])
     best = minimize_scalar(misfit, bounds=(low, high), method="bounded", options={"xatol": 0.02})
     plan = tried[best.x] if best.x in tried else plan_at(best.x)
-    return plan.goal, plan
+    return FoundGoal(plan.goal, plan)

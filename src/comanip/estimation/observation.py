@@ -22,6 +22,8 @@ from __future__ import annotations
 
 import math
 
+from typing import NamedTuple
+
 import numpy as np
 
 from comanip.arguments import as_matrix, as_positive, as_vector
@@ -66,7 +68,18 @@ def observed_state(model: ReachingModel, state, name: str = "observed") -> np.nd
     return as_vector(name, state, 2 * model.n, "state [q; qdot] in m and m/s, or rad and rad/s")
 
 
-def observed_sequence(model: ReachingModel, states, times) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class ObservedSequence(NamedTuple):
+    """Checked, time-ordered observations."""
+
+    states: np.ndarray
+    """(K, 2n) [q; qdot]."""
+    times: np.ndarray
+    """(K,) s."""
+    steps: np.ndarray
+    """(K,) the grid step at or before each time."""
+
+
+def observed_sequence(model: ReachingModel, states, times) -> ObservedSequence:
     """Checked time-ordered observations: states (K, 2n), times (K,) s in [0, H·h] -> (states, times, steps (K,)).
 
     A single observation may be given as a state (2n,) and a scalar time.
@@ -87,7 +100,7 @@ def observed_sequence(model: ReachingModel, states, times) -> tuple[np.ndarray, 
     if np.any(np.diff(times) < 0):
         raise ValueError(f"times must be non-decreasing (s), got {times.tolist()}")
     steps = np.array([observation_step(model, t, allow_start=True, name="times") for t in times])
-    return states, times, steps
+    return ObservedSequence(states, times, steps)
 
 
 def observation_covariance(observation_std, n: int) -> np.ndarray:

@@ -14,10 +14,20 @@ shape: the minimum-jerk reach (:meth:`ReachProfile.minimum_jerk`) and a movement
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 _POINTS = 201
+
+
+class ProfilePoints(NamedTuple):
+    """A shape read at normalised times phi (any shape)."""
+
+    fraction: np.ndarray
+    """r(phi): 0 before 0, 1 after 1."""
+    rate: np.ndarray
+    """r'(phi): 0 outside (0, 1)."""
 
 
 @dataclass(frozen=True)
@@ -50,9 +60,9 @@ class ReachProfile:
         s = np.linspace(0.0, 1.0, _POINTS)
         return cls(s, 10 * s**3 - 15 * s**4 + 6 * s**5, 30 * s**2 * (1 - s) ** 2, "minimum jerk")
 
-    def __call__(self, phi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    def __call__(self, phi: np.ndarray) -> "ProfilePoints":
         """(r(phi), r'(phi)) at normalised times ``phi`` (any shape); 0 before 0, (1, 0) after 1."""
         phi = np.asarray(phi, dtype=float)
         inside = (phi > 0) & (phi < 1)
-        return (np.interp(phi, self.phase, self.fraction, left=0.0, right=1.0),
-                np.where(inside, np.interp(phi, self.phase, self.rate), 0.0))
+        return ProfilePoints(np.interp(phi, self.phase, self.fraction, left=0.0, right=1.0),
+                             np.where(inside, np.interp(phi, self.phase, self.rate), 0.0))
