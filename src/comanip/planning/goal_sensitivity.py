@@ -12,7 +12,7 @@ from comanip.optim import CholeskyFactor
 
 
 class GoalSensitivity:
-    """d tau*/d goal (H·n, d) of one plan, computed on first use (about 0.05 ms), not after every solve.
+    """d tau*/d goal (H·n, d) of one plan, computed on first use, not after every solve.
 
     Args:
         curvature: the exact Newton terms the plan was solved with (their ``goal_cross_derivative``).

@@ -3,7 +3,7 @@
 Notation as in :mod:`comanip.planning.curvature`: x = tau flattened (H·n,), z_i = (mu_x,i, vech Sigma_x,i),
 phi_i = -w_i R / |J_best|, T_ik = d mu_q,i / d tau_k (n, n), G_ik = J_i T_ik. For a nonlinear body A_i,
 B_i and J_i depend on the mean path, and the exact Hessian needs third derivatives of the rigid-body
-dynamics along all of it (CasADi's: about 20 s per evaluation for the Panda). The Hessian here keeps
+dynamics along all of it (far too slow to evaluate for an arm in a Newton loop). The Hessian here keeps
 
 - Z_i's mean rows exactly (G_ik, by the chain rule along the mean: T_{i+1,k} = A_i T_ik, T_{k+1,k} = B_k);
 - Z_i's covariance rows from the noise injected at each step (A, B held fixed) and from J_i's dependence
@@ -15,9 +15,8 @@ dynamics along all of it (CasADi's: about 20 s per evaluation for the Panda). Th
   Σ_i c_i tr Sigma_qdot,i through the noise injected at each step (A, B held);
 
 and leaves out the curvature of the dynamics and the dependence of A_i, B_i on the mean path. Along the
-eigenvectors of the exact Hessian it agrees to a few per cent except in a handful of directions of
-negative curvature (measured on the Panda, benchmarks/README.md); the Newton method's secant corrections
-learn those. The gradient is exact, so the optimum is that of the docs/formulation.md §4 objective.
+eigenvectors of the exact Hessian it agrees closely except in a few directions of negative curvature; the
+Newton method's secant corrections learn those. The gradient is exact, so the optimum is that of the docs/formulation.md §4 objective.
 
 The objective and gradient come from one CasADi function, the per-step pieces of the Hessian from a second one
 evaluated on the first one's rollout only when a Hessian is assembled (with ``hessian_refresh`` about one

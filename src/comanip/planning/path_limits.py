@@ -7,8 +7,8 @@ rows of d mu_i / d tau, exact along the mean (the curvature object computes them
 Jacobians). The Newton method (:func:`comanip.optim.active_set_newton.newton_minimize`) keeps the few binding
 ones in its working set; most reaches bind none and pay nothing.
 
-An augmented Lagrangian (penalty rounds with multiplier updates) was measured first: 70–200 Newton
-iterations per warm Franka solve against 50–70 with the working set (benchmarks/README.md).
+An augmented Lagrangian (penalty rounds with multiplier updates) needs more Newton iterations per warm arm
+solve than the working set.
 """
 
 from __future__ import annotations

@@ -14,7 +14,7 @@ Two solvers (``SolverOptions.method``):
   (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from per-step pieces: exact for point masses
   (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
   (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
-  Several times faster than IPOPT on the point masses, to the same optimum (benchmarks/README.md).
+  Several times faster than IPOPT on the point masses, to the same optimum (docs/results/speed.md).
 - ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference,
   point masses only.
 
@@ -145,7 +145,7 @@ class SolverOptions:
     in a background thread once the planner has spent ``compile_after`` seconds solving, its solves going on
     uncompiled meanwhile: compiling costs 3–17 s for every new model, which short-lived planners (a fit's,
     one per parameter set) would not win back, while a long-lived one (a control loop, a sweep) solves
-    about a third faster afterwards (benchmarks/README.md). A model compiled before (by any planner, in any
+    faster afterwards (docs/results/speed.md). A model compiled before (by any planner, in any
     process, with this version of the package) is loaded compiled from the disk cache when built."""
     compile_after: float = 2.0
     """Seconds of solving (the sum of ``plan.solve_time``) after which a point-mass planner with ``compile=None``
@@ -315,9 +315,9 @@ class Planner:
         """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w of the
         goal if any does (the reachability witness of :meth:`_unreachable_plan`).
 
-        A cold solve: the inverse kinematics from the start (about 15 ms for the Panda; its guesses reach for
-        it). A warm start from a plan: ``WITNESS_STEPS`` damped least-squares steps (clipped to the limits) from
-        the plan's final mean position, about 0.1 ms, when they bring the hand within w of the goal (a warm
+        A cold solve: the inverse kinematics from the start (its guesses reach for it). A warm start from a plan:
+        ``WITNESS_STEPS`` damped least-squares steps (clipped to the limits) from the plan's final mean position,
+        far cheaper, when they bring the hand within w of the goal (a warm
         solve to a goal moved by a few cm: they do), else the inverse kinematics from that position."""
         model, body = self.model, self.model.body
         if not (isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size)):
@@ -362,7 +362,7 @@ class Planner:
         (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
         # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
-        # multi-threaded BLAS on a busy machine waits for cores (measured several times slower).
+        # multi-threaded BLAS on a busy machine waits for cores.
         with self._blas:
             results = self._results_from(guesses, params, deadline, until_converged)
         # The plan within the limits with the lowest objective wins, whatever its status: a start that stalls short

@@ -6,9 +6,8 @@ Panda's ready pose). :class:`ArmReachLibrary` keeps plans from there to goals on
 hand (spacing 7 cm, between 0.12 and 0.33 m from it), so every goal 0.15–0.3 m away has an entry within about
 6 cm. A cold solve from the ready pose then starts like a warm solve: from the nearest entries' plans, each
 also moved onto the new goal by a joint-space minimum-jerk correction (:func:`retargeted_torques`), ranked
-with the minimum-jerk guesses by their objective. On the Panda that is 12–30 Newton iterations instead of
-75–140 for three minimum-jerk starts (median 14 against 93 on 200 random problems; benchmarks/README.md,
-``cold_quality.py``).
+with the minimum-jerk guesses by their objective, which takes several times fewer Newton iterations than the
+minimum-jerk starts alone (``benchmarks/cold_quality.py`` checks it; docs/results/speed.md).
 
 A library belongs to one model (its :func:`~comanip.model.model_key`): entries are only initial
 guesses, but a guess from another model's optimum can lead to another local optimum. The library of the

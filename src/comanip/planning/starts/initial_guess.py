@@ -130,8 +130,8 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
     per duration (s): delta tau = M(q_i) delta qddot_i + D delta qdot_i along the plan's mean (H+1, 2n).
 
     For a linear body the mean is affine in the torques, so each result moves the whole planned mean path
-    by a smooth reach of shift_q: a plan for one goal becomes a good start for a nearby goal (three to
-    four times fewer Newton iterations than the unmodified plan, benchmarks/README.md). For a nonlinear
+    by a smooth reach of shift_q: a plan for one goal becomes a good start for a nearby goal (far fewer Newton
+    iterations than the unmodified plan: docs/results/speed.md). For a nonlinear
     body (M evaluated along ``mean``, required then) it holds to first order. ``linear_dynamics``: as for
     :func:`minimum_jerk_torques`.
     """

@@ -116,8 +116,7 @@ class StartPolicy:
         """The first-order prediction of the optimal torques (H, n) for ``goal`` from a plan that carries its
         goal sensitivity for this planner's problem (same start and width, another goal): tau* + (d tau*/d goal)
         (goal - its goal), the tangential predictor of parametric optimisation; None for any other warm start.
-        On warm planar solves to goals moved by up to 5 cm its gradient is about a tenth of the retargeted
-        plan's, and the solves take 4.7 instead of 5.9 Newton iterations (benchmarks/README.md)."""
+        For goals moved by a few cm it starts closer to the optimum than the retargeted plan."""
         sensitivity = warm_start.goal_sensitivity
         if sensitivity is None or not sensitivity.is_for(self.curvature) or warm_start.width != params.width \
                 or not np.array_equal(warm_start.start, params.start):
@@ -171,7 +170,7 @@ class StartPolicy:
         benchmarks/cold_quality.py checks the ranked starts against it under the cold-search rule (within 1e-4 of
         its objective in at least 98 % of random problems, never 1e-3 worse, as many successes).
         A ``budgeted`` solve (max_wall_time given) uses only library reaches solved before: solving a new one is a
-        whole cold search outside the budget (about 0.1 s on the Cartesian preset); without them a narrow goal
+        whole cold search outside the budget; without them a narrow goal
         runs every minimum-jerk guess.
         """
         start, goal, width = params.start, params.goal, params.width
