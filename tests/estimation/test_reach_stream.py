@@ -59,3 +59,8 @@ def test_a_stream_refuses_time_going_back_and_skips_lost_samples():
         stream.update(0.0, np.zeros(3), np.zeros(3))
     with pytest.raises(ValueError, match="radius"):
         SegmentationSettings(radius=0.0)
+
+
+def test_bad_estimator_options_are_refused_when_the_stream_is_made():
+    with pytest.raises(ValueError, match="width"):
+        ReachStream(comanip.presets.arm(), width=-0.01)

@@ -169,12 +169,17 @@ class ReachStream:
         settings: :class:`SegmentationSettings`.
         estimator_options: keyword arguments for each reach's :class:`OnlineGoalEstimator` (``prior_std``,
             ``width``, ``options``, ``cache``; the start comes from the stream).
+
+    The model's reach family is built here (a second or so, once per model and width, kept in the cache), so
+    that the first reach of the stream starts as fast as the others; bad options are refused here too.
     """
 
     def __init__(self, model, settings: SegmentationSettings | None = None, **estimator_options):
         self.model = model
         self.segmenter = ReachSegmenter(settings)
         self._options = estimator_options
+        body_model = getattr(model, "model", model)
+        OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
         self.reset()
 
     def reset(self) -> None:
