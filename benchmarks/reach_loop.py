@@ -133,6 +133,19 @@ def through_stream(preset: str, t, position, velocity):
     return starts, goals, numbers, moving, times
 
 
+def published(statuses, goal_times, goals, t, clock_zero: float):
+    """What a node published, on the stream's clock (``clock_zero``: the stamp of stream time 0): its reach starts
+    (s) from its statuses' values, and per sample time ``t`` (K,) the latest goal published (K, 3; NaN before
+    the first) and the reach it belongs to (K,), from goals (G, 3) stamped ``goal_times`` (G,) s, in order."""
+    starts = sorted({float(v["reach_start_stamp_s"]) - clock_zero for v in statuses if int(v["reach"]) > 0})
+    goal_t = np.asarray(goal_times) - clock_zero
+    latest = np.searchsorted(goal_t, t + 1e-9, side="right") - 1
+    goal = np.asarray(goals)
+    at = goal[np.maximum(latest, 0)]
+    return starts, np.where((latest >= 0)[:, None], at, np.nan), np.searchsorted(starts, goal_t[np.maximum(latest, 0)] + 1e-9,
+                                                                               side="right")
+
+
 def through_node(preset: str, rate: float, t, position, velocity):
     """The samples replayed through the goal node in lock step: its reach starts (s, each reach's clock zero),
     per sample the latest goal published (3,) and the reach it belongs to, the latencies (ms) the node's
@@ -144,12 +157,8 @@ def through_node(preset: str, rate: float, t, position, velocity):
     with Replay(NodeSettings(preset=preset, estimation_rate=2 * rate), None) as replay:
         recording = replay.run(t[tracked], np.c_[position, velocity][tracked])
     values = [v for *_, v in recording.statuses if int(v["reach"]) > 0]
-    starts = sorted({float(v["reach_start_stamp_s"]) - BASE_STAMP for v in values})
-    goal_t = np.array([stamp - BASE_STAMP for stamp, *_ in recording.goals])
-    goal = np.array([g for _, g, _, _ in recording.goals])
-    latest = np.searchsorted(goal_t, t + 1e-9, side="right") - 1
-    goals = np.where((latest >= 0)[:, None], goal[np.maximum(latest, 0)], np.nan)
-    numbers = np.searchsorted(starts, goal_t[np.maximum(latest, 0)] + 1e-9, side="right")
+    starts, goals, numbers = published(values, [stamp for stamp, *_ in recording.goals], [g for _, g, _, _ in recording.goals],
+                                       t, BASE_STAMP)
     latency = 1e3 * np.array([float(v["last_latency_s"]) for v in values if v["last_latency_s"] not in (None, "")], dtype=float)
     latency = latency[np.isfinite(latency)]
     return starts, goals, numbers, latency, 1e3 * recording.wall_time / tracked.sum()
@@ -166,14 +175,9 @@ def live(preset: str, rate: float, seconds: float, t, position, velocity):
     keep = (t <= seconds) & np.all(np.isfinite(position), axis=1) & np.all(np.isfinite(velocity), axis=1)
     run = two_processes(rate, t[keep], np.c_[position, velocity][keep], goal=position[keep][-1],
                         parameters={"preset": preset, "person": "recorded"})
-    begin = run["begin"]
-    starts = sorted({float(v["reach_start_stamp_s"]) - begin for v in run["statuses"] if int(v["reach"]) > 0})
     stamps = sorted(run["goals"])
-    goal_t = np.array(stamps) - begin
-    goal = np.array([run["goals"][s][1] for s in stamps])
-    latest = np.searchsorted(goal_t, t + 1e-9, side="right") - 1
-    goals = np.where(((latest >= 0) & (t <= seconds))[:, None], goal[np.maximum(latest, 0)], np.nan)
-    numbers = np.searchsorted(starts, goal_t[np.maximum(latest, 0)] + 1e-9, side="right")
+    starts, goals, numbers = published(run["statuses"], stamps, [run["goals"][s][1] for s in stamps], t, run["begin"])
+    goals[t > seconds] = np.nan
     latency = 1e3 * np.array([run["goals"][s][0] - s for s in stamps])
     return starts, goals, numbers, latency
 

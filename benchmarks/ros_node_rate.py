@@ -168,7 +168,7 @@ def main(argv=None) -> None:
             for label, src in codes.items():
                 runs[label].append(two_processes(rate, times, states, src))
         for label, results in runs.items():
-            m = {key: float(np.median([r[key] for r in results])) for key in results[0] if key not in ("goals", "statuses")}
+            m = {key: float(np.median([r[key] for r in results])) for key in results[0] if key not in ("begin", "goals", "statuses")}
             print(f"| real time, two processes | {label} | {rate:g} | {m['estimates']:.0f} | {m['rate_hz']:.2f} | {m['ratio']:.3f} "
                   f"| {m['skipped']:.0f} | {m['median_ms']:.1f} | {m['p95_ms']:.1f} | {m['cold_ms']:.0f} "
                   f"| {_optional(m['status_rate_hz'], 2)} | {_optional(m['status_latency_ms'], 1)} "

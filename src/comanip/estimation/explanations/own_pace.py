@@ -118,8 +118,9 @@ class ModelAtOwnPace:
     def _add(self, hand: HandTrace) -> None:
         """Average the observations not yet added into their grid steps."""
         model = self.model
-        rows = np.column_stack([hand.t, hand.position, hand.velocity])[self._added:]
-        for time_s, *observation in rows:
+        new = slice(self._added, hand.count)
+        for time_s, position, velocity in zip(hand.t[new], hand.position[new], hand.velocity[new]):
+            observation = np.concatenate([position, velocity])
             before, fraction = grid_position(time_s, model.h, model.H)
             self._counts[before] += 1
             self._sums[before] += observation
