@@ -3,6 +3,8 @@ online estimator on reaches at another pace than the model's and with a correcti
 
 from pathlib import Path
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -171,7 +173,7 @@ def test_a_recorded_hand_that_stalls_after_a_failed_update_keeps_the_whitening_i
 
 def test_the_people_models_tree_walk_equals_scikit_learns_predict(people):
     from comanip.estimation.people_model import TreeEnsemble, _along_regressor, _samples
-    X, along, _, _ = _samples(people[:20])
+    X, along, _, _, _ = _samples(people[:20])
     regressor = _along_regressor(X, along, seed=0)
     walked = np.array([TreeEnsemble.of(regressor)(x) for x in X])
     np.testing.assert_allclose(walked, regressor.predict(X), rtol=0, atol=1e-9)
@@ -187,6 +189,11 @@ def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(peopl
         a, b = (m.predict(r.t[:k], r.position[:k], r.velocity[:k], r.position[0]) for m in (model, back))
         np.testing.assert_array_equal(a.goal, b.goal)
         np.testing.assert_array_equal(a.covariance, b.covariance)
+        assert a.end_time == b.end_time and a.end_time >= r.t[k - 1]
+    # a model saved without the remaining-time regressor loads and predicts where, not when
+    where_only = PeopleModel.load(replace(model, remaining=None).save(tmp_path / "where.npz"))
+    answer = where_only.predict(r.t, r.position, r.velocity, r.position[0])
+    assert where_only.remaining is None and answer.end_time is None
     (tmp_path / "other.npz").write_bytes(b"not a model")
     with pytest.raises(ValueError, match="is not a people model"):
         PeopleModel.load(tmp_path / "other.npz")
@@ -216,10 +223,14 @@ ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" /
 
 @pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
 def test_the_online_estimator_predicts_recorded_arm_reaches_better_than_where_the_hand_is():
+    """Where the hand stops, better than its current position; and when, at half of the movement: the predicted
+    reach arrives near when the hand does, nearer than the model's own reach from the stream's start."""
+    from comanip.analysis.speed_profile import speed_metrics
     from comanip.recordings import load_tathum
     model = comanip.presets.arm()
     reaches = [trial.streamed_recording() for trial in load_tathum(ARMS)[::9]]          # 20 reaches, as a tracker streams them
     mine, current = {f: [] for f in FRACTIONS}, {f: [] for f in FRACTIONS}
+    arrival, own_pace = [], []
     for r in reaches:
         estimator = comanip.OnlineGoalEstimator(model, np.r_[r.position[0], np.zeros(model.state_size - 3)])
         until = {f: r.seen_until(f) for f in FRACTIONS}
@@ -229,5 +240,11 @@ def test_the_online_estimator_predicts_recorded_arm_reaches_better_than_where_th
                 if seen == k + 1:
                     mine[f].append(np.linalg.norm(estimate.goal - r.end) / r.distance)
                     current[f].append(np.linalg.norm(r.position[k] - r.end) / r.distance)
+                if seen == k + 1 and f == 0.5:
+                    arrives = speed_metrics(estimate.t - estimate.t[0], estimate.ee_speed).movement_time + estimate.t[0]
+                    arrival.append(abs(arrives - r.end_time) / r.movement_time)
+                    untimed = speed_metrics(model.h * np.arange(model.H + 1), estimate.ee_speed * (estimate.t[1] - estimate.t[0]) / model.h)
+                    own_pace.append(abs(untimed.movement_time - r.end_time) / r.movement_time)
     for f in FRACTIONS:
         assert np.median(mine[f]) < 0.8 * np.median(current[f]), (f, np.median(mine[f]), np.median(current[f]))
+    assert np.median(arrival) <= 0.15 and np.median(arrival) < 0.5 * np.median(own_pace), (np.median(arrival), np.median(own_pace))

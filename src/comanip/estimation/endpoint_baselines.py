@@ -27,10 +27,12 @@ MOVING_SPEED = 0.02
 
 @dataclass(frozen=True)
 class EndpointPrediction:
-    """A predicted endpoint: ``goal`` (d,) m and, where the predictor has one, its ``covariance`` (d, d) m²."""
+    """A predicted endpoint: ``goal`` (d,) m and, where the predictor has one, its ``covariance`` (d, d) m² and
+    when the hand gets there, ``end_time`` (s, on the observations' clock)."""
 
     goal: np.ndarray
     covariance: np.ndarray | None = None
+    end_time: float | None = None
 
 
 class PrefixPredictor:

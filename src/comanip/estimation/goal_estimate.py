@@ -18,7 +18,8 @@ class GoalEstimate(Plan):
     t_obs: float = 0.0
     """Time of the observation after the start (s)."""
     observed_step: int = 0
-    """The plan step n_o = floor(t_obs / h) it was matched to."""
+    """The step n_o of the predicted reach at or before t_obs that it was matched to (floor(t_obs / h) for a
+    reach from t = 0 at the model's pace)."""
     observed_state: np.ndarray = field(default_factory=lambda: np.zeros(0))
     """The observed state s_o (nx,)."""
     observation_residual: np.ndarray = field(default_factory=lambda: np.zeros(0))

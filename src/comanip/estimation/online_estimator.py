@@ -50,6 +50,7 @@ from comanip.estimation.hand_rest import lost_sample
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
+from comanip.estimation.reach_timing import timed_plan
 from comanip.estimation.people_model import shipped_people_model
 from comanip.model import ReachingModel
 from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
@@ -234,15 +235,15 @@ class OnlineGoalEstimator:
         model, n = self.model, self.model.n
         goal, status = explained.goal, explained.status
         prediction = self.reach.prediction(goal, order=0)
-        before, fraction = grid_position(self._last_time, model.h, model.H)
-        predicted = (1 - fraction) * prediction.mean[before, :2 * n] + fraction * prediction.mean[min(before + 1, model.H), :2 * n]
+        timed = timed_plan(prediction.mean, prediction.cov, prediction.torque, model.h, n, explained.timing)
+        before, fraction = grid_position(max(self._last_time - timed.t[0], 0.0), timed.t[1] - timed.t[0], model.H)
+        predicted = (1 - fraction) * timed.mean[before, :2 * n] + fraction * timed.mean[min(before + 1, model.H), :2 * n]
         observed = self._hand.last_observation
         plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),
                     objective=prediction.objective, solve_time=time.perf_counter() - t_begin, iterations=explained.iterations,
-                    t=model.h * np.arange(model.H + 1), mean=prediction.mean, cov=prediction.cov, torque=prediction.torque,
-                    ee_mean=prediction.mean[:, :n].copy(), ee_cov=prediction.cov[:, :n, :n].copy(),
-                    ee_velocity=prediction.mean[:, n:2 * n].copy(), start=self.start.copy(), goal=np.array(goal, dtype=float),
-                    width=self.width, model_name=model.name)
+                    t=timed.t, mean=timed.mean, cov=timed.cov, torque=timed.torque, ee_mean=timed.mean[:, :n].copy(),
+                    ee_cov=timed.cov[:, :n, :n].copy(), ee_velocity=timed.mean[:, n:2 * n].copy(), start=self.start.copy(),
+                    goal=np.array(goal, dtype=float), width=self.width, model_name=model.name)
         return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=before, observed_state=observed,
                                observation_residual=predicted - observed, prior_goal=self.prior_goal, method="online",
                                goal_covariance=np.array(explained.covariance, dtype=float))

@@ -22,6 +22,7 @@ import numpy as np
 from comanip.estimation.profile_fit import ProfileFit, fit_profile
 from comanip.estimation.reach_family import ReachFamily
 from comanip.estimation.reach_profile import ReachProfile
+from comanip.estimation.reach_timing import ReachTiming, movement_span
 
 PACE_STD = 0.35
 """Standard deviation of log(pace) a priori: people take their own time, within about ×0.5–×2 of the model's."""
@@ -64,6 +65,11 @@ class PacedFit:
     observations: int
     """Observations at or after the fitted onset."""
 
+    @property
+    def timing(self) -> ReachTiming:
+        """The fitted onset and movement time."""
+        return ReachTiming(self.onset, self.duration)
+
 
 class PacedModel:
     """Fits of the model's mean reach at the person's pace, for one reach family (module docstring)."""
@@ -81,9 +87,7 @@ class PacedModel:
             along = self.family.along(np.array([D]))[0]                 # (H+1, blocks): position, velocity, ...
             h = self.family.model.h
             t = h * np.arange(len(along))
-            speed = np.abs(along[:, 1])
-            moving = np.flatnonzero(speed >= 0.05 * speed.max())
-            first, last = int(moving[0]), min(int(moving[-1]) + 1, len(speed) - 1)
+            first, last = movement_span(np.abs(along[:, 1]))
             profile = ReachProfile.from_path(t[first:last + 1], along[first:last + 1, 0], along[first:last + 1, 1],
                                              "the model's reach")
             self._shapes[key] = _Shape(profile, float(t[last] - t[first]), float(t[first]),

@@ -5,9 +5,11 @@ x_0) :func:`movement_features` computes numbers that say how far along its movem
 them without units: time since the onset tau, path length since the onset L, the speed now over the peak
 speed so far, the acceleration, time since the peak speed over tau, the path length at the peak over L, the
 straightness |x_K - x_0| / L, the angle between the velocity and the displacement, and v_peak tau / L.
-Two gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
+Gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
 them how far beyond the hand the endpoint lies along the direction of motion u (the velocity's while the hand
-moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, and the log of the expected squared error. The predicted
+moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, the
+log of the expected squared error, and when the hand stops: log(r / tau + ``REMAINING_FLOOR``) for the time r
+still to go (s). The predicted
 endpoint is never behind the hand along u, and a hand that has stopped (its positions still for a tenth of a
 second after it left the start and its net speed over that time below half ``REST_FRACTION`` of its peak speed,
 :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of its peak for ``REST_TIME``) is at its
@@ -66,6 +68,8 @@ STOPPING_TIME = 0.1
 """A hand moving at speed v can still cover about v times this (s) before it stops. While its path so far is
 shorter than that, the movement says little (a sample or two after the onset) and the predicted endpoint's
 standard deviation (per axis) is never below it, whatever the regressors say."""
+REMAINING_FLOOR = 0.02
+"""Added to the time still to go over tau before its log is regressed (a hand at its end has none to go)."""
 REST_SPREAD = 0.03
 """Standard deviation of a stopped hand's endpoint estimate, a fraction of the path length."""
 _MIN_PATH = 1e-4
@@ -119,6 +123,8 @@ class PeopleModel:
     """The kind of movement it was fitted to, a key of :data:`KINDS` (which features it reads)."""
     trained_on: str = ""
     """What the model was fitted on."""
+    remaining: "TreeEnsemble | None" = None
+    """Regressor of log(time still to go / tau + ``REMAINING_FLOOR``); None: the model does not say when."""
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -146,7 +152,7 @@ class PeopleModel:
     @classmethod
     def _fit(cls, recordings, kind: str, trained_on: str, seed: int, say) -> "PeopleModel":
         from sklearn.ensemble import HistGradientBoostingRegressor
-        X, along, across, owner = _samples(recordings)
+        X, along, across, remaining, owner = _samples(recordings)
         X = X[:, [FEATURES.index(name) for name in KINDS[kind]]]
         fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
         predicted = np.zeros(len(X))
@@ -159,7 +165,11 @@ class PeopleModel:
         d = recordings[0].position.shape[1]
         factor = float(np.quantile(squared / np.exp(spread.predict(X)), 0.95) / chi2.ppf(0.95, d) * d)
         say("along regressor, all samples")
-        return cls(TreeEnsemble.of(_along_regressor(X, along, seed)), TreeEnsemble.of(spread), factor, kind, trained_on)
+        along_regressor = _along_regressor(X, along, seed)
+        say("remaining-time regressor")
+        timing = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
+            X, np.log(remaining + REMAINING_FLOOR))
+        return cls(TreeEnsemble.of(along_regressor), TreeEnsemble.of(spread), factor, kind, trained_on, TreeEnsemble.of(timing))
 
     def predict(self, t, position, velocity, start) -> EndpointPrediction | None:
         """The endpoint (d,) m and its covariance (d, d) m² from the movement so far (:func:`movement_features`'
@@ -173,21 +183,23 @@ class PeopleModel:
         stopped = (REST_SPREAD * path) ** 2 / len(u) * np.eye(len(u))
         resting = resting_position(t, position, creep=0.5 * REST_FRACTION * features[3])
         if resting is not None and has_left(position, start):
-            return EndpointPrediction(resting, stopped)
+            return EndpointPrediction(resting, stopped, float(t[-1]))
         if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
-            return EndpointPrediction(position[-1].copy(), stopped)
+            return EndpointPrediction(position[-1].copy(), stopped, float(t[-1]))
         x = features[self.columns]
         along, log_squared = self.along(x), self.spread(x)
         goal = position[-1] + path * max(along, 0.0) * u
         variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
         if path < STOPPING_TIME * speed[-1]:
             variance = max(variance, (STOPPING_TIME * speed[-1]) ** 2)
-        return EndpointPrediction(goal, variance * np.eye(len(u)))
+        end_time = None if self.remaining is None else \
+            float(t[-1]) + features[0] * max(math.exp(self.remaining(x)) - REMAINING_FLOOR, 0.0)
+        return EndpointPrediction(goal, variance * np.eye(len(u)), end_time)
 
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` as plain arrays (``.npz``); :meth:`load` reads it back."""
         path = Path(path)
-        arrays = {f"{name}_{field}": value for name in ("along", "spread")
+        arrays = {f"{name}_{field}": value for name in ("along", "spread", "remaining") if getattr(self, name) is not None
                   for field, value in getattr(self, name).arrays().items()}
         with open(path, "wb") as stream:
             np.savez_compressed(stream, coverage_factor=self.coverage_factor, kind=self.kind, trained_on=self.trained_on,
@@ -199,9 +211,11 @@ class PeopleModel:
         """A model written by :meth:`save` (a one-line ValueError for a file that is not one)."""
         try:
             with np.load(path, allow_pickle=False) as data:
-                ensembles = [TreeEnsemble(**{field: data[f"{name}_{field}"] for field in TreeEnsemble.FIELDS})
-                             for name in ("along", "spread")]
-                return cls(*ensembles, float(data["coverage_factor"]), str(data["kind"]), str(data["trained_on"]))
+                along, spread, remaining = (TreeEnsemble(**{field: data[f"{name}_{field}"] for field in TreeEnsemble.FIELDS})
+                                            if f"{name}_feature" in data else None for name in ("along", "spread", "remaining"))
+                if along is None or spread is None:
+                    raise KeyError("along or spread regressor")
+                return cls(along, spread, float(data["coverage_factor"]), str(data["kind"]), str(data["trained_on"]), remaining)
         except (OSError, KeyError, ValueError) as error:
             raise ValueError(f"{str(path)!r} is not a people model written by PeopleModel.save ({error})") from None
 
@@ -264,9 +278,10 @@ def _along_regressor(X, along, seed: int):
 
 
 def _samples(recordings):
-    """Features (N, F), the endpoint's offset from the hand over L along u (N,) and across it (N,), and the
-    index of the recording of each sample (N,), for every sample from onset to end of the recordings."""
-    X, along, across, owner = [], [], [], []
+    """Features (N, F), the endpoint's offset from the hand over L along u (N,) and across it (N,), the time
+    still to go to the end over tau (N,), and the index of the recording of each sample (N,), for every sample
+    from onset to end of the recordings."""
+    X, along, across, remaining, owner = [], [], [], [], []
     for index, recording in enumerate(recordings):
         for k in range(2, len(recording.t) + 1):
             described = movement_features(recording.t[:k], recording.position[:k], recording.velocity[:k], recording.position[0])
@@ -278,8 +293,9 @@ def _samples(recordings):
             X.append(features)
             along.append(on / path)
             across.append(math.sqrt(max(float(e @ e) - on * on, 0.0)) / path)
+            remaining.append(max(recording.end_time - recording.t[k - 1], 0.0) / features[0])
             owner.append(index)
-    return np.array(X), np.array(along), np.array(across), np.array(owner)
+    return np.array(X), np.array(along), np.array(across), np.array(remaining), np.array(owner)
 
 
 def shipped_people_model(kind: str = "mouse") -> PeopleModel:

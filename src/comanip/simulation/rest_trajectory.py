@@ -1,11 +1,12 @@
 """A planned reach as the impedance controller's rest motion (docs/formulation.md §8: the plan's mean is the rest position).
 
-The plan gives the mean end effector x_i at the steps t_i = i·h. Between steps the rest position follows
+The plan gives the mean end effector x_i at its times t_i (i·h for a plan from t = 0). Between steps the rest position follows
 a C² cubic spline through the x_i (leaving and arriving with the plan's first and last velocities), so
 rest position and velocity are smooth at the control rate (a piecewise-linear rest would jerk the arm
 every h seconds). The spline goes through the positions, not the plan's velocities: the model's forward
 Euler step moves x_i with v_i over a whole step, so no smooth curve honours both (see
-:mod:`comanip.simulation.person`). After the plan's last step the rest holds its final point.
+:mod:`comanip.simulation.person`). Before the plan's first time and after its last the rest holds the plan's first
+and last points.
 """
 
 from __future__ import annotations
@@ -39,8 +40,8 @@ class RestTrajectory:
         sampled every dt (s) over duration (s) from time_offset on."""
         spline = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
         tau = np.arange(int(np.ceil(duration / dt)) + 2) * dt
-        inside = np.minimum(tau, plan.t[-1])
-        velocity = np.where((tau <= plan.t[-1])[:, None], spline(inside, 1), 0.0)
+        inside = np.clip(tau, plan.t[0], plan.t[-1])
+        velocity = np.where(((tau >= plan.t[0]) & (tau <= plan.t[-1]))[:, None], spline(inside, 1), 0.0)
         return cls(spline(inside), velocity, time_offset, dt)
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:

@@ -19,6 +19,7 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_rest import has_left
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
+from comanip.estimation.reach_timing import ReachTiming
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 
@@ -136,6 +137,9 @@ class Explained:
     """Newton iterations spent."""
     misfit: float | None = None
     """How far the hand is from this explanation, in its own measure (None: not measured)."""
+    timing: ReachTiming | None = None
+    """When the reach moves, where this explanation says (the estimate's predicted reach is played at it);
+    None: at the model's own pace from t = 0."""
 
 
 class Explanation(Protocol):

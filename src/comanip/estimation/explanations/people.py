@@ -1,6 +1,7 @@
 """The model of recorded people's movements (:class:`~comanip.estimation.people_model.PeopleModel`): where people
-whose hand moved like this one stopped. It explains any hand that has started to move; its goal is combined with
-the prior and never lies behind a hand that has moved past it."""
+whose hand moved like this one stopped, and when. It explains any hand that has started to move; its goal is
+combined with the prior and never lies behind a hand that has moved past it, and the predicted reach runs from the
+hand's onset to when the people model says it stops (a model that does not say when: at the model's own pace)."""
 
 from __future__ import annotations
 
@@ -8,6 +9,7 @@ from comanip.estimation.explanations.base import Explained, HandTrace, Reach
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.people_model import PeopleModel
 from comanip.estimation.estimate_status import EstimateStatus
+from comanip.estimation.reach_timing import ReachTiming
 from comanip.optim import Status
 
 
@@ -25,5 +27,7 @@ class RecordedPeople:
         predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
         if predicted is None:
             return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
+        timing = None if predicted.end_time is None else \
+            ReachTiming(hand.onset(), max(predicted.end_time - hand.onset(), hand.t[-1] - hand.onset()))
         return reach.landed(Explained(predicted.goal, predicted.covariance, True, EstimateStatus.PEOPLE_MODEL,
-                                      "the goal is the people model's"), hand.position[-1])
+                                      "the goal is the people model's", timing=timing), hand.position[-1])

@@ -63,11 +63,12 @@ class ModelAtPersonPace:
         fitted = self.fit(hand, None if latest is None else latest.goal)
         if fitted.misfit > self.options.paced_threshold or not self.settled(fitted):
             return Explained(fitted.goal, fitted.covariance, False, Status.FAILED,
-                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})", misfit=fitted.misfit)
+                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})", misfit=fitted.misfit,
+                             timing=fitted.timing)
         landing = reach.prediction(fitted.goal, order=0).cov[-1, :reach.model.n, :reach.model.n]
         return reach.landed(Explained(fitted.goal, fitted.covariance + landing, True, Status.SOLVED, "the model's reach "
                                       f"at the person's pace (×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does",
-                                      misfit=fitted.misfit), hand.position[-1])
+                                      misfit=fitted.misfit, timing=fitted.timing), hand.position[-1])
 
     def settled(self, fitted: PacedFit) -> bool:
         """Whether a paced fit pins the goal's distance: its relative std along the reach at most
