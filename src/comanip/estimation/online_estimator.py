@@ -2,7 +2,8 @@
 
 A person at rest at s_0 reaches for an unknown goal g; positions and velocities of their hand arrive one at a
 time, at any times t_k ≥ 0. After each, :meth:`OnlineGoalEstimator.update` returns an estimate of g, its
-covariance and the model's predicted reach to it. The estimate comes from explanations of the hand
+covariance and the model's predicted reach to it, played when the explanation that gives it says the hand moves
+(:mod:`~comanip.estimation.reach_timing`). The estimate comes from explanations of the hand
 (:mod:`comanip.estimation.explanations`), asked in order; **the first that explains the hand gives the
 estimate** (none: the prior, status ``uninformative``). With ``OnlineOptions(timing="estimated")`` (the default):
 
@@ -201,9 +202,7 @@ class OnlineGoalEstimator:
         the start (ms?), a hand over 3 m from its start or at over 50 m/s (mm?), or beyond a person's reach."""
         if self._warned:
             return
-        distance = float(np.linalg.norm(position - self.start_position))
-        speed = float(np.linalg.norm(velocity))
-        problem = None
+        distance, speed, problem = float(np.linalg.norm(position - self.start_position)), float(np.linalg.norm(velocity)), None
         if time_s > MAX_REACH_DURATION_S:
             problem = (f"time_s {time_s:g} s is longer than one reach ({MAX_REACH_DURATION_S:g} s at most): is it in ms "
                        "(comanip takes s), or is this the next reach (reset())?")
