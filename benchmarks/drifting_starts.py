@@ -59,7 +59,7 @@ def main(argv=None) -> None:
         starts = planner.starts.cold_guesses(params, 3) + list(
             turned + minimum_jerk_torques(model.body, model.h, model.H, motion, np.zeros(n), durations, planner.starts.linear_dynamics))
         ranks = np.array([planner.starts.objective(s, params) for s in starts])
-        results = [planner._run_solver(s, params, np.inf) for s in starts]
+        results = [planner.solver.solve(s, params) for s in starts]
         J = np.array([r.fun for r in results])
         its = [r.nit for r in results]
         guess, library = int(np.argmin(ranks[:3])), 3 + int(np.argmin(ranks[3:]))
