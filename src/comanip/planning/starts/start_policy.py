@@ -165,13 +165,12 @@ class StartPolicy:
             return self.arm_library_starts(params, goal_q)
         if self.library is None:
             return self.searched_guesses(params, goal_q)
-        motion = start.copy()
-        motion[: self.model.n] = 0.0
+        motion = _motion(start, self.model.n)
         moving = bool(np.any(motion))
         narrow = self.narrow_after_stops(params, motion)
-        if moving and narrow and self.stops(motion).any():
-            # a hand carried on by its motion: its local optima are not the library's (ranked starts built from them
-            # ended above the full search on planar goals: benchmarks/results/solver_speed_runs.md)
+        if self._carries_on(motion, narrow):
+            # its local optima are not the library's (ranked starts built from them ended above the full search on
+            # planar goals, and so did every subset of the guesses tried: benchmarks/drifting_starts.py)
             return self.cold_guesses(params, self.options.n_starts)
         if moving:
             candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)
@@ -191,6 +190,18 @@ class StartPolicy:
         scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
             [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
         return [min(scored, key=lambda pair: pair[0])[1]]
+
+    def carried_on(self, params: ReachParameters) -> bool:
+        """Whether a point mass's start moves so that a stop of its motion ends away from the start and the goal lies
+        beyond ``narrow_ratio`` widths from the start or from where a stop ends: a 'ranked' cold solve then runs
+        every minimum-jerk guess (:meth:`cold_starts`)."""
+        motion = _motion(params.start, self.model.n)
+        return self._carries_on(motion, self.narrow_after_stops(params, motion))
+
+    def _carries_on(self, motion: np.ndarray, narrow: bool) -> bool:
+        """:meth:`carried_on` for the start's ``motion`` (nx,, its position zeroed) and whether the goal is narrow
+        after its stops (:meth:`narrow_after_stops`)."""
+        return narrow and bool(np.any(motion)) and bool(self.stops(motion).any())
 
     def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, budgeted: bool = False,
                         every_optimum: bool = False) -> list[np.ndarray]:
@@ -289,6 +300,13 @@ class StartPolicy:
     def objective(self, torque: np.ndarray, params: ReachParameters) -> float:
         """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
         return self.solver.objective(torque, params)
+
+
+def _motion(start: np.ndarray, n: int) -> np.ndarray:
+    """The start state (nx,) with its position (the first n entries) zeroed: its motion alone."""
+    motion = start.copy()
+    motion[:n] = 0.0
+    return motion
 
 
 def _damped_drift(body, linear_dynamics: LinearDynamics | None) -> np.ndarray | None:
