@@ -12,13 +12,13 @@ Two solver strategies (``SolverOptions.method``, chosen when the planner is buil
 :class:`~comanip.planning.reach_solver.ReachSolver`); the start policy (``planner.starts``) proposes the starts and
 the strategy solves them:
 
-- ``newton`` (default, :class:`~comanip.planning.newton_reach_solver.NewtonReachSolver`): a regularised Newton method with an active set for the limits
-  (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from per-step pieces: exact for point masses
-  (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
+- ``newton`` (default, :class:`~comanip.planning.newton_reach_solver.NewtonReachSolver`): a regularised Newton
+  method with an active set for the limits (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from
+  per-step pieces: exact for point masses (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
   (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
   Several times faster than IPOPT on the point masses, to the same optimum (docs/results/speed.md).
-- ``ipopt`` (:class:`~comanip.planning.ipopt_reach_solver.IpoptReachSolver`): IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference,
-  point masses only.
+- ``ipopt`` (:class:`~comanip.planning.ipopt_reach_solver.IpoptReachSolver`): IPOPT with CasADi's exact Hessian
+  of the whole single-shooting problem: the reference, point masses only.
 
 Goals out of an arm's reach (inverse-kinematics residual beyond the goal width) return a plan with
 status 'unreachable' before any solver work.
