@@ -14,8 +14,8 @@ the strategy solves them:
 
 - ``newton`` (default, :class:`~comanip.planning.newton_reach_solver.NewtonReachSolver`): a regularised Newton
   method with an active set for the limits (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from
-  per-step pieces: exact for point masses (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
-  (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
+  per-step pieces: exact for point masses (:mod:`comanip.planning.curvature`), approximate with secant corrections
+  for nonlinear bodies (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
   Several times faster than IPOPT on the point masses, to the same optimum (docs/results/speed.md).
 - ``ipopt`` (:class:`~comanip.planning.ipopt_reach_solver.IpoptReachSolver`): IPOPT with CasADi's exact Hessian
   of the whole single-shooting problem: the reference, point masses only.
