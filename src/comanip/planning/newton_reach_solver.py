@@ -19,7 +19,7 @@ from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
-from comanip.planning.reach_solver import ReachSolver
+from comanip.planning.reach_solver import Rank, ReachSolver
 from comanip.planning.single_thread_blas import SingleThreadBlas
 from comanip.planning.start_threads import StartThreads, usable_cores
 from comanip.planning.terms import Curvature
@@ -83,15 +83,15 @@ class NewtonReachSolver(ReachSolver):
     def objective(self, torque: np.ndarray, params: ReachParameters) -> float:
         return self.curvature.value(np.ravel(torque), params)
 
-    def start_rank(self, torque: np.ndarray, params: ReachParameters) -> tuple[bool, float]:
-        """(mean path beyond a joint limit, objective) of a start (H, n). A start beyond the limits can have the
-        lowest objective and still be the worst: the solver must first bring it back (on the Panda, starts
-        retargeted far ended 'constraints_violated')."""
+    def start_rank(self, torque: np.ndarray, params: ReachParameters) -> Rank:
+        """The rank of a start (H, n): its mean path beyond a joint limit, its objective. A start beyond the limits
+        can have the lowest objective and still be the worst: the solver must first bring it back (on the Panda,
+        starts retargeted far ended 'constraints_violated')."""
         curvature = self.curvature
         if not curvature.carries_belief or not self.limits.active:
-            return False, self.objective(torque, params)
+            return Rank(False, self.objective(torque, params))
         evaluation = curvature.value_and_data(np.ravel(torque), params)
-        return self.limits.violation(curvature.mean_path(evaluation.data)) > LIMIT_TOLERANCE, evaluation.f
+        return Rank(self.limits.violation(curvature.mean_path(evaluation.data)) > LIMIT_TOLERANCE, evaluation.f)
 
     def ends_at_goal(self, torque: np.ndarray, params: ReachParameters) -> bool:
         model, curvature = self.problem.model, self.curvature

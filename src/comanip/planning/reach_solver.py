@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
@@ -26,9 +26,17 @@ if TYPE_CHECKING:
     from comanip.planning.planner import SolverOptions
 
 
-def rank(result: SolverResult) -> tuple[bool, float]:
-    """Order of the starts' results: within the limits first, then the lower normalised objective."""
-    return result.status == Status.CONSTRAINTS_VIOLATED, result.fun
+class Rank(NamedTuple):
+    """Where a start or a solve's result stands among others (the lowest is the best): within the limits first, then
+    the lower objective."""
+
+    beyond_limits: bool
+    objective: float
+
+
+def rank(result: SolverResult) -> Rank:
+    """The rank of a solve's result: its status 'constraints_violated', its normalised objective."""
+    return Rank(result.status == Status.CONSTRAINTS_VIOLATED, result.fun)
 
 
 def iteration_limit(problem: ReachProblem, options: SolverOptions) -> int:
@@ -67,9 +75,9 @@ class ReachSolver(ABC):
         """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
         plan can rest on the zero-reward plateau instead)."""
 
-    def start_rank(self, torque: np.ndarray, params: ReachParameters) -> tuple[bool, float]:
-        """(mean path beyond a joint limit, objective) of a start (H, n): its order among candidate starts."""
-        return False, self.objective(torque, params)
+    def start_rank(self, torque: np.ndarray, params: ReachParameters) -> Rank:
+        """The rank of a start (H, n) among candidate starts: its mean path beyond a joint limit, its objective."""
+        return Rank(False, self.objective(torque, params))
 
     def solve(self, guess: np.ndarray, params: ReachParameters, deadline: float = np.inf) -> SolverResult[np.ndarray, LocalModel]:
         """One solve from torques ``guess`` (H, n) until ``deadline`` (perf_counter, s); a non-finite plan comes back
