@@ -77,7 +77,7 @@ def measure(preset: str, compile: bool) -> dict:
              "Cholesky": best_ms(lambda: scipy.linalg.cho_factor(matrix, check_finite=False)),
              "secant update": (best_ms(lambda: symmetric_rank_one_update(correction, matrix, step, gradient))
                                if not curvature.exact else float("nan")),
-             "make_plan": best_ms(lambda: planner._make_plan(plan.torque, params, status="solved", success=True,
+             "make_plan": best_ms(lambda: planner.solver.make_plan(plan.torque, params, status="solved", success=True,
                                                              message="", solve_time=0.0, iterations=0)),
              "warm solve": 1e3 * float(np.median([s.solve_time for s in solves])),
              "iterations": float(np.mean([s.iterations for s in solves])),

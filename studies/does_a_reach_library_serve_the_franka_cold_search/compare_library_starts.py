@@ -23,7 +23,8 @@ import numpy as np
 import comanip
 from comanip.optim import Status
 from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES
-from comanip.planning.planner import SolverOptions, _rank
+from comanip.planning.planner import SolverOptions
+from comanip.planning.reach_solver import rank as _rank
 from comanip.planning.reach_parameters import ReachParameters
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
@@ -48,8 +49,8 @@ def main(argv=None) -> None:
         library_start = planner.starts.lowest_objective(guesses + planner.starts.library_candidates(params, CANDIDATE_ENTRIES),
                                                         params)
         best_ranked = int(np.argmin([planner.starts.objective(g, params) for g in guesses]))
-        library, *solved = (planner._run_solver(s, params, np.inf) for s in [library_start] + guesses)
-        converged = library.status == Status.SOLVED and planner._ends_at_goal(library.x, params)
+        library, *solved = (planner.solver.solve(s, params) for s in [library_start] + guesses)
+        converged = library.status == Status.SOLVED and planner.solver.ends_at_goal(library.x, params)
         winner = min(range(3), key=lambda j: _rank(solved[j]))
         full = solved[winner]
         winners[winner] += 1

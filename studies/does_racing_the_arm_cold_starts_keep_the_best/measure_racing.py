@@ -51,12 +51,12 @@ def main(argv=None) -> None:
     for index, (start, goal, width) in enumerate(arm_problems(model, args.problems)):
         params = ReachParameters(start, goal, width)
         guesses = full.starts.searched_guesses(params)
-        finished = [full._run_solver(guess, params, np.inf) for guess in guesses]
+        finished = [full.solver.solve(guess, params) for guess in guesses]
         best = min(range(len(guesses)), key=lambda j: rank(finished[j]))
         row = {"problem": index, "moving": bool(np.any(start[model.n:])), "full_objective": finished[best].fun,
                "full_iterations": sum(r.nit for r in finished), "full_success": finished[best].success}
         for k in budgets:
-            raced = [short[k]._run_solver(guess, params, np.inf) for guess in guesses]
+            raced = [short[k].solver.solve(guess, params) for guess in guesses]
             kept = min(range(len(guesses)), key=lambda j: rank(raced[j]))
             row[f"race{k}_relative"] = (finished[kept].fun - finished[best].fun) / abs(finished[best].fun)
             row[f"race{k}_iterations"] = sum(r.nit for r in raced) + finished[kept].nit - raced[kept].nit

@@ -36,13 +36,13 @@ def staged_starts(planner, params, checkpoints: list[int]) -> list[dict]:
     """Each minimum-jerk start solved to the end, with (objective, converged within the limits) at each checkpoint."""
     rows = []
     for guess in planner.starts.searched_guesses(params):
-        solve = planner._newton_solve(guess, params, np.inf, planner.curvature)
+        solve = planner.solver.newton_solve(guess, params, np.inf, planner.curvature)
         row = {}
         for k in checkpoints:
             result = solve.advance(k)
             row[f"fun_{k}"] = result.fun
             row[f"converged_{k}"] = solve.finished and result.status in CONVERGED and result.violation <= LIMIT_TOLERANCE
-        result = solve.advance(planner._max_iterations)
+        result = solve.advance(planner.solver.max_iterations)
         row.update(fun=result.fun, iterations=result.nit, success=result.success, violated=result.violation > LIMIT_TOLERANCE)
         rows.append(row)
     return rows

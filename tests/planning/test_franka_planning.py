@@ -258,7 +258,7 @@ def test_a_ranked_cold_search_abandons_starts_a_converged_start_beats():
     goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
     full = comanip.Planner(model, SolverOptions(cold_search="all", threads=1))
     params = ReachParameters(start, goal, model.width)
-    starts = [full._run_solver(guess, params, np.inf) for guess in full.starts.searched_guesses(params)]
+    starts = [full.solver.solve(guess, params) for guess in full.starts.searched_guesses(params)]
     shortest = min(result.nit for result in starts)
     assert max(result.nit for result in starts) > shortest + 1  # the case needs a start still running
     assert max(result.fun for result in starts) - min(result.fun for result in starts) < 1e-6 * abs(starts[0].fun)

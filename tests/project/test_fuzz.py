@@ -253,7 +253,7 @@ def test_found_by_fuzzing_a_goal_whose_distance_overflows_is_a_value_error(small
 def test_the_reach_library_skips_a_distance_that_overflows():
     from comanip.planning.starts.reach_library import ReachLibrary
 
-    library = ReachLibrary(lambda *args: pytest.fail("no entry to solve"), 2, 4, 0.02)
+    library = ReachLibrary(None, lambda params: pytest.fail("no entry to solve"), 2, 4, 0.02)
     assert library.guess(np.zeros(4), np.array([0.0, 1.35e154]), 0.02) is None
 
 

@@ -8,15 +8,17 @@ Single shooting: the torques are the only decision variables and mu, Sigma are C
 them, so Sigma stays positive semi-definite at every iterate (multiple shooting over Sigma lets iterates go
 indefinite, docs/formulation.md §9). Start state, goal and width are parameters, so one build serves every solve.
 
-Two solvers (``SolverOptions.method``):
+Two solver strategies (``SolverOptions.method``, chosen when the planner is built: ``planner.solver``, a
+:class:`~comanip.planning.reach_solver.ReachSolver`); the start policy (``planner.starts``) proposes the starts and
+the strategy solves them:
 
-- ``newton`` (default): a regularised Newton method with an active set for the limits
-  (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from per-step pieces: exact for point masses
-  (:mod:`comanip.planning.curvature`), approximate with secant corrections for nonlinear bodies
-  (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
+- ``newton`` (default, :class:`~comanip.planning.newton_reach_solver.NewtonReachSolver`): a regularised Newton
+  method with an active set for the limits (:mod:`comanip.optim.active_set_newton`) on a Hessian assembled from
+  per-step pieces: exact for point masses (:mod:`comanip.planning.curvature`), approximate with secant corrections
+  for nonlinear bodies (:mod:`comanip.planning.linearised_curvature`, compiled to C on first use and cached on disk).
   Several times faster than IPOPT on the point masses, to the same optimum (docs/results/speed.md).
-- ``ipopt``: IPOPT with CasADi's exact Hessian of the whole single-shooting problem: the reference,
-  point masses only.
+- ``ipopt`` (:class:`~comanip.planning.ipopt_reach_solver.IpoptReachSolver`): IPOPT with CasADi's exact Hessian
+  of the whole single-shooting problem: the reference, point masses only.
 
 Goals out of an arm's reach (inverse-kinematics residual beyond the goal width) return a plan with
 status 'unreachable' before any solver work.
@@ -32,34 +34,25 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass, field
 
-import casadi as ca
 import numpy as np
-
-from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_bounded_vector, as_count, as_goal_width, as_optional_positive, as_position, as_positive
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
-from comanip.planning.curvature import ReachCurvature
-from comanip.optim import CONVERGED, Evaluation, LocalModel, NewtonSolve, SolverResult, Status
-from comanip.planning.ipopt_status import IpoptDeadline, IpoptSolver, ipopt_status
-from comanip.planning.goal_sensitivity import GoalSensitivity
-from comanip.planning.linearised_curvature import LinearisedCurvature
-from comanip.optim.active_set_newton import newton_solve
-from comanip.optim.newton_loop import never
-from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
+from comanip.optim import Evaluation
+from comanip.planning.ipopt_reach_solver import IpoptReachSolver
+from comanip.planning.newton_reach_solver import NewtonReachSolver
+from comanip.planning.path_limits import PathLimits
 from comanip.planning.plan import Plan, PlanStatus, with_reach_check
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
-from comanip.planning.start_threads import StartThreads, usable_cores
+from comanip.planning.reach_solver import ReachSolver, rank
+from comanip.planning.single_thread_blas import SingleThreadBlas
 from comanip.planning.starts import StartPolicy
 from comanip.planning.terms import Curvature
 
 SOLVER_METHODS = ("newton", "ipopt")
 COLD_SEARCHES = ("ranked", "all")
-LOCAL_OPTIMUM_TOLERANCE = 1e-6
-"""Relative objective difference below which two converged plans of one cold search count as the same local
-optimum (a point-mass reach library keeps one plan per local optimum)."""
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
 full inverse kinematics (:meth:`Planner._goal_joints`); how close each step lands:
@@ -193,71 +186,19 @@ class Planner:
 
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
-        self._curvature = self._newton_terms() if self.options.method == "newton" else None
-        body, H = self.model.body, self.model.H
-        self._torque_bounds = (np.tile(-body.tau_max, H), np.tile(body.tau_max, H))
-        self._limits = PathLimits.of(self.model)
-        self._blas = _SingleThreadBlas()
-        self._ipopt = self._ipopt_solver() if self.options.method == "ipopt" else None
-        self.starts = StartPolicy(self.model, self.options, problem, self._curvature, self._limits, self._solve_reach)
+        limits, blas = PathLimits.of(self.model), SingleThreadBlas()
+        self.solver: ReachSolver = NewtonReachSolver(problem, self.options, blas, limits) \
+            if self.options.method == "newton" else IpoptReachSolver(problem, self.options, blas)
+        """How each solve runs from its starts (:class:`~comanip.planning.reach_solver.ReachSolver`), chosen by
+        ``SolverOptions.method``."""
+        self.starts = StartPolicy(self.model, self.options, problem, self.solver)
         """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`)."""
-        self._solving_time = 0.0 if self.options.compile is None and body.is_linear and self._curvature else None
-        threads = min(self.options.n_starts, usable_cores()) if self.options.threads is None else self.options.threads
-        self._start_threads = StartThreads(self._curvature, threads) \
-            if threads > 1 and isinstance(self._curvature, LinearisedCurvature) else None
-
-    def _solve_reach(self, start, goal, width) -> list[np.ndarray]:
-        """The distinct converged plans (torques (H, n), lowest objective first) of a cold solve from the
-        minimum-jerk guesses: a point-mass reach library's entry. Plans whose objectives agree to
-        ``LOCAL_OPTIMUM_TOLERANCE`` (relative) count as one."""
-        params = ReachParameters(start, goal, width)
-        with self._blas:
-            results = sorted(self._results_from(self.starts.searched_guesses(params), params, np.inf), key=_rank)
-        kept: list[SolverResult] = []
-        for result in results:
-            within_limits = not result.violation > LIMIT_TOLERANCE  # IPOPT reports no violation (NaN)
-            if result.status in CONVERGED and within_limits and \
-                    all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
-                kept.append(result)
-        return [result.x for result in kept] or [results[0].x]
 
     @property
     def curvature(self) -> Curvature | None:
         """The Newton method's objective, gradient and Hessian terms (None for ``method="ipopt"``); the goal
         estimator reuses them."""
-        return self._curvature
-
-    @property
-    def _max_iterations(self) -> int:
-        if self.options.max_iterations is not None:
-            return self.options.max_iterations
-        return self.options.point_mass_iterations if self.model.body.is_linear else self.options.arm_iterations
-
-    @property
-    def _tolerance(self) -> float:
-        """The Newton method's convergence tolerance: ``arm_tolerance`` for nonlinear bodies, if set."""
-        options = self.options
-        return options.tolerance if self.model.body.is_linear or options.arm_tolerance is None else options.arm_tolerance
-
-    def _newton_terms(self):
-        """Objective, gradient and Hessian for the Newton method: exact for linear bodies, structured
-        approximation with secant corrections for nonlinear ones."""
-        compile = self.options.compile
-        if self.model.body.is_linear:
-            return ReachCurvature(self.problem, compile=compile)
-        return LinearisedCurvature(self.problem, compile=compile is not False)
-
-    def _ipopt_solver(self) -> IpoptSolver:
-        """IPOPT on the whole single-shooting problem with CasADi's exact Hessian."""
-        problem = self.problem
-        params = ca.vertcat(problem.s0, problem.goal, problem.width)
-        ipopt = {"print_level": 0, "sb": "yes", "max_iter": self._max_iterations,
-                 "tol": self.options.tolerance, **self.options.ipopt}
-        deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])
-        solver = ca.nlpsol("planner", "ipopt",
-                           {"x": ca.vec(problem.tau), "p": params, "f": -problem.objective / problem.best_objective},
-                           {"ipopt": ipopt, "print_time": False, "error_on_fail": False, "iteration_callback": deadline})
-        return IpoptSolver(solver, deadline)
+        return self.solver.curvature
 
     def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
         """Validated (start (nx,), goal (d,), width) or ValueError naming the argument (:func:`reach_inputs`)."""
@@ -294,22 +235,13 @@ class Planner:
         unreachable = self._unreachable_plan(params, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
-        with self._blas:  # the starts' small products too: one BLAS switch per solve
+        with self.solver.blas:  # the starts' small products too: one BLAS switch per solve
             guesses = self.starts.guesses(params, warm_start, budgeted=max_wall_time is not None,
                                           goal_q=goal_q if warm_start is None else None)
             from_library = warm_start is None and self.starts.from_arm_library(start)
             plan = with_reach_check(self._solve_from(guesses, params, t_begin, max_wall_time, until_converged=from_library))
-        self._count_solving_time(plan.solve_time)
+        self.solver.count_solving_time(plan.solve_time)
         return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
-
-    def _count_solving_time(self, seconds: float) -> None:
-        """Add a solve's time; past ``compile_after`` seconds, start the point mass's background compile."""
-        if self._solving_time is None:
-            return
-        self._solving_time += seconds
-        if self._solving_time >= self.options.compile_after:
-            self._curvature.compile_in_background()
-            self._solving_time = None
 
     def _goal_joints(self, start, goal, width, warm_start) -> np.ndarray:
         """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w of the
@@ -340,177 +272,34 @@ class Planner:
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
-        return self._make_plan(torque, params, status=PlanStatus.UNREACHABLE, success=False, message=message,
-                               solve_time=time.perf_counter() - t_begin, iterations=0)
-
-    def _sensitivity_of(self, result: SolverResult) -> GoalSensitivity | None:
-        """The goal sensitivity of a converged point-mass solve (from the Newton method's last factorisation and
-        the evaluation at the plan); None otherwise."""
-        curvature = self._curvature
-        if curvature is None or not curvature.exact or not result.success or result.local_model is None \
-                or result.local_model.factor is None:
-            return None
-        return GoalSensitivity(curvature, result.local_model.factor, result.local_model.data, self._blas)
+        return self.solver.make_plan(torque, params, status=PlanStatus.UNREACHABLE, success=False, message=message,
+                                     solve_time=time.perf_counter() - t_begin, iterations=0)
 
     def _solve_from(self, guesses, params: ReachParameters, t_begin: float, max_wall_time: float | None,
                     until_converged: bool = False) -> Plan:
-        """The best plan from the guesses (each (H, n)): solved in turn, or, when every guess is solved, as the
-        cold search :meth:`_searched` runs them. ``until_converged``: stop at the first whose solve converges
+        """The best plan from the guesses (each (H, n)), solved by the planner's strategy
+        (:meth:`ReachSolver.results <comanip.planning.reach_solver.ReachSolver.results>`). ``until_converged``: stop at the first whose solve converges
         ('solved') within the limits and ends at the goal (later guesses are fallbacks). A solve that stalled
         ('solved_acceptable', along a redundant arm's flat directions) does not stop the search: on 200 cold
         franka_rest problems 5 library starts did, one of them 6.4e-6 above the plan of the full search
         (benchmarks/cold_quality.py, problem 175)."""
         deadline = np.inf if max_wall_time is None else t_begin + max_wall_time
-        # The Newton systems have a few hundred unknowns: one BLAS thread solves them fastest, and a
-        # multi-threaded BLAS on a busy machine waits for cores.
-        with self._blas:
-            results = self._results_from(guesses, params, deadline, until_converged)
+        solver = self.solver
+        results = solver.results(guesses, params, deadline, until_converged)
         # The plan within the limits with the lowest objective wins, whatever its status: a start that stalls short
         # of the tolerances can still be far better than one that converged on the zero-reward plateau (seen on the
         # Panda), and the status then says it did not converge.
-        best = min(results, key=_rank)
+        best = min(results, key=rank)
         evaluation = None if best.local_model is None else Evaluation(best.fun, None, best.local_model.data)
-        plan = self._make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
-                               solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
-        plan.goal_sensitivity = self._sensitivity_of(best)
+        plan = solver.make_plan(best.x, params, evaluation, status=best.status, success=best.success, message=best.message,
+                                solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
+        plan.goal_sensitivity = solver.sensitivity(best)
         return plan
-
-    def _results_from(self, guesses, params: ReachParameters, deadline: float, until_converged: bool = False) -> list[SolverResult]:
-        """One result per guess solved (each (H, n)): in turn, or, when every guess is solved, as the cold search
-        :meth:`_searched` runs them (``until_converged``: :meth:`_solve_from`)."""
-        if until_converged or len(guesses) == 1 or self._curvature is None:
-            return self._solved_in_turn(guesses, params, deadline, until_converged)
-        return [self._finite(result, guess, params) for guess, result in zip(guesses, self._searched(guesses, params, deadline))]
-
-    def _solved_in_turn(self, guesses, params: ReachParameters, deadline: float, until_converged: bool) -> list[SolverResult]:
-        """The guesses' solves one after another, each to convergence, until the deadline has passed (after the
-        first) or, ``until_converged``, the best so far is 'solved' and ends at the goal."""
-        results = []
-        for guess in guesses:
-            if results and time.perf_counter() > deadline:
-                break
-            results.append(self._finite(self._run_solver(guess, params, deadline), guess, params))
-            best = min(results, key=_rank)
-            if until_converged and best.status == Status.SOLVED and self._ends_at_goal(best.x, params):
-                break
-        return results
-
-    def _searched(self, guesses, params: ReachParameters, deadline: float) -> list[SolverResult]:
-        """Every guess's solve, side by side on the start threads if the planner has them (:attr:`SolverOptions.threads`).
-        'ranked' abandons a start that has not converged after ``abandon_after`` iterations when a start that has
-        converged within the limits by then has a lower objective than it has there; 'all' runs every start to the
-        end. The results do not depend on the threads: each start is solved alone, in the same two stages."""
-        threads = self._start_threads
-        terms = threads.terms(len(guesses)) if threads is not None else [self._curvature] * len(guesses)
-        run = threads.map if threads is not None else _one_after_another
-        budget = self._max_iterations
-        checkpoint = min(budget, self.options.abandon_after) if self.options.cold_search == "ranked" else budget
-        solves = [self._newton_solve(guess, params, deadline, curvature) for guess, curvature in zip(guesses, terms)]
-        results = run(lambda solve: solve.advance(checkpoint), solves)
-        lowest = min((result.fun for result in results if result.status in CONVERGED and result.violation <= LIMIT_TOLERANCE),
-                     default=np.inf)
-        going_on = [k for k, (solve, result) in enumerate(zip(solves, results)) if not solve.finished and not result.fun > lowest]
-        for k, result in zip(going_on, run(lambda k: solves[k].advance(budget), going_on)):
-            results[k] = result
-        return [self._as_torques(result) for result in results]
-
-    def _finite(self, result: SolverResult, guess: np.ndarray, params: ReachParameters) -> SolverResult:
-        """The result, or, where the solver returned a non-finite plan, the guess (H, n) with status 'failed'."""
-        if np.isfinite(result.x).all() and np.isfinite(result.fun):
-            return result
-        objective = self.problem.objective_value(guess, params.start, params.goal, params.width) / self.problem.normaliser(params.width)
-        return SolverResult(guess, objective, Status.FAILED, "solver returned a non-finite plan; returning the initial guess",
-                            result.nit, np.inf)
-
-    def _ends_at_goal(self, torque: np.ndarray, params: ReachParameters) -> bool:
-        """True when the mean end effector of torques (H, n) ends within the goal width of the goal (a converged
-        plan can rest on the zero-reward plateau instead)."""
-        model, curvature = self.model, self._curvature
-        q_end = curvature.mean_path(curvature.value_and_data(np.ravel(torque), params).data)[-1, : model.n]
-        end = np.asarray(model.body.kinematics_function(q_end)[0]).ravel()
-        return bool(np.linalg.norm(end - params.goal) <= params.width)
-
-    def _make_plan(self, torque, params: ReachParameters, evaluation: Evaluation | None = None, **fields) -> Plan:
-        """The Plan of torques (H, n); ``evaluation``: the Newton method's own evaluation at them (its f and data),
-        from which an arm's belief is taken without evaluating again."""
-        curvature = self._curvature
-        if curvature is None or not curvature.carries_belief:  # a point mass's expanded rollout is cheap
-            return self.problem.make_plan(torque, params, **fields)
-        evaluation = evaluation if evaluation is not None else curvature.evaluate(np.ravel(torque), params)
-        return self.problem.make_plan(torque, params, belief=curvature.trajectory(evaluation.data),
-                                      objective=evaluation.f * curvature.normaliser(params.width), **fields)
-
-    def _run_solver(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
-        """One solve from torques guess (H, n) until ``deadline`` (perf_counter, s): x the torques (H, n),
-        fun the normalised objective."""
-        if self._curvature is None:
-            return self._run_ipopt(guess, params, deadline)
-        return self._as_torques(self._newton_solve(guess, params, deadline, self._curvature).advance(self._max_iterations))
-
-    def _newton_solve(self, guess: np.ndarray, params: ReachParameters, deadline: float, curvature: Curvature) -> NewtonSolve:
-        """The Newton method's solve from torques guess (H, n) until ``deadline`` (perf_counter, s), evaluated with
-        ``curvature`` (the planner's terms or a start's own copy of them), to run in stages."""
-        value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
-        return newton_solve(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
-                            *self._torque_bounds, tolerance=self._tolerance, secant=not curvature.exact,
-                            hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
-                            constraints=self._limits.for_newton(curvature) if self._limits.active else None,
-                            constraint_tolerance=LIMIT_TOLERANCE, value=value,
-                            expired=(lambda: time.perf_counter() > deadline) if deadline < np.inf else never)
-
-    def _as_torques(self, result: SolverResult[np.ndarray, LocalModel]) -> SolverResult[np.ndarray, LocalModel]:
-        """The result with x as torques (H, n)."""
-        result.x = result.x.reshape(self.model.H, self.model.n)
-        return result
-
-    def _run_ipopt(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
-        solver = self._ipopt.function
-        self._ipopt.deadline.time = deadline
-        result = solver(x0=np.ravel(guess), p=params.vector)
-        stats = solver.stats()
-        status = ipopt_status(stats, self._ipopt.deadline)
-        torque = np.asarray(result["x"]).reshape(self.model.H, self.model.n)
-        return SolverResult(torque, float(result["f"]), status, stats["return_status"], int(stats.get("iter_count", 0)), np.nan)
-
-
-class _SingleThreadBlas:
-    """A context in which the BLAS libraries loaded when it was made run on one thread (their thread counts are
-    restored on leaving; nested contexts leave them to the outermost). threadpoolctl's own ``limit`` looks the
-    libraries up on every entry, which costs about as much as a point mass's Newton step."""
-
-    def __init__(self):
-        self._libraries = ThreadpoolController().select(user_api="blas").lib_controllers
-        self._depth, self._restore = 0, []
-
-    def __enter__(self):
-        if self._depth == 0:
-            self._restore = [(library, library.num_threads) for library in self._libraries if library.num_threads != 1]
-            for library, _ in self._restore:
-                library.set_num_threads(1)
-        self._depth += 1
-        return self
-
-    def __exit__(self, *exception):
-        self._depth -= 1
-        if self._depth == 0:
-            for library, threads in self._restore:
-                library.set_num_threads(threads)
-        return False
 
 
 def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
     """Distance (m) of the body's end effector at joint position q (n,) from a point (d,)."""
     return float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - point))
-
-
-def _one_after_another(function, items) -> list:
-    """[function(item) for each item]: the start threads' ``map``, in the calling thread."""
-    return [function(item) for item in items]
-
-
-def _rank(candidate: SolverResult) -> tuple[bool, float]:
-    """Order of the starts' results: within the limits first, then the lower normalised objective."""
-    return candidate.status == Status.CONSTRAINTS_VIOLATED, candidate.fun
 
 
 def reach_inputs(model: ReachingModel, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:

@@ -26,7 +26,11 @@ from typing import Callable
 
 import numpy as np
 
+from comanip.optim import CONVERGED
+from comanip.planning.path_limits import LIMIT_TOLERANCE
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.reach_solver import ReachSolver, rank
 
 GRID_RATIO = 1.4
 """Ratio of successive entries' D/w: a query's is at most √1.4 ≈ 1.18 times off its entry's."""
@@ -39,6 +43,9 @@ PACES = (0.9, 0.95, 1.0, 1.05, 1.1)
 reach differ in the step at which the hand brakes, and the best one's step moves between grid points (with the
 entries' plans at their own pace only, the ranked start missed the full search's optimum on some planar goals;
 benchmarks/cold_quality.py --workspace checks these paces)."""
+LOCAL_OPTIMUM_TOLERANCE = 1e-6
+"""Relative objective difference below which two converged plans of one cold search count as the same local
+optimum (an entry keeps one plan per local optimum)."""
 SYMMETRY_TOLERANCE = 1e-9
 """Relative objective difference under a random turn and shift below which a model counts as symmetric."""
 
@@ -93,16 +100,17 @@ class ReachLibrary:
     ``narrow_ratio`` widths several local optima compete, and which is lowest changes between grid points.
 
     Args:
-        solve: (start (state_size,), goal (n,), width) -> the converged plans (each torques (H, n)) of the
-            planner's cold search, lowest objective first.
+        solver: the planner's solver strategy, which solves an entry from ``starts``.
+        starts: the starts (each torques (H, n)) of the planner's cold search for a reach's parameters (the start
+            policy's minimum-jerk guesses).
         n: dimension of the point mass (= d).
         state_size: length of the model's state (2n plus any activation states).
         width: w_0 (m), the width grid's anchor (the model's default).
     """
 
-    def __init__(self, solve: Callable[[np.ndarray, np.ndarray, float], list[np.ndarray]], n: int, state_size: int,
-                 width: float):
-        self._solve, self.n, self.state_size, self.width = solve, n, state_size, float(width)
+    def __init__(self, solver: ReachSolver, starts: Callable[[ReachParameters], list[np.ndarray]], n: int,
+                 state_size: int, width: float):
+        self.solver, self.starts, self.n, self.state_size, self.width = solver, starts, n, state_size, float(width)
         self._entries: dict[tuple[int, int], list[np.ndarray]] = {}
 
     def guess(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> np.ndarray | None:
@@ -141,7 +149,21 @@ class ReachLibrary:
             if key not in self._entries:
                 if not solve_missing:
                     return []
-                self._entries[key] = self._solve(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
+                self._entries[key] = self.solved(ReachParameters(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0],
+                                                                 entry_width))
             kept = self._entries[key] if bracket else self._entries[key][:1]
             plans += [(distance / entry_distance) * torque @ turn for torque in kept]
         return plans
+
+    def solved(self, params: ReachParameters) -> list[np.ndarray]:
+        """An entry: the distinct converged plans (torques (H, n), lowest objective first) of the cold search from
+        :attr:`starts` within the limits, plans whose objectives agree to ``LOCAL_OPTIMUM_TOLERANCE`` (relative)
+        counting as one; the best plan when none converged."""
+        results = sorted(self.solver.results(self.starts(params), params), key=rank)
+        kept = []
+        for result in results:
+            within_limits = not result.violation > LIMIT_TOLERANCE  # IPOPT reports no violation (NaN)
+            if result.status in CONVERGED and within_limits and \
+                    all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
+                kept.append(result)
+        return [result.x for result in kept] or [results[0].x]

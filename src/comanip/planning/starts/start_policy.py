@@ -10,22 +10,19 @@ to the goal) or an arm's :class:`ArmReachLibrary` (moved onto the goal), as ``So
 
 from __future__ import annotations
 
-from typing import Callable
-
 import numpy as np
 
 from comanip.arguments import as_matrix
 from comanip.caching.buffered_function import BufferedFunction
 from comanip.model import ReachingModel
-from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
 from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.reach_solver import ReachSolver
 from comanip.planning.starts.arm_reach_library import CANDIDATE_ENTRIES, WARM_CANDIDATE_ENTRIES, ArmReachLibrary, bundled_library
 from comanip.planning.starts.initial_guess import (LinearDynamics, brake_durations, braked_torques, guess_durations,
                                                    linear_dynamics_of, minimum_jerk_torques, retargeted_torques)
 from comanip.planning.starts.reach_library import ReachLibrary, is_symmetric
-from comanip.planning.terms import Curvature
 
 
 class StartPolicy:
@@ -35,15 +32,15 @@ class StartPolicy:
         model: the model planned for.
         options: the planner's ``SolverOptions`` (``cold_search``, ``n_starts``, ``narrow_ratio``,
             ``far_warm_start``, ``arm_library``).
-        problem: the reach problem; curvature: the Newton method's terms (None for IPOPT); limits: the joint
-            limits on the mean path.
-        solve_reach: (start, goal, width) -> the torques (H, n) of a cold solve from :meth:`searched_guesses`,
-            with which a point mass's reach library solves its entries.
+        problem: the reach problem.
+        solver: the planner's solver strategy: it ranks the starts (their objectives and joint limits), and a point
+            mass's reach library solves its entries with it from :meth:`searched_guesses`.
     """
 
-    def __init__(self, model: ReachingModel, options, problem: ReachProblem, curvature: Curvature | None,
-                 limits: PathLimits, solve_reach: Callable[[np.ndarray, np.ndarray, float], np.ndarray]):
-        self.model, self.options, self.problem, self.curvature, self.limits = model, options, problem, curvature, limits
+    def __init__(self, model: ReachingModel, options, problem: ReachProblem, solver: ReachSolver):
+        self.model, self.options, self.problem, self.solver = model, options, problem, solver
+        self.curvature = solver.curvature
+        """The Newton method's terms (None for IPOPT): warm starts are predicted and moved with them."""
         body, H = model.body, model.H
         self.torque_box = (np.tile(-body.tau_max, (H, 1)), np.tile(body.tau_max, (H, 1)))
         self.unbounded = not np.isfinite(body.tau_max).any()
@@ -55,7 +52,7 @@ class StartPolicy:
         self.task_to_joint_shift = np.linalg.pinv(np.asarray(body.kinematics_function(np.zeros(body.n))[1])) \
             if body.is_linear else None
         self.kinematics = BufferedFunction(body.kinematics_function)
-        self.library = self._reach_library(solve_reach)
+        self.library = self._reach_library()
         ranked_arm = options.cold_search == "ranked" and not body.is_linear
         self.arm_library = self._arm_reach_library() if ranked_arm else None
 
@@ -69,7 +66,7 @@ class StartPolicy:
                              f"to the model it was made for (comanip library --preset <this model's YAML>)")
         return library
 
-    def _reach_library(self, solve_reach) -> ReachLibrary | None:
+    def _reach_library(self) -> ReachLibrary | None:
         """Solved reaches to start 'ranked' cold solves from (:mod:`comanip.planning.starts.reach_library`), for a
         point mass whose objective is unchanged by turning and shifting the problem; None otherwise."""
         model = self.model
@@ -77,7 +74,7 @@ class StartPolicy:
             return None
         if not is_symmetric(self.problem):
             return None
-        return ReachLibrary(solve_reach, model.n, model.state_size, model.width)
+        return ReachLibrary(self.solver, self.searched_guesses, model.n, model.state_size, model.width)
 
     def from_arm_library(self, start) -> bool:
         """Whether a cold solve from ``start`` (nx,) starts from the arm reach library (its ready pose)."""
@@ -141,18 +138,8 @@ class StartPolicy:
         path keeps the joint limits (all candidates if none does)."""
         low, high = self.torque_box
         if self.unbounded:  # no torque bound (the point masses): clipping would only copy
-            return min(candidates, key=lambda c: self._rank(c, params))
-        return min((np.clip(c, low, high) for c in candidates), key=lambda c: self._rank(c, params))
-
-    def _rank(self, torque: np.ndarray, params: ReachParameters) -> tuple[bool, float]:
-        """(mean path beyond a joint limit, objective) of a start (H, n): its order among candidates. A start
-        beyond the limits can have the lowest objective and still be the worst: the solver must first bring it
-        back (on the Panda, starts retargeted far ended 'constraints_violated')."""
-        curvature = self.curvature
-        if curvature is None or not curvature.carries_belief or not self.limits.active:
-            return False, self.objective(torque, params)
-        evaluation = curvature.value_and_data(np.ravel(torque), params)
-        return self.limits.violation(curvature.mean_path(evaluation.data)) > LIMIT_TOLERANCE, evaluation.f
+            return min(candidates, key=lambda c: self.solver.start_rank(c, params))
+        return min((np.clip(c, low, high) for c in candidates), key=lambda c: self.solver.start_rank(c, params))
 
     def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
@@ -178,13 +165,12 @@ class StartPolicy:
             return self.arm_library_starts(params, goal_q)
         if self.library is None:
             return self.searched_guesses(params, goal_q)
-        motion = start.copy()
-        motion[: self.model.n] = 0.0
+        motion = _motion(start, self.model.n)
         moving = bool(np.any(motion))
         narrow = self.narrow_after_stops(params, motion)
-        if moving and narrow and self.stops(motion).any():
-            # a hand carried on by its motion: its local optima are not the library's (ranked starts built from them
-            # ended above the full search on planar goals: benchmarks/results/solver_speed_runs.md)
+        if self._carries_on(motion, narrow):
+            # its local optima are not the library's (ranked starts built from them ended above the full search on
+            # planar goals, and so did every subset of the guesses tried: benchmarks/drifting_starts.py)
             return self.cold_guesses(params, self.options.n_starts)
         if moving:
             candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)
@@ -204,6 +190,18 @@ class StartPolicy:
         scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
             [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
         return [min(scored, key=lambda pair: pair[0])[1]]
+
+    def carried_on(self, params: ReachParameters) -> bool:
+        """Whether a point mass's start moves so that a stop of its motion ends away from the start and the goal lies
+        beyond ``narrow_ratio`` widths from the start or from where a stop ends: a 'ranked' cold solve then runs
+        every minimum-jerk guess (:meth:`cold_starts`)."""
+        motion = _motion(params.start, self.model.n)
+        return self._carries_on(motion, self.narrow_after_stops(params, motion))
+
+    def _carries_on(self, motion: np.ndarray, narrow: bool) -> bool:
+        """:meth:`carried_on` for the start's ``motion`` (nx,, its position zeroed) and whether the goal is narrow
+        after its stops (:meth:`narrow_after_stops`)."""
+        return narrow and bool(np.any(motion)) and bool(self.stops(motion).any())
 
     def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, budgeted: bool = False,
                         every_optimum: bool = False) -> list[np.ndarray]:
@@ -301,9 +299,14 @@ class StartPolicy:
 
     def objective(self, torque: np.ndarray, params: ReachParameters) -> float:
         """J (or J normalised, for comparisons at fixed parameters) of torques (H, n)."""
-        if self.curvature is not None:
-            return self.curvature.value(np.ravel(torque), params)
-        return self.problem.objective_value(torque, params.start, params.goal, params.width)
+        return self.solver.objective(torque, params)
+
+
+def _motion(start: np.ndarray, n: int) -> np.ndarray:
+    """The start state (nx,) with its position (the first n entries) zeroed: its motion alone."""
+    motion = start.copy()
+    motion[:n] = 0.0
+    return motion
 
 
 def _damped_drift(body, linear_dynamics: LinearDynamics | None) -> np.ndarray | None:
