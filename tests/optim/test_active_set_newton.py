@@ -103,3 +103,19 @@ def test_a_solve_paused_and_resumed_takes_the_iterates_of_one_run(secant):
     np.testing.assert_array_equal(resumed.x, whole.x)
     assert resumed.fun == whole.fun and abs(resumed.nit - whole.nit) <= 1
     assert staged.advance(1000) is resumed  # a finished solve only reports
+
+
+@pytest.mark.parametrize("bad", [np.nan, np.inf])
+def test_a_start_where_f_or_its_gradient_is_not_finite_fails_with_a_result(bad):
+    """A start where the objective or its gradient is not finite ends the solve at once with status 'failed' and
+    the start as its best point, never an exception (a control loop reads the result)."""
+    from comanip.optim import Status, newton_solve
+
+    def evaluate(x):
+        return Evaluation(bad if x[0] > 0 else float(x @ x), np.where(x > 0, bad, 2 * x), x)
+
+    result = newton_solve(evaluate, lambda x: 2 * np.eye(3), np.ones(3), np.full(3, -2.0), np.full(3, 2.0),
+                          tolerance=1e-10).advance(50)
+    assert result.status == Status.FAILED and not result.success and result.nit == 0
+    np.testing.assert_array_equal(result.x, np.ones(3))
+    assert "not finite at the start" in result.message

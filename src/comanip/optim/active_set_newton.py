@@ -142,9 +142,10 @@ def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
     method = ActiveSetNewton(evaluate, hessians, ConstraintSet(lb, ub, constraints), value, tolerance=tolerance,
                              constraint_tolerance=constraint_tolerance, margin=margin)
     x = np.array(x0, dtype=float) if method.problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)
-    point = method.finite_point(x, evaluate(x))
+    start = evaluate(x)
+    point = method.finite_point(x, start)
     if point is None:
-        return NewtonSolve(None, None, final=SolverResult(x, f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
+        return NewtonSolve(None, None, final=SolverResult(x, start.f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
     return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
 
 
