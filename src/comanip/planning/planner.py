@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import NamedTuple
 
 import numpy as np
 
@@ -200,8 +201,8 @@ class Planner:
         estimator reuses them."""
         return self.solver.curvature
 
-    def check_inputs(self, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
-        """Validated (start (nx,), goal (d,), width) or ValueError naming the argument (:func:`reach_inputs`)."""
+    def check_inputs(self, start, goal, width) -> ReachInputs:
+        """Validated start (nx,), goal (d,) and width, or ValueError naming the argument (:func:`reach_inputs`)."""
         return reach_inputs(self.model, start, goal, width)
 
     def solve(self, start, goal, width: float | None = None, warm_start=None, max_wall_time: float | None = None) -> Plan:
@@ -302,9 +303,20 @@ def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
     return float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - point))
 
 
-def reach_inputs(model: ReachingModel, start, goal, width) -> tuple[np.ndarray, np.ndarray, float]:
-    """Validated (start (nx,), goal (d,), width (m)) of a reach for ``model``, or ValueError naming the argument;
-    no planner needed, so callers can check every input before building one.
+class ReachInputs(NamedTuple):
+    """A reach's inputs, checked (:func:`reach_inputs`)."""
+
+    start: np.ndarray
+    """Start state (nx,)."""
+    goal: np.ndarray
+    """Goal (d,), m."""
+    width: float
+    """Goal width (m)."""
+
+
+def reach_inputs(model: ReachingModel, start, goal, width) -> ReachInputs:
+    """The checked start (nx,), goal (d,) and width (m) of a reach for ``model``, or ValueError naming the
+    argument; no planner needed, so callers can check every input before building one.
 
     A start of [q; qdot] (2n,) for a model with activation stages gets them at zero force."""
     size = 2 * model.n if np.shape(start) == (2 * model.n,) else model.state_size
@@ -313,7 +325,7 @@ def reach_inputs(model: ReachingModel, start, goal, width) -> tuple[np.ndarray, 
                                           if size != 2 * model.n else "")))
     goal = as_position("goal", goal, model.d)
     width = model.width if width is None else as_goal_width("width", width)
-    return start, goal, width
+    return ReachInputs(start, goal, width)
 
 
 def plan_reach(model: ReachingModel, start, goal, width: float | None = None, **solve_options) -> Plan:

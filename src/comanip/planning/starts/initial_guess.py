@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import casadi as ca
 import numpy as np
@@ -17,7 +18,15 @@ from comanip.bodies.body import Body
 from comanip.caching.buffered_function import BufferedFunction
 
 
-def minimum_jerk(x0, v0, x1, duration, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+class Quintic(NamedTuple):
+    """A quintic profile sampled at times (:func:`minimum_jerk`)."""
+
+    position: np.ndarray
+    velocity: np.ndarray
+    acceleration: np.ndarray
+
+
+def minimum_jerk(x0, v0, x1, duration, t) -> Quintic:
     """Quintic from x0 (k,) at velocity v0 (k,), zero acceleration, to rest at x1 (k,) after duration (s).
 
     Returns position, velocity, acceleration, each (len(t), k); held at x1 after the duration. ``duration``
@@ -26,7 +35,7 @@ def minimum_jerk(x0, v0, x1, duration, t) -> tuple[np.ndarray, np.ndarray, np.nd
     """
     durations = np.asarray(duration, dtype=float)
     pos, vel, acc = _quintic(x0, v0, x1, _QuinticTimes(durations, np.asarray(t, dtype=float)))
-    return (pos, vel, acc) if durations.ndim else (pos[0], vel[0], acc[0])
+    return Quintic(pos, vel, acc) if durations.ndim else Quintic(pos[0], vel[0], acc[0])
 
 
 class _QuinticTimes:
