@@ -139,7 +139,7 @@ class PeopleModel:
     def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None) -> "PeopleModel":
         """Fit on recordings (:class:`comanip.recordings.Recording`) of one ``kind`` of movement, every sample
         from each one's onset to its end: the spread and the coverage factor on two-fold out-of-sample errors
-        of the along regressor, then the along regressor on all samples. ``progress``: called with a line of
+        of the along regressor, then the along and remaining-time regressors on all samples. ``progress``: called with a line of
         text per stage. Needs scikit-learn."""
         from threadpoolctl import ThreadpoolController
         if kind not in KINDS:
@@ -167,9 +167,10 @@ class PeopleModel:
         say("along regressor, all samples")
         along_regressor = _along_regressor(X, along, seed)
         say("remaining-time regressor")
-        timing = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
+        remaining_regressor = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
             X, np.log(remaining + REMAINING_FLOOR))
-        return cls(TreeEnsemble.of(along_regressor), TreeEnsemble.of(spread), factor, kind, trained_on, TreeEnsemble.of(timing))
+        return cls(TreeEnsemble.of(along_regressor), TreeEnsemble.of(spread), factor, kind, trained_on,
+                   TreeEnsemble.of(remaining_regressor))
 
     def predict(self, t, position, velocity, start) -> EndpointPrediction | None:
         """The endpoint (d,) m and its covariance (d, d) m² from the movement so far (:func:`movement_features`'
