@@ -149,21 +149,23 @@ class ReachLibrary:
             if key not in self._entries:
                 if not solve_missing:
                     return []
-                self._entries[key] = self.solved(ReachParameters(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0],
-                                                                 entry_width))
+                entry = ReachParameters(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
+                self._entries[key] = distinct_optima(self.solver, self.starts, entry)
             kept = self._entries[key] if bracket else self._entries[key][:1]
             plans += [(distance / entry_distance) * torque @ turn for torque in kept]
         return plans
 
-    def solved(self, params: ReachParameters) -> list[np.ndarray]:
-        """An entry: the distinct converged plans (torques (H, n), lowest objective first) of the cold search from
-        :attr:`starts` within the limits, plans whose objectives agree to ``LOCAL_OPTIMUM_TOLERANCE`` (relative)
-        counting as one; the best plan when none converged."""
-        results = sorted(self.solver.results(self.starts(params), params), key=rank)
-        kept = []
-        for result in results:
-            within_limits = not result.violation > LIMIT_TOLERANCE  # IPOPT reports no violation (NaN)
-            if result.status in CONVERGED and within_limits and \
-                    all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
-                kept.append(result)
-        return [result.x for result in kept] or [results[0].x]
+
+def distinct_optima(solver: ReachSolver, starts: Callable[[ReachParameters], list[np.ndarray]],
+                    params: ReachParameters) -> list[np.ndarray]:
+    """A library entry: the distinct converged plans (torques (H, n), lowest objective first) of the cold search
+    from ``starts(params)`` within the limits, plans whose objectives agree to ``LOCAL_OPTIMUM_TOLERANCE`` (relative)
+    counting as one; the best plan when none converged."""
+    results = sorted(solver.results(starts(params), params), key=rank)
+    kept = []
+    for result in results:
+        within_limits = not result.violation > LIMIT_TOLERANCE  # IPOPT reports no violation (NaN)
+        if result.status in CONVERGED and within_limits and \
+                all(abs(result.fun - other.fun) > LOCAL_OPTIMUM_TOLERANCE * abs(other.fun) for other in kept):
+            kept.append(result)
+    return [result.x for result in kept] or [results[0].x]

@@ -170,7 +170,9 @@ class StartPolicy:
         narrow = self.narrow_after_stops(params, motion)
         if self._carries_on(motion, narrow):
             # its local optima are not the library's (ranked starts built from them ended above the full search on
-            # planar goals, and so did every subset of the guesses tried: benchmarks/drifting_starts.py)
+            # planar goals, and so did every subset of the guesses tried: benchmarks/drifting_starts.py; a library of
+            # solved moving-start reaches meets the cold-search rule only on a grid where nearly every problem needs
+            # a new entry: benchmarks/moving_library.py)
             return self.cold_guesses(params, self.options.n_starts)
         if moving:
             candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)
