@@ -172,7 +172,7 @@ class StartPolicy:
             # its local optima are not the library's (ranked starts built from them ended above the full search on
             # planar goals, and so did every subset of the guesses tried: benchmarks/drifting_starts.py; a library of
             # solved moving-start reaches meets the cold-search rule only on a grid where nearly every problem needs
-            # a new entry: benchmarks/moving_library.py)
+            # a new entry: studies/does_a_library_of_moving_start_reaches_pay_off/)
             return self.cold_guesses(params, self.options.n_starts)
         if moving:
             candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)

@@ -1,8 +1,8 @@
-"""A library of solved moving-start reaches for the point masses' cold solves that a start's motion carries on:
-how close its starts come to the full search, and whether it ever fills.
+"""Does a library of solved moving-start reaches pay off for the point masses' cold solves that a start's motion
+carries on? How close its starts come to the full search, and whether it ever fills.
 
-    .venv/bin/python benchmarks/moving_library.py [--presets planar,cartesian] [--steps 0.025,0.05,0.1,0.2]
-                                                  [--fresh 400]
+    PYTHONPATH=src python studies/does_a_library_of_moving_start_reaches_pay_off/measure_library.py \
+        [--presets planar,cartesian] [--steps 0.025,0.05,0.1,0.2] [--fresh 400]
 
 A symmetric point mass plans the same reach for every start and goal that an orthogonal map and a shift take onto
 one another, and nearly the same for lengths (positions, velocities, widths) scaled together: a start moving with
@@ -36,7 +36,7 @@ from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_solver import ReachSolver
 from comanip.planning.starts.reach_library import WIDTH_RATIO, distinct_optima
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # the workspace sets
 import workspace  # noqa: E402
 from drifting_starts import spread  # noqa: E402
 
