@@ -27,7 +27,7 @@ class RecordedPeople:
         predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
         if predicted is None:
             return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
-        timing = None if predicted.end_time is None else \
-            ReachTiming(hand.onset(), max(predicted.end_time - hand.onset(), hand.t[-1] - hand.onset()))
+        onset = hand.onset()
+        timing = None if predicted.end_time is None else ReachTiming(onset, max(predicted.end_time, hand.t[-1]) - onset)
         return reach.landed(Explained(predicted.goal, predicted.covariance, True, EstimateStatus.PEOPLE_MODEL,
                                       "the goal is the people model's", timing=timing), hand.position[-1])

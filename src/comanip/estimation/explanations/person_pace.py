@@ -63,8 +63,7 @@ class ModelAtPersonPace:
         fitted = self.fit(hand, None if latest is None else latest.goal)
         if fitted.misfit > self.options.paced_threshold or not self.settled(fitted):
             return Explained(fitted.goal, fitted.covariance, False, Status.FAILED,
-                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})", misfit=fitted.misfit,
-                             timing=fitted.timing)
+                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})", misfit=fitted.misfit)
         landing = reach.prediction(fitted.goal, order=0).cov[-1, :reach.model.n, :reach.model.n]
         return reach.landed(Explained(fitted.goal, fitted.covariance + landing, True, Status.SOLVED, "the model's reach "
                                       f"at the person's pace (×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does",
