@@ -7,9 +7,12 @@ speed so far, the acceleration, time since the peak speed over tau, the path len
 straightness |x_K - x_0| / L, the angle between the velocity and the displacement, and v_peak tau / L.
 Gradient-boosted regressors (scikit-learn, fitted on recordings by :meth:`PeopleModel.fit`) predict from
 them how far beyond the hand the endpoint lies along the direction of motion u (the velocity's while the hand
-moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), in units of L, the
-log of the expected squared error, and when the hand stops: log(r / tau + ``REMAINING_FLOOR``) for the time r
-still to go (s). The predicted
+moves, ``DIRECTION_SPEED``; near rest its displacement over the last ``DIRECTION_WINDOW`` s), the log of the
+expected squared error, and when the hand stops: log(r / tau + ``REMAINING_FLOOR``) for the time r still to go
+(s). How far beyond the hand is regressed as the share of the whole path still to go, s = a / (1 + |a|) for
+the distance beyond the hand over L, a: s lies in (-1, 1), while a runs to thousands a few samples after the
+onset (L of a millimetre or two), and trees fitted to a let such values leak into predictions mid-movement.
+The predicted
 endpoint is never behind the hand along u, and a hand that has stopped (its positions still for a tenth of a
 second after it left the start and its net speed over that time below half ``REST_FRACTION`` of its peak speed,
 :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of its peak for ``REST_TIME``) is at its
@@ -72,6 +75,8 @@ REMAINING_FLOOR = 0.02
 """Added to the time still to go over tau before its log is regressed (a hand at its end has none to go)."""
 REST_SPREAD = 0.03
 """Standard deviation of a stopped hand's endpoint estimate, a fraction of the path length."""
+MAX_SHARE = 0.999
+"""The largest share of the path still to go a prediction is taken at (a = 999 path lengths)."""
 _MIN_PATH = 1e-4
 _MIN_RECENT = 2e-3
 
@@ -114,7 +119,8 @@ class PeopleModel:
     """The fitted endpoint model (module docstring)."""
 
     along: "TreeEnsemble"
-    """Regressor of the endpoint's distance beyond the hand along u, over L (its ``QUANTILE`` quantile)."""
+    """Regressor of the share of the path still to go along u, s = a / (1 + |a|) with a the endpoint's distance
+    beyond the hand along u over L (its ``QUANTILE`` quantile); ``along_target`` says which."""
     spread: "TreeEnsemble"
     """Regressor of log(|error|² / L²) from the features."""
     coverage_factor: float
@@ -125,10 +131,15 @@ class PeopleModel:
     """What the model was fitted on."""
     remaining: "TreeEnsemble | None" = None
     """Regressor of log(time still to go / tau + ``REMAINING_FLOOR``); None: the model does not say when."""
+    along_target: str = "share"
+    """What ``along`` predicts, a key of :data:`ALONG_TARGETS`: ``share`` (s) or, in models saved before it
+    existed, ``over path`` (a itself)."""
 
     def __post_init__(self):
         if self.kind not in KINDS:
             raise ValueError(f"kind must be one of {sorted(KINDS)}, got {self.kind!r}")
+        if self.along_target not in ALONG_TARGETS:
+            raise ValueError(f"along_target must be one of {sorted(ALONG_TARGETS)}, got {self.along_target!r}")
 
     @property
     def columns(self) -> np.ndarray:
@@ -158,14 +169,15 @@ class PeopleModel:
         predicted = np.zeros(len(X))
         for k in (0, 1):
             say(f"along regressor, fold {k + 1} of 2 ({int((fold != k).sum())} samples)")
-            predicted[fold == k] = _along_regressor(X[fold != k], along[fold != k], seed).predict(X[fold == k])
+            predicted[fold == k] = beyond_over_path(_along_regressor(X[fold != k], share_to_go(along[fold != k]),
+                                                                     seed).predict(X[fold == k]))
         squared = (np.maximum(predicted, 0.0) - along) ** 2 + across**2
         say("spread regressor")
         spread = HistGradientBoostingRegressor(max_iter=120, learning_rate=0.06, random_state=seed).fit(X, np.log(squared + 1e-6))
         d = recordings[0].position.shape[1]
         factor = float(np.quantile(squared / np.exp(spread.predict(X)), 0.95) / chi2.ppf(0.95, d) * d)
         say("along regressor, all samples")
-        along_regressor = _along_regressor(X, along, seed)
+        along_regressor = _along_regressor(X, share_to_go(along), seed)
         say("remaining-time regressor")
         remaining_regressor = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
             X, np.log(remaining + REMAINING_FLOOR))
@@ -188,7 +200,7 @@ class PeopleModel:
         if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
             return EndpointPrediction(position[-1].copy(), stopped, float(t[-1]))
         x = features[self.columns]
-        along, log_squared = self.along(x), self.spread(x)
+        along, log_squared = float(ALONG_TARGETS[self.along_target](self.along(x))), self.spread(x)
         goal = position[-1] + path * max(along, 0.0) * u
         variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
         if path < STOPPING_TIME * speed[-1]:
@@ -204,7 +216,7 @@ class PeopleModel:
                   for field, value in getattr(self, name).arrays().items()}
         with open(path, "wb") as stream:
             np.savez_compressed(stream, coverage_factor=self.coverage_factor, kind=self.kind, trained_on=self.trained_on,
-                                **arrays)
+                                along_target=self.along_target, **arrays)
         return path
 
     @classmethod
@@ -216,7 +228,9 @@ class PeopleModel:
                                             if f"{name}_feature" in data else None for name in ("along", "spread", "remaining"))
                 if along is None or spread is None:
                     raise KeyError("along or spread regressor")
-                return cls(along, spread, float(data["coverage_factor"]), str(data["kind"]), str(data["trained_on"]), remaining)
+                target = str(data["along_target"]) if "along_target" in data else "over path"
+                return cls(along, spread, float(data["coverage_factor"]), str(data["kind"]), str(data["trained_on"]), remaining,
+                           target)
         except (OSError, KeyError, ValueError) as error:
             raise ValueError(f"{str(path)!r} is not a people model written by PeopleModel.save ({error})") from None
 
@@ -272,10 +286,27 @@ class TreeEnsemble:
         return self.baseline + float(self.value[rows, node].sum())
 
 
-def _along_regressor(X, along, seed: int):
+def share_to_go(beyond: np.ndarray) -> np.ndarray:
+    """The share of the whole path still to go, s = a / (1 + |a|), for distances beyond the hand over the path
+    so far a (any shape): in (-1, 1), negative where the endpoint lies behind the hand."""
+    return beyond / (1.0 + np.abs(beyond))
+
+
+def beyond_over_path(share: np.ndarray) -> np.ndarray:
+    """a = s / (1 - |s|), the inverse of :func:`share_to_go`, for s kept within ±``MAX_SHARE``."""
+    share = np.clip(share, -MAX_SHARE, MAX_SHARE)
+    return share / (1.0 - np.abs(share))
+
+
+ALONG_TARGETS = {"share": beyond_over_path, "over path": lambda beyond: beyond}
+"""What a people model's along regressor may predict, and how that turns into a, the distance beyond the hand
+over the path so far."""
+
+
+def _along_regressor(X, share, seed: int):
     from sklearn.ensemble import HistGradientBoostingRegressor
     return HistGradientBoostingRegressor(max_iter=250, learning_rate=0.06, loss="quantile", quantile=QUANTILE,
-                                         random_state=seed).fit(X, along)
+                                         random_state=seed).fit(X, share)
 
 
 def _samples(recordings):
