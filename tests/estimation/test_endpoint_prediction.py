@@ -7,6 +7,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 import comanip
 from comanip.estimation.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
@@ -194,6 +196,11 @@ def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(peopl
     where_only = PeopleModel.load(replace(model, remaining=None).save(tmp_path / "where.npz"))
     answer = where_only.predict(r.t, r.position, r.velocity, r.position[0])
     assert where_only.remaining is None and answer.end_time is None
+    # a model saved before the along regressor predicted the share still to go reads its trees as distances over L
+    with np.load(tmp_path / "people.npz") as data:
+        arrays = {name: data[name] for name in data.files if name != "along_target"}
+    np.savez(tmp_path / "older.npz", **arrays)
+    assert PeopleModel.load(tmp_path / "older.npz").along_target == "over path"
     (tmp_path / "other.npz").write_bytes(b"not a model")
     with pytest.raises(ValueError, match="is not a people model"):
         PeopleModel.load(tmp_path / "other.npz")
@@ -248,3 +255,33 @@ def test_the_online_estimator_predicts_recorded_arm_reaches_better_than_where_th
     for f in FRACTIONS:
         assert np.median(mine[f]) < 0.8 * np.median(current[f]), (f, np.median(mine[f]), np.median(current[f]))
     assert np.median(arrival) <= 0.15 and np.median(arrival) < 0.5 * np.median(own_pace), (np.median(arrival), np.median(own_pace))
+
+
+@given(st.floats(-900.0, 900.0, allow_nan=False))
+def test_the_share_of_the_path_still_to_go_is_bounded_and_gives_the_distance_back(beyond):
+    from comanip.estimation.people_model import beyond_over_path, share_to_go
+    share = share_to_go(np.array([beyond, beyond + 1e-3]))
+    assert np.all(np.abs(share) < 1) and share[1] > share[0] and np.sign(share[0]) == np.sign(beyond)
+    np.testing.assert_allclose(beyond_over_path(share[:1]), [beyond], rtol=1e-9, atol=1e-12)
+
+
+@pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
+def test_a_people_model_fitted_on_arm_reaches_keeps_its_goal_near_the_reach_on_others():
+    """Fitted on half of the recorded reaches, on the other half after a quarter of the movement: the goal stays
+    within two distances of the start and moves by less than one distance from one update to the next (a hand a
+    few samples after its onset has a path of a millimetre or two, and a regressor of the distance still to go
+    over that path learns values in the thousands)."""
+    from comanip.estimation.people_model import PeopleModel
+    from comanip.recordings import load_tathum
+    reaches = [trial.streamed_recording() for trial in load_tathum(ARMS)]
+    model = PeopleModel.fit(reaches[1::2], kind="arm")
+    farthest, largest_move = 0.0, 0.0
+    for r in reaches[0::2][:40]:
+        previous = None
+        for k in range(r.seen_until(0.25), r.seen_until(1.0) + 1):
+            goal = model.predict(r.t[:k], r.position[:k], r.velocity[:k], r.position[0]).goal
+            farthest = max(farthest, np.linalg.norm(goal - r.position[0]) / r.distance)
+            if previous is not None:
+                largest_move = max(largest_move, np.linalg.norm(goal - previous) / r.distance)
+            previous = goal
+    assert farthest < 2.0 and largest_move < 1.0, (farthest, largest_move)
