@@ -17,7 +17,8 @@ endpoint is never behind the hand along u, and a hand that has stopped (its posi
 second after it left the start and its net speed over that time below half ``REST_FRACTION`` of its peak speed,
 :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of its peak for ``REST_TIME``) is at its
 endpoint. Its covariance is isotropic: the predicted squared error times a
-factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (out-of-sample errors), and
+factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (errors and their predicted
+spread both out of sample), and
 while the path so far is short, never below the distance the hand can still cover at its speed
 (``STOPPING_TIME``).
 
@@ -149,8 +150,10 @@ class PeopleModel:
     @classmethod
     def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None) -> "PeopleModel":
         """Fit on recordings (:class:`comanip.recordings.Recording`) of one ``kind`` of movement, every sample
-        from each one's onset to its end: the spread and the coverage factor on two-fold out-of-sample errors
-        of the along regressor, then the along and remaining-time regressors on all samples. ``progress``: called with a line of
+        from each one's onset to its end: the spread regressor on two-fold out-of-sample errors of the along
+        regressor, and the coverage factor on those errors over the spread each fold's spread regressor predicts
+        for the other fold (a spread fitted on the very errors it is scored on predicts them too well), then
+        the along, spread and remaining-time regressors on all samples. ``progress``: called with a line of
         text per stage. Needs scikit-learn."""
         from threadpoolctl import ThreadpoolController
         if kind not in KINDS:
@@ -172,10 +175,15 @@ class PeopleModel:
             predicted[fold == k] = beyond_over_path(_along_regressor(X[fold != k], share_to_go(along[fold != k]),
                                                                      seed).predict(X[fold == k]))
         squared = (np.maximum(predicted, 0.0) - along) ** 2 + across**2
-        say("spread regressor")
-        spread = HistGradientBoostingRegressor(max_iter=120, learning_rate=0.06, random_state=seed).fit(X, np.log(squared + 1e-6))
+        log_squared = np.log(squared + 1e-6)
+        spread_out_of_sample = np.zeros(len(X))
+        for k in (0, 1):
+            say(f"spread regressor, fold {k + 1} of 2")
+            spread_out_of_sample[fold == k] = _spread_regressor(X[fold != k], log_squared[fold != k], seed).predict(X[fold == k])
         d = recordings[0].position.shape[1]
-        factor = float(np.quantile(squared / np.exp(spread.predict(X)), 0.95) / chi2.ppf(0.95, d) * d)
+        factor = float(np.quantile(squared / np.exp(spread_out_of_sample), 0.95) / chi2.ppf(0.95, d) * d)
+        say("spread regressor, all samples")
+        spread = _spread_regressor(X, log_squared, seed)
         say("along regressor, all samples")
         along_regressor = _along_regressor(X, share_to_go(along), seed)
         say("remaining-time regressor")
@@ -301,6 +309,11 @@ def beyond_over_path(share: np.ndarray) -> np.ndarray:
 ALONG_TARGETS = {"share": beyond_over_path, "over path": lambda beyond: beyond}
 """What a people model's along regressor may predict, and how that turns into a, the distance beyond the hand
 over the path so far."""
+
+
+def _spread_regressor(X, log_squared, seed: int):
+    from sklearn.ensemble import HistGradientBoostingRegressor
+    return HistGradientBoostingRegressor(max_iter=120, learning_rate=0.06, random_state=seed).fit(X, log_squared)
 
 
 def _along_regressor(X, share, seed: int):
