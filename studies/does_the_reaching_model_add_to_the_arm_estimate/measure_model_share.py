@@ -25,10 +25,8 @@ and each shape fit's misfit (chi² per observed number; the estimator accepts at
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -40,9 +38,10 @@ from comanip.estimation.people_model import (FEATURES, KINDS, PeopleModel, _alon
                                              movement_features, share_to_go)
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_profile import ReachProfile
-from comanip.recordings import load_tathum
 
-ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # arm_reaches.py
+from arm_reaches import streamed_arm_reaches  # noqa: E402
+
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 BLENDS = (0.1, 0.2, 0.3, 0.5)
 PHASE = np.linspace(0.0, 1.0, 201)
@@ -113,14 +112,7 @@ def paced_trace(recording, paced: PacedModel) -> dict:
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--arms", type=Path, default=ARMS)
-    parser.add_argument("--limit", type=int, default=None)
-    args = parser.parse_args(argv)
-    if not args.arms.is_dir():
-        sys.exit(f"no arm reaches at {args.arms}")
-    warnings.simplefilter("ignore")
-    recordings = [trial.streamed_recording() for trial in load_tathum(args.arms)[:args.limit]]
+    recordings = streamed_arm_reaches(__doc__.split("\n\n")[0], argv)
     model = comanip.presets.arm()
     paced = PacedModel(comanip.OnlineGoalEstimator(model, np.zeros(model.state_size)).family)
     model_shape = paced.shape(float(np.median([r.distance for r in recordings])))

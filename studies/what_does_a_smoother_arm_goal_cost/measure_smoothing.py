@@ -17,18 +17,17 @@ the movement time and the share of updates after a quarter of it that move the g
 
 from __future__ import annotations
 
-import argparse
 import math
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
 
 from comanip.estimation.people_model import PeopleModel
-from comanip.recordings import load_tathum
 
-ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # arm_reaches.py
+from arm_reaches import streamed_arm_reaches  # noqa: E402
+
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 TIME_CONSTANTS_S = (0.0, 0.008, 0.016, 0.032, 0.064)
 JUMP = 0.1
@@ -56,14 +55,7 @@ def smoothed(times: np.ndarray, goals: np.ndarray, time_constant: float) -> np.n
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--arms", type=Path, default=ARMS)
-    parser.add_argument("--limit", type=int, default=None)
-    args = parser.parse_args(argv)
-    if not args.arms.is_dir():
-        sys.exit(f"no arm reaches at {args.arms}")
-    warnings.simplefilter("ignore")
-    recordings = [trial.streamed_recording() for trial in load_tathum(args.arms)[:args.limit]]
+    recordings = streamed_arm_reaches(__doc__.split("\n\n")[0], argv)
     traces = [None] * len(recordings)
     for parity in (0, 1):
         print(f"half {parity + 1} of 2 ...", file=sys.stderr, flush=True)

@@ -12,9 +12,7 @@ and settling checks). Printed as a markdown block (progress on stderr).
 
 from __future__ import annotations
 
-import argparse
 import sys
-import warnings
 from pathlib import Path
 
 import numpy as np
@@ -24,9 +22,10 @@ from comanip.estimation import OnlineOptions
 from comanip.estimation.explanations import Explained, HandAtRest, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.people_model import shipped_people_model
-from comanip.recordings import load_tathum
 
-ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # arm_reaches.py
+from arm_reaches import streamed_arm_reaches  # noqa: E402
+
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 
 
@@ -60,15 +59,8 @@ def explanations(model, options, family):
 
 
 def main(argv=None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--arms", type=Path, default=ARMS)
-    parser.add_argument("--limit", type=int, default=None)
-    args = parser.parse_args(argv)
-    if not args.arms.is_dir():
-        sys.exit(f"no arm reaches at {args.arms}")
-    warnings.simplefilter("ignore")
+    recordings = streamed_arm_reaches(__doc__.split("\n\n")[0], argv)
     model, options = comanip.presets.arm(), OnlineOptions()
-    recordings = [trial.streamed_recording() for trial in load_tathum(args.arms)[:args.limit]]
     family = comanip.OnlineGoalEstimator(model, np.zeros(model.state_size)).family
     rows = []
     for name, (make, scored) in explanations(model, options, family).items():
