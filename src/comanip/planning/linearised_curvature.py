@@ -52,8 +52,9 @@ class LinearisedCurvature:
 
     Args:
         problem: the model's :class:`ReachProblem` (its weights and normaliser are used).
-        compile: build the per-solve function as C (recommended: about ten times faster than CasADi's
-            virtual machine for the Panda; the first build takes a minute and is cached on disk).
+        compile: build the per-solve functions as C for this processor (recommended: about ten times faster than
+            CasADi's virtual machine for the Panda, with the same numbers up to rounding; the first build takes a
+            few minutes and is cached on disk, :func:`~comanip.caching.compiled.compiled`).
     """
 
     exact = False
@@ -69,7 +70,7 @@ class LinearisedCurvature:
         d = model.d
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
         tag = model_key(model)  # a model built before loads its C functions without generating their source (~1 s)
-        self._gradient, self._pieces, self._value = (BufferedFunction(compiled_or_cached(function, tag) if compile else function)
+        self._gradient, self._pieces, self._value = (BufferedFunction(compiled_or_cached(function, tag, for_this_processor=True) if compile else function)
                                                      for function in self._functions(problem))
         self._noise_hessian = _noise_second_derivatives(model)
         # D[j, l, r, s] as a matrix ((r, s), (j, l)): <S, ∂²N/∂tau_j ∂tau_l> for every (j, l) is S.ravel() @ it
