@@ -40,11 +40,12 @@ def test_a_build_for_this_processor_is_keyed_on_it_and_falls_back_to_the_plain_f
     x = ca.SX.sym("x", 3)
     f = ca.Function("processor_test", [x], [ca.sin(x) * ca.sumsqr(x) + x[0] * x[1]])
     point = np.array([0.3, -1.0, 2.0])
-    monkeypatch.setattr(compiled_module, "_processor", lambda: "processor-a")
-    monkeypatch.setattr(compiled_module, "PROCESSOR_FLAGS", ("-O2", "-march=native", "-fPIC", "-shared"))
-    assert compiled_module._flags(True) == ["-O2", "-march=processor-a", "-fPIC", "-shared"]
+    monkeypatch.setattr(compiled_module, "_processor", lambda: "fingerprint-a")
+    monkeypatch.setattr(compiled_module, "PROCESSOR_FLAGS", ("-O2", "-mno-such-instructions", "-fPIC", "-shared"))
+    assert compiled_module._flags(True) == ["-O2", "-mno-such-instructions", "-fPIC", "-shared",
+                                            "-DCOMANIP_PROCESSOR=fingerprint-a"]
     assert compiled_module._flags(False) == list(compiled_module.COMPILE_FLAGS)
-    # a processor the compiler rejects: the plain build, same numbers up to rounding, filed under the plain flags
+    # flags the compiler rejects: the plain build, same numbers up to rounding, filed under the plain flags
     fast = compiled_module.compiled_or_cached(f, "model A", for_this_processor=True)
     np.testing.assert_allclose(np.asarray(fast(point)).ravel(), np.asarray(f(point)).ravel(), rtol=1e-14)
     assert compiled_module.cached_compiled("processor_test", "model A") is not None

@@ -133,27 +133,28 @@ def _tag_key(tag: str, flags: list[str]) -> str:
 
 
 def _flags(for_this_processor: bool) -> list[str]:
-    """The compiler flags of a build, the processor they build for among them (:func:`_processor`)."""
+    """The compiler flags of a build; a build for this processor ends with a definition naming the instructions the
+    compiler chooses for it (:func:`_processor`), so that the cache keys tell processors apart."""
     processor = _processor() if for_this_processor else None
     if processor is None:
         return list(COMPILE_FLAGS)
-    return [flag if flag != "-march=native" else f"-march={processor}" for flag in PROCESSOR_FLAGS]
+    return [*PROCESSOR_FLAGS, f"-DCOMANIP_PROCESSOR={processor}"]
 
 
 @functools.lru_cache(maxsize=1)
 def _processor() -> str | None:
-    """The processor ``-march=native`` builds for, as the compiler names it (e.g. 'znver3'); None where the compiler
-    does not say (then no build is made for this processor alone)."""
+    """A fingerprint of what ``-march=native`` means to the compiler here: the processor it names and the instruction
+    sets it enables (a virtual machine may hide some of a processor's); None where the compiler does not say (then
+    no build is made for this processor alone)."""
     try:
         shown = subprocess.run([*_compiler(), "-march=native", "-Q", "--help=target"], capture_output=True, text=True,
                                timeout=60).stdout
     except (OSError, subprocess.SubprocessError):
         return None
-    for line in shown.splitlines():
-        words = line.split()
-        if len(words) == 2 and words[0] == "-march=" and words[1] != "native":
-            return words[1]
-    return None
+    targets = sorted(" ".join(line.split()) for line in shown.splitlines() if line.strip().startswith("-m"))
+    if not any(target.startswith("-march= ") and target != "-march= native" for target in targets):
+        return None
+    return hashlib.sha256("\n".join(targets).encode()).hexdigest()[:16]
 
 
 FUNCTION_SOURCES = ("casadi", "adam-robotics", "example-robot-data")
