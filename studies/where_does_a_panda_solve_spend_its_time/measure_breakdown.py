@@ -1,6 +1,6 @@
 """Where does a Panda solve spend its time? Per Newton iteration and per solve, piece by piece, on the workspace sets.
 
-    PYTHONPATH=src .venv/bin/python studies/where_does_a_panda_solve_spend_its_time/measure_breakdown.py [--problems 45] [--compare REF]
+    PYTHONPATH=src .venv/bin/python studies/where_does_a_panda_solve_spend_its_time/measure_breakdown.py [--problems 45] [--compare REF] [--markdown]
 
 The sampled sets of ``benchmarks/workspace.py`` (starts at rest): ``franka_rest`` warm (the plan to the problem's
 goal, untimed, then the solve to its warm goal from it) and cold, and the paper's ``franka`` cold with its starts
@@ -16,7 +16,9 @@ piece is timed where it runs (wall clock, inclusive):
 
 Prints, per case, the median solve time and iterations, then per piece its calls and milliseconds per iteration
 and its share of all solve time. ``--compare REF``: the same in a process importing REF's ``src`` (another
-checkout), printed after this checkout's. Timings move with the machine's load; the counts do not.
+checkout, or a git revision of this repository), printed after this checkout's. ``--markdown``: one table for the
+speed page instead, a column per case, REF's milliseconds in brackets. Timings move with the machine's load; the
+counts do not.
 """
 
 from __future__ import annotations
@@ -138,6 +140,49 @@ def table(preset: str, kind: str, row: dict, label: str) -> str:
     return "\n".join(lines)
 
 
+def markdown(rows: dict, references: dict, command: str) -> str:
+    """The speed page's table: a row per piece, a column per case (``rows`` and ``references`` keyed by case)."""
+
+    def cell(row: dict, reference: dict | None, piece: str) -> str:
+        its, total = row["iterations"], row["seconds"]
+        seconds = row["pieces"][piece][1]
+        text = f"{1e3 * seconds / its:.2f} ms, {100 * seconds / total:.0f} %"
+        if reference is not None:
+            text += f" ({1e3 * reference['pieces'][piece][1] / reference['iterations']:.2f})"
+        return text
+
+    def rest(row: dict) -> float:
+        return row["seconds"] - sum(seconds for _, seconds in row["pieces"].values())
+
+    cases = list(rows)
+    lines = [f"Measured by `{command}` (ms per Newton iteration and share of all solve time"
+             + (", in brackets the reference's ms" if references else "") + "):", "",
+             "| piece (calls per iteration) | " + " | ".join(f"`{preset}` {kind}" for preset, kind in cases) + " |",
+             "|---" * (len(cases) + 1) + "|"]
+    for piece in LOOP_PIECES:
+        calls = " / ".join(f"{rows[case]['pieces'][piece][0] / rows[case]['iterations']:.2f}" for case in cases)
+        lines.append(f"| {piece} ({calls}) | " + " | ".join(cell(rows[c], references.get(c), piece) for c in cases) + " |")
+    lines.append("| rest of the iteration | " + " | ".join(
+        f"{1e3 * rest(rows[c]) / rows[c]['iterations']:.2f} ms, {100 * rest(rows[c]) / rows[c]['seconds']:.0f} %"
+        for c in cases) + " |")
+
+    def per_iteration(row: dict) -> str:
+        return f"{1e3 * (row['seconds'] - sum(row['pieces'][p][1] for p in SOLVE_PIECES)) / row['iterations']:.2f} ms"
+
+    lines.append("| **per iteration** | " + " | ".join(
+        f"**{per_iteration(rows[c])}**" + (f" ({per_iteration(references[c])})" if c in references else "")
+        for c in cases) + " |")
+    for piece in SOLVE_PIECES:
+        lines.append(f"| per solve: {piece} | " + " | ".join(
+            f"{1e3 * rows[c]['pieces'][piece][1] / max(rows[c]['pieces']['building the plan'][0], 1):.1f} ms, "
+            f"{100 * rows[c]['pieces'][piece][1] / rows[c]['seconds']:.0f} %" for c in cases) + " |")
+    lines.append("| median solve, median iterations | " + " | ".join(
+        f"{rows[c]['median_ms']:.1f} ms, {rows[c]['median_iterations']:.0f}"
+        + (f" ({references[c]['median_ms']:.1f} ms, {references[c]['median_iterations']:.0f})" if c in references else "")
+        for c in cases) + " |")
+    return "\n".join(lines)
+
+
 def measured_elsewhere(src: Path, preset: str, kind: str, count: int) -> dict:
     """measure(...) in a fresh process importing comanip from ``src``."""
     done = subprocess.run([sys.executable, __file__, "--row", preset, kind, "--problems", str(count)],
@@ -148,16 +193,34 @@ def measured_elsewhere(src: Path, preset: str, kind: str, count: int) -> dict:
 def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--problems", type=int, default=45, help="problems per case (default: %(default)s)")
-    parser.add_argument("--compare", type=Path, default=None, help="another checkout to measure after this one")
+    parser.add_argument("--compare", default=None,
+                        help="another checkout to measure after this one, or a git revision of this repository")
+    parser.add_argument("--markdown", action="store_true", help="one table for the speed page")
     parser.add_argument("--row", nargs=2, default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.row is not None:
         print(json.dumps(measure(*args.row, args.problems)))
         return
-    sources = [("", ROOT / "src")] + ([(" (REF)", args.compare.resolve() / "src")] if args.compare else [])
-    for preset, kind in CASES:
-        for label, src in sources:
-            print(table(preset, kind, measured_elsewhere(src, preset, kind, args.problems), label), flush=True)
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from solve_times import reference_source
+
+    reference, clean_up = reference_source(args.compare) if args.compare else (None, lambda: None)
+    rows, references = {}, {}
+    try:
+        for case in CASES:
+            rows[case] = measured_elsewhere(ROOT / "src", *case, args.problems)
+            if not args.markdown:
+                print(table(*case, rows[case], ""), flush=True)
+            if reference is not None:
+                references[case] = measured_elsewhere(reference, *case, args.problems)
+                if not args.markdown:
+                    print(table(*case, references[case], " (REF)"), flush=True)
+    finally:
+        clean_up()
+    if args.markdown:
+        command = "studies/where_does_a_panda_solve_spend_its_time/measure_breakdown.py --markdown" + (
+            f" --compare {args.compare}" if args.compare else "")
+        print(markdown(rows, references, command))
 
 
 if __name__ == "__main__":
