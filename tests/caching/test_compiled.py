@@ -35,6 +35,34 @@ def test_compiled_cache_keys_on_the_function_and_falls_back_without_a_compiler(t
     np.testing.assert_allclose(BufferedFunction(fallback)(np.ones(3))[0].ravel(), np.cos(np.ones(3)))
 
 
+def test_a_build_for_this_processor_is_keyed_on_it_and_falls_back_to_the_plain_flags(tmp_path, monkeypatch):
+    monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
+    x = ca.SX.sym("x", 3)
+    f = ca.Function("processor_test", [x], [ca.sin(x) * ca.sumsqr(x) + x[0] * x[1]])
+    point = np.array([0.3, -1.0, 2.0])
+    monkeypatch.setattr(compiled_module, "_processor", lambda: "fingerprint-a")
+    monkeypatch.setattr(compiled_module, "PROCESSOR_FLAGS", ("-O2", "-mno-such-instructions", "-fPIC", "-shared"))
+    assert compiled_module._flags(True) == ["-O2", "-mno-such-instructions", "-fPIC", "-shared",
+                                            "-DCOMANIP_PROCESSOR=fingerprint-a"]
+    assert compiled_module._flags(False) == list(compiled_module.COMPILE_FLAGS)
+    # flags the compiler rejects: the plain build, same numbers up to rounding, filed under the plain flags
+    fast = compiled_module.compiled_or_cached(f, "model A", for_this_processor=True)
+    np.testing.assert_allclose(np.asarray(fast(point)).ravel(), np.asarray(f(point)).ravel(), rtol=1e-14)
+    assert compiled_module.cached_compiled("processor_test", "model A") is not None
+    assert compiled_module.cached_compiled("processor_test", "model A", for_this_processor=True) is None
+    monkeypatch.setattr(compiled_module, "_processor", lambda: None)  # a compiler that names no processor
+    assert compiled_module._flags(True) == list(compiled_module.COMPILE_FLAGS)
+
+
+def test_a_build_for_this_processor_matches_the_uncompiled_function(tmp_path, monkeypatch):
+    monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
+    x = ca.SX.sym("x", 4)
+    f = ca.Function("native_test", [x], [ca.mtimes(ca.reshape(ca.cos(x), 2, 2), ca.reshape(x, 2, 2)) * ca.sumsqr(x)])
+    point = np.array([0.3, -1.0, 2.0, 0.7])
+    fast = compiled(f, for_this_processor=True)
+    np.testing.assert_allclose(np.asarray(fast(point)), np.asarray(f(point)), rtol=1e-13, atol=1e-15)
+
+
 def test_a_tagged_build_is_found_without_generating_source_and_only_for_the_same_libraries(tmp_path, monkeypatch):
     monkeypatch.setenv("COMANIP_CACHE_DIR", str(tmp_path))
     x = ca.SX.sym("x", 2)

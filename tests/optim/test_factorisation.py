@@ -37,3 +37,20 @@ def test_a_lower_factor_solves_and_inverts_like_an_upper_one(rng):
         inverse = factor.inverse()
         np.testing.assert_array_equal(inverse, inverse.T)
         np.testing.assert_allclose(inverse, np.linalg.inv(matrix), rtol=1e-10, atol=1e-12)
+
+
+def test_a_row_major_matrix_gives_the_factor_of_its_column_major_copy(rng):
+    """A C-ordered matrix is factored as its transpose (no reordering copy): the same system, either triangle read."""
+    from comanip.optim import shifted_cholesky
+
+    A = rng.normal(size=(40, 40))
+    matrix = A @ A.T + np.eye(40)
+    b = rng.normal(size=40)
+    for lower in (False, True):
+        row_major = shifted_cholesky(matrix, (0.0,), lower=lower)
+        column_major = shifted_cholesky(np.asfortranarray(matrix), (0.0,), lower=lower)
+        np.testing.assert_allclose(row_major.solve(b), column_major.solve(b), rtol=1e-12)
+        np.testing.assert_allclose(row_major.inverse(), column_major.inverse(), rtol=1e-10, atol=1e-13)
+    skewed = matrix.copy()
+    skewed[np.tril_indices(40, -1)] = 1e3  # only the upper triangle is read (lower=False)
+    np.testing.assert_allclose(shifted_cholesky(skewed, (0.0,)).solve(b), np.linalg.solve(matrix, b), rtol=1e-9)

@@ -48,6 +48,12 @@ from comanip.progress import elapsed
 COMPILE_FLAGS = ("-O1", "-fPIC", "-shared")
 """Flags for the C compiler: -O1, because the generated code is straight-line SX instructions, which -O2 does not
 make faster but takes longer to compile."""
+PROCESSOR_FLAGS = ("-O2", "-march=native", "-fPIC", "-shared")
+"""Flags for a function built ``for_this_processor``: this processor's own instructions, and -O2, which fuses
+multiplications and additions into its fused multiply-adds. Large functions (an arm's gradient) run markedly faster
+(docs/results/speed.md); the build takes about three times longer, the numbers are rounded differently from
+CasADi's virtual machine (a fused multiply-add rounds once), and the library runs only on processors like this one,
+so the processor is part of its cache key."""
 
 
 def cache_dir() -> Path:
@@ -58,7 +64,7 @@ def cache_dir() -> Path:
     return Path(base) / "comanip"
 
 
-def compiled(function: ca.Function, tag: str | None = None) -> ca.Function:
+def compiled(function: ca.Function, tag: str | None = None, for_this_processor: bool = False) -> ca.Function:
     """``function`` as compiled C, built on first use and loaded from the disk cache afterwards.
 
     The returned function has the same name, inputs and outputs. It has no derivatives: compile the
@@ -67,32 +73,38 @@ def compiled(function: ca.Function, tag: str | None = None) -> ca.Function:
     ``tag``: a string that, with this package's source code, determines the function (e.g. the model's
     parameters); the library is then also filed under it, so :func:`cached_compiled` finds it later without
     generating the C source (itself costly for large functions).
+
+    ``for_this_processor``: build with :data:`PROCESSOR_FLAGS` (faster, rounded differently from the uncompiled
+    function) where the compiler names the processor it builds for; elsewhere, or if that build fails, with
+    :data:`COMPILE_FLAGS`.
     """
     name = function.name()
     generator = ca.CodeGenerator(name, {"with_header": False})
     generator.add(function)
     source = generator.dump()
-    compiler = _compiler()
-    key = hashlib.sha256("\n".join([source, " ".join(compiler + list(COMPILE_FLAGS)), ca.__version__]).encode()).hexdigest()[:20]
+    compiler, flags = _compiler(), _flags(for_this_processor)
+    key = hashlib.sha256("\n".join([source, " ".join(compiler + flags), ca.__version__]).encode()).hexdigest()[:20]
     library = cache_dir() / f"{name}_{key}.so"
     if not library.exists():
         try:
             with elapsed(f"compiling {name} to C (first use of this model; cached in {cache_dir()})"):
-                _build(source, compiler, library)
+                _build(source, compiler, flags, library)
         except (OSError, subprocess.CalledProcessError) as error:
+            if for_this_processor:
+                return compiled(function, tag)
             detail = getattr(error, "stderr", "") or error
             warnings.warn(f"could not compile {name} with {' '.join(compiler)} ({str(detail)[:300]}); "
                           "using CasADi's virtual machine instead (same results, slower)", RuntimeWarning, stacklevel=2)
             return function
     if tag is not None:
-        _file_under_tag(name, tag, library)
+        _file_under_tag(name, tag, flags, library)
     return ca.external(name, str(library))
 
 
-def cached_compiled(name: str, tag: str) -> ca.Function | None:
-    """The compiled function ``name`` filed under ``tag`` by an earlier :func:`compiled` with this package's
-    source code, this CasADi and this compiler; None if there is none."""
-    index = cache_dir() / f"{name}_{_tag_key(tag)}.tag"
+def cached_compiled(name: str, tag: str, for_this_processor: bool = False) -> ca.Function | None:
+    """The compiled function ``name`` filed under ``tag`` by an earlier :func:`compiled` (with the same
+    ``for_this_processor``) with this package's source code, this CasADi and this compiler; None if there is none."""
+    index = cache_dir() / f"{name}_{_tag_key(tag, _flags(for_this_processor))}.tag"
     try:
         library = cache_dir() / index.read_text().strip()
     except OSError:
@@ -100,24 +112,49 @@ def cached_compiled(name: str, tag: str) -> ca.Function | None:
     return ca.external(name, str(library)) if library.exists() else None
 
 
-def _file_under_tag(name: str, tag: str, library: Path) -> None:
-    """Write the index file naming ``library`` for (name, tag), atomically."""
-    index = cache_dir() / f"{name}_{_tag_key(tag)}.tag"
+def _file_under_tag(name: str, tag: str, flags: list[str], library: Path) -> None:
+    """Write the index file naming ``library`` for (name, tag, flags), atomically."""
+    index = cache_dir() / f"{name}_{_tag_key(tag, flags)}.tag"
     scratch = index.with_suffix(f".{os.getpid()}.{threading.get_ident()}")
     scratch.write_text(library.name)
     os.replace(scratch, index)
 
 
-def compiled_or_cached(function: ca.Function, tag: str) -> ca.Function:
+def compiled_or_cached(function: ca.Function, tag: str, for_this_processor: bool = False) -> ca.Function:
     """:func:`cached_compiled` if ``function`` was compiled under ``tag`` before, else :func:`compiled`."""
-    return cached_compiled(function.name(), tag) or compiled(function, tag)
+    return cached_compiled(function.name(), tag, for_this_processor) or compiled(function, tag, for_this_processor)
 
 
-def _tag_key(tag: str) -> str:
+def _tag_key(tag: str, flags: list[str]) -> str:
     """Key of a tag: with the package's source, the versions of the libraries that build the functions and
-    the compiler, the function is fixed."""
-    parts = [tag, _source_fingerprint(), " ".join(_compiler() + list(COMPILE_FLAGS))]
+    the compiler and its flags, the function is fixed."""
+    parts = [tag, _source_fingerprint(), " ".join(_compiler() + flags)]
     return hashlib.sha256("\n".join(parts).encode()).hexdigest()[:20]
+
+
+def _flags(for_this_processor: bool) -> list[str]:
+    """The compiler flags of a build; a build for this processor ends with a definition naming the instructions the
+    compiler chooses for it (:func:`_processor`), so that the cache keys tell processors apart."""
+    processor = _processor() if for_this_processor else None
+    if processor is None:
+        return list(COMPILE_FLAGS)
+    return [*PROCESSOR_FLAGS, f"-DCOMANIP_PROCESSOR={processor}"]
+
+
+@functools.lru_cache(maxsize=1)
+def _processor() -> str | None:
+    """A fingerprint of what ``-march=native`` means to the compiler here: the processor it names and the instruction
+    sets it enables (a virtual machine may hide some of a processor's); None where the compiler does not say (then
+    no build is made for this processor alone)."""
+    try:
+        shown = subprocess.run([*_compiler(), "-march=native", "-Q", "--help=target"], capture_output=True, text=True,
+                               timeout=60).stdout
+    except (OSError, subprocess.SubprocessError):
+        return None
+    targets = sorted(" ".join(line.split()) for line in shown.splitlines() if line.strip().startswith("-m"))
+    if not any(target.startswith("-march= ") and target != "-march= native" for target in targets):
+        return None
+    return hashlib.sha256("\n".join(targets).encode()).hexdigest()[:16]
 
 
 FUNCTION_SOURCES = ("casadi", "adam-robotics", "example-robot-data")
@@ -215,14 +252,14 @@ def compile_in_background(owner: object, functions_of: Callable[[object], list[c
     return compilers().in_background(owner, functions_of, tag)
 
 
-def _build(source: str, compiler: list[str], library: Path) -> None:
-    """Compile C source into ``library``, atomically (a concurrent build of the same key is harmless)."""
+def _build(source: str, compiler: list[str], flags: list[str], library: Path) -> None:
+    """Compile C source into ``library`` with ``flags``, atomically (a concurrent build of the same key is harmless)."""
     library.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(dir=library.parent) as scratch:
         c_file = Path(scratch) / f"{library.stem}.c"
         c_file.write_text(source)
         built = Path(scratch) / library.name
-        process = subprocess.Popen([*compiler, *COMPILE_FLAGS, str(c_file), "-o", str(built), "-lm"],
+        process = subprocess.Popen([*compiler, *flags, str(c_file), "-o", str(built), "-lm"],
                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
         compilers().running[process] = scratch
         try:

@@ -44,7 +44,9 @@ def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float], lower: bool = 
 
     ``matrix`` (N, N) is read as symmetric (its upper triangle, or its lower one when ``lower``); delta = 0 factors
     it as it is. A matrix with a NaN or inf never gives a factor: it fails the factorisation or reaches the factor's
-    diagonal, which is checked.
+    diagonal, which is checked. A row-major (C-ordered) matrix is factored as its transpose, the same numbers in
+    LAPACK's column-major order, so no reordering copy is made; the factor then sits in the other triangle
+    (:attr:`CholeskyFactor.lower` says which).
     """
     shifted, diagonal, scale = None, None, None
     for delta in shifts:
@@ -58,9 +60,11 @@ def shifted_cholesky(matrix: np.ndarray, shifts: Iterable[float], lower: bool = 
             np.fill_diagonal(shifted, diagonal + delta * scale)
             candidate = shifted
         # LAPACK directly: scipy.linalg.cho_factor's checks and wrappers cost as much as factoring a 60 x 60 matrix
-        factor, info = _potrf(candidate, lower=lower, clean=False, overwrite_a=False)
+        transposed = candidate.flags.c_contiguous and not candidate.flags.f_contiguous
+        factored_lower = lower != transposed
+        factor, info = _potrf(candidate.T if transposed else candidate, lower=factored_lower, clean=False, overwrite_a=False)
         if info == 0 and math.isfinite(np.trace(factor)):
-            return CholeskyFactor(factor, lower, delta)
+            return CholeskyFactor(factor, factored_lower, delta)
         if info < 0:
             raise ValueError(f"LAPACK potrf rejected argument {-info} (matrix {matrix.shape})")
     return None

@@ -20,7 +20,7 @@ Newton method's secant corrections learn those. The gradient is exact, so the op
 
 The objective and gradient come from one CasADi function, the per-step pieces of the Hessian from a second one
 evaluated on the first one's rollout only when a Hessian is assembled (with ``hessian_refresh`` about one
-iteration in three on the Panda, where the gradient takes 1.9 ms and the pieces 1.2 ms). Both are
+iteration in three on the Panda, where the pieces cost about half as much as the gradient). Both are
 MX graphs over per-step SX functions (belief step, reward, kinematics), compiled to C on first use
 (:mod:`comanip.caching.compiled`); generating C for the expanded problem instead gives hundreds of megabytes
 that do not compile in minutes.
@@ -52,14 +52,15 @@ class LinearisedCurvature:
 
     Args:
         problem: the model's :class:`ReachProblem` (its weights and normaliser are used).
-        compile: build the per-solve function as C (recommended: about ten times faster than CasADi's
-            virtual machine for the Panda; the first build takes a minute and is cached on disk).
+        compile: build the per-solve functions as C for this processor (recommended: about ten times faster than
+            CasADi's virtual machine for the Panda, with the same numbers up to rounding; the first build takes a
+            minute or two and is cached on disk, :func:`~comanip.caching.compiled.compiled`).
     """
 
     exact = False
     """The Hessian is an approximation (the solver adds secant corrections)."""
     cheap_value = True
-    """:meth:`value_and_data` is the forward rollout alone, a sixth of :meth:`evaluate`'s cost."""
+    """:meth:`value_and_data` is the forward rollout alone, a fraction of :meth:`evaluate`'s cost."""
     carries_belief = True
     """The data holds the mean path, its sensitivities and the covariances."""
 
@@ -69,7 +70,7 @@ class LinearisedCurvature:
         d = model.d
         self._triangle = np.array([(a, b) for b in range(d) for a in range(b + 1)])
         tag = model_key(model)  # a model built before loads its C functions without generating their source (~1 s)
-        self._gradient, self._pieces, self._value = (BufferedFunction(compiled_or_cached(function, tag) if compile else function)
+        self._gradient, self._pieces, self._value = (BufferedFunction(compiled_or_cached(function, tag, for_this_processor=True) if compile else function)
                                                      for function in self._functions(problem))
         self._noise_hessian = _noise_second_derivatives(model)
         # D[j, l, r, s] as a matrix ((r, s), (j, l)): <S, ∂²N/∂tau_j ∂tau_l> for every (j, l) is S.ravel() @ it
@@ -86,8 +87,8 @@ class LinearisedCurvature:
         - gradient: ``(x, s0, goal, width) -> (f, grad, mean, cov)``;
         - pieces: ``(x, goal, width, mean, cov) -> (A, B, J, phi_hess, phi_grad, W, dvech/dq)``, the fields of
           :class:`~comanip.planning.terms.ArmPieces` (W its ``kinematic_hessian``), from the gradient's rollout;
-        - value: ``(x, s0, goal, width) -> (f, mean)``, the forward rollout alone (0.6 ms against the gradient's
-          1.9 ms on the Panda), for line-search trials and comparisons of initial guesses.
+        - value: ``(x, s0, goal, width) -> (f, mean)``, the forward rollout alone (a fraction of the gradient's
+          cost), for line-search trials and comparisons of initial guesses.
 
         A model with a speed cost adds a fifth input to gradient and value, its weights [stop_weight,
         joint_velocity_weight] (2,).
@@ -144,7 +145,7 @@ class LinearisedCurvature:
 
     def pieces(self, data: ArmTerms) -> ArmPieces:
         """The Hessian's per-step pieces at the evaluation ``data``, computed on first request and kept in
-        ``data.pieces`` (1.2 ms on the Panda)."""
+        ``data.pieces``."""
         if data.pieces is None:
             data.pieces = ArmPieces(*self._pieces(data.x, data.goal, data.width, data.mean, data.cov))
         return data.pieces

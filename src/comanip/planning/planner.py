@@ -135,7 +135,7 @@ class SolverOptions:
     compile: bool | None = None
     """Compile the Newton method's per-solve function to C (cached on disk, see comanip.caching.compiled).
     True: when the planner is built. False: never. None: when built for nonlinear bodies, where CasADi's
-    virtual machine is ten times slower (a first build takes about a minute for the Panda); for a point mass,
+    virtual machine is ten times slower (a first build takes a minute or two for the Panda); for a point mass,
     in a background thread once the planner has spent ``compile_after`` seconds solving, its solves going on
     uncompiled meanwhile: compiling costs 3–17 s for every new model, which short-lived planners (a fit's,
     one per parameter set) would not win back, while a long-lived one (a control loop, a sweep) solves
