@@ -118,7 +118,7 @@ class SolverOptions:
     """An arm's reach library for 'ranked' cold solves from its ready pose, at rest or moving (its nearest plan
     also competes with a warm start there): a file written by ``comanip library`` (.npz) for this model. None:
     the library shipped for the model (``franka_rest``), if any (:mod:`comanip.planning.starts.arm_reach_library`)."""
-    abandon_after: int = 100
+    abandon_after: int = 80
     """Newton iterations after which a 'ranked' cold search that runs every start (an arm without a reach library, a
     point mass's narrow goal) abandons a start that has not converged, when a start that has converged within the
     limits by then has a lower objective than it has there: on the Panda long starts crawl along a joint limit and
