@@ -3,7 +3,7 @@
 The people model's goal is recomputed from scratch at each update, so it moves as fast as the evidence
 does: on the development arm reaches its error falls from about 0.4 to 0.2 of the distance between a quarter
 and half of the movement time, about a dozen updates at 125 Hz, and a goal that uses each update's evidence
-at once must move by about 0.1 of the distance per update there. A causal average of its goals, an
+at once moves with it. A causal average of its goals, an
 exponential one with time constant tau_s (g_k = g_(k-1) + (1 - exp(-dt / tau_s)) (p_k - g_(k-1)), reset
 at the onset), moves less per update and lags the evidence. Each reach is streamed as a live tracker
 delivers it (as in benchmarks/real_people.py --source arms) and scored with a people model fitted on the
