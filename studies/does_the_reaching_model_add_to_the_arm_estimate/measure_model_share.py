@@ -8,8 +8,8 @@ people model fitted on the other half of the split (the reaches of the other par
    (variable projection over movement time and onset, log T ~ N(log T_ref, 0.35²), as
    :func:`comanip.estimation.profile_fit.fit_profile`): x(t) = x_0 + Delta r(phi) along a straight line, or
    with a bow, + B 4 r(phi) (1 - r(phi)), which leaves the start and reaches the goal along a curved path.
-   Two shapes: the `arm` preset's mean reach (T_ref its movement time) and, as a ceiling no reaching model
-   can pass by its shape alone, the recorded people's own mean profile along their line (T_ref their median
+   Two shapes: the `arm` preset's mean reach (T_ref its movement time) and, as a ceiling for a model's mean
+   reach fitted this way, the recorded people's own mean profile along their line (T_ref their median
    movement time), both from the other half.
 2. **A blend.** The people model's goal moved a fraction w of the way to the estimator's paced fit
    (:class:`comanip.estimation.paced_model.PacedModel`), for the best w.
