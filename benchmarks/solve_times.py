@@ -333,14 +333,33 @@ def measure_case(key: str, repeats: int) -> dict:
 
 def summary(name: str, build_time: float, paper_time: float | None, runs: list[Timed]) -> dict:
     """A row from its solves: name, build_s, median_s, p90_s, iterations (median, p90; None if not counted), ok,
-    runs, paper_s, and the ``SLOWEST`` solves (seconds, iterations, problem)."""
+    runs, paper_s, the ``SLOWEST`` solves (seconds, iterations, problem) and every solve's iterations (counted)."""
     times = np.array([run.seconds for run in runs])
     counted = [run.iterations for run in runs if run.iterations is not None]
     iterations = (float(np.median(counted)), float(np.percentile(counted, 90))) if counted else None
     slowest = [(run.seconds, run.iterations, run.problem) for run in sorted(runs, key=lambda run: -run.seconds)[:SLOWEST]]
     return {"name": name, "build_s": build_time, "median_s": float(np.median(times)),
             "p90_s": float(np.percentile(times, 90)), "iterations": iterations, "ok": int(sum(run.success for run in runs)),
-            "runs": len(runs), "paper_s": paper_time, "slowest": slowest}
+            "runs": len(runs), "paper_s": paper_time, "slowest": slowest, "counted": counted}
+
+
+def whole_workspace_lines(rows: list[dict]) -> list[str]:
+    """Per preset whose two cold workspace cases (at rest, moving start) are both among ``rows``: the Newton
+    iterations of a cold solve over the whole set, median / p90 and their ratio (no slow corner: p90 within twice the
+    median)."""
+    cold = {}
+    for row in rows:
+        preset, _, kind = row["name"].partition(" workspace cold, ")
+        if kind and row["counted"]:
+            cold.setdefault(preset, []).append(row["counted"])
+    lines = []
+    for preset, parts in cold.items():
+        if len(parts) == 2:
+            counted = np.concatenate(parts)
+            median, p90 = np.median(counted), np.percentile(counted, 90)
+            lines.append(f"- {preset}: {median:.0f} / {p90:.0f} iterations over {len(counted)} problems, "
+                         f"p90 {p90 / median:.1f} × the median")
+    return lines
 
 
 def text_row(row: dict) -> str:
@@ -370,6 +389,9 @@ def markdown_table(rows: list[dict], repeats: int) -> str:
         iterations = "–" if row["iterations"] is None else f"{row['iterations'][0]:.0f} / {row['iterations'][1]:.0f}"
         lines.append(f"| {row['name']} | {_time(row['median_s'])} | {_time(row['p90_s'])} | {iterations} | "
                      f"{row['ok']}/{row['runs']} | {_time(row['paper_s']) if row['paper_s'] else '–'} |")
+    pooled = whole_workspace_lines(rows)
+    if pooled:
+        lines += ["", "Cold solves over each whole workspace set, at rest and moving (Newton iterations, median / p90):", ""] + pooled
     listed = [row for row in rows if any(problem for *_, problem in row["slowest"])]
     if listed:
         lines += ["", f"The {SLOWEST} slowest solves of each workspace case (D: goal distance, w: width, v0: start speed):", ""]
@@ -395,6 +417,11 @@ def markdown_comparison(pairs: list[tuple[dict, dict]], repeats: int, reference:
         lines.append(f"| {new['name']} | {_time(new['median_s'])} | {_time(new['p90_s'])} | {iterations(new)} | "
                      f"{new['ok']}/{new['runs']} | {_time(ref['median_s'])} | {_time(ref['p90_s'])} | {iterations(ref)} | "
                      f"{ref['ok']}/{ref['runs']} |")
+    for label, side in (("this code", 0), ("the previous code", 1)):
+        pooled = whole_workspace_lines([pair[side] for pair in pairs])
+        if pooled:
+            lines += ["", f"Cold solves over each whole workspace set, at rest and moving, {label} (Newton iterations, "
+                      "median / p90):", ""] + pooled
     lines += ["", f"The {SLOWEST} slowest solves of each case, this code (D: goal distance, w: width, v0: start speed):", ""]
     for new, _ in pairs:
         lines.append(f"- {new['name']}: " + "; ".join(f"{_time(seconds)} ({iterations} it, {problem})"
