@@ -111,7 +111,8 @@ class ReachLibrary:
     def __init__(self, solver: ReachSolver, starts: Callable[[ReachParameters], list[np.ndarray]], n: int,
                  state_size: int, width: float):
         self.solver, self.starts, self.n, self.state_size, self.width = solver, starts, n, state_size, float(width)
-        self._entries: dict[tuple[int, int], list[np.ndarray]] = {}
+        self._entries: dict[tuple[int, int], list[list[np.ndarray]]] = {}
+        """Per grid point, its plans (lowest objective first), each at every pace of :data:`PACES`."""
 
     def guess(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> np.ndarray | None:
         """Torques (H, n) of the nearest entry's best plan turned towards goal (n,) and scaled to its distance from
@@ -125,13 +126,12 @@ class ReachLibrary:
         :meth:`guess` does, each also run at the other :data:`PACES`: torques (H, n) near each local optimum the
         goal's problem has where several compete. Empty when the goal is at the start, or an entry is not solved
         yet and not ``solve_missing``."""
-        plans = self._near_entries(start, goal, width, solve_missing, bracket=True)
-        return [plan if pace == 1.0 else at_pace(plan, pace) for plan in plans for pace in PACES]
+        return self._near_entries(start, goal, width, solve_missing, bracket=True)
 
     def _near_entries(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool,
                       bracket: bool) -> list[np.ndarray]:
-        """The plans (H, n) of the nearest entry (its best only), or of both bracketing entries (all of them), turned
-        and scaled onto the goal; empty as :meth:`local_optima` says."""
+        """The plans (H, n) of the nearest entry (its best only), or of both bracketing entries (all of them, each at
+        every pace of :data:`PACES`), turned and scaled onto the goal; empty as :meth:`local_optima` says."""
         offset = np.asarray(goal, dtype=float) - start[: self.n]
         with np.errstate(over="ignore"):
             distance = float(np.linalg.norm(offset))
@@ -150,8 +150,11 @@ class ReachLibrary:
                 if not solve_missing:
                     return []
                 entry = ReachParameters(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
-                self._entries[key] = distinct_optima(self.solver, self.starts, entry)
-            kept = self._entries[key] if bracket else self._entries[key][:1]
+                optima = distinct_optima(self.solver, self.starts, entry)
+                # each plan at every pace, computed once: turning and scaling commute with the change of pace
+                self._entries[key] = [[plan if pace == 1.0 else at_pace(plan, pace) for pace in PACES] for plan in optima]
+            kept = [paced for plan in self._entries[key] for paced in plan] if bracket \
+                else [self._entries[key][0][PACES.index(1.0)]]
             plans += [(distance / entry_distance) * torque @ turn for torque in kept]
         return plans
 
