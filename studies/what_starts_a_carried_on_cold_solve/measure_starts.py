@@ -43,7 +43,7 @@ import comanip
 from comanip.optim import SolverResult
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.starts.initial_guess import minimum_jerk_torques
-from comanip.planning.starts.reach_library import PACES
+from comanip.planning.starts.reach_library import PACES, at_pace
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, problems, workspace_problems  # noqa: E402
@@ -232,6 +232,65 @@ def predicted(every: bool, with_guesses: bool) -> Callable[[Problem], Outcome]:
     return strategy
 
 
+WIDE_PACES = (0.6, 0.7, 0.8, 0.9, 1.0, 1.1, 1.2, 1.3, 1.4)
+"""Paces (:func:`at_pace`) at which :func:`paced_predictions` runs each rest plan: the moving-start optima of the
+Cartesian preset arrive up to half again as late as the rest plans, or earlier."""
+
+
+def paced_predictions(problem: Problem, paces=WIDE_PACES) -> tuple[list[np.ndarray], int]:
+    """Each rest optimum of the library (:func:`library_plans`) at each pace, plus the velocity correction of the
+    tangential predictor at its own pace: -(∇²f)⁻¹ ∂²f/∂τ∂s0 (s0 - s0_rest), one Hessian per plan; and the
+    Hessians spent."""
+    predictor = PREDICTORS[id(problem.planner)]
+    curvature, rest = predictor.curvature, problem.rest_params()
+    plans = library_plans(problem, every=True)
+    candidates = []
+    for plan in plans:
+        evaluation = curvature.evaluate(np.ravel(plan), rest)
+        hessian = curvature.hessian(evaluation.data)
+        move = predictor.cross_derivative(evaluation.data) @ (problem.params.start - rest.start)
+        correction = -_positive_definite_solve(hessian, move).reshape(plan.shape)
+        candidates += [at_pace(plan, pace) + correction for pace in paces]
+    return candidates, len(plans)
+
+
+def raced(count: int, k: int, paces=WIDE_PACES, with_guesses: bool = True) -> Callable[[Problem], Outcome]:
+    """The paced predictions (and the minimum-jerk guesses), the ``count`` of lowest objective each given ``k``
+    Newton iterations, the best of them then solved on."""
+
+    def strategy(problem: Problem) -> Outcome:
+        candidates, hessians = paced_predictions(problem, paces)
+        if with_guesses:
+            candidates += problem.guesses
+        objectives = [problem.starts.objective(c, problem.params) for c in candidates]
+        chosen = [candidates[j] for j in np.argsort(objectives)[:count]]
+        solver, params = problem.solver, problem.params
+        with solver.blas:
+            solves = [solver.newton_solve(c, params, np.inf, solver.curvature) for c in chosen]
+            firsts = [solve.advance(k) for solve in solves]
+            best = min(range(len(solves)), key=lambda j: firsts[j].fun)
+            final = solves[best].advance(solver.max_iterations)
+        spent = sum(r.nit for j, r in enumerate(firsts) if j != best)
+        return Outcome(final.fun, final.success, spent + final.nit, len(candidates), hessians)
+
+    return strategy
+
+
+def prediction_and_guesses(guesses: int) -> Callable[[Problem], Outcome]:
+    """The lowest-objective paced prediction and the ``guesses`` lowest-objective minimum-jerk guesses, each solved
+    (the two families end on different local optima)."""
+
+    def strategy(problem: Problem) -> Outcome:
+        candidates, hessians = paced_predictions(problem)
+        objectives = [problem.starts.objective(c, problem.params) for c in candidates]
+        predicted_start = candidates[int(np.argmin(objectives))]
+        order = np.argsort(problem.guess_objectives)[:guesses]
+        results = [problem.solve(predicted_start)] + [problem.solved_guess(int(k)) for k in order]
+        return best_of(results, evaluations=len(candidates) + len(problem.guesses), hessians=hessians)
+
+    return strategy
+
+
 PREDICTORS: dict[int, VelocityPredictor] = {}
 
 STRATEGIES: dict[str, Callable[[Problem], Outcome]] = {
@@ -246,6 +305,13 @@ STRATEGIES: dict[str, Callable[[Problem], Outcome]] = {
     "predictor from nearest rest plan": predicted(every=False, with_guesses=False),
     "predictor from each rest optimum": predicted(every=True, with_guesses=False),
     "predictor from each rest optimum + guesses": predicted(every=True, with_guesses=True),
+    "paced predictions + guesses, lowest solved": raced(1, 0),
+    "paced predictions + guesses, 3 lowest raced k=1": raced(3, 1),
+    "paced predictions + guesses, 3 lowest raced k=2": raced(3, 2),
+    "paced predictions + guesses, 4 lowest raced k=2": raced(4, 2),
+    "paced predictions + guesses, 4 lowest raced k=3": raced(4, 3),
+    "lowest paced prediction + lowest guess": prediction_and_guesses(1),
+    "lowest paced prediction + two lowest guesses": prediction_and_guesses(2),
 }
 
 
@@ -302,10 +368,10 @@ def main(argv=None) -> None:
     parser.add_argument("--sets", default="workspace,random", help="workspace (sampled sets), random (cold_quality.py's)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the random problems (default: %(default)s)")
     parser.add_argument("--problems", type=int, default=200, help="problems per set, carried on or not")
-    parser.add_argument("--strategies", default=None, help="comma-separated names (default: all)")
+    parser.add_argument("--strategies", default=None, help="names separated by semicolons (default: all)")
     parser.add_argument("--markdown", action="store_true", help="print a Markdown table")
     args = parser.parse_args(argv)
-    names = list(STRATEGIES) if args.strategies is None else [s.strip() for s in args.strategies.split(",")]
+    names = list(STRATEGIES) if args.strategies is None else [s.strip() for s in args.strategies.split(";")]
     rows, yardsticks = [], []
     for preset in args.presets.split(","):
         for problem_set in args.sets.split(","):
