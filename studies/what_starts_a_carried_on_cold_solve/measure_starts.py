@@ -16,7 +16,12 @@ describes each):
 - a scan of minimum-jerk guesses over many durations, ranked by objective, the best one or two solved;
 - the tangential predictor in the start's velocity from the reach library's at-rest plans: d tau*/d s0 =
   -(∇²_ττ f)⁻¹ ∂²f/∂τ∂s0 at each plan near a local optimum for the same start position, goal and width, the
-  predicted starts ranked by objective (alone, and beside the minimum-jerk guesses).
+  predicted starts ranked by objective (alone, and beside the minimum-jerk guesses);
+- the same from each rest optimum run at paces 0.6–1.4 (one Hessian per optimum), the lowest solved, or the 3–4
+  lowest raced for k Newton iterations and the best continued, or the lowest solved beside the one or two
+  lowest-objective guesses.
+
+The findings are in README.md beside this script.
 
 Each start is solved as the planner solves it (the planner's solver, one BLAS thread). Printed per preset and set:
 the carried-on problems; per strategy the Newton iterations of the solves it runs (median / p90 / largest, summed
@@ -327,7 +332,7 @@ def measure(preset: str, problem_set: str, count: int, seed: int, names: list[st
     planner = comanip.Planner(model)
     PREDICTORS[id(planner)] = VelocityPredictor(planner)
     cases = workspace_problems(preset, count) if problem_set == "workspace" else problems(model, count, seed)
-    outcomes: dict[str, list[tuple[float, Outcome]]] = {name: [] for name in names}
+    outcomes: dict[str, list[tuple[float, Outcome, Outcome]]] = {name: [] for name in names}
     every_cold = []
     for index, (start, goal, width) in enumerate(cases):
         every_cold.append(planner.solve(start, goal, width).iterations)
