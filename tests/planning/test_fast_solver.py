@@ -192,6 +192,7 @@ def test_a_point_mass_planner_compiles_in_the_background_after_its_solving_time(
 @pytest.mark.parametrize("kwargs, word", [(dict(method="lbfgs"), "method"), (dict(tolerance=0.0), "tolerance"),
                                           (dict(max_iterations=0), "max_iterations"), (dict(n_starts=1.5), "n_starts"),
                                           (dict(cold_search="best"), "cold_search"), (dict(narrow_ratio=0.0), "narrow_ratio"),
+                                          (dict(arm_narrow_ratio=-4.0), "arm_narrow_ratio"),
                                           (dict(compile_after=-1.0), "compile_after"),
                                           (dict(arm_tolerance=-1e-6), "arm_tolerance"), (dict(hessian_refresh=0), "hessian_refresh"),
                                           (dict(threads=0), "threads")])

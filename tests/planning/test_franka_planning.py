@@ -262,12 +262,37 @@ def test_a_ranked_cold_search_abandons_starts_a_converged_start_beats():
     shortest = min(result.nit for result in starts)
     assert max(result.nit for result in starts) > shortest + 1  # the case needs a start still running
     assert max(result.fun for result in starts) - min(result.fun for result in starts) < 1e-6 * abs(starts[0].fun)
-    options = dict(abandon_after=shortest + 1, threads=1)
+    options = dict(abandon_after=shortest + 1, threads=1, arm_narrow_ratio=1e9)  # every start, as in the full search
     reference = full.solve(start, goal)
     searched = comanip.Planner(model, SolverOptions(**options)).solve(start, goal)
     assert searched.success and searched.iterations < reference.iterations
     assert searched.objective == pytest.approx(reference.objective, rel=1e-6)
     assert comanip.Planner(model, SolverOptions(cold_search="all", **options)).solve(start, goal).iterations == reference.iterations
+
+
+def test_a_ranked_cold_search_leaves_out_the_worst_guess_only_for_a_narrow_goal():
+    """Beyond arm_narrow_ratio widths a ranked cold search from rest without a reach library runs every minimum-jerk
+    guess but the one of highest objective; nearer, from a moving start, and for 'all', every guess."""
+    from comanip.planning.planner import SolverOptions
+    from comanip.planning.reach_parameters import ReachParameters
+
+    model = comanip.presets.franka()
+    start = np.r_[model.body.home_position, np.zeros(7)]
+    goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
+    distance = float(np.linalg.norm([0.15, 0.1, -0.1]))
+    planner = comanip.Planner(model, SolverOptions(threads=1))
+    ratio = planner.options.arm_narrow_ratio
+    narrow, near = (ReachParameters(start, goal, distance / (ratio * factor)) for factor in (2.0, 0.5))
+    guesses = planner.starts.cold_guesses(narrow, planner.options.n_starts)
+    worst = max(range(len(guesses)), key=lambda k: planner.starts.objective(guesses[k], narrow))
+    kept = planner.starts.searched_guesses(narrow)
+    assert len(kept) == len(guesses) - 1
+    assert not any(np.array_equal(guess, guesses[worst]) for guess in kept)
+    assert len(planner.starts.searched_guesses(near)) == len(guesses)
+    moving = ReachParameters(np.r_[model.body.home_position, np.full(7, 0.1)], goal, narrow.width)
+    assert len(planner.starts.searched_guesses(moving)) == len(guesses)
+    full = comanip.Planner(model, SolverOptions(cold_search="all", threads=1))
+    assert len(full.starts.searched_guesses(narrow)) == len(guesses)
 
 
 def test_franka_plans_around_the_workspace_reach_their_goals_within_the_limits(franka_planner):

@@ -100,7 +100,8 @@ class SolverOptions:
     (:meth:`StartPolicy.cold_starts <comanip.planning.starts.StartPolicy.cold_starts>`), about as fast as a warm
     solve, with every guess solved where a moving hand's local optima compete (point masses) or the guesses as
     fallbacks (arms). An arm
-    without a library, or away from its ready pose, runs every guess as 'all' does. benchmarks/cold_quality.py
+    without a library, or away from its ready pose, runs every guess as 'all' does, except from rest the one of
+    highest objective for a goal beyond ``arm_narrow_ratio`` widths. benchmarks/cold_quality.py
     compares 'ranked' with 'all' under the cold-search rule (docs/results/speed.md)."""
     narrow_ratio: float = 20.0
     """Reach distance over goal width beyond which local optima compete in a point mass's 'ranked' cold solve: it
@@ -110,6 +111,11 @@ class SolverOptions:
     the start and from where a stop of its motion ends. Far, narrow goals of the planar preset have several local
     optima (the lowest-objective minimum-jerk start ended 0.7 % worse on 1 of 200 random problems, at 54 widths;
     none below 20 widths on any point-mass preset)."""
+    arm_narrow_ratio: float = 4.0
+    """Reach distance over goal width beyond which an arm's 'ranked' cold search from rest without a reach library
+    leaves out its minimum-jerk guess of highest objective: there that start seldom ends best and is the slowest to
+    converge (it lies near the zero-reward plateau). Nearer or wider goals, and moving starts, run every guess
+    (studies/may_an_arm_cold_search_leave_out_its_worst_guess/)."""
     far_warm_start: float = 3.0
     """Goal widths: a warm start (a plan to another goal) whose final hand position is farther than this
     from the new goal lies where the goal's reward underflows, so ``n_starts`` fresh reaches compete with it. For
@@ -154,6 +160,7 @@ class SolverOptions:
             as_count(name, getattr(self, name))
         as_positive("far_warm_start", self.far_warm_start, "goal widths")
         as_positive("narrow_ratio", self.narrow_ratio, "reach distance over goal width")
+        as_positive("arm_narrow_ratio", self.arm_narrow_ratio, "reach distance over goal width")
         as_positive("compile_after", self.compile_after, "s of solving")
         if self.cold_search not in COLD_SEARCHES:
             raise ValueError(f"cold_search must be one of {COLD_SEARCHES}, got {self.cold_search!r}")

@@ -144,8 +144,8 @@ class StartPolicy:
     def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
-        An arm at the ready pose of its reach library: :meth:`arm_library_starts`. 'all', or another nonlinear
-        body or start: every minimum-jerk guess. 'ranked', for a symmetric point mass: the candidate of lowest
+        An arm at the ready pose of its reach library: :meth:`arm_library_starts`. 'all': every minimum-jerk
+        guess; another nonlinear body or start: :meth:`searched_guesses`. 'ranked', for a symmetric point mass: the candidate of lowest
         objective (evaluating one costs about a hundredth of solving from it) among the minimum-jerk guesses and the
         nearest solved reach of the :class:`ReachLibrary` (from a moving start: :meth:`stopped_reaches`). Where
         several local optima compete (a goal farther than ``narrow_ratio`` widths from the start or from where a stop
@@ -279,17 +279,26 @@ class StartPolicy:
         return candidates
 
     def searched_guesses(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all', a nonlinear body
-        or a goal beyond ``narrow_ratio`` widths; otherwise the one of lowest objective."""
+        """The minimum-jerk guesses a cold solve without a reach library runs: all for 'all' and for a point mass's
+        goal beyond ``narrow_ratio`` widths, otherwise the point mass's one of lowest objective; for a nonlinear body
+        at rest all but the one of highest objective beyond ``arm_narrow_ratio`` widths, else all."""
         guesses = self.cold_guesses(params, self.options.n_starts, goal_q)
-        if self.options.cold_search == "all" or not self.model.body.is_linear or self.narrow(params):
+        if self.options.cold_search == "all" or len(guesses) == 1:
+            return guesses
+        if not self.model.body.is_linear:
+            if np.any(_motion(params.start, self.model.n)) or not self.narrow(params, self.options.arm_narrow_ratio):
+                return guesses
+            return sorted(guesses, key=lambda guess: self.objective(guess, params))[:-1]
+        if self.narrow(params):
             return guesses
         return [min(guesses, key=lambda guess: self.objective(guess, params))]
 
-    def narrow(self, params: ReachParameters) -> bool:
-        """True when the goal is farther than ``narrow_ratio`` widths from the start's end-effector position."""
+    def narrow(self, params: ReachParameters, ratio: float | None = None) -> bool:
+        """True when the goal is farther than ``ratio`` (default ``narrow_ratio``) widths from the start's
+        end-effector position."""
+        ratio = self.options.narrow_ratio if ratio is None else ratio
         position = self.kinematics(params.start[: self.model.n])[0].ravel()
-        return bool(np.linalg.norm(params.goal - position) > self.options.narrow_ratio * params.width)
+        return bool(np.linalg.norm(params.goal - position) > ratio * params.width)
 
     def cold_guesses(self, params: ReachParameters, count: int, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """Minimum-jerk reaches to ``goal_q`` (n,), the inverse-kinematics solution from the start (computed
