@@ -48,7 +48,7 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
                "cartesian_cold_uncompiled,human,human_cold,human_cartesian,human_cartesian_cold,planar_cold_moving,"
                "cartesian_cold_moving,franka,franka_cold,franka_rest,franka_rest_cold,franka_rest_cold_moving,franka_replan"]),
-    "speed-workspace": ("solve times over the sampled workspace sets, this code beside the code before them, taking turns (about 20 min)",
+    "speed-workspace": ("solve times over the sampled workspace sets, this code beside the code before them, taking turns (about 5 min on a quiet machine)",
                         ["benchmarks/solve_times.py", "--markdown", "--repeats", "100", "--compare", "323f41c", "--only",
                          "planar_workspace_cold,planar_workspace_cold_moving,planar_workspace_warm,planar_workspace_warm_moving,cartesian_workspace_cold,cartesian_workspace_cold_moving,cartesian_workspace_warm,cartesian_workspace_warm_moving,human_workspace_cold,human_workspace_cold_moving,human_workspace_warm,human_workspace_warm_moving,human_cartesian_workspace_cold,human_cartesian_workspace_cold_moving,human_cartesian_workspace_warm,human_cartesian_workspace_warm_moving,franka_workspace_cold,franka_workspace_cold_moving,franka_workspace_warm,franka_workspace_warm_moving,franka_rest_workspace_cold,franka_rest_workspace_cold_moving,franka_rest_workspace_warm,franka_rest_workspace_warm_moving"]),
     "panda-breakdown": ("where a Panda solve spends its time, piece by piece, beside the code before its functions were built for the processor (about 10 min)",
