@@ -4,12 +4,14 @@
                                                 [--compare /path/to/worktree-at-main]
     .venv/bin/python benchmarks/cold_quality.py --presets franka_rest,franka   # the Panda: minutes per problem set
     .venv/bin/python benchmarks/cold_quality.py --workspace [--presets planar]   # the sampled workspace sets
+    .venv/bin/python benchmarks/cold_quality.py --presets franka_rest --away     # arms from poses off the ready pose
 
 Problems (the same for both sides, seeded): point masses: goals 0.1–0.4 m from the start in uniformly drawn
 directions, widths log-uniform over 5–50 mm, every other start in motion (velocities uniform in ±0.3 m/s per
 axis); arms: from the ready pose, goals 0.15–0.3 m from its hand, widths log-uniform over 2.5–10 cm, every
 tenth start in motion (±0.3 rad/s per joint; the reach library's plans then start with braking moves
-superposed). ``--workspace``: the problems of each preset's sampled workspace set instead (benchmarks/workspace.py:
+superposed); ``--away``: from joint positions within ±0.3 rad of the ready pose, where no reach library serves
+and an arm's cold search runs its minimum-jerk guesses. ``--workspace``: the problems of each preset's sampled workspace set instead (benchmarks/workspace.py:
 point masses' goals 0.05–0.8 m away, starts moving at up to 1 m/s; arms' goals 0.1–0.3 m away; widths 5–50 mm).
 The reference is the code of another checkout (``--compare``: its src/ is imported in a separate process)
 or, without it, this code with ``SolverOptions(cold_search="all")`` (every minimum-jerk guess solved to
@@ -58,14 +60,22 @@ def problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndar
     return out
 
 
-def arm_problems(model, count: int, seed: int = 0) -> list[tuple[np.ndarray, np.ndarray, float]]:
-    """An arm's cold problems: from its ready pose, at rest except every tenth start (joint velocities uniform in
-    ±0.3 rad/s), to goals 0.15–0.3 m from its hand in uniform directions, widths log-uniform over 2.5–10 cm."""
+AWAY = 0.3
+"""Largest offset (rad) of each joint from the ready pose in ``--away`` problems."""
+
+
+def arm_problems(model, count: int, seed: int = 0, away: bool = False) -> list[tuple[np.ndarray, np.ndarray, float]]:
+    """An arm's cold problems: from its ready pose (``away``: from joint positions drawn uniformly within ±AWAY rad of
+    it, clipped to the limits, where no reach library serves), at rest except every tenth start (joint velocities
+    uniform in ±0.3 rad/s), to goals 0.15–0.3 m from its hand in uniform directions, widths log-uniform over
+    2.5–10 cm."""
     rng = np.random.default_rng(seed)
-    hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     out = []
     for k in range(count):
-        start = np.r_[model.body.home_position, np.zeros(model.n)]
+        pose = model.body.clip_to_limits(model.body.home_position + rng.uniform(-AWAY, AWAY, model.n)) if away \
+            else model.body.home_position
+        hand = np.asarray(model.body.kinematics_function(pose)[0]).ravel()
+        start = np.r_[pose, np.zeros(model.n)]
         if k % 10 == 9:
             start[model.n:] = rng.uniform(-0.3, 0.3, model.n)
         direction = rng.normal(size=model.d)
@@ -83,9 +93,9 @@ def workspace_problems(preset: str, count: int) -> list[tuple[np.ndarray, np.nda
     return [(p.start, p.goal, p.width) for p in workspace.load(preset)[:count]]
 
 
-def worker(preset: str, count: int, cold_search: str | None, seed: int = 0, sampled: bool = False) -> None:
-    """Solve the preset's problems (``sampled``: its workspace set's) with the comanip on sys.path; one JSON line per
-    problem on stdout."""
+def worker(preset: str, count: int, cold_search: str | None, seed: int = 0, sampled: bool = False, away: bool = False) -> None:
+    """Solve the preset's problems (``sampled``: its workspace set's; ``away``: an arm's from poses away from the ready
+    pose) with the comanip on sys.path; one JSON line per problem on stdout."""
     import comanip
     from comanip.planning.planner import SolverOptions
 
@@ -95,14 +105,18 @@ def worker(preset: str, count: int, cold_search: str | None, seed: int = 0, samp
     rest = np.r_[model.body.home_position, np.zeros(model.n)]
     hand = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel()
     planner.solve(rest, hand + 0.2 * np.eye(model.d)[0], model.width)  # one-off work, untimed
-    for start, goal, width in (workspace_problems(preset, count) if sampled else problems(model, count, seed)):
+    chosen = workspace_problems(preset, count) if sampled else \
+        arm_problems(model, count, seed, away) if away else problems(model, count, seed)
+    for start, goal, width in chosen:
         plan = planner.solve(start, goal, width)
+        hand = np.asarray(model.body.kinematics_function(start[: model.n])[0]).ravel()
         print(json.dumps({"objective": plan.objective, "success": plan.success, "time": plan.solve_time,
                           "iterations": plan.iterations, "distance_over_width": float(np.linalg.norm(goal - hand) / width),
                           "moving": bool(np.any(start[model.n:]))}), flush=True)
 
 
-def run_side(src: Path, cold_search: str | None, preset: str, count: int, seed: int = 0, sampled: bool = False) -> list[dict]:
+def run_side(src: Path, cold_search: str | None, preset: str, count: int, seed: int = 0, sampled: bool = False,
+             away: bool = False) -> list[dict]:
     """The worker's rows for one preset, run in a fresh process importing comanip from ``src``."""
     env = {**os.environ, "PYTHONPATH": str(src)}
     command = [sys.executable, __file__, "--worker", preset, "--problems", str(count), "--seed", str(seed)]
@@ -110,6 +124,8 @@ def run_side(src: Path, cold_search: str | None, preset: str, count: int, seed: 
         command += ["--cold-search", cold_search]
     if sampled:
         command += ["--workspace"]
+    if away:
+        command += ["--away"]
     done = subprocess.run(command, env=env, check=True, capture_output=True, text=True)
     return [json.loads(line) for line in done.stdout.splitlines() if line.startswith("{")]
 
@@ -172,11 +188,12 @@ def main(argv=None) -> None:
                         help="the CSV of every problem's row (default: %(default)s)")
     parser.add_argument("--summarise", type=Path, default=None, help="print the table of a CSV written before, solve nothing")
     parser.add_argument("--workspace", action="store_true", help="the sampled workspace sets' problems (benchmarks/workspace.py)")
+    parser.add_argument("--away", action="store_true", help=f"arms: start from poses within ±{AWAY} rad of the ready pose per joint")
     parser.add_argument("--worker", default=None, help=argparse.SUPPRESS)
     parser.add_argument("--cold-search", default=None, help=argparse.SUPPRESS)
     args = parser.parse_args(argv)
     if args.worker:
-        worker(args.worker, args.problems, args.cold_search, args.seed, args.workspace)
+        worker(args.worker, args.problems, args.cold_search, args.seed, args.workspace, args.away)
         return
     if args.summarise:
         rows = read_rows(args.summarise)
@@ -188,8 +205,8 @@ def main(argv=None) -> None:
     print(f"reference: {label}; {args.problems} problems per preset; equal = within {RELATIVE:g} relative", flush=True)
     rows = []
     for preset in args.presets.split(","):
-        new = run_side(here, None, preset, args.problems, args.seed, args.workspace)
-        ref = run_side(*reference, preset, args.problems, args.seed, args.workspace)
+        new = run_side(here, None, preset, args.problems, args.seed, args.workspace, args.away)
+        ref = run_side(*reference, preset, args.problems, args.seed, args.workspace, args.away)
         for k, (a, b) in enumerate(zip(new, ref)):
             relative = (a["objective"] - b["objective"]) / abs(b["objective"])
             verdict = "worse" if relative > RELATIVE else "better" if relative < -RELATIVE else "equal"

@@ -145,9 +145,10 @@ class StartPolicy:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
         An arm at the ready pose of its reach library: :meth:`arm_library_starts`. 'all': every minimum-jerk
-        guess; another nonlinear body or start: :meth:`searched_guesses`. 'ranked', for a symmetric point mass: the candidate of lowest
-        objective (evaluating one costs about a hundredth of solving from it) among the minimum-jerk guesses and the
-        nearest solved reach of the :class:`ReachLibrary` (from a moving start: :meth:`stopped_reaches`). Where
+        guess; another nonlinear body or start: :meth:`searched_guesses`. 'ranked', for a symmetric point mass: the
+        candidate of lowest objective (evaluating one costs about a hundredth of solving from it) among the
+        minimum-jerk guesses and the nearest solved reach of the :class:`ReachLibrary` (from a moving start:
+        :meth:`stopped_reaches`). Where
         several local optima compete (a goal farther than ``narrow_ratio`` widths from the start or from where a stop
         of its motion ends) a minimum-jerk guess of lowest objective can end on a worse one: the candidates are then
         the library's plans near each local optimum (:meth:`ReachLibrary.local_optima`, superposed on a stop from a
