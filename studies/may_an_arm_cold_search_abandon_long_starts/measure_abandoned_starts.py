@@ -48,16 +48,17 @@ def staged_starts(planner, params, checkpoints: list[int]) -> list[dict]:
     return rows
 
 
-def abandoning(starts: list[dict], k: int) -> tuple[dict, int]:
-    """The start the search abandoning at checkpoint k keeps (the planner's rule), and the iterations it spends."""
+def abandoning(starts: list[dict], k: int) -> tuple[dict, list[int]]:
+    """The start the search abandoning at checkpoint k keeps (the planner's rule), and the iterations each start
+    spends."""
     lowest = min((s[f"fun_{k}"] for s in starts if s[f"converged_{k}"]), default=np.inf)
-    kept, spent = [], 0
+    kept, spent = [], []
     for s in starts:
         if s["iterations"] <= k or not s[f"fun_{k}"] > lowest:
             kept.append(s)
-            spent += s["iterations"]
+            spent.append(s["iterations"])
         else:
-            spent += k
+            spent.append(k)
     return min(kept, key=lambda s: (s["violated"], s["fun"])), spent
 
 
@@ -89,7 +90,7 @@ def main(argv=None) -> None:
     for k in checkpoints:
         kept = [abandoning(starts, k) for starts in problems]
         excess = np.array([(plan["fun"] - best["fun"]) / abs(best["fun"]) for (plan, _), best in zip(kept, full)])
-        spent = np.array([spent for _, spent in kept])
+        spent = np.array([sum(spent) for _, spent in kept])
         ok = sum(plan["success"] for plan, _ in kept)
         close, worst = float(np.mean(excess <= RULE_CLOSE)), float(excess.max())
         met = close >= RULE_SHARE and worst <= RULE_WORST and ok >= full_ok

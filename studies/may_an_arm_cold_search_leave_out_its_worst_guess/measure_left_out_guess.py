@@ -43,11 +43,8 @@ def scored(starts: list[dict], leave_out: bool, checkpoint: int) -> tuple[dict, 
     """The start a search keeps (``leave_out``: without the start of highest objective) and the iterations of its
     longest start kept."""
     kept = sorted(starts, key=lambda s: s["initial"])[:-1] if leave_out else starts
-    plan, _ = abandoning(kept, checkpoint)
-    lowest = min((s[f"fun_{checkpoint}"] for s in kept if s[f"converged_{checkpoint}"]), default=np.inf)
-    longest = max(s["iterations"] if s["iterations"] <= checkpoint or not s[f"fun_{checkpoint}"] > lowest else checkpoint
-                  for s in kept)
-    return plan, longest
+    plan, spent = abandoning(kept, checkpoint)
+    return plan, max(spent)
 
 
 def summarise(problems: list[list[dict]], checkpoint: int, ratios: list[float], title: str) -> None:
