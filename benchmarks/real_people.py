@@ -31,6 +31,7 @@ from scipy.stats import chi2
 
 from comanip.analysis.speed_profile import speed_metrics
 from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
+from forecast_scores import forecast_markdown, forecast_rows
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
@@ -328,7 +329,7 @@ def main(argv=None):
     names = list(made)
     out = args.out or Path(__file__).parent / "results" / f"real_people_{args.source}_{args.split if args.source != 'simulated' else 'planar'}"
     out.mkdir(parents=True, exist_ok=True)
-    rows, latency, diagnosed = [], {name: [] for name in names}, {}
+    rows, latency, diagnosed, forecasts = [], {name: [] for name in names}, {}, {}
     first = {name: [] for name in names}
     begin = time.perf_counter()
     for i, recording in enumerate(movements):
@@ -338,6 +339,7 @@ def main(argv=None):
             answers, times, predictor = run_predictor(made[name], recording)
             if isinstance(predictor, _Online):
                 diagnosed.setdefault(name, []).append(diagnostics(predictor.trace, recording))
+                forecasts.setdefault(name, []).extend(forecast_rows(predictor.trace, recording, name))
             latency[name] += times[1:]
             first[name].append(times[0])
             errors = [float(np.linalg.norm(goal - recording.end)) / D for goal, _ in answers]
@@ -363,6 +365,8 @@ def main(argv=None):
     table = markdown(summary, lat, len(movements), title)
     if diagnosed:
         table += "\n\n" + diagnostics_markdown(diagnosed)
+    for name, scored in forecasts.items():
+        table += "\n\n" + forecast_markdown(scored, name)
     if args.source == "arms":
         for name in diagnosed:
             table += "\n\n" + aims_markdown(name, summary, lat, diagnosed)
@@ -374,6 +378,12 @@ def main(argv=None):
         writer = csv.DictWriter(stream, fieldnames=list(rows[0]))
         writer.writeheader()
         writer.writerows(rows)
+    if forecasts:
+        with open(out / "forecasts.csv", "w", newline="") as stream:
+            writer = csv.DictWriter(stream, fieldnames=list(next(iter(forecasts.values()))[0]))
+            writer.writeheader()
+            for scored in forecasts.values():
+                writer.writerows(scored)
     (out / "summary.json").write_text(json.dumps({"source": args.source, "split": args.split, "scale_m_per_px": scale,
                                                   "movements": len(movements), "summary": summary, "latency_s": lat},
                                                  indent=1))

@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 from dataclasses import dataclass, field, fields
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from comanip.planning.plan import Plan
+
+if TYPE_CHECKING:
+    from comanip.estimation.hand_forecast import HandForecast
 
 
 @dataclass
@@ -42,6 +46,12 @@ class GoalEstimate(Plan):
     'paper': the Gauss–Newton curvature of the observation's negative log-likelihood under the model's belief,
     plus the prior's; 'online': the inverse Hessian, its spread along the reach from a quadrature early on,
     :mod:`comanip.estimation.online_estimator`)."""
+    forecast: "HandForecast | None" = None
+    """'online': the forecast of the rest of the reach from the hand's state at t_obs
+    (:class:`~comanip.estimation.hand_forecast.HandForecast`; ``forecast.at(t)`` gives the hand's mean position,
+    velocity and covariance at any time t). The estimate's plan fields (``t``, ``mean``, ``ee_mean``, ``ee_cov``,
+    ``ee_velocity``) are its grid, from t_obs on; before the first observation (None) they are the model's reach
+    from the start."""
     plan_status: str | None = None
     """For an 'uninformative' estimate (observation at step 0): the status of the plan to the prior goal."""
 

@@ -45,7 +45,10 @@ from comanip.estimation.estimation_planner import checked_model
 from comanip.estimation.explanations import (Explained, Explanation, HandAtRest, HandTrace, ModelAtOwnPace,
                                              ModelAtPersonPace, Reach, RecordedPeople)
 from comanip.estimation.explanations.base import grid_position
+from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.hand_forecast import continued_reach
+from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.hand_rest import lost_sample
 from comanip.estimation.model_families import FamilyCache, default_families
@@ -103,6 +106,9 @@ class OnlineGoalEstimator:
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self.explanations = list(explanations) if explanations is not None else self._explanations(d)
+        self._transition = np.asarray(linearised_step_function(model.body, model.h)(
+            np.zeros(model.state_size), np.zeros(model.n))[1])
+        """A (nx, nx): the model's one-step state map (linear dynamics), for the forecast's belief."""
         self._blas = ThreadpoolController()
         self._hand = HandTrace(d)
         self.reset(start)
@@ -238,11 +244,21 @@ class OnlineGoalEstimator:
         before, fraction = grid_position(max(self._last_time - timed.t[0], 0.0), timed.t[1] - timed.t[0], model.H)
         predicted = (1 - fraction) * timed.mean[before, :2 * n] + fraction * timed.mean[min(before + 1, model.H), :2 * n]
         observed = self._hand.last_observation
+        covariance = np.array(explained.covariance, dtype=float)
+        forecast = None
+        t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
+        if self._hand.count:
+            stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
+            forecast = continued_reach(self.family, self._transition, self.start_position, self._last_time, observed[:n],
+                                       observed[n:], np.asarray(goal, dtype=float), covariance, stop,
+                                       recent_acceleration(self._hand.t, self._hand.velocity))
+            t, mean, cov = forecast.t, forecast.mean, forecast.cov
+            torque = np.zeros((len(t) - 1, n))
         plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),
                     objective=prediction.objective, solve_time=time.perf_counter() - t_begin, iterations=explained.iterations,
-                    t=timed.t, mean=timed.mean, cov=timed.cov, torque=timed.torque, ee_mean=timed.mean[:, :n].copy(),
-                    ee_cov=timed.cov[:, :n, :n].copy(), ee_velocity=timed.mean[:, n:2 * n].copy(), start=self.start.copy(),
+                    t=t, mean=mean, cov=cov, torque=torque, ee_mean=mean[:, :n].copy(),
+                    ee_cov=cov[:, :n, :n].copy(), ee_velocity=mean[:, n:2 * n].copy(), start=self.start.copy(),
                     goal=np.array(goal, dtype=float), width=self.width, model_name=model.name)
         return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=before, observed_state=observed,
                                observation_residual=predicted - observed, prior_goal=self.prior_goal, method="online",
-                               goal_covariance=np.array(explained.covariance, dtype=float))
+                               goal_covariance=covariance, forecast=forecast)

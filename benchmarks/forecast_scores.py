@@ -1,0 +1,85 @@
+"""Scores of the online estimator's forecast of the hand (where it will be 0.1, 0.2 and 0.3 s on), beside kinematic
+forecasters given the same inputs, for ``real_people.py``.
+
+From the update at 25 % and 50 % of a movement's MT, each forecaster's position at +LEADS s is compared with the
+recorded hand's (held at its endpoint after the movement ends): error / D. The kinematic forecasters get the
+hand's position and velocity of that update and the acceleration from its last velocities
+(:func:`comanip.estimation.path_baselines.recent_acceleration`); minimum jerk also gets the estimate's own goal and
+stop time. The forecast's 95 % region (its covariance) is checked on the recorded position.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.stats import chi2
+
+from comanip.estimation import path_baselines as kinematic
+
+LEADS = (0.1, 0.2, 0.3)
+FROM = (0.25, 0.5)
+KINEMATIC = ("hand stays", "constant velocity", "constant acceleration", "minimum jerk to the estimate's goal and stop")
+
+
+def forecast_rows(trace, recording, name: str) -> list[dict]:
+    """One row per (start fraction, lead, forecaster) for one movement; ``trace`` is [(t, estimate)] of every
+    update of the online estimator ``name``."""
+    D = recording.distance
+    rows = []
+    for start in FROM:
+        k = recording.seen_until(start) - 1
+        if k < 1 or k >= len(trace):
+            continue
+        t_now, estimate = trace[k]
+        forecast = estimate.forecast
+        if forecast is None:
+            continue
+        x, v = recording.position[k], recording.velocity[k]
+        a = kinematic.recent_acceleration(recording.t[:k + 1], recording.velocity[:k + 1])
+        lead = np.array(LEADS)
+        truth = np.array([recording.position_at(t_now + s) for s in lead])
+        predicted = forecast.at(t_now + lead)
+        stop_in = forecast.stop_time - t_now
+        paths = {"hand stays": kinematic.hand_stays(x, lead),
+                 "constant velocity": kinematic.constant_velocity(x, v, lead),
+                 "constant acceleration": kinematic.constant_acceleration(x, v, a, lead),
+                 "minimum jerk to the estimate's goal and stop": kinematic.minimum_jerk_to(x, v, a, estimate.goal, stop_in, lead),
+                 name: predicted.position}
+        for forecaster, path in paths.items():
+            for i, s in enumerate(lead):
+                error = path[i] - truth[i]
+                covered = None
+                if forecaster == name:
+                    try:
+                        covered = bool(error @ np.linalg.solve(predicted.covariance[i], error) <= chi2.ppf(0.95, len(error)))
+                    except np.linalg.LinAlgError:
+                        covered = False
+                rows.append({"movement": recording.name, "forecaster": forecaster, "from": start, "lead_s": float(s),
+                             "error": float(np.linalg.norm(error)) / D, "covered": covered})
+    return rows
+
+
+def forecast_markdown(rows, name: str) -> str:
+    """Median error / D per forecaster, start fraction and lead, the forecast's coverage, and whether it is below
+    every kinematic forecaster."""
+    header = " | ".join(f"{int(100 * f)} % +{s:.1f} s" for f in FROM for s in LEADS)
+    lines = [f"Where the hand will be, error / D (median over movements), from 25 % and 50 % of MT:", "",
+             f"| forecaster | {header} |", "|---|" + "---|" * (len(FROM) * len(LEADS))]
+    medians = {}
+    for forecaster in (*KINEMATIC, name):
+        cells = []
+        for f in FROM:
+            for s in LEADS:
+                errors = [r["error"] for r in rows if r["forecaster"] == forecaster and r["from"] == f and r["lead_s"] == s]
+                medians[forecaster, f, s] = float(np.median(errors)) if errors else float("nan")
+                cells.append(f"{medians[forecaster, f, s]:.3f}")
+        label = f"**{forecaster}**" if forecaster == name else forecaster
+        lines.append(f"| {label} | " + " | ".join(cells) + " |")
+    below = [all(medians[name, f, s] < medians[k, f, s] for k in KINEMATIC) for f in FROM for s in LEADS]
+    lines.append("| below every kinematic forecaster | " + " | ".join("yes" if b else "no" for b in below) + " |")
+    cover = []
+    for f in FROM:
+        for s in LEADS:
+            flags = [r["covered"] for r in rows if r["forecaster"] == name and r["from"] == f and r["lead_s"] == s]
+            cover.append(f"{100 * np.mean(flags):.0f} %" if flags else "–")
+    lines.append("| forecast's 95 % region holds the hand | " + " | ".join(cover) + " |")
+    return "\n".join(lines)

@@ -1,0 +1,216 @@
+"""The forecast of a reach under way: the reaching model's continuation from the hand's state now.
+
+A robot moving with a person follows where their hand will be, not only where it stops. At an update at time
+t_now (s) the hand is at x (d,) m moving at v (d,) m/s, heading for the estimated goal g (d,) m, where it stops
+at t_stop (s, the estimate's timing). The forecast is the model's own reach, continued from the hand:
+
+1. **The phase.** The model's reach from rest to the distance D = |g - x_0| (a member of the
+   :class:`~comanip.estimation.reach_family.ReachFamily`, along its axis a(tau) m, a'(tau) m/s, moving from
+   tau_on to tau_end) is at phase tau when the hand is: the dimensionless ratio
+
+       phi(tau) = a'(tau) (tau_end - tau) / (a(tau_end) - a(tau))
+
+   (speed times time to go over distance to go) equals the hand's, |v_g| (t_stop - t_now) / |g - x|, v_g the
+   hand's velocity towards g. phi rises from 0 at the onset to its largest value near the end; a hand outside
+   that range is read at the nearest end.
+2. **The continuation.** From its phase on, the model's reach is its optimal continuation from the state it is
+   in (a plan from rest, by the principle of optimality, goes on as planned). It is turned onto the line from
+   x to g, scaled to the distance left, r = |g - x|, and played at the pace p = (t_stop - t_now) / (tau_end - tau):
+
+       x(t) = x + u (a(tau + s) - a(tau)) r / (a(tau_end) - a(tau)),   s = (t - t_now) / p,
+
+   so it starts at the hand, arrives at g at t_stop (and stays) and leaves with the hand's speed towards g. Every state block
+   (velocity, activation forces) is scaled as :mod:`~comanip.estimation.reach_timing` plays a plan at a pace.
+3. **The rest of the hand's velocity** (across the line, or along it where the phase was read at an end), dv,
+   is carried by a term dv sigma (1 - sigma / R)², sigma = t - t_now, R = t_stop - t_now: it leaves with dv and
+   is gone, at rest, by t_stop. So the forecast's velocity at t_now is the hand's. Given the hand's acceleration,
+   the rest of it, da, is carried likewise by da sigma² (1 - sigma / R)³ / 2 (the state's force blocks stay the
+   model's).
+4. **Its covariance** is the model's belief of the rest of the reach given the state now (the motor noise still to
+   come: Sigma_j - A^(j-k) Sigma_k A^(j-k)^T from the model's closed-form belief Sigma_j, turned and scaled like
+   the mean), plus the goal's uncertainty carried in proportion to the distance covered,
+   ((x(t) - x) · u / r)² P_g.
+
+Shapes: d task dimensions (= n, a point mass), nx = blocks · n state entries, M query times.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from comanip.estimation.reach_family import ReachFamily
+from comanip.estimation.reach_timing import movement_span
+
+SHORTEST_REMAINING_S = 0.02
+"""Time to the stop (s) a forecast gives at least: a hand seen after its estimated stop still has to stop."""
+
+
+class ForecastPoint(NamedTuple):
+    """The forecast at M times."""
+
+    t: np.ndarray
+    """Times (M,), s, on the estimator's clock."""
+    position: np.ndarray
+    """Mean hand positions (M, d), m."""
+    velocity: np.ndarray
+    """Mean hand velocities (M, d), m/s."""
+    covariance: np.ndarray
+    """Hand position covariances (M, d, d), m²."""
+
+
+@dataclass(frozen=True)
+class HandForecast:
+    """The forecast of the rest of a reach from the hand's state at ``t[0]`` (module docstring), on a grid of
+    K + 1 times; :meth:`at` reads it at any time.
+
+    Shapes: K + 1 grid times, nx state entries, d = n task dimensions."""
+
+    t: np.ndarray
+    """Grid times (K+1,), s, from the update's time t_now to the stop t_stop."""
+    mean: np.ndarray
+    """Mean states [x; v; activation forces] (K+1, nx) in m, m/s, N."""
+    cov: np.ndarray
+    """State covariances (K+1, nx, nx), the goal's uncertainty included in the position block."""
+    stop_time: float
+    """t_stop (s): when the forecast hand arrives (its speed falls below 5 % of its peak for good)."""
+    pace: float
+    """p: forecast time per model time (> 1 slower than the model's reach)."""
+    phase: float
+    """tau (s of model time): where in the model's reach the hand is."""
+
+    d: int
+    """Task dimensions d (the first block of the state is the hand's position)."""
+
+    @property
+    def position(self) -> np.ndarray:
+        """Mean hand positions (K+1, d), m."""
+        return self.mean[:, :self.d]
+
+    @property
+    def velocity(self) -> np.ndarray:
+        """Mean hand velocities (K+1, d), m/s."""
+        return self.mean[:, self.d:2 * self.d]
+
+    def at(self, times) -> ForecastPoint:
+        """The forecast at ``times`` (M,) s (a number: M = 1): position and velocity by cubic Hermite
+        interpolation of the grid's positions and velocities, covariance linearly between grid times. Before
+        t_now it is the hand now; after the grid's end, at rest at its last point."""
+        times = np.atleast_1d(np.asarray(times, dtype=float))
+        if times.ndim != 1 or not np.all(np.isfinite(times)):
+            raise ValueError(f"times must be finite times in s, a number or a 1-D array; got shape {times.shape}")
+        d = self.d
+        t, x, v = self.t, self.mean[:, :d], self.mean[:, d:2 * d]
+        clipped = np.clip(times, t[0], t[-1])
+        k = np.clip(np.searchsorted(t, clipped, side="right") - 1, 0, len(t) - 2)
+        dt = t[k + 1] - t[k]
+        s = ((clipped - t[k]) / dt)[:, None]
+        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+        position = h00 * x[k] + h10 * dt[:, None] * v[k] + h01 * x[k + 1] + h11 * dt[:, None] * v[k + 1]
+        d00, d10, d01, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, -6 * s**2 + 6 * s, 3 * s**2 - 2 * s
+        velocity = (d00 * x[k] + d01 * x[k + 1]) / dt[:, None] + d10 * v[k] + d11 * v[k + 1]
+        velocity[times > t[-1]] = 0.0
+        velocity[times < t[0]] = v[0]
+        weight = s[:, :, None]
+        covariance = (1 - weight) * self.cov[k, :d, :d] + weight * self.cov[k + 1, :d, :d]
+        return ForecastPoint(times, position, velocity, covariance)
+
+
+def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np.ndarray, t_now: float,
+                    position: np.ndarray, velocity: np.ndarray, goal: np.ndarray, goal_covariance: np.ndarray,
+                    stop_time: float | None, acceleration: np.ndarray | None = None) -> HandForecast:
+    """The forecast (module docstring) of the hand at ``position`` (d,) m and ``velocity`` (d,) m/s at ``t_now``
+    (s), heading for ``goal`` (d,) m with covariance ``goal_covariance`` (d, d) m², in a reach that started at
+    rest at ``reach_start`` (d,) m and stops at ``stop_time`` (s; None: where the model's own reach from t = 0
+    does), accelerating at ``acceleration`` (d,) m/s² now (None: as the model's reach does at its phase).
+    ``transition`` is the model's one-step state map A (nx, nx)."""
+    model = family.model
+    n, nx, H, h = family.n, family.nx, family.H, model.h
+    blocks = nx // n
+    to_goal = goal - position
+    r = float(np.linalg.norm(to_goal))
+    D = float(np.linalg.norm(goal - reach_start))
+    along = family.along(np.array([max(D, r, 1e-9)]))[0]              # (H+1, blocks) in the member's frame
+    a, speed = along[:, 0], along[:, 1]
+    first, last = movement_span(np.abs(speed)) if np.abs(speed).max() > 0 else (0, H)
+    tau = h * np.arange(H + 1)
+    end = tau[last]
+    if stop_time is None:
+        stop_time = end
+    remaining = max(stop_time - t_now, SHORTEST_REMAINING_S)
+    u = to_goal / r if r > 0 else (velocity / np.linalg.norm(velocity) if np.linalg.norm(velocity) > 0 else np.eye(n)[0])
+    towards = float(velocity @ u)
+
+    # 1. the phase: phi(tau) over the moving part, read where it equals the hand's
+    left = a[last] - a[first:last]
+    phi = speed[first:last] * (end - tau[first:last]) / np.maximum(left, 1e-12)
+    phase = _phase(tau[first:last], phi, towards * remaining / max(r, 1e-12), end - remaining)
+    pace = remaining / max(end - phase, h)
+
+    # 2. the continuation: the member from its phase on, on the model's grid, turned, scaled and played at p
+    steps = tau[(tau > phase + 1e-9) & (tau <= end)]
+    model_times = np.r_[phase, steps]
+    tail = np.array([np.interp(model_times, tau, along[:, b]) for b in range(blocks)]).T     # (K+1, blocks)
+    left_now = max(a[last] - tail[0, 0], 1e-12)
+    scale = r / left_now
+    block_scale = scale * np.r_[1.0, 1.0 / pace, [pace ** -2] * (blocks - 2)]
+    shifted = tail.copy()
+    shifted[:, 0] -= tail[0, 0]
+    shifted *= block_scale
+    t = t_now + pace * (model_times - phase)
+    mean = (shifted[:, :, None] * u).reshape(len(t), blocks * n)
+    mean[:, :n] += position
+
+    # 3. the rest of the velocity and acceleration, gone by the stop
+    dv = velocity - mean[0, n:2 * n]
+    sigma = np.minimum(t - t_now, remaining)
+    left_share = 1 - sigma / remaining
+    mean[:, :n] += np.outer(sigma * left_share**2, dv)
+    mean[:, n:2 * n] += np.outer(left_share * (1 - 3 * sigma / remaining), dv)
+    if acceleration is not None:
+        model_acceleration = np.interp(phase, tau[:-1] + h / 2, np.diff(speed) / h) * scale / pace**2
+        da = acceleration - (model_acceleration * u - 4 * dv / remaining)
+        mean[:, :n] += np.outer(0.5 * sigma**2 * left_share**3, da)
+        mean[:, n:2 * n] += np.outer(sigma * left_share**2 * (1 - 2.5 * sigma / remaining), da)
+
+    # 4. the covariance: the motor noise still to come, and the goal's uncertainty along the way
+    k0 = int(min(round(phase / h), H))
+    member_cov = _member_covariance(family, max(D, r, 1e-9))
+    frame = family.frame(u)
+    cov = np.zeros((len(t), nx, nx))
+    propagated = member_cov[k0]
+    grid_steps = np.r_[k0, np.round(steps / h).astype(int)]
+    previous = k0
+    for i, j in enumerate(grid_steps):
+        for _ in range(j - previous):
+            propagated = transition @ propagated @ transition.T
+        previous = j
+        cov[i] = member_cov[j] - propagated
+    cov = 0.5 * (cov + cov.transpose(0, 2, 1))
+    scales = np.repeat(np.r_[1.0, 1.0 / pace, [pace ** -2] * (blocks - 2)], n) * scale
+    cov = frame @ (cov * np.outer(scales, scales)) @ frame.T
+    covered = np.clip(((mean[:, :n] - position) @ u) / max(r, 1e-12), 0.0, None)
+    cov[:, :n, :n] += covered[:, None, None] ** 2 * goal_covariance
+    arrival = t_now + pace * (end - phase)
+    return HandForecast(t=t, mean=mean, cov=cov, stop_time=float(arrival), pace=float(pace), phase=float(phase), d=n)
+
+
+def _phase(tau: np.ndarray, phi: np.ndarray, hand_phi: float, guess: float) -> float:
+    """The model time tau (s) at which phi (sampled at ``tau``, (K,)) equals ``hand_phi``: where phi crosses it
+    more than once (it rises, then falls in the reach's last steps), the crossing nearest ``guess`` (s, the
+    phase at the model's own pace); where it never does, the sample nearest in phi, the earliest first."""
+    above = phi >= hand_phi
+    crossings = np.flatnonzero(above[1:] != above[:-1])
+    if len(crossings) == 0:
+        return float(tau[int(np.argmin(np.abs(phi - hand_phi)))])
+    w = (hand_phi - phi[crossings]) / (phi[crossings + 1] - phi[crossings])
+    found = tau[crossings] + w * (tau[crossings + 1] - tau[crossings])
+    return float(found[int(np.argmin(np.abs(found - guess)))])
+
+
+def _member_covariance(family: ReachFamily, distance: float) -> np.ndarray:
+    """Sigma_i (H+1, nx, nx) of the family's member at ``distance`` (m), in its own frame."""
+    return family.prediction(np.zeros(family.model.d), np.r_[distance, np.zeros(family.model.d - 1)], order=0).cov
