@@ -29,7 +29,6 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
-from comanip.analysis.speed_profile import speed_metrics
 from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
 from forecast_scores import forecast_markdown, forecast_rows
 
@@ -88,14 +87,13 @@ class _Online:
 def diagnostics(trace, recording) -> dict:
     """From an online estimator's updates on one movement: the share of updates after a quarter of the
     movement that the reaching model carries (status not ``people_model``), the share whose goal moved by more
-    than 0.1 D, and the predicted reach's arrival minus the hand's (its end), over MT, at half of the movement."""
+    than 0.1 D, and the forecast's stop minus the hand's (its end), over MT, at half of the movement."""
     t = np.array([time_s for time_s, _ in trace])
     after = t >= recording.onset + 0.25 * recording.movement_time
     goals = np.array([estimate.goal for _, estimate in trace])
     jumps = np.linalg.norm(np.diff(goals, axis=0), axis=1) / recording.distance
     half = trace[min(int(np.searchsorted(t, recording.onset + 0.5 * recording.movement_time, side="right")), len(t)) - 1][1]
-    speed = half.ee_speed                               # a GoalEstimate is the Plan of its predicted reach
-    arrival = speed_metrics(half.t, speed).movement_time if speed.max() > 0 else math.nan
+    arrival = half.forecast.stop_time if half.forecast is not None else math.nan
     carried = [str(estimate.status) != "people_model" for (_, estimate), a in zip(trace, after) if a]
     return {"model_share": float(np.mean(carried)) if carried else math.nan,
             "jumps": float(np.mean(jumps[after[1:]] > 0.1)) if after[1:].any() else math.nan,

@@ -230,8 +230,8 @@ ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" /
 
 @pytest.mark.skipif(not ARMS.is_dir(), reason="the recorded arm reaches (../shared/data/arm_reaches) are not beside this clone")
 def test_the_online_estimator_predicts_recorded_arm_reaches_better_than_where_the_hand_is():
-    """Where the hand stops, better than its current position; and when, at half of the movement: the predicted
-    reach arrives near when the hand does, nearer than the model's own reach from the stream's start."""
+    """Where the hand stops, better than its current position; and when, at half of the movement: the forecast
+    arrives near when the hand does, nearer than the model's own reach from the stream's start."""
     from comanip.analysis.speed_profile import speed_metrics
     from comanip.recordings import load_tathum
     model = comanip.presets.arm()
@@ -248,9 +248,9 @@ def test_the_online_estimator_predicts_recorded_arm_reaches_better_than_where_th
                     mine[f].append(np.linalg.norm(estimate.goal - r.end) / r.distance)
                     current[f].append(np.linalg.norm(r.position[k] - r.end) / r.distance)
                 if seen == k + 1 and f == 0.5:
-                    arrives = speed_metrics(estimate.t - estimate.t[0], estimate.ee_speed).movement_time + estimate.t[0]
-                    arrival.append(abs(arrives - r.end_time) / r.movement_time)
-                    untimed = speed_metrics(model.h * np.arange(model.H + 1), estimate.ee_speed * (estimate.t[1] - estimate.t[0]) / model.h)
+                    arrival.append(abs(estimate.forecast.stop_time - r.end_time) / r.movement_time)
+                    own = estimator.reach.prediction(estimate.goal, order=0, covariance=False).mean[:, 3:6]
+                    untimed = speed_metrics(model.h * np.arange(model.H + 1), np.linalg.norm(own, axis=1))
                     own_pace.append(abs(untimed.movement_time - r.end_time) / r.movement_time)
     for f in FRACTIONS:
         assert np.median(mine[f]) < 0.8 * np.median(current[f]), (f, np.median(mine[f]), np.median(current[f]))

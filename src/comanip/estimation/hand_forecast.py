@@ -8,7 +8,7 @@ at t_stop (s, the estimate's timing). The forecast is the model's own reach, con
    :class:`~comanip.estimation.reach_family.ReachFamily`, along its axis a(tau) m, a'(tau) m/s, moving from
    tau_on to tau_end) is at phase tau when the hand is: the dimensionless ratio
 
-       phi(tau) = a'(tau) (tau_end - tau) / (a(tau_end) - a(tau))
+       phi(tau) = a'(tau) (tau_end - tau) / (D - a(tau))
 
    (speed times time to go over distance to go) equals the hand's, |v_g| (t_stop - t_now) / |g - x|, v_g the
    hand's velocity towards g. phi rises from 0 at the onset to its largest value near the end; a hand outside
@@ -41,6 +41,8 @@ from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
+
+from scipy.interpolate import CubicSpline
 
 from comanip.estimation.reach_family import ReachFamily
 from comanip.estimation.reach_timing import movement_span
@@ -84,6 +86,14 @@ class HandForecast:
 
     d: int
     """Task dimensions d (the first block of the state is the hand's position)."""
+    continuation: CubicSpline
+    """The model's continuation alone (steps 1–2 of the module docstring): a C² cubic spline of position (m) over
+    time (s) through its grid positions (the model's Euler step moves x_i with v_i over a whole step, so no
+    smooth curve honours the grid velocities too; step 3 makes the forecast's velocity the hand's)."""
+    velocity_rest: np.ndarray
+    """dv (d,), m/s: the hand's velocity beyond the continuation's (step 3)."""
+    acceleration_rest: np.ndarray
+    """da (d,), m/s²: the hand's acceleration beyond the continuation's and dv's term (step 3)."""
 
     @property
     def position(self) -> np.ndarray:
@@ -96,27 +106,30 @@ class HandForecast:
         return self.mean[:, self.d:2 * self.d]
 
     def at(self, times) -> ForecastPoint:
-        """The forecast at ``times`` (M,) s (a number: M = 1): position and velocity by cubic Hermite
-        interpolation of the grid's positions and velocities, covariance linearly between grid times. Before
-        t_now it is the hand now; after the grid's end, at rest at its last point."""
+        """The forecast at ``times`` (M,) s (a number: M = 1): the continuation's spline, the rest of the hand's velocity and acceleration in closed form, the
+        covariance linearly between grid times. Before t_now it is the hand now; after the stop, at rest on it."""
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1 or not np.all(np.isfinite(times)):
             raise ValueError(f"times must be finite times in s, a number or a 1-D array; got shape {times.shape}")
-        d = self.d
-        t, x, v = self.t, self.mean[:, :d], self.mean[:, d:2 * d]
+        d, t = self.d, self.t
         clipped = np.clip(times, t[0], t[-1])
         k = np.clip(np.searchsorted(t, clipped, side="right") - 1, 0, len(t) - 2)
-        dt = t[k + 1] - t[k]
-        s = ((clipped - t[k]) / dt)[:, None]
-        h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
-        position = h00 * x[k] + h10 * dt[:, None] * v[k] + h01 * x[k + 1] + h11 * dt[:, None] * v[k + 1]
-        d00, d10, d01, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, -6 * s**2 + 6 * s, 3 * s**2 - 2 * s
-        velocity = (d00 * x[k] + d01 * x[k + 1]) / dt[:, None] + d10 * v[k] + d11 * v[k + 1]
-        velocity[times > t[-1]] = 0.0
-        velocity[times < t[0]] = v[0]
+        s = ((clipped - t[k]) / (t[k + 1] - t[k]))[:, None]
+        position, velocity = self.continuation(clipped), self.continuation(clipped, 1)
+        velocity[times >= t[-1]] = 0.0
+        rest_position, rest_velocity = _rest_terms(clipped - t[0], t[-1] - t[0], self.velocity_rest, self.acceleration_rest)
         weight = s[:, :, None]
         covariance = (1 - weight) * self.cov[k, :d, :d] + weight * self.cov[k + 1, :d, :d]
-        return ForecastPoint(times, position, velocity, covariance)
+        return ForecastPoint(times, position + rest_position, velocity + rest_velocity, covariance)
+
+
+def _rest_terms(sigma: np.ndarray, remaining: float, dv: np.ndarray, da: np.ndarray):
+    """Position and velocity (M, d) of step 3's terms at times sigma (M,) s after t_now, R = ``remaining`` s."""
+    sigma = np.minimum(sigma, remaining)[:, None]
+    left = 1 - sigma / remaining
+    position = sigma * left**2 * dv + 0.5 * sigma**2 * left**3 * da
+    velocity = left * (1 - 3 * sigma / remaining) * dv + sigma * left**2 * (1 - 2.5 * sigma / remaining) * da
+    return position, velocity
 
 
 def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np.ndarray, t_now: float,
@@ -145,13 +158,13 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     towards = float(velocity @ u)
 
     # 1. the phase: phi(tau) over the moving part, read where it equals the hand's
-    left = a[last] - a[first:last]
+    left = max(D, r) - a[first:last]
     phi = speed[first:last] * (end - tau[first:last]) / np.maximum(left, 1e-12)
     phase = _phase(tau[first:last], phi, towards * remaining / max(r, 1e-12), end - remaining)
     pace = remaining / max(end - phase, h)
 
     # 2. the continuation: the member from its phase on, on the model's grid, turned, scaled and played at p
-    steps = tau[(tau > phase + 1e-9) & (tau <= end)]
+    steps = tau[(tau > phase + 0.25 * h) & (tau <= end)]           # no sliver of a first step
     model_times = np.r_[phase, steps]
     tail = np.array([np.interp(model_times, tau, along[:, b]) for b in range(blocks)]).T     # (K+1, blocks)
     left_now = max(a[last] - tail[0, 0], 1e-12)
@@ -165,16 +178,15 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     mean[:, :n] += position
 
     # 3. the rest of the velocity and acceleration, gone by the stop
-    dv = velocity - mean[0, n:2 * n]
-    sigma = np.minimum(t - t_now, remaining)
-    left_share = 1 - sigma / remaining
-    mean[:, :n] += np.outer(sigma * left_share**2, dv)
-    mean[:, n:2 * n] += np.outer(left_share * (1 - 3 * sigma / remaining), dv)
-    if acceleration is not None:
-        model_acceleration = np.interp(phase, tau[:-1] + h / 2, np.diff(speed) / h) * scale / pace**2
-        da = acceleration - (model_acceleration * u - 4 * dv / remaining)
-        mean[:, :n] += np.outer(0.5 * sigma**2 * left_share**3, da)
-        mean[:, n:2 * n] += np.outer(sigma * left_share**2 * (1 - 2.5 * sigma / remaining), da)
+    if len(t) == 1:                          # a hand at or past the stop: the continuation holds still
+        t, mean = np.r_[t, t[0] + remaining], np.vstack([mean, mean])
+        mean[1, n:] = 0.0
+    continuation = CubicSpline(t, mean[:, :n])
+    dv = velocity - continuation(t_now, 1)
+    da = np.zeros(n) if acceleration is None else acceleration - (continuation(t_now, 2) - 4 * dv / remaining)
+    rest_position, rest_velocity = _rest_terms(t - t_now, remaining, dv, da)
+    mean[:, n:2 * n] = continuation(t, 1) + rest_velocity
+    mean[:, :n] += rest_position
 
     # 4. the covariance: the motor noise still to come, and the goal's uncertainty along the way
     k0 = int(min(round(phase / h), H))
@@ -183,6 +195,7 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     cov = np.zeros((len(t), nx, nx))
     propagated = member_cov[k0]
     grid_steps = np.r_[k0, np.round(steps / h).astype(int)]
+    grid_steps = np.r_[grid_steps, [grid_steps[-1]] * (len(t) - len(grid_steps))].astype(int)
     previous = k0
     for i, j in enumerate(grid_steps):
         for _ in range(j - previous):
@@ -195,7 +208,8 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     covered = np.clip(((mean[:, :n] - position) @ u) / max(r, 1e-12), 0.0, None)
     cov[:, :n, :n] += covered[:, None, None] ** 2 * goal_covariance
     arrival = t_now + pace * (end - phase)
-    return HandForecast(t=t, mean=mean, cov=cov, stop_time=float(arrival), pace=float(pace), phase=float(phase), d=n)
+    return HandForecast(t=t, mean=mean, cov=cov, stop_time=float(arrival), pace=float(pace), phase=float(phase), d=n,
+                        continuation=continuation, velocity_rest=dv, acceleration_rest=da)
 
 
 def _phase(tau: np.ndarray, phi: np.ndarray, hand_phi: float, guess: float) -> float:
