@@ -83,3 +83,40 @@ def forecast_markdown(rows, name: str) -> str:
             cover.append(f"{100 * np.mean(flags):.0f} %" if flags else "–")
     lines.append("| forecast's 95 % region holds the hand | " + " | ".join(cover) + " |")
     return "\n".join(lines)
+
+
+def forecast_figure(examples, path, title: str) -> None:
+    """Recorded reaches (distance from the start along start → end, over time) with the forecast from 25 % and
+    50 % of MT (mean and 95 % band) and constant velocity; ``examples`` is [(recording, trace)]."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, axes = plt.subplots(1, len(examples), figsize=(3.2 * len(examples), 3.2), squeeze=False)
+    for ax, (recording, trace) in zip(axes[0], examples):
+        start, end = recording.start, recording.end
+        axis = (end - start) / recording.distance
+        along = (recording.position - start) @ axis
+        ax.plot(recording.t - recording.onset, along, color="k", lw=1.5, label="recorded hand")
+        for fraction, color in zip(FROM, ("tab:blue", "tab:orange")):
+            k = recording.seen_until(fraction) - 1
+            if k < 1 or k >= len(trace) or trace[k][1].forecast is None:
+                continue
+            t_now, estimate = trace[k]
+            times = t_now + np.linspace(0.0, max(LEADS), 31)
+            ahead = estimate.forecast.at(times)
+            mean = (ahead.position - start) @ axis
+            spread = 1.96 * np.sqrt(np.einsum("i,kij,j->k", axis, ahead.covariance, axis))
+            ax.plot(times - recording.onset, mean, color=color, label=f"forecast from {int(100 * fraction)} % of MT")
+            ax.fill_between(times - recording.onset, mean - spread, mean + spread, color=color, alpha=0.15)
+            straight = kinematic.constant_velocity(recording.position[k], recording.velocity[k], times - t_now)
+            ax.plot(times - recording.onset, (straight - start) @ axis, color=color, ls=":", lw=1,
+                    label=f"constant velocity from {int(100 * fraction)} %")
+        ax.set_ylim(-0.1 * recording.distance, 1.6 * recording.distance)
+        ax.set_xlabel("time since onset (s)")
+        ax.set_title(recording.name.split("/")[-1], fontsize=8)
+    axes[0, 0].set_ylabel("hand along start → end (m)")
+    axes[0, 0].legend(fontsize=6, loc="lower right")
+    fig.suptitle(title, fontsize=9)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)

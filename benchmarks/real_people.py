@@ -30,11 +30,13 @@ import numpy as np
 from scipy.stats import chi2
 
 from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
-from forecast_scores import forecast_markdown, forecast_rows
+from forecast_scores import forecast_figure, forecast_markdown, forecast_rows
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
 WORSE_MARGIN = 0.05
+FORECAST_EXAMPLES = 4
+"""Movements whose forecasts the forecast figure shows (the first of the set)."""
 
 
 def predictors(model_names, library, exclude_self: bool, people_for):
@@ -327,7 +329,7 @@ def main(argv=None):
     names = list(made)
     out = args.out or Path(__file__).parent / "results" / f"real_people_{args.source}_{args.split if args.source != 'simulated' else 'planar'}"
     out.mkdir(parents=True, exist_ok=True)
-    rows, latency, diagnosed, forecasts = [], {name: [] for name in names}, {}, {}
+    rows, latency, diagnosed, forecasts, examples = [], {name: [] for name in names}, {}, {}, {}
     first = {name: [] for name in names}
     begin = time.perf_counter()
     for i, recording in enumerate(movements):
@@ -338,6 +340,8 @@ def main(argv=None):
             if isinstance(predictor, _Online):
                 diagnosed.setdefault(name, []).append(diagnostics(predictor.trace, recording))
                 forecasts.setdefault(name, []).extend(forecast_rows(predictor.trace, recording, name))
+                if len(examples.setdefault(name, [])) < FORECAST_EXAMPLES:
+                    examples[name].append((recording, predictor.trace))
             latency[name] += times[1:]
             first[name].append(times[0])
             errors = [float(np.linalg.norm(goal - recording.end)) / D for goal, _ in answers]
@@ -389,6 +393,9 @@ def main(argv=None):
     figure(summary, out / "error_by_fraction.png", title)
     if args.figure:
         figure(summary, args.figure, title)
+    for name, shown in examples.items():
+        for where in [out / "forecast_paths.png"] + ([args.figure.with_name(args.figure.stem + "_forecast.png")] if args.figure else []):
+            forecast_figure(shown, where, f"{name}: the forecast of the hand on {title}")
     print(f"wrote {out}", file=log)
 
 

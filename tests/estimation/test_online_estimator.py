@@ -199,9 +199,11 @@ def test_updates_at_any_time_use_every_observation(online):
             estimator.update(times[-1], position, s[3:])
     assert estimate.success and estimate.method == "online"
     assert np.linalg.norm(estimate.goal - goal) < 1e-3
-    # the predicted reach is the model's plan to the estimate, through the observations
-    assert estimate.mean.shape == (model.H + 1, 6) and estimate.torque.shape == (model.H, 3)
-    assert np.abs(estimate.ee_mean - planner.solve(np.zeros(6), estimate.goal).ee_mean).max() < 1e-4
+    # the predicted path is the forecast from the last observation: the rest of the model's plan to the estimate
+    assert estimate.t[0] == times[-1] and estimate.mean.shape[1] == 6
+    rest = planner.solve(np.zeros(6), estimate.goal)
+    later = rest.t[(rest.t > times[-1]) & (rest.t < estimate.forecast.stop_time)]
+    assert np.abs(estimate.forecast.at(later).position - rest.ee_mean[np.searchsorted(rest.t, later)]).max() < 3e-3
     assert np.abs(estimate.observation_residual).max() < 1e-3
     # the last estimate used all observations: it is sharper than one from the last observation alone
     alone = fresh(online).update(times[-1], *np.split(state_at(plan.mean, model.h, times[-1])[:6], 2))

@@ -56,9 +56,25 @@ class GoalEstimate(Plan):
     """For an 'uninformative' estimate (observation at step 0): the status of the plan to the prior goal."""
 
     @property
+    def reach_distance(self) -> float:
+        """D (m): from the reach's start to g_hat (the path of an online estimate starts at the hand now)."""
+        if self.forecast is None:
+            return super().reach_distance
+        return float(np.linalg.norm(self.start[:self.forecast.d] - self.goal))
+
+    @property
     def estimated_goal(self) -> np.ndarray:
         """g_hat (d,), m: the plan's goal."""
         return self.goal
+
+    def to_dict(self) -> dict:
+        """JSON-ready dictionary (arrays as nested lists); the forecast as its stop, pace and phase (its grid is
+        the plan fields')."""
+        out = super().to_dict()
+        if self.forecast is not None:
+            out["forecast"] = {"stop_time_s": self.forecast.stop_time, "pace": self.forecast.pace,
+                               "phase_s": self.forecast.phase}
+        return out
 
     @classmethod
     def of(cls, plan: Plan, **details) -> "GoalEstimate":

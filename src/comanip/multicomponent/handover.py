@@ -183,7 +183,7 @@ def plan_handover(plan: Plan, model: TransitionModel, ramp_time: float = DEFAULT
 
     goal = np.asarray(plan.goal, dtype=float)
     path = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
-    goal_distance = float(np.linalg.norm(plan.ee_mean[0] - goal))
+    goal_distance = plan.reach_distance
     mean, std = model.predict(goal_distance, plan.width)
     transition_time, status = _first_time_within(path, goal, mean, plan.t[0], plan.t[-1])
     end = max(plan.t[-1], transition_time + ramp_time)

@@ -80,6 +80,11 @@ class Plan:
     solve from this plan to a moved goal starts from its first-order prediction."""
 
     @property
+    def reach_distance(self) -> float:
+        """D (m): from where the reach starts to the goal, |x(t_0) - g|."""
+        return float(np.linalg.norm(self.ee_mean[0] - np.asarray(self.goal, dtype=float)))
+
+    @property
     def ee_speed(self) -> np.ndarray:
         """Speed of the mean end effector ||d mu_x/dt|| (H+1,), m/s."""
         return np.linalg.norm(self.ee_velocity, axis=1)
