@@ -14,15 +14,18 @@ import numpy as np
 from scipy.stats import chi2
 
 from comanip.estimation import path_baselines as kinematic
+from comanip.estimation.hand_forecast import continued_reach
 
 LEADS = (0.1, 0.2, 0.3)
 FROM = (0.25, 0.5)
 KINEMATIC = ("hand stays", "constant velocity", "constant acceleration", "minimum jerk to the estimate's goal and stop")
+GIVEN_THE_END = ("the forecast given the recorded endpoint and stop", "minimum jerk given the recorded endpoint and stop")
+"""What a perfect goal and stop would give each shape: not predictors, the ceiling of each."""
 
 
-def forecast_rows(trace, recording, name: str) -> list[dict]:
+def forecast_rows(trace, recording, name: str, estimator) -> list[dict]:
     """One row per (start fraction, lead, forecaster) for one movement; ``trace`` is [(t, estimate)] of every
-    update of the online estimator ``name``."""
+    update of the online estimator ``name`` (an :class:`~comanip.OnlineGoalEstimator`, ``estimator``)."""
     D = recording.distance
     rows = []
     for start in FROM:
@@ -43,7 +46,11 @@ def forecast_rows(trace, recording, name: str) -> list[dict]:
                  "constant velocity": kinematic.constant_velocity(x, v, lead),
                  "constant acceleration": kinematic.constant_acceleration(x, v, a, lead),
                  "minimum jerk to the estimate's goal and stop": kinematic.minimum_jerk_to(x, v, a, estimate.goal, stop_in, lead),
-                 name: predicted.position}
+                 name: predicted.position,
+                 GIVEN_THE_END[0]: continued_reach(estimator.family, estimator.transition, estimator.start_position, t_now,
+                                                   x, v, recording.end, np.zeros((len(x), len(x))), recording.end_time,
+                                                   a).at(t_now + lead).position,
+                 GIVEN_THE_END[1]: kinematic.minimum_jerk_to(x, v, a, recording.end, recording.end_time - t_now, lead)}
         for forecaster, path in paths.items():
             for i, s in enumerate(lead):
                 error = path[i] - truth[i]
@@ -82,6 +89,10 @@ def forecast_markdown(rows, name: str) -> str:
             flags = [r["covered"] for r in rows if r["forecaster"] == name and r["from"] == f and r["lead_s"] == s]
             cover.append(f"{100 * np.mean(flags):.0f} %" if flags else "–")
     lines.append("| forecast's 95 % region holds the hand | " + " | ".join(cover) + " |")
+    for forecaster in GIVEN_THE_END:
+        lines.append(f"| {forecaster} | " + " | ".join(
+            f"{np.median([r['error'] for r in rows if r['forecaster'] == forecaster and r['from'] == f and r['lead_s'] == s]):.3f}"
+            for f in FROM for s in LEADS) + " |")
     return "\n".join(lines)
 
 

@@ -339,7 +339,7 @@ def main(argv=None):
             answers, times, predictor = run_predictor(made[name], recording)
             if isinstance(predictor, _Online):
                 diagnosed.setdefault(name, []).append(diagnostics(predictor.trace, recording))
-                forecasts.setdefault(name, []).extend(forecast_rows(predictor.trace, recording, name))
+                forecasts.setdefault(name, []).extend(forecast_rows(predictor.trace, recording, name, predictor.estimator))
                 if len(examples.setdefault(name, [])) < FORECAST_EXAMPLES:
                     examples[name].append((recording, predictor.trace))
             latency[name] += times[1:]

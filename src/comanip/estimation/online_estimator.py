@@ -106,7 +106,7 @@ class OnlineGoalEstimator:
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self.explanations = list(explanations) if explanations is not None else self._explanations(d)
-        self._transition = np.asarray(linearised_step_function(model.body, model.h)(
+        self.transition = np.asarray(linearised_step_function(model.body, model.h)(
             np.zeros(model.state_size), np.zeros(model.n))[1])
         """A (nx, nx): the model's one-step state map (linear dynamics), for the forecast's belief."""
         self._blas = ThreadpoolController()
@@ -249,7 +249,7 @@ class OnlineGoalEstimator:
         t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
         if self._hand.count:
             stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
-            forecast = continued_reach(self.family, self._transition, self.start_position, self._last_time, observed[:n],
+            forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
                                        observed[n:], np.asarray(goal, dtype=float), covariance, stop,
                                        recent_acceleration(self._hand.t, self._hand.velocity))
             t, mean, cov = forecast.t, forecast.mean, forecast.cov
