@@ -4,7 +4,7 @@ A recording (:class:`comanip.recordings.Recording`: positions p(t), m, on a scre
 tracker's space (d = 3)) is mapped onto the scenario's reach from the handle's start x_0 (3,) to the goal g
 (3,), both m:
 
-    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2 + v(t) e_3),   0 ≤ t ≤ lead + MT_rec
+    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2 + v(t) e_3),   0 ≤ t ≤ lead + MT_rec + END_HOLD
 
 with u(t), w(t), v(t) the recorded displacement p(t_0 + t) - p(t_0) along the recorded chord c = p_end - p(t_0),
 across it horizontally (along up × c) and across it upward (along c × (up × c)), with up the recording's
@@ -16,6 +16,13 @@ change), e_2 = z × e_1 (normalised) the horizontal unit vector across it and e_
 |g - x_0|. So the path starts at x_0, ends at g, keeps the recording's timing, speed profile and deviations
 from its chord (scaled, sideways ones horizontal, upward ones upward), and a planar recording's x–y
 direction is turned onto the scenario's.
+
+The recorded positions p(t) are first low-passed (:data:`SMOOTHING_HZ`, zero phase, the hand held at its last
+sample for :data:`END_HOLD` after the recording's end, which the playback includes: 0 ≤ t ≤ lead + MT_rec +
+END_HOLD). A pointing fingertip stops on its target by touching it, decelerating within a few tens of ms, and a
+tracker adds noise; a person guiding a handle does neither, and through the feedforward M_load xddot_d below
+both would become the person's force (a 16 kg handle decelerated at 5 m/s² is 80 N). The low-pass keeps the
+reach itself, whose speed profile lies below about 3 Hz.
 
 A 3-D recording's upward direction is that of the surface its reaches start and end on
 (:func:`surface_normal`): the normal of the plane through the starts and ends of a set of recordings,
@@ -34,6 +41,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
+from scipy.signal import butter, sosfiltfilt
 
 from comanip.arguments import as_matrix, as_vector
 from comanip.recordings.recording import Recording
@@ -51,6 +59,12 @@ MIN_DISTANCE = 0.1
 """... it spans at least this distance (m), so that scaling it to a reach does not magnify its sampling noise."""
 MAX_MOVEMENT_TIME = 2.0
 """... and it lasts at most this long (s)."""
+SMOOTHING_HZ = 6.0
+"""Cut-off (Hz, in the recording's own time) of the low-pass the recorded positions pass through before they are
+played (second-order Butterworth run forward and backward: zero phase; module docstring)."""
+END_HOLD = 0.1
+"""Time (s, the recording's own) the recorded hand is held at its last sample after the recording's end, and played:
+the low-passed path comes to rest within it (to 0.1 % of the step it smooths, at SMOOTHING_HZ)."""
 RECORDING_STRIDE = 37
 """Trial seed k plays usable recording (k · stride) mod N of the development split, N usable recordings: a
 stride spreads consecutive seeds over the file (whose movements come in runs by person)."""
@@ -72,8 +86,8 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
 
     up: the recording's upward direction (3,), for a 3-D recording (:func:`surface_normal`); a planar one lies
     flat and takes none. Returns (t (K,) s from the playback's start, positions (K, 3) m): t[0] = 0 at start,
-    t[-1] = PLAYBACK_LEAD + MT_rec at goal (the recording's onset at PLAYBACK_LEAD, or at 0 when it has no
-    samples that early).
+    t[-1] = PLAYBACK_LEAD + MT_rec + END_HOLD at goal, to within a sample step (the recording's onset at
+    PLAYBACK_LEAD, or at 0 when it has no samples that early).
     """
     start, goal = as_vector("start", start, 3, "m"), as_vector("goal", goal, 3, "m")
     d = recording.position.shape[1]
@@ -91,9 +105,13 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
     distance = float(np.linalg.norm(reach))
     if distance == 0:
         raise ValueError("a recorded reach needs a start away from its goal")
-    first = max(recording.onset - PLAYBACK_LEAD, float(recording.t[0]))
-    keep = (recording.t >= first - 1e-9) & (recording.t <= recording.end_time + 1e-9)
-    t, recorded = recording.t[keep] - first, np.pad(recording.position[keep], ((0, 0), (0, 3 - d)))
+    times, smoothed = _low_passed(recording)
+    first = max(recording.onset - PLAYBACK_LEAD, float(times[0]))
+    keep = times >= first - 1e-9
+    # time 0 is the first sample played, not `first` (between samples): a path that began before its first
+    # sample would be extrapolated there, not at rest
+    t = times[keep] - times[keep][0]
+    recorded = np.pad(smoothed[keep], ((0, 0), (0, 3 - d)))
     length = float(np.linalg.norm(recorded[-1] - recorded[0]))
     if length == 0:
         raise ValueError(f"recording {recording.name!r} ends where it starts")
@@ -102,6 +120,18 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
     position = start + (distance / length) * components @ _chord_frame(reach, np.array([0.0, 0.0, 1.0]))
     position[-1] = goal   # equal up to rounding
     return t, position
+
+
+def _low_passed(recording: Recording) -> tuple[np.ndarray, np.ndarray]:
+    """The recording's samples to its end and then :data:`END_HOLD` more held at the last one (times (K,) s on the
+    recording's clock), low-passed at :data:`SMOOTHING_HZ` (positions (K, d) m)."""
+    inside = recording.t <= recording.end_time + 1e-9
+    t, position = recording.t[inside], recording.position[inside]
+    step = float(np.median(np.diff(t)))
+    held = int(np.ceil(END_HOLD / step - 1e-9))
+    t = np.r_[t, t[-1] + step * np.arange(1, held + 1)]
+    position = np.vstack([position, np.repeat(position[-1:], held, axis=0)])
+    return t, sosfiltfilt(butter(2, SMOOTHING_HZ, fs=1.0 / step, output="sos"), position, axis=0)
 
 
 def _chord_frame(chord: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -145,7 +175,7 @@ class RecordedPerson:
         self.goal = as_vector("goal", goal, 3, "m")
         t, position = recorded_reach(recording, start, goal, up)
         self.duration = float(t[-1] * parameters.pace)
-        """The path's duration (s): the playback's (lead and movement time) times the pace."""
+        """The path's duration (s): the playback's (lead, movement time and END_HOLD) times the pace."""
         rest = [(1, np.zeros(3)), (2, np.zeros(3))]
         self._path = make_interp_spline(t * parameters.pace, position - position[0], k=5, bc_type=(rest, rest))
         self._load_inertia = np.zeros((3, 3))
