@@ -187,8 +187,11 @@ along its online estimate of the person's goal (`{sync['policy']}` policy). The 
   to them ({sync['holding_force_N']:.1f} N at rest); the force beyond that peaks at {sync['peak_force_change_N']:.1f} N (RMS
   {sync['rms_force_change_N']:.1f} N), {against_range(sync['peak_force_change_N'], (low, high))} the {low:.0f}–{high:.0f} N people apply to guide a
   partner through a held contact (Sawers et al. 2017); the whole force peaks at {sync['peak_force_N']:.1f} N (RMS
-  {sync['rms_force_N']:.1f} N), {against_range(sync['peak_force_N'], (low, high))} that range. Look at how closely the robot's height
-  follows the person's progress: a robot that predicts the goal well makes the person push less.
+  {sync['rms_force_N']:.1f} N), {against_range(sync['peak_force_N'], (low, high))} that range. Above the weight, the person's force
+  accelerates and brakes the handle and, where the robot's height is not the person's, pushes against the robot.
+
+Look at how the forecasts close in on the hand's path as the reach goes on while the goal estimate settles, and at
+when the force peaks against the green band of what people apply.
 
 `demo.json` holds these numbers; `co_manipulation.csv` and `forecasts.csv` the series the figure draws;
 `sync_near_trial0.csv` the trial's samples. `comanip simulate sync --person {sync['person']} --policy all` compares the

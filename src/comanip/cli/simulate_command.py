@@ -36,7 +36,8 @@ def add_parser(subparsers) -> None:
                                          "person), recorded (a recorded mouse movement, the 'data' extra), arm (a "
                                          "recorded arm reach of examples/data/arm_reaches) or FOLDER (your own arm "
                                          "reaches, TAT-HUM layout); add -xP to play it P times as long, e.g. "
-                                         "arm-x2.5; trial k plays recording k·37 mod N of the N usable ones")
+                                         "arm-x2.5; the trial with seed s plays recording 37·s mod N of the N "
+                                         "that play as a reach")
     add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
