@@ -71,7 +71,7 @@ def test_the_reports_forces_and_goal_errors_are_those_of_the_series_it_writes(de
     assert series["goal_estimate_error_m"][-1] == pytest.approx(sync["goal_error_final_m"], abs=1e-6)
     for key in ("peak_force_N", "rms_force_N", "peak_force_change_N", "rms_force_change_N", "holding_force_N"):
         assert f"{sync[key]:.1f} N" in report, key
-    assert f"is {100 * sync['goal_error_final_m']:.1f} cm" in report
+    assert f"is {1e3 * sync['goal_error_final_m']:.1f} mm" in report
 
 
 @pytest.mark.slow

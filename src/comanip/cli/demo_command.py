@@ -77,7 +77,7 @@ def run(args) -> int:
              f"online prediction of {prediction.recording.name}: goal {100 * online['error_m'][0.4]:.1f} cm off at 40 % of the movement, "
              f"{100 * online['error_m'][1.0]:.1f} cm at its end ({online['updates']} updates)",
              f"robot beside a person guiding the handle ({step3['person']}, {demo.SYNC_POLICY} policy): force beyond holding "
-             f"{step3['peak_force_change_N']:.0f} N at its peak, goal estimate {100 * step3['goal_error_final_m']:.1f} cm off at the end",
+             f"{step3['peak_force_change_N']:.0f} N at its peak, goal estimate {1e3 * step3['goal_error_final_m']:.1f} mm off at the end",
              f"what to look at: {out / 'report.md'}"]
     report(args, lines, numbers, out, files)
     return 0
@@ -178,9 +178,9 @@ would take 6 times the force. The handle's movement takes {sync['movement_time_s
 {sync['peak_speed_m_per_s']:.2f} m/s. The person leads x–y; from t_o = {sync['observation_time_s']:.1f} s the robot leads the height
 along its online estimate of the person's goal (`{sync['policy']}` policy). The figure shows what this section names:
 
-- **{QUANTITIES['goal']}** (top left): at the end of the trial the goal estimate is {100 * sync['goal_error_final_m']:.1f} cm
+- **{QUANTITIES['goal']}** (top left): at the end of the trial the goal estimate is {1e3 * sync['goal_error_final_m']:.1f} mm
   from the person's goal, at half the movement {100 * sync['goal_error_50pct_m']:.1f} cm; the handle ends
-  {100 * sync['final_error_m']:.1f} cm from the goal.
+  {1e3 * sync['final_error_m']:.1f} mm from the goal.
 - **{QUANTITIES['path']}** (bottom): the robot's forecast of where the hand goes from the moment it is made (not
   the goal at the end, above), against where the hand went until the movement ends: {forecasts}.
 - **{QUANTITIES['force']}** (top right), from t_o on: the person holds the object's weight, which this robot leaves
