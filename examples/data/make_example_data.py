@@ -4,7 +4,8 @@
 
 They are made by the model itself (noisy open-loop executions of its plans), so the examples have a known
 answer: the observed reach goes to [0.3, 0.1] m, the recordings were made with kappa = 0.03, the hand CSV
-reaches for [0.35, 0.1, 0.05] m. Formats: docs/data_formats.md.
+reaches for [0.35, 0.1, 0.05] m. Formats: docs/data_formats.md. The recorded arm reaches in ``arm_reaches/`` are
+people's, copied, not made here (``arm_reaches/tathum/SOURCE.md``).
 """
 
 from __future__ import annotations

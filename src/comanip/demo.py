@@ -5,12 +5,16 @@
 2. **predict a recorded person's goal online**: a recorded movement of the ``cursory`` data (a person's mouse
    reach, scaled to m), shifted to start at the origin, fed sample by sample as it happens (time since the
    onset s, position m, velocity m/s) to :class:`comanip.OnlineGoalEstimator` of the planar preset; each
-   update's goal is compared with where the person was aiming (the recording's target);
-3. **run the robot beside the same person** in the synchronisation scenario (:mod:`comanip.simulation.sync_scenario`):
-   a simulated Panda and a person whose hand follows that recording, the robot leading the height along its
-   online estimate of the person's goal (the ``continuous`` policy).
+   update's goal is compared with where the person was aiming (the recording's target, which these recordings
+   hold and the arm recordings of step 3 do not);
+3. **run the robot beside a person guiding the handle** in the synchronisation scenario
+   (:mod:`comanip.simulation.sync_scenario`): a simulated Panda and a person whose hand follows a recorded arm
+   reach (:data:`SYNC_PERSON`), the robot leading the height along its online estimate of the person's goal (the
+   ``continuous`` policy). What the robot believed along the way is read back by :func:`robot_forecasts`: the
+   goal estimate over time and, at :data:`FORECAST_FRACTIONS` of the movement, its forecast of the hand's path.
 
-Needs the ``data`` extra (the recording) and, for step 3, the ``sim`` extra.
+Needs the ``data`` extra (step 2's recording), the ``sim`` extra (step 3) and the arm reaches of
+``examples/data/arm_reaches`` (a clone of the source: :data:`comanip.simulation.people.SHIPPED_ARM_REACHES`).
 """
 
 from __future__ import annotations
@@ -35,6 +39,27 @@ SYNC_GOAL = "near"
 """The sync scenario's goal (a name of :data:`comanip.simulation.NAMED_GOALS`)."""
 SYNC_POLICY = "continuous"
 """The sync robot's policy: the online goal estimate, updated as the hand moves."""
+SYNC_PERSON = "arm-x2.5"
+"""The sync scenario's person (:func:`comanip.simulation.people.choose_person`): a recorded arm reach played 2.5
+times slower. A fingertip pointing 0.22 m takes 0.42 s (the median of the recorded arm reaches); a person moving
+a handle whose apparent mass is 7–16 kg moves it more slowly, and 2.5 is the slow-down that gives the median
+recorded mouse movement the model's person's time with this handle (one rule for every recorded person, chosen
+before these reaches were played)."""
+GUIDING_FORCE_N = (10.0, 30.0)
+"""The force people exchange when one guides the other through a held contact (N): 10–30 N between partners in a
+partnered stepping task (Sawers et al. 2017, J. NeuroEng. Rehabil. 14:8). The report puts the person's force
+against it."""
+FORECAST_FRACTIONS = (0.25, 0.5, 0.75)
+"""Fractions of the movement time at which the report and the figure show the robot's forecast of the hand."""
+QUANTITIES = {"goal": "the goal estimate over time", "path": "the predicted path of the hand against the hand",
+              "force": "the force between the person and the handle"}
+"""The names the report and the figure of step 3 give what they show."""
+
+
+def against_range(value: float, bounds: tuple[float, float]) -> str:
+    """Where value lies against bounds (low, high): "below", "within" or "above"."""
+    low, high = bounds
+    return "below" if value < low else "above" if value > high else "within"
 
 
 @dataclass
@@ -94,11 +119,72 @@ def predict_online(recording: Recording, model=None) -> OnlinePrediction:
                             statuses, np.asarray(recording.target, dtype=float) - origin)
 
 
-def run_sync_beside(seed: int = 0):
-    """Step 3: one sync trial (:data:`SYNC_GOAL`, :data:`SYNC_POLICY`) with the recorded person of ``seed``; the
-    :class:`comanip.simulation.ScenarioResult` (its setup's ``recording(seed)`` is the movement played)."""
-    from comanip.simulation import PersonParameters, SyncSettings, run_scenario
+@dataclass
+class Forecast:
+    """The robot's forecast of the hand made at one update, on the trial's samples from then to the movement's end."""
 
-    settings = SyncSettings(goal=SYNC_GOAL, trials=1, seed=seed, policy=SYNC_POLICY,
-                            person=PersonParameters(hand_path="recorded"))
-    return run_scenario("sync", {SYNC_GOAL: settings}, None, progress=False)
+    made_at: float
+    """Time of the update (s from the start of the reach)."""
+    goal: np.ndarray
+    """The goal estimate of that update (3,), m."""
+    t: np.ndarray
+    """Times (F,), s, from ``made_at`` to the movement time MT."""
+    position: np.ndarray
+    """The forecast hand (F, 3), m: the estimate's predicted path of the hand (``ee_mean``), held at its last point
+    after the estimate's horizon."""
+    hand: np.ndarray
+    """The handle at those times (F, 3), m."""
+
+    @property
+    def error(self) -> np.ndarray:
+        """Distance of the forecast from the hand (F,), m."""
+        return np.linalg.norm(self.position - self.hand, axis=1)
+
+    @property
+    def rms_error(self) -> float:
+        """RMS of :attr:`error` (m): how far the forecast was from where the hand went."""
+        return float(np.sqrt(np.mean(self.error**2)))
+
+
+def run_sync_beside(seed: int = 0):
+    """Step 3: one sync trial (:data:`SYNC_GOAL`, :data:`SYNC_POLICY`, :data:`SYNC_PERSON`) whose person plays
+    recording ``seed`` (:meth:`comanip.simulation.ScenarioSetup.recording`); the
+    :class:`comanip.simulation.ScenarioResult`."""
+    from comanip.simulation import SyncSettings, choose_person, run_scenario
+
+    person = choose_person(SYNC_PERSON)
+    settings = SyncSettings(goal=SYNC_GOAL, trials=1, seed=seed, policy=SYNC_POLICY, person=person.parameters)
+    return run_scenario("sync", {SYNC_GOAL: settings}, None, progress=False, arm_reaches=person.arm_reaches)
+
+
+def robot_forecasts(result) -> list[Forecast]:
+    """The continuous robot's forecasts of the hand in the sync trial of ``result`` (:func:`run_sync_beside`) at
+    :data:`FORECAST_FRACTIONS` of its movement time: the robot's estimator fed again the handle states the robot
+    saw (the same samples at the same times give the same estimates), read at the last update at or before each
+    fraction."""
+    from comanip.simulation.policies import POLICIES
+    from comanip.simulation.sync_scenario import policy_context
+
+    settings, setup = result.settings, result.setup
+    trial = result.goals[SYNC_GOAL].trials[0]
+    record, movement_time = trial.record, trial.metrics["movement_time_s"]
+    policy = POLICIES[settings.policy](policy_context(settings, setup, setup.settled_start(np.zeros(3))))
+    wanted = [f * movement_time for f in FORECAST_FRACTIONS]
+    forecasts = []
+    for k, t in enumerate(record.t):
+        if t > wanted[len(forecasts)] + 1e-9:
+            forecasts.append(_forecast(policy.estimator.latest, record, movement_time))
+            if len(forecasts) == len(wanted):
+                break
+        policy.observe(t, record.position[k], record.velocity[k])
+    return forecasts
+
+
+def _forecast(estimate, record, movement_time: float) -> Forecast:
+    """The estimate's predicted path of the hand against the record's handle from the estimate's last observation
+    (its ``t_obs``, s) to the movement time (s)."""
+    made_at = float(estimate.t_obs)
+    keep = (record.t >= made_at - 1e-9) & (record.t <= movement_time + 1e-9)
+    t = record.t[keep]
+    path = np.column_stack([np.interp(t, estimate.t, estimate.ee_mean[:, a]) for a in range(3)])
+    return Forecast(made_at, np.array(estimate.goal, dtype=float), t, path, record.position[keep])

@@ -7,7 +7,8 @@ import pytest
 
 from comanip.recordings.recording import Recording
 from comanip.simulation.person import PersonParameters, SimulatedPerson
-from comanip.simulation.recorded_person import PLAYBACK_LEAD, RecordedPerson, recorded_reach, surface_normal, usable_for_reach
+from comanip.simulation.recorded_person import (END_HOLD, PLAYBACK_LEAD, RecordedPerson, recorded_reach, surface_normal,
+                                                usable_for_reach)
 
 GOAL = np.array([0.30, 0.10, -0.15])
 ARMS = Path(__file__).resolve().parents[3] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
@@ -58,7 +59,7 @@ def test_a_recorded_path_starts_at_the_start_and_ends_at_the_scaled_turned_endpo
     start = np.array([0.31, 0.0, 0.47])
     goal = np.array([0.45, 0.15, 0.20])
     t, position = recorded_reach(_synthetic_recording(angle), start, goal)
-    assert t[0] == 0.0 and t[-1] == pytest.approx(PLAYBACK_LEAD + 0.5)
+    assert t[0] == 0.0 and t[-1] == pytest.approx(PLAYBACK_LEAD + 0.5 + END_HOLD)
     np.testing.assert_allclose(position[0], start, atol=1e-12)
     np.testing.assert_allclose(position[-1], goal, atol=1e-12)
     # mid-movement the bulge is sideways, horizontal and scaled by the reach's distance over the recording's
@@ -66,11 +67,12 @@ def test_a_recorded_path_starts_at_the_start_and_ends_at_the_scaled_turned_endpo
     middle = int(np.argmin(np.abs(t - (PLAYBACK_LEAD + 0.25))))
     offset = position[middle] - (start + 0.5 * reach)
     scale = np.linalg.norm(reach) / 0.2
-    np.testing.assert_allclose(offset @ reach, 0.0, atol=1e-9)
-    assert offset[2] == pytest.approx(0.0, abs=1e-12)
-    assert np.linalg.norm(offset) == pytest.approx(0.02 * scale, rel=1e-9)
+    np.testing.assert_allclose(offset @ reach / np.linalg.norm(reach), 0.0, atol=3e-4)   # mid-way, to the low-pass
+    sideways = offset - (offset @ reach) / (reach @ reach) * reach
+    assert sideways[2] == pytest.approx(0.0, abs=1e-12)
+    assert np.linalg.norm(sideways) == pytest.approx(0.02 * scale, rel=1e-2)       # the low-pass keeps a reach's bulge
     # left of the recorded direction stays left of the reach's x–y direction
-    assert reach[0] * offset[1] - reach[1] * offset[0] > 0
+    assert reach[0] * sideways[1] - reach[1] * sideways[0] > 0
 
 
 def _tracked_reach(chord, up, side: float, rise: float, origin=(0.1, 0.2, 0.3)) -> Recording:
@@ -96,7 +98,7 @@ def test_a_3d_recorded_path_keeps_its_timing_and_its_scaled_deviations_sideways_
     recording = _tracked_reach([-0.06, 0.01, -0.2], up, side=0.01, rise=0.03)
     start, goal = np.array([0.31, 0.0, 0.47]), np.array([0.45, 0.15, 0.20])
     t, position = recorded_reach(recording, start, goal, up)
-    np.testing.assert_allclose(t, recording.t[recording.t >= 0.1 - PLAYBACK_LEAD - 1e-9] - (0.1 - PLAYBACK_LEAD), atol=1e-12)
+    assert t[0] == 0.0 and t[-1] == pytest.approx(PLAYBACK_LEAD + 0.5 + END_HOLD)
     np.testing.assert_allclose(position[0], start, atol=1e-12)
     np.testing.assert_allclose(position[-1], goal, atol=1e-12)
     reach = goal - start
@@ -105,15 +107,15 @@ def test_a_3d_recorded_path_keeps_its_timing_and_its_scaled_deviations_sideways_
     across /= np.linalg.norm(across)
     upward = np.cross(reach, across) / np.linalg.norm(reach)
     assert upward[2] > 0
-    # the progress along the chord keeps the recording's normalised timing
+    # the progress along the chord keeps the recording's normalised timing (to the low-pass's smoothing)
     recorded_progress = (recording.position - recording.position[0]) @ (recording.position[-1] - recording.position[0])
     recorded_progress /= recorded_progress[-1]
     progress = (position - start) @ reach / (reach @ reach)
-    np.testing.assert_allclose(progress, np.interp(t + 0.1 - PLAYBACK_LEAD, recording.t, recorded_progress), atol=1e-9)
+    np.testing.assert_allclose(progress, np.interp(t + 0.1 - PLAYBACK_LEAD, recording.t, recorded_progress), atol=5e-3)
     middle = int(np.argmin(np.abs(t - (PLAYBACK_LEAD + 0.25))))
     offset = position[middle] - (start + 0.5 * reach)
-    assert offset @ across == pytest.approx(0.01 * scale, rel=1e-6)      # sideways stays horizontal, scaled
-    assert offset @ upward == pytest.approx(0.03 * scale, rel=1e-6)      # upward stays upward, scaled
+    assert offset @ across == pytest.approx(0.01 * scale, rel=1e-2)      # sideways stays horizontal, scaled (to the low-pass)
+    assert offset @ upward == pytest.approx(0.03 * scale, rel=1e-2)      # upward stays upward, scaled
 
 
 def test_a_3d_recording_needs_its_up_direction_and_a_planar_one_takes_none():
@@ -122,6 +124,24 @@ def test_a_3d_recording_needs_its_up_direction_and_a_planar_one_takes_none():
         recorded_reach(_tracked_reach([0.2, 0.0, 0.0], [0.0, 0.0, 1.0], 0.0, 0.01), start, goal)
     with pytest.raises(ValueError, match="up"):
         recorded_reach(_synthetic_recording(0.0), start, goal, up=[0.0, 0.0, 1.0])
+
+
+def test_a_fingertip_that_stops_on_its_target_is_played_as_a_hand_that_comes_to_rest():
+    # a reach at 1 m/s that touches down: from full speed to rest in 20 ms (50 m/s²), then still
+    step = 0.004
+    t = np.arange(0.0, 0.5 + step / 2, step)
+    speed = np.where(t < 0.1, 0.0, np.where(t < 0.3, (t - 0.1) / 0.2, np.clip(1.0 - (t - 0.3) / 0.02, 0.0, 1.0)))
+    x = np.concatenate([[0.0], np.cumsum(0.5 * (speed[1:] + speed[:-1]) * step)])
+    position = np.column_stack([x, np.zeros_like(x)])
+    recording = Recording(name="touch", t=t, position=position, velocity=np.gradient(position, step, axis=0), onset=0.1,
+                          end_time=0.32)
+    start, goal = np.zeros(3), np.array([x[-1], 0.0, 0.0])
+    person = RecordedPerson(recording, PersonParameters(hand_path="recorded", anticipates_inertia=False), start, goal)
+    times = np.arange(0.0, person.duration, 0.001)
+    acceleration = np.array([np.linalg.norm(person.intended_motion(time)[2]) for time in times])
+    assert acceleration.max() < 0.5 * 50.0                  # the touch-down is smoothed, not played as recorded
+    _, velocity, _ = person.intended_motion(person.duration - 1e-3)
+    assert np.linalg.norm(velocity) < 0.01                 # and the hand has come to rest by the playback's end
 
 
 @pytest.mark.parametrize("sign", [1.0, -1.0])
@@ -156,7 +176,7 @@ def test_a_recorded_person_holds_the_offset_leaves_from_rest_and_stays_at_the_go
     start, goal, hold = np.array([0.31, 0.0, 0.47]), np.array([0.45, 0.15, 0.20]), np.array([0.31, 0.0, 0.48])
     parameters = PersonParameters(hand_path="recorded", anticipates_inertia=False, pace=1.3)
     person = RecordedPerson(_synthetic_recording(1.0), parameters, start, goal)
-    assert person.duration == pytest.approx(1.3 * (PLAYBACK_LEAD + 0.5))
+    assert person.duration == pytest.approx(1.3 * (PLAYBACK_LEAD + 0.5 + END_HOLD))
     person.start(hold)
     force = person.force(0.0, start, np.zeros(3))
     np.testing.assert_allclose(person.intended_position, hold, atol=1e-12)
@@ -182,7 +202,8 @@ def test_usable_recordings_of_the_development_split_map_onto_a_reach():
         t, position = recorded_reach(recording, start, goal)
         np.testing.assert_allclose(position[0], start, atol=1e-12)
         np.testing.assert_allclose(position[-1], goal, atol=1e-12)
-        assert t[-1] == pytest.approx(min(recording.onset, PLAYBACK_LEAD) + recording.movement_time)
+        step = recording.t[1] - recording.t[0]
+        assert t[-1] == pytest.approx(PLAYBACK_LEAD + recording.movement_time + END_HOLD, abs=step)
 
 
 @pytest.mark.parametrize("bad, message", [({"pace": 0.0}, "pace"), ({"pace": float("nan")}, "pace"),

@@ -2,11 +2,15 @@
 under impedance control and a simulated person, in MuJoCo. Writes a figure, one CSV per trial, a summary
 JSON and (where offscreen rendering works) a frame strip per goal. For sync, ``--policy NAME|all`` chooses
 the robot (default: the paper's one-shot estimate) and writes a table (CSV and markdown, median and IQR
-over trials) and a figure comparing the policies over the same trials and person seeds."""
+over trials) and a figure comparing the policies over the same trials and person seeds, and ``--person``
+chooses the person (default: the model's own): ``model``, ``recorded`` (a recorded mouse movement), ``arm`` (a
+recorded arm reach of examples/data/arm_reaches), or a folder of your own arm reaches in the TAT-HUM layout,
+each optionally with ``-xP`` to play it P times slower (``arm-x2.5``) or faster (``model-x0.7``)."""
 
 from __future__ import annotations
 
 import json
+from dataclasses import dataclass
 from pathlib import Path
 
 from comanip.cli.commands import command_help
@@ -28,6 +32,12 @@ def add_parser(subparsers) -> None:
                                          "minimum-jerk, one-shot (default), continuous, or all of them")
     parser.add_argument("--trigger", help="handover only: what releases the robot, goal_distance (default: the handle "
                                           "within T of the known goal) or estimate (within T of the online goal estimate)")
+    parser.add_argument("--person", help="sync only: who holds the handle, model (default: the reaching model's "
+                                         "person), recorded (a recorded mouse movement, the 'data' extra), arm (a "
+                                         "recorded arm reach of examples/data/arm_reaches) or FOLDER (your own arm "
+                                         "reaches, TAT-HUM layout); add -xP to play it P times as long, e.g. "
+                                         "arm-x2.5; the trial with seed s plays recording 37·s mod N of the N "
+                                         "that play as a reach")
     add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
@@ -38,9 +48,9 @@ def run(args) -> int:
     from comanip.simulation.report import write_summary
     from comanip.simulation.scenario_runs import run_scenario
 
-    settings_by_goal, policies = scenario_settings(args)    # every setting checked before any solver or model is built
+    choice = scenario_settings(args)    # every setting checked before any solver or model is built
     out = output_dir(args.out, "simulate", args.force)
-    result = run_scenario(args.scenario, settings_by_goal, policies)
+    result = run_scenario(args.scenario, choice.settings_by_goal, choice.policies, arm_reaches=choice.arm_reaches)
     files, strips = write_outputs(result, out, frames=not args.no_frames)
     summary = result.summary()
     summary_path = out / f"{args.scenario}_summary.json"
@@ -57,15 +67,27 @@ def run(args) -> int:
     return 0
 
 
-def scenario_settings(args) -> tuple[dict, list[str] | None]:
-    """Each goal's settings {label: settings} and the compared policies (None: the settings' own only), every
-    argument checked (one-line ValueError)."""
+@dataclass(frozen=True)
+class ScenarioChoice:
+    """What the command line chose: each goal's settings, the compared policies and the arm people's folder."""
+
+    settings_by_goal: dict
+    """{goal label: settings}."""
+    policies: list[str] | None
+    """The compared robot policies (None: the settings' own only)."""
+    arm_reaches: Path | None
+    """The TAT-HUM folder an arm person plays (None: the person is not an arm)."""
+
+
+def scenario_settings(args) -> ScenarioChoice:
+    """What the arguments choose, every argument checked (one-line ValueError)."""
     from comanip.simulation import resolve_goal, scenario
+    from comanip.simulation.people import choose_person
     from comanip.simulation.policies import POLICIES, check_policy
 
     settings_class, _ = scenario(args.scenario)
     common = {"trials": args.trials, "width": args.width, "kappa": args.kappa, "seed": args.seed, "duration": args.duration}
-    policies = None
+    policies, arm_reaches = None, None
     if args.policy is not None:
         if args.scenario != "sync":
             raise ValueError(f"--policy applies to the sync scenario only, got scenario {args.scenario!r}")
@@ -75,7 +97,13 @@ def scenario_settings(args) -> tuple[dict, list[str] | None]:
         if args.scenario != "handover":
             raise ValueError(f"--trigger applies to the handover scenario only, got scenario {args.scenario!r}")
         common["release_trigger"] = args.trigger
-    return {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in args.goal or ["near", "far"]}, policies
+    if args.person is not None:
+        if args.scenario != "sync":
+            raise ValueError(f"--person applies to the sync scenario only, got scenario {args.scenario!r}")
+        person = choose_person(args.person)
+        common["person"], arm_reaches = person.parameters, person.arm_reaches
+    settings = {_label(goal): settings_class(goal=tuple(resolve_goal(goal)), **common) for goal in args.goal or ["near", "far"]}
+    return ScenarioChoice(settings, policies, arm_reaches)
 
 
 def write_outputs(result, out: Path, frames: bool) -> tuple[list[Path], dict]:

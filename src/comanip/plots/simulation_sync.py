@@ -22,7 +22,8 @@ def _band(ax, x, values, color, label, ls="-"):
 def plot_sync(runs: dict[str, list[SyncTrial]], observation_time: float, path: str | Path, title: str = "") -> Path:
     """Save the figure for runs {goal label: trials}: top, speeds over time of the handle (the robot's end
     effector, solid), the person's intended hand (dashed) and the robot's estimated trajectory (dotted);
-    bottom, estimated trajectory minus handle per axis over t / MT (from t_o on)."""
+    bottom, the robot's last prediction of the path (the one it ended with) minus the handle per axis over t / MT
+    (from t_o on): not the goal estimate's error, which the summary reports."""
     fig = plt.figure(figsize=(12, 7.5))
     grid = fig.add_gridspec(2, 3, height_ratios=[1.1, 1.0])
     ax_speed = fig.add_subplot(grid[0, :])
@@ -48,7 +49,7 @@ def plot_sync(runs: dict[str, list[SyncTrial]], observation_time: float, path: s
     ax_speed.grid(alpha=0.3)
     for axis, ax in zip("xyz", ax_error):
         ax.axhline(0.0, color="k", lw=0.6)
-        ax.set(xlabel="t / MT", ylabel=f"{axis} error (mm)", title=f"estimated − actual, {axis}")
+        ax.set(xlabel="t / MT", ylabel=f"{axis} error (mm)", title=f"the last prediction's path − the handle, {axis}")
         ax.grid(alpha=0.3)
     ax_error[0].legend(fontsize=8)
     return save_figure(fig, path, title or "co-manipulation synchronisation (simulated)")

@@ -4,18 +4,28 @@ A recording (:class:`comanip.recordings.Recording`: positions p(t), m, on a scre
 tracker's space (d = 3)) is mapped onto the scenario's reach from the handle's start x_0 (3,) to the goal g
 (3,), both m:
 
-    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2 + v(t) e_3),   0 ≤ t ≤ lead + MT_rec
+    x_path(t) = x_0 + (D_reach / D_rec) (u(t) e_1 + w(t) e_2 + v(t) e_3),   0 ≤ t ≤ lead + MT_rec + END_HOLD
 
 with u(t), w(t), v(t) the recorded displacement p(t_0 + t) - p(t_0) along the recorded chord c = p_end - p(t_0),
 across it horizontally (along up × c) and across it upward (along c × (up × c)), with up the recording's
 upward direction (a planar recording lies flat: up = its plane's normal, v = 0); D_rec = |c|;
-t_0 = onset - lead (:data:`PLAYBACK_LEAD`: the playback begins with the hand at rest shortly before the
-recorded onset, so the intention leaves from rest as a person's does). On the scenario's side e_1 =
+t_0 = onset - lead (:data:`PLAYBACK_LEAD`: the playback begins with the hand at rest shortly before the recorded
+onset, so the intention leaves from rest as a person's does). On the scenario's side e_1 =
 (g - x_0) / D_reach is the reach's direction (z included: the recording's progress carries the reach's height
 change), e_2 = z × e_1 (normalised) the horizontal unit vector across it and e_3 = e_1 × e_2, D_reach =
 |g - x_0|. So the path starts at x_0, ends at g, keeps the recording's timing, speed profile and deviations
 from its chord (scaled, sideways ones horizontal, upward ones upward), and a planar recording's x–y
 direction is turned onto the scenario's.
+
+The recorded positions p(t) are first low-passed (:data:`SMOOTHING_HZ`, zero phase, the hand held where it is at
+the onset before it, and at its last sample for :data:`END_HOLD` after the recording's end, which the playback
+includes: 0 ≤ t ≤ lead + MT_rec + END_HOLD). A zero-phase low-pass anticipates the reach's start (by 1.5 cm/s 50 ms
+before the onset of a fast reach); over the lead, the path's displacement from where it rests is faded in
+(times 10 s³ - 15 s⁴ + 6 s⁵, s from 0 to 1 over the lead), so that it leaves from rest at t = 0 and is the
+low-passed recording from the onset on. A pointing fingertip stops on its target by touching it, decelerating within a few tens of ms, and a
+tracker adds noise; a person guiding a handle does neither, and through the feedforward M_load xddot_d below
+both would become the person's force (a 16 kg handle decelerated at 5 m/s² is 80 N). The low-pass keeps the
+reach itself, whose speed profile lies below about 3 Hz.
 
 A 3-D recording's upward direction is that of the surface its reaches start and end on
 (:func:`surface_normal`): the normal of the plane through the starts and ends of a set of recordings,
@@ -34,14 +44,16 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.interpolate import make_interp_spline
+from scipy.signal import butter, sosfiltfilt
 
 from comanip.arguments import as_matrix, as_vector
 from comanip.recordings.recording import Recording
 from comanip.simulation.person import PersonParameters
 
 PLAYBACK_LEAD = 0.05
-"""Time (s) before the recorded onset at which the playback (the trial's t = 0) starts: the hand is at rest there
-(the onset is where the speed last was below 2.5 % of its peak; a mouse sends no samples while still)."""
+"""Time (s, the recording's own) before the recorded onset at which the playback (the trial's t = 0) starts: the
+hand rests there (the onset is where the speed last was below 2.5 % of its peak; a mouse sends no samples while
+still)."""
 MAX_ONSET_SPEED = 0.1
 """A recording usable as a reach starts from rest: it has PLAYBACK_LEAD of samples before its onset, and its
 speed at the onset is at most this fraction of its peak."""
@@ -51,6 +63,12 @@ MIN_DISTANCE = 0.1
 """... it spans at least this distance (m), so that scaling it to a reach does not magnify its sampling noise."""
 MAX_MOVEMENT_TIME = 2.0
 """... and it lasts at most this long (s)."""
+SMOOTHING_HZ = 6.0
+"""Cut-off (Hz, in the recording's own time) of the low-pass the recorded positions pass through before they are
+played (second-order Butterworth run forward and backward: zero phase; module docstring)."""
+END_HOLD = 0.15
+"""Time (s, the recording's own) the recorded hand is held at its last sample after the recording's end, and played:
+the low-passed path comes to rest within it (to 0.1 % of the step it smooths, at SMOOTHING_HZ, in 0.12 s)."""
 RECORDING_STRIDE = 37
 """Trial seed k plays usable recording (k · stride) mod N of the development split, N usable recordings: a
 stride spreads consecutive seeds over the file (whose movements come in runs by person)."""
@@ -72,8 +90,8 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
 
     up: the recording's upward direction (3,), for a 3-D recording (:func:`surface_normal`); a planar one lies
     flat and takes none. Returns (t (K,) s from the playback's start, positions (K, 3) m): t[0] = 0 at start,
-    t[-1] = PLAYBACK_LEAD + MT_rec at goal (the recording's onset at PLAYBACK_LEAD, or at 0 when it has no
-    samples that early).
+    t[-1] = PLAYBACK_LEAD + MT_rec + END_HOLD at goal (the recording's onset at PLAYBACK_LEAD), to within a sample
+    step.
     """
     start, goal = as_vector("start", start, 3, "m"), as_vector("goal", goal, 3, "m")
     d = recording.position.shape[1]
@@ -91,9 +109,9 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
     distance = float(np.linalg.norm(reach))
     if distance == 0:
         raise ValueError("a recorded reach needs a start away from its goal")
-    first = max(recording.onset - PLAYBACK_LEAD, float(recording.t[0]))
-    keep = (recording.t >= first - 1e-9) & (recording.t <= recording.end_time + 1e-9)
-    t, recorded = recording.t[keep] - first, np.pad(recording.position[keep], ((0, 0), (0, 3 - d)))
+    times, smoothed = _low_passed(recording)
+    t = times - times[0]
+    recorded = np.pad(smoothed, ((0, 0), (0, 3 - d)))
     length = float(np.linalg.norm(recorded[-1] - recorded[0]))
     if length == 0:
         raise ValueError(f"recording {recording.name!r} ends where it starts")
@@ -102,6 +120,21 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
     position = start + (distance / length) * components @ _chord_frame(reach, np.array([0.0, 0.0, 1.0]))
     position[-1] = goal   # equal up to rounding
     return t, position
+
+
+def _low_passed(recording: Recording) -> tuple[np.ndarray, np.ndarray]:
+    """The recording's samples from its onset to its end, after :data:`PLAYBACK_LEAD` of the onset's held before and
+    followed by :data:`END_HOLD` of the last one held (times (K,) s on the recording's clock), low-passed at
+    :data:`SMOOTHING_HZ` and faded in from rest over the lead (positions (K, d) m; module docstring)."""
+    moving = (recording.t >= recording.onset - 1e-9) & (recording.t <= recording.end_time + 1e-9)
+    t, position = recording.t[moving], recording.position[moving]
+    step = float(np.median(np.diff(recording.t)))
+    before, after = int(np.ceil(PLAYBACK_LEAD / step - 1e-9)), int(np.ceil(END_HOLD / step - 1e-9))
+    t = np.r_[t[0] - step * np.arange(before, 0, -1), t, t[-1] + step * np.arange(1, after + 1)]
+    position = np.vstack([np.repeat(position[:1], before, axis=0), position, np.repeat(position[-1:], after, axis=0)])
+    smoothed = sosfiltfilt(butter(2, SMOOTHING_HZ, fs=1.0 / step, output="sos"), position, axis=0)
+    s = np.clip(np.arange(len(t)) / before, 0.0, 1.0)[:, None]
+    return t, position[0] + (smoothed - position[0]) * (10 * s**3 - 15 * s**4 + 6 * s**5)
 
 
 def _chord_frame(chord: np.ndarray, up: np.ndarray) -> np.ndarray:
@@ -145,7 +178,7 @@ class RecordedPerson:
         self.goal = as_vector("goal", goal, 3, "m")
         t, position = recorded_reach(recording, start, goal, up)
         self.duration = float(t[-1] * parameters.pace)
-        """The path's duration (s): the playback's (lead and movement time) times the pace."""
+        """The path's duration (s): the playback's (lead, movement time and END_HOLD) times the pace."""
         rest = [(1, np.zeros(3)), (2, np.zeros(3))]
         self._path = make_interp_spline(t * parameters.pace, position - position[0], k=5, bc_type=(rest, rest))
         self._load_inertia = np.zeros((3, 3))

@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from comanip.simulation.handover_scenario import HandoverRun, HandoverSettings, HandoverTrial, run_handover
 from comanip.simulation.policies import check_policy
@@ -100,10 +101,12 @@ class ScenarioResult:
 
 
 def run_scenario(name: str, settings_by_goal: dict[str, ScenarioSettings], policies: list[str] | None = None,
-                 progress: bool = True) -> ScenarioResult:
+                 progress: bool = True, arm_reaches: str | Path | None = None) -> ScenarioResult:
     """Run scenario ``name`` on each goal's settings (labels as given) with one shared setup; ``policies``
     (sync only; names of :data:`comanip.simulation.policies.POLICIES`) runs each of them over the same trials
-    and person seeds, the settings' own policy being one of them. Progress bars unless progress=False."""
+    and person seeds, the settings' own policy being one of them. Progress bars unless progress=False.
+    arm_reaches: the TAT-HUM folder the setup's arm people play (:class:`ScenarioSetup`; a person chosen by name
+    says which, :func:`comanip.simulation.people.choose_person`)."""
     scenario(name)
     if not settings_by_goal:
         raise ValueError("settings_by_goal must name at least one goal")
@@ -111,7 +114,7 @@ def run_scenario(name: str, settings_by_goal: dict[str, ScenarioSettings], polic
         if name != "sync":
             raise ValueError(f"policies apply to the sync scenario only, got scenario {name!r}")
         policies = [check_policy(policy) for policy in policies]
-    setup = ScenarioSetup(next(iter(settings_by_goal.values())))
+    setup = ScenarioSetup(next(iter(settings_by_goal.values())), arm_reaches=arm_reaches)
     goals = {}
     for label, settings in settings_by_goal.items():
         begin = time.perf_counter()

@@ -101,7 +101,11 @@ class ScenarioSetup:
         from comanip.recordings import load_tathum
 
         recordings = [trial.recording() for trial in load_tathum(self.arm_reaches)]
-        return [recording for recording in recordings if usable_for_reach(recording)]
+        usable = [recording for recording in recordings if usable_for_reach(recording)]
+        if not usable:
+            raise ValueError(f"none of the {len(recordings)} arm reaches in {str(self.arm_reaches)!r} plays as a reach "
+                             f"(usable_for_reach: from rest, fairly straight, at least 0.1 m, at most 2 s)")
+        return usable
 
     @cached_property
     def arm_up(self) -> np.ndarray:
