@@ -42,8 +42,6 @@ from typing import NamedTuple
 
 import numpy as np
 
-from scipy.interpolate import CubicSpline
-
 from comanip.estimation.reach_family import ReachFamily
 from comanip.estimation.reach_timing import movement_span
 
@@ -86,10 +84,11 @@ class HandForecast:
 
     d: int
     """Task dimensions d (the first block of the state is the hand's position)."""
-    continuation: CubicSpline
-    """The model's continuation alone (steps 1–2 of the module docstring): a C² cubic spline of position (m) over
-    time (s) through its grid positions (the model's Euler step moves x_i with v_i over a whole step, so no
-    smooth curve honours the grid velocities too; step 3 makes the forecast's velocity the hand's)."""
+    continuation: np.ndarray
+    """The model's continuation alone (steps 1–2 of the module docstring) at the grid times: positions and the
+    slopes of the cubic Hermite curve through them, (K+1, 2d) m and m/s, each slope that of the chord across its
+    neighbours (:func:`_chord_slopes`; the model's Euler step moves x_i with v_i over a whole step, so no smooth curve honours the grid
+    velocities too; step 3 makes the forecast's velocity the hand's)."""
     velocity_rest: np.ndarray
     """dv (d,), m/s: the hand's velocity beyond the continuation's (step 3)."""
     acceleration_rest: np.ndarray
@@ -106,7 +105,7 @@ class HandForecast:
         return self.mean[:, self.d:2 * self.d]
 
     def at(self, times) -> ForecastPoint:
-        """The forecast at ``times`` (M,) s (a number: M = 1): the continuation's spline, the rest of the hand's velocity and acceleration in closed form, the
+        """The forecast at ``times`` (M,) s (a number: M = 1): the continuation's Hermite curve, the rest of the hand's velocity and acceleration in closed form, the
         covariance linearly between grid times. Before t_now it is the hand now; after the stop, at rest on it."""
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1 or not np.all(np.isfinite(times)):
@@ -114,13 +113,39 @@ class HandForecast:
         d, t = self.d, self.t
         clipped = np.clip(times, t[0], t[-1])
         k = np.clip(np.searchsorted(t, clipped, side="right") - 1, 0, len(t) - 2)
+        position, velocity = _hermite(t, self.continuation[:, :d], self.continuation[:, d:], clipped, k)
         s = ((clipped - t[k]) / (t[k + 1] - t[k]))[:, None]
-        position, velocity = self.continuation(clipped), self.continuation(clipped, 1)
         velocity[times >= t[-1]] = 0.0
         rest_position, rest_velocity = _rest_terms(clipped - t[0], t[-1] - t[0], self.velocity_rest, self.acceleration_rest)
         weight = s[:, :, None]
         covariance = (1 - weight) * self.cov[k, :d, :d] + weight * self.cov[k + 1, :d, :d]
         return ForecastPoint(times, position + rest_position, velocity + rest_velocity, covariance)
+
+
+def _hermite(t: np.ndarray, x: np.ndarray, m: np.ndarray, times: np.ndarray, k: np.ndarray):
+    """Position and velocity (M, d) at ``times`` (M,) s, in intervals ``k`` (M,), of the cubic Hermite curve through
+    positions x (K+1, d) m with slopes m (K+1, d) m/s at times t (K+1,) s."""
+    dt = (t[k + 1] - t[k])[:, None]
+    s = (times[:, None] - t[k, None]) / dt
+    h00, h10, h01, h11 = 2 * s**3 - 3 * s**2 + 1, s**3 - 2 * s**2 + s, -2 * s**3 + 3 * s**2, s**3 - s**2
+    position = h00 * x[k] + h10 * dt * m[k] + h01 * x[k + 1] + h11 * dt * m[k + 1]
+    d00, d10, d01, d11 = 6 * s**2 - 6 * s, 3 * s**2 - 4 * s + 1, -6 * s**2 + 6 * s, 3 * s**2 - 2 * s
+    velocity = (d00 * x[k] + d01 * x[k + 1]) / dt + d10 * m[k] + d11 * m[k + 1]
+    return position, velocity
+
+
+def _chord_slopes(t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Slopes (K+1, d) of positions x (K+1, d) at times t (K+1,): the chord across the neighbours; at each end,
+    the slope of the parabola through the end interval with its inner slope (so the end interval bends as its
+    neighbour does). Two points: the chord."""
+    chord = (x[1:] - x[:-1]) / (t[1:] - t[:-1])[:, None]
+    if len(t) == 2:
+        return np.vstack([chord, chord])
+    slopes = np.empty_like(x)
+    slopes[1:-1] = (x[2:] - x[:-2]) / (t[2:] - t[:-2])[:, None]
+    slopes[0] = 2 * chord[0] - slopes[1]
+    slopes[-1] = 2 * chord[-1] - slopes[-2]
+    return slopes
 
 
 def _rest_terms(sigma: np.ndarray, remaining: float, dv: np.ndarray, da: np.ndarray):
@@ -165,11 +190,12 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
 
     # 2. the continuation: the member from its phase on, on the model's grid, turned, scaled and played at p
     steps = tau[(tau > phase + 0.25 * h) & (tau <= end)]           # no sliver of a first step
-    model_times = np.r_[phase, steps]
+    model_times = np.concatenate(([phase], steps))
     tail = np.array([np.interp(model_times, tau, along[:, b]) for b in range(blocks)]).T     # (K+1, blocks)
     left_now = max(a[last] - tail[0, 0], 1e-12)
     scale = r / left_now
-    block_scale = scale * np.r_[1.0, 1.0 / pace, [pace ** -2] * (blocks - 2)]
+    per_block = np.array([1.0, 1.0 / pace] + [pace ** -2] * (blocks - 2))
+    block_scale = scale * per_block
     shifted = tail.copy()
     shifted[:, 0] -= tail[0, 0]
     shifted *= block_scale
@@ -179,23 +205,27 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
 
     # 3. the rest of the velocity and acceleration, gone by the stop
     if len(t) == 1:                          # a hand at or past the stop: the continuation holds still
-        t, mean = np.r_[t, t[0] + remaining], np.vstack([mean, mean])
+        t, mean = np.array([t[0], t[0] + remaining]), np.vstack([mean, mean])
         mean[1, n:] = 0.0
-    continuation = CubicSpline(t, mean[:, :n])
-    dv = velocity - continuation(t_now, 1)
-    da = np.zeros(n) if acceleration is None else acceleration - (continuation(t_now, 2) - 4 * dv / remaining)
+    slopes = _chord_slopes(t, mean[:, :n])
+    continuation = np.hstack([mean[:, :n], slopes])
+    dv = velocity - slopes[0]
+    dt = t[1] - t[0]                          # the continuation's acceleration now, on its Hermite curve
+    start_acceleration = 6 * (mean[1, :n] - mean[0, :n]) / dt**2 - (4 * slopes[0] + 2 * slopes[1]) / dt
+    da = np.zeros(n) if acceleration is None else acceleration - (start_acceleration - 4 * dv / remaining)
     rest_position, rest_velocity = _rest_terms(t - t_now, remaining, dv, da)
-    mean[:, n:2 * n] = continuation(t, 1) + rest_velocity
+    mean[:, n:2 * n] = slopes + rest_velocity
     mean[:, :n] += rest_position
 
     # 4. the covariance: the motor noise still to come, and the goal's uncertainty along the way
     k0 = int(min(round(phase / h), H))
-    member_cov = _member_covariance(family, max(D, r, 1e-9))
+    member_cov = family.member_covariance(max(D, r, 1e-9))
     frame = family.frame(u)
     cov = np.zeros((len(t), nx, nx))
     propagated = member_cov[k0]
-    grid_steps = np.r_[k0, np.round(steps / h).astype(int)]
-    grid_steps = np.r_[grid_steps, [grid_steps[-1]] * (len(t) - len(grid_steps))].astype(int)
+    grid_steps = np.round(model_times / h).astype(int)
+    grid_steps[0] = k0
+    grid_steps = np.concatenate((grid_steps, [grid_steps[-1]] * (len(t) - len(grid_steps)))).astype(int)
     previous = k0
     for i, j in enumerate(grid_steps):
         for _ in range(j - previous):
@@ -203,7 +233,7 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
         previous = j
         cov[i] = member_cov[j] - propagated
     cov = 0.5 * (cov + cov.transpose(0, 2, 1))
-    scales = np.repeat(np.r_[1.0, 1.0 / pace, [pace ** -2] * (blocks - 2)], n) * scale
+    scales = np.repeat(block_scale, n)
     cov = frame @ (cov * np.outer(scales, scales)) @ frame.T
     covered = np.clip(((mean[:, :n] - position) @ u) / max(r, 1e-12), 0.0, None)
     cov[:, :n, :n] += covered[:, None, None] ** 2 * goal_covariance
@@ -223,8 +253,3 @@ def _phase(tau: np.ndarray, phi: np.ndarray, hand_phi: float, guess: float) -> f
     w = (hand_phi - phi[crossings]) / (phi[crossings + 1] - phi[crossings])
     found = tau[crossings] + w * (tau[crossings + 1] - tau[crossings])
     return float(found[int(np.argmin(np.abs(found - guess)))])
-
-
-def _member_covariance(family: ReachFamily, distance: float) -> np.ndarray:
-    """Sigma_i (H+1, nx, nx) of the family's member at ``distance`` (m), in its own frame."""
-    return family.prediction(np.zeros(family.model.d), np.r_[distance, np.zeros(family.model.d - 1)], order=0).cov

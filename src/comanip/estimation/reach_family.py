@@ -207,6 +207,14 @@ class ReachFamily:
         c = self._path.c[:, k, :size]
         return (((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]).reshape(len(distances), self.H + 1, self.blocks)
 
+    def member_covariance(self, distance: float) -> np.ndarray:
+        """Sigma_i (H+1, nx, nx) of the plan to ``distance`` (m, within the range) along e_1, in that frame."""
+        x = math.log(min(max(distance, self._low), self._high))
+        k = min(max(bisect.bisect_left(self._knots, x) - 1, 0), len(self._knots) - 2)
+        dx = x - self._knots[k]
+        c = self._cov.c[:, k]
+        return (((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]).reshape(self.H + 1, self.nx, self.nx)
+
     def frame(self, u: np.ndarray) -> np.ndarray:
         """T (nx, nx): the orthogonal map Q (Q e_1 = u) applied to every state block."""
         Q, n = reflection_onto(u), self.n
@@ -236,9 +244,8 @@ class ReachFamily:
         mean[:, :n] += start_position
         cov = None
         if covariance:
-            cc = self._cov.c[:, k]
             T = self.frame(u)
-            cov = T @ (((cc[0] * dx + cc[1]) * dx + cc[2]) * dx + cc[3]).reshape(H + 1, self.nx, self.nx) @ T.T
+            cov = T @ self.member_covariance(D) @ T.T
         jacobian = curvature = mixed = None
         if order >= 1:
             radial = u[:, None] * u
