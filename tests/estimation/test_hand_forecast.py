@@ -3,6 +3,8 @@ model's own reach where the hand moves like the model, with the model's belief o
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import comanip
 from comanip.belief import sample_trajectories
@@ -131,3 +133,21 @@ def test_recent_acceleration_is_the_slope_of_the_last_velocities():
     t = np.arange(20) * 0.008
     velocity = np.column_stack([1.0 + 5.0 * t, -2.0 * t])
     np.testing.assert_allclose(path_baselines.recent_acceleration(t, velocity), [5.0, -2.0])
+
+
+@settings(max_examples=60)
+@given(st.lists(st.floats(-0.4, 0.4), min_size=3, max_size=3), st.lists(st.floats(-3.0, 3.0), min_size=3, max_size=3),
+       st.lists(st.floats(-40.0, 40.0), min_size=3, max_size=3), st.floats(-0.3, 0.8), st.floats(0.0, 1.0))
+def test_any_hand_state_gives_a_bounded_forecast_that_ends_on_the_goal(arm, position, velocity, acceleration, stop_in, t_now):
+    """Wherever the hand is and however it moves, the forecast stays near the line to the goal, within what its
+    velocity and acceleration can carry it in the time left, and stops on the goal."""
+    _, family, transition, goal, _ = arm
+    x, v, a = np.array(position), np.array(velocity), np.array(acceleration)
+    forecast = continued_reach(family, transition, np.zeros(3), t_now, x, v, goal, 1e-4 * np.eye(3), t_now + stop_in, a)
+    R = max(forecast.stop_time - t_now, 0.02)
+    path = forecast.at(t_now + np.linspace(0.0, R + 0.1, 40))
+    assert np.all(np.isfinite(path.position)) and np.all(np.isfinite(path.covariance))
+    reach = np.linalg.norm(goal - x) + np.linalg.norm(v) * R + np.linalg.norm(a) * R**2
+    assert np.linalg.norm(path.position - x, axis=1).max() <= 2 * reach + 1e-9
+    np.testing.assert_allclose(path.position[-1], goal, atol=1e-9)
+    assert np.all(np.linalg.eigvalsh(path.covariance) >= -1e-12)

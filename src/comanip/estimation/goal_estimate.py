@@ -11,6 +11,7 @@ from comanip.planning.plan import Plan
 
 if TYPE_CHECKING:
     from comanip.estimation.hand_forecast import HandForecast
+    from comanip.estimation.reach_timing import TimedPlan
 
 
 @dataclass
@@ -52,6 +53,9 @@ class GoalEstimate(Plan):
     velocity and covariance at any time t). The estimate's plan fields (``t``, ``mean``, ``ee_mean``, ``ee_cov``,
     ``ee_velocity``) are its grid, from t_obs on; before the first observation (None) they are the model's reach
     from the start."""
+    timed_reach: "TimedPlan | None" = None
+    """'online': the model's whole reach from the start to g_hat, played at the estimate's timing
+    (:func:`~comanip.estimation.reach_timing.timed_plan`): what the forecast continues from the hand."""
     plan_status: str | None = None
     """For an 'uninformative' estimate (observation at step 0): the status of the plan to the prior goal."""
 
@@ -71,6 +75,7 @@ class GoalEstimate(Plan):
         """JSON-ready dictionary (arrays as nested lists); the forecast as its stop, pace and phase (its grid is
         the plan fields')."""
         out = super().to_dict()
+        out.pop("timed_reach", None)
         if self.forecast is not None:
             out["forecast"] = {"stop_time_s": self.forecast.stop_time, "pace": self.forecast.pace,
                                "phase_s": self.forecast.phase}

@@ -45,6 +45,8 @@ import numpy as np
 from comanip.estimation.reach_family import ReachFamily
 from comanip.estimation.reach_timing import movement_span
 
+LAST_SHARE = 0.05
+"""The phase is read where at least this share of the model's reach is still to go."""
 SHORTEST_REMAINING_S = 0.02
 """Time to the stop (s) a forecast gives at least: a hand seen after its estimated stop still has to stop."""
 
@@ -163,7 +165,8 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     """The forecast (module docstring) of the hand at ``position`` (d,) m and ``velocity`` (d,) m/s at ``t_now``
     (s), heading for ``goal`` (d,) m with covariance ``goal_covariance`` (d, d) m², in a reach that started at
     rest at ``reach_start`` (d,) m and stops at ``stop_time`` (s; None: where the model's own reach from t = 0
-    does), accelerating at ``acceleration`` (d,) m/s² now (None: as the model's reach does at its phase).
+    does), accelerating at ``acceleration`` (d,) m/s² now (None, or an entry NaN: as the model's reach does at
+    its phase).
     ``transition`` is the model's one-step state map A (nx, nx)."""
     model = family.model
     n, nx, H, h = family.n, family.nx, family.H, model.h
@@ -183,16 +186,19 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     towards = float(velocity @ u)
 
     # 1. the phase: phi(tau) over the moving part, read where it equals the hand's
-    left = max(D, r) - a[first:last]
-    phi = speed[first:last] * (end - tau[first:last]) / np.maximum(left, 1e-12)
-    phase = _phase(tau[first:last], phi, towards * remaining / max(r, 1e-12), end - remaining)
+    # phases with at least LAST_SHARE of the reach still to go: nearer the end the distance left is too small to
+    # scale onto the hand's (the rest of its velocity goes to step 3)
+    usable = first + max(int(np.count_nonzero(a[last] - a[first:last] >= LAST_SHARE * (a[last] - a[first]))), 1)
+    left = max(D, r) - a[first:usable]
+    phi = speed[first:usable] * (end - tau[first:usable]) / np.maximum(left, 1e-12)
+    phase = _phase(tau[first:usable], phi, towards * remaining / max(r, 1e-12), end - remaining)
     pace = remaining / max(end - phase, h)
 
     # 2. the continuation: the member from its phase on, on the model's grid, turned, scaled and played at p
     steps = tau[(tau > phase + 0.25 * h) & (tau <= end)]           # no sliver of a first step
     model_times = np.concatenate(([phase], steps))
     tail = np.array([np.interp(model_times, tau, along[:, b]) for b in range(blocks)]).T     # (K+1, blocks)
-    left_now = max(a[last] - tail[0, 0], 1e-12)
+    left_now = max(a[last] - tail[0, 0], LAST_SHARE * (a[last] - a[first]), 1e-12)
     scale = r / left_now
     per_block = np.array([1.0, 1.0 / pace] + [pace ** -2] * (blocks - 2))
     block_scale = scale * per_block
@@ -212,7 +218,7 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
     dv = velocity - slopes[0]
     dt = t[1] - t[0]                          # the continuation's acceleration now, on its Hermite curve
     start_acceleration = 6 * (mean[1, :n] - mean[0, :n]) / dt**2 - (4 * slopes[0] + 2 * slopes[1]) / dt
-    da = np.zeros(n) if acceleration is None else acceleration - (start_acceleration - 4 * dv / remaining)
+    da = np.zeros(n) if acceleration is None else np.nan_to_num(acceleration - (start_acceleration - 4 * dv / remaining))
     rest_position, rest_velocity = _rest_terms(t - t_now, remaining, dv, da)
     mean[:, n:2 * n] = slopes + rest_velocity
     mean[:, :n] += rest_position

@@ -234,6 +234,13 @@ class OnlineGoalEstimator:
         return self._result(Explained(self.prior_mean, self.prior_cov, True, EstimateStatus.UNINFORMATIVE,
                                       "the estimate is the prior"), t_begin, reasons)
 
+    def _person_acceleration(self) -> np.ndarray:
+        """The hand's acceleration (d,) m/s² from its last velocities, NaN on the axes a robot leads
+        (``options.led_axes``: their motion is the robot's, which the forecast must not feed back)."""
+        acceleration = recent_acceleration(self._hand.t, self._hand.velocity)
+        acceleration[list(self.options.led_axes)] = np.nan
+        return acceleration
+
     def _result(self, explained: Explained, t_begin: float, reasons: Sequence[str] = ()) -> GoalEstimate:
         """The estimate of ``explained``, with the model's predicted reach to its goal; its message follows
         why the explanations asked before it did not explain the hand."""
@@ -251,7 +258,7 @@ class OnlineGoalEstimator:
             stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
             forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
                                        observed[n:], np.asarray(goal, dtype=float), covariance, stop,
-                                       recent_acceleration(self._hand.t, self._hand.velocity))
+                                       self._person_acceleration())
             t, mean, cov = forecast.t, forecast.mean, forecast.cov
             torque = np.zeros((len(t) - 1, n))
         plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),
@@ -261,4 +268,4 @@ class OnlineGoalEstimator:
                     goal=np.array(goal, dtype=float), width=self.width, model_name=model.name)
         return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=before, observed_state=observed,
                                observation_residual=predicted - observed, prior_goal=self.prior_goal, method="online",
-                               goal_covariance=covariance, forecast=forecast)
+                               goal_covariance=covariance, forecast=forecast, timed_reach=timed)

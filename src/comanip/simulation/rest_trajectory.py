@@ -38,10 +38,23 @@ class RestTrajectory:
     def from_plan(cls, plan: Plan, time_offset: float, dt: float, duration: float) -> "RestTrajectory":
         """A plan in task space (d = 3) as the rest motion: the plan at t - time_offset for real time t (s),
         sampled every dt (s) over duration (s) from time_offset on."""
-        spline = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
+        return cls._through(plan.t, plan.ee_mean, plan.ee_velocity[0], plan.ee_velocity[-1], time_offset, dt, duration)
+
+    @classmethod
+    def from_timed_reach(cls, reach, dt: float, duration: float) -> "RestTrajectory":
+        """A point mass's reach played at a person's timing (a
+        :class:`~comanip.estimation.reach_timing.TimedPlan` of a 3-D point mass, on the estimator's clock) as the
+        rest motion, as :meth:`from_plan` plays a plan from time 0."""
+        return cls._through(reach.t, reach.mean[:, :3], reach.mean[0, 3:6], reach.mean[-1, 3:6], 0.0, dt, duration)
+
+    @classmethod
+    def _through(cls, t, position, first_velocity, last_velocity, time_offset: float, dt: float, duration: float):
+        """The C² spline through positions (K, d) m at times t (K,) s, leaving and arriving with the given
+        velocities (d,) m/s, sampled every dt over duration from time_offset on (module docstring)."""
+        spline = CubicSpline(t, position, bc_type=((1, first_velocity), (1, last_velocity)))
         tau = np.arange(int(np.ceil(duration / dt)) + 2) * dt
-        inside = np.clip(tau, plan.t[0], plan.t[-1])
-        velocity = np.where(((tau >= plan.t[0]) & (tau <= plan.t[-1]))[:, None], spline(inside, 1), 0.0)
+        inside = np.clip(tau, t[0], t[-1])
+        velocity = np.where(((tau >= t[0]) & (tau <= t[-1]))[:, None], spline(inside, 1), 0.0)
         return cls(spline(inside), velocity, time_offset, dt)
 
     def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:

@@ -1,7 +1,9 @@
 """(e) comanip's continuous estimate: the robot feeds every observation of the handle, one every
 ``update_interval`` from the start of the reach, to an :class:`comanip.estimation.OnlineGoalEstimator`
-(warm-started from its previous estimate) and, from t_o on, leads along the latest estimate's predicted
-reach, replanned at every update."""
+(warm-started from its previous estimate) and, from t_o on, leads along the model's whole reach to the latest
+estimate's goal at the estimate's timing (``estimate.timed_reach``), replanned at every update. Not along the
+estimate's forecast of the hand: that starts at the handle, which the robot itself moves on the axes it leads,
+so leading along it feeds the robot's own motion back into its lead."""
 
 from __future__ import annotations
 
@@ -73,9 +75,9 @@ class ContinuousPolicy:
             self._next_observation += self.update_interval
 
     def predict(self, t: float) -> Prediction | None:
-        """The latest estimate's goal and predicted reach; None (do not lead yet) before the first observation,
+        """The latest estimate's goal and the model's reach to it at its timing; None (do not lead yet) before the first observation,
         e.g. when update_interval is longer than t_o."""
         c, estimate = self.context, self.estimator.latest
         if estimate is None:
             return None
-        return Prediction(np.array(estimate.goal), RestTrajectory.from_plan(estimate, 0.0, c.dt, c.duration), estimate)
+        return Prediction(np.array(estimate.goal), RestTrajectory.from_timed_reach(estimate.timed_reach, c.dt, c.duration), estimate)
