@@ -73,9 +73,10 @@ class GoalEstimate(Plan):
 
     def to_dict(self) -> dict:
         """JSON-ready dictionary (arrays as nested lists); the forecast as its stop, pace and phase (its grid is
-        the plan fields')."""
+        the plan fields'), the timed reach as its times and mean states."""
         out = super().to_dict()
-        out.pop("timed_reach", None)
+        if self.timed_reach is not None:
+            out["timed_reach"] = {"t": self.timed_reach.t.tolist(), "mean": self.timed_reach.mean.tolist()}
         if self.forecast is not None:
             out["forecast"] = {"stop_time_s": self.forecast.stop_time, "pace": self.forecast.pace,
                                "phase_s": self.forecast.phase}
