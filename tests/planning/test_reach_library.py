@@ -6,7 +6,7 @@ import pytest
 
 import comanip
 from comanip.planning.reach_parameters import ReachParameters
-from comanip.planning.planner import SolverOptions
+from comanip.planning.solver_options import SolverOptions
 from comanip.planning.starts.reach_library import is_symmetric, reflection_onto
 
 RELATIVE = 1e-6

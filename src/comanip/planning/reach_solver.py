@@ -19,11 +19,11 @@ from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.single_thread_blas import SingleThreadBlas
+from comanip.planning.solver_options import SolverOptions
 from comanip.planning.terms import Curvature
 
 if TYPE_CHECKING:
     from comanip.planning.goal_sensitivity import GoalSensitivity
-    from comanip.planning.planner import SolverOptions
 
 
 class Rank(NamedTuple):
