@@ -54,7 +54,7 @@ from comanip.planning.terms import Curvature
 
 WITNESS_STEPS = 3
 """Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
-full inverse kinematics (:meth:`Planner._goal_joints`); how close each step lands:
+full inverse kinematics (:meth:`Planner.goal_joints`); how close each step lands:
 studies/how_many_steps_does_the_arm_reachability_witness_need/."""
 
 
@@ -126,7 +126,7 @@ class Planner:
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
         params = ReachParameters(start, goal, width)
-        goal_q = None if self.model.body.is_linear else self._goal_joints(start, goal, width, warm_start)
+        goal_q = None if self.model.body.is_linear else self.goal_joints(start, goal, width, self._final_position(warm_start))
         unreachable = self._unreachable_plan(params, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
@@ -138,32 +138,43 @@ class Planner:
         self.solver.count_solving_time(plan.solve_time)
         return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
 
-    def _goal_joints(self, start, goal, width, warm_start) -> np.ndarray:
-        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w of the
-        goal if any does (the reachability witness of :meth:`_unreachable_plan`).
+    def goal_joints(self, start, goal, width: float, near: np.ndarray | None = None) -> np.ndarray:
+        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w (m) of
+        the goal (d,) if any does: the reachability witness of a solve.
 
-        A cold solve: the inverse kinematics from the start (its guesses reach for it). A warm start from a plan:
-        ``WITNESS_STEPS`` damped least-squares steps (clipped to the limits) from the plan's final mean position,
-        far cheaper, when they bring the hand within w of the goal (a warm
-        solve to a goal moved by a few cm: they do), else the inverse kinematics from that position."""
-        model, body = self.model, self.model.body
-        if not (isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size)):
-            return body.inverse_kinematics(goal, start[: model.n])
-        final = warm_start.mean[-1, : model.n]
-        near = body.clip_to_limits(body.least_squares_inverse_kinematics(goal, final, WITNESS_STEPS))
-        return near if _distance(body, near, goal) <= width else body.inverse_kinematics(goal, final)
+        Without ``near``: the inverse kinematics from the start (nx,) (a cold solve's guesses reach for it). With a
+        joint position ``near`` (n,), e.g. the final mean position of a plan to a nearby goal: ``WITNESS_STEPS``
+        damped least-squares steps from it (clipped to the limits), far cheaper, when they bring the hand within w of
+        the goal (a goal moved by a few cm: they do), else the inverse kinematics from ``near``."""
+        body = self.model.body
+        if near is None:
+            return body.inverse_kinematics(goal, start[: self.model.n])
+        witness = body.clip_to_limits(body.least_squares_inverse_kinematics(goal, near, WITNESS_STEPS))
+        return witness if _distance(body, witness, goal) <= width else body.inverse_kinematics(goal, near)
+
+    def reaches(self, goal_q: np.ndarray, goal, width: float) -> bool:
+        """Whether the end effector at joint position ``goal_q`` (n,) lies within the goal width w (m) of the goal
+        (d,)."""
+        return _distance(self.model.body, goal_q, goal) <= width
+
+    def _final_position(self, warm_start) -> np.ndarray | None:
+        """The final mean joint position (n,) of a warm-start plan of this model, None for any other warm start."""
+        model = self.model
+        if isinstance(warm_start, Plan) and warm_start.mean.shape == (model.H + 1, model.state_size):
+            return warm_start.mean[-1, : model.n]
+        return None
 
     def _unreachable_plan(self, params: ReachParameters, goal_q: np.ndarray | None, t_begin: float) -> Plan | None:
         """A plan with status 'unreachable' when no joint position within the limits puts the end effector
-        within the goal width of the goal (the residual of ``goal_q`` (n,), :meth:`_goal_joints`, > w); None
+        within the goal width of the goal (the residual of ``goal_q`` (n,), :meth:`goal_joints`, > w); None
         otherwise, and for point masses (``goal_q`` None: they reach everywhere). An arm is checked before any
         solver work."""
         model, body, goal, width = self.model, self.model.body, params.goal, params.width
         if goal_q is None:
             return None
-        residual = _distance(body, goal_q, goal)
-        if residual <= width:
+        if self.reaches(goal_q, goal, width):
             return None
+        residual = _distance(body, goal_q, goal)
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
