@@ -174,6 +174,8 @@ class Replanner:
             goal_q = planner.goal_joints(params.start, params.goal, params.width, near=goal_q)
             if not planner.reaches(goal_q, params.goal, params.width):
                 return self._unreachable(guess, params, goal_q, began)
+        if moved:
+            guess = self._moved_onto_goal(guess, ReachParameters(params.start, previous.params.goal, previous.params.width), params)
         solver = planner.solver
         with solver.blas:
             solve = solver.newton_solve(guess, params, self._deadline(began), solver.curvature)
@@ -193,6 +195,16 @@ class Replanner:
 
         return Replan(progress_of(result), torque, params, result.status, result.message, result.nit, ended - began,
                       result.optimality, result.start_optimality, goal_q, build_plan)
+
+    def _moved_onto_goal(self, torque: np.ndarray, planned: ReachParameters, params: ReachParameters) -> np.ndarray:
+        """The shifted plan's torques (H, n) for ``planned``'s goal, or the same moved onto the cycle's goal by the start
+        policy's joint-space minimum-jerk corrections, whichever starts lower
+        (:meth:`StartPolicy.retargeted <comanip.planning.starts.StartPolicy.retargeted>`)."""
+        planner = self.planner
+        curvature, starts = planner.solver.curvature, planner.starts
+        mean = None if planner.model.body.is_linear else \
+            curvature.mean_path(curvature.value_and_data(np.ravel(torque), planned).data)
+        return starts.lowest_objective(starts.retargeted(torque, mean, planned.goal, params.goal), params)
 
     def _deadline(self, began: float) -> float:
         """The time (perf_counter, s) after which no Newton iteration starts: the budget's end less the longest recent

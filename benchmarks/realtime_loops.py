@@ -1,0 +1,206 @@
+"""Closed loops at a robot's rate, replanned on a per-cycle budget, against the same loops replanned to convergence.
+
+    .venv/bin/python benchmarks/realtime_loops.py [--presets franka_rest,planar] [--problems 20] [--rate 100] [--markdown]
+
+Problems: ``--problems`` spread evenly over each preset's workspace set (``benchmarks/workspace/<preset>.json``: the
+Panda from its ready pose to goals 0.1–0.3 m away, point masses from the origin to goals 0.05–0.8 m away, widths
+5–50 mm, starts at rest and moving); each problem's goal jumps once, at 30 % of the horizon H·h, by 5 cm (even
+problems) or 20 cm (odd) in a seeded random direction (for an arm, to a goal it reaches). Every loop runs
+1.5·H·h seconds at ``--rate`` Hz with motor noise, the same noise seed for every loop of a problem, its first plan a
+full (cold) solve from the start, every later cycle warm from the previous plan shifted by the cycle.
+
+Loops, taking turns problem by problem in one process:
+
+- ``converged``: every cycle's replan runs until it converges (the reference);
+- ``1 iteration``: one Newton iteration per cycle (``Replanner(planner, iterations=1)``);
+- ``budget``: as many iterations as a wall budget per cycle allows, every cost in it (``--budget``: 5 ms for arms,
+  1 ms for point masses);
+- ``full solve, budget``: the code before the real-time replanner, ``Planner.solve`` warm from the shifted plan with
+  ``max_wall_time`` the same budget, its per-solve set-up (the reachability witness, the start policy) in every cycle.
+
+Per preset and loop: the executed cost (:func:`comanip.execution.executed_cost`) relative to the converged loop's,
+summed over the problems and the largest per problem ((J - J_converged) / |J_converged|, lower is better); reach
+successes (the hand within w of the final goal at the end); every cycle's wall time after the first plan (median, p99,
+largest) and the first plans' (cold, median); the share of cycles flagged 'not_contracting'; and the slowest cycles.
+Wall times are of the machine this runs on, with its load (the 1-minute load average is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import comanip
+from comanip.execution import execute_receding_horizon, executed_cost
+from comanip.optim import Progress
+from comanip.planning.replanner import Replan, Replanner, shifted_torques
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import workspace  # noqa: E402  (the sampled problem sets beside this script)
+
+JUMPS = (0.05, 0.2)
+"""Goal jumps (m), alternating over the problems."""
+JUMP_AT = 0.3
+"""When the goal jumps, as a share of the horizon H·h."""
+RUN_LENGTH = 1.5
+"""A loop's duration in horizons H·h."""
+BUDGETS = {"arm": 0.005, "point mass": 0.001}
+"""Default wall budget per cycle (s)."""
+LOOPS = ("converged", "1 iteration", "budget", "full solve, budget")
+SLOWEST = 3
+
+
+class BudgetedFullSolves:
+    """The replanning before :class:`Replanner`: a full warm :meth:`Planner.solve` per cycle from the previous plan
+    shifted to the cycle, with ``max_wall_time``."""
+
+    def __init__(self, planner: comanip.Planner, max_wall_time: float):
+        self.planner, self.max_wall_time = planner, max_wall_time
+
+    def first_plan(self, start, goal, width=None) -> Replan:
+        return Replan.of_plan(self.planner.solve(start, goal, width))
+
+    def replan(self, previous: Replan, state, elapsed: float, goal=None, width=None) -> Replan:
+        began = time.perf_counter()
+        warm = shifted_torques(previous.torque, elapsed / self.planner.model.h)
+        plan = self.planner.solve(state, goal, width, warm_start=warm, max_wall_time=self.max_wall_time)
+        replan = Replan.of_plan(plan, wall_time=time.perf_counter() - began)
+        if not plan.converged:  # a budgeted full solve says nothing of contraction: flagged as not converged
+            replan.status = Progress.NOT_CONTRACTING
+        return replan
+
+
+@dataclass
+class LoopRuns:
+    """One loop's runs over a preset's problems."""
+
+    costs: list[float] = field(default_factory=list)
+    successes: list[bool] = field(default_factory=list)
+    cycle_times: list[np.ndarray] = field(default_factory=list)
+    """Per problem, its cycles' wall times after the first plan (s)."""
+    first_times: list[float] = field(default_factory=list)
+    flagged: int = 0
+    cycles: int = 0
+    problems: list[int] = field(default_factory=list)
+    """The workspace set's numbers of the problems."""
+    budget: float | None = None
+    """The wall budget per cycle (s), for the budgeted loops."""
+
+
+def jumped_goal(planner: comanip.Planner, problem, size: float, rng: np.random.Generator) -> np.ndarray:
+    """The problem's goal moved by ``size`` (m) in a random direction; for an arm, one it reaches from the start."""
+    model = planner.model
+    for _ in range(100):
+        direction = rng.normal(size=model.d)
+        goal = problem.goal + size * direction / np.linalg.norm(direction)
+        if model.body.is_linear or planner.reaches(planner.goal_joints(problem.start, goal, problem.width), goal, problem.width):
+            return goal
+    raise RuntimeError(f"no reachable goal {size} m from {problem.goal}")
+
+
+def run_preset(preset: str, count: int, rate: float, budget: float | None, progress) -> dict[str, LoopRuns]:
+    model = comanip.presets.load(preset)
+    planner = comanip.Planner(model)
+    kind = "point mass" if model.body.is_linear else "arm"
+    budget = BUDGETS[kind] if budget is None else budget
+    problems = workspace.load(preset)
+    chosen = np.unique(np.linspace(0, len(problems) - 1, count).round().astype(int))
+    period = 1.0 / rate
+    steps = round(RUN_LENGTH * model.H * model.h / period)
+    loops = {"converged": Replanner(planner, iterations=None), "1 iteration": Replanner(planner, iterations=1),
+             "budget": Replanner(planner, iterations=None, max_wall_time=budget),
+             "full solve, budget": BudgetedFullSolves(planner, budget)}
+    runs = {name: LoopRuns(budget=budget if "budget" in name else None) for name in loops}
+    rng = np.random.default_rng(0)
+    for number, index in enumerate(chosen):
+        problem = problems[index]
+        jump = [(JUMP_AT * model.H * model.h, jumped_goal(planner, problem, JUMPS[number % 2], rng))]
+        for name, replanning in loops.items():
+            run = execute_receding_horizon(replanning, problem.start, problem.goal, problem.width, steps=steps,
+                                           rng=np.random.default_rng(int(index)), period=period, goal_jumps=jump)
+            record = runs[name]
+            record.costs.append(executed_cost(planner, run, problem.width))
+            record.successes.append(bool(np.linalg.norm(run.ee[-1] - run.goals[-1]) <= problem.width))
+            record.cycle_times.append(run.replan_times[1:])
+            record.first_times.append(float(run.replan_times[0]))
+            record.flagged += sum(status == Progress.NOT_CONTRACTING for status in run.replan_statuses[1:])
+            record.cycles += steps - 1
+            record.problems.append(int(index))
+        progress(f"{preset} problem {number + 1}/{len(chosen)} (#{index}, {problem.describe()})")
+    return runs
+
+
+def summary(runs: dict[str, LoopRuns]) -> dict[str, dict]:
+    """Per loop: relative costs, successes, cycle-time statistics (ms) and the slowest cycles."""
+    reference = np.array(runs["converged"].costs)
+    out = {}
+    for name, record in runs.items():
+        costs = np.array(record.costs)
+        relative = (costs - reference) / np.abs(reference)
+        times = np.concatenate(record.cycle_times)
+        slowest = sorted(((t, problem, cycle + 1) for problem, cycle_times in zip(record.problems, record.cycle_times)
+                          for cycle, t in enumerate(cycle_times)), reverse=True)[:SLOWEST]
+        out[name] = {"total": float((costs.sum() - reference.sum()) / abs(reference.sum())),
+                     "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(costs),
+                     "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
+                     "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
+                     "flagged": record.flagged / record.cycles, "cycles": record.cycles,
+                     "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
+    return out
+
+
+def loop_label(name: str, row: dict) -> str:
+    return f"{name} ({1e3 * row['budget']:g} ms)" if row["budget"] is not None else name
+
+
+def markdown(results: dict[str, dict[str, dict]], args) -> str:
+    lines = [f"Measured by `benchmarks/realtime_loops.py --markdown --presets {args.presets} --problems {args.problems} "
+             f"--rate {args.rate:g}` ({args.rate:g} Hz loops of 1.5 H·h with motor noise, each problem's goal jumping by "
+             f"5 or 20 cm at 0.3 H·h; costs relative to the converged loop's, summed over the problems and the largest "
+             f"per problem; cycle times after the first plan; 1-minute load average {os.getloadavg()[0]:.1f} on "
+             f"{os.cpu_count()} cores at the end):", "",
+             "| preset | loop | executed cost vs converged, all / largest | reached | cycle median | p99 | largest | first plan (cold) | flagged |",
+             "|---|---|---|---|---|---|---|---|---|"]
+    for preset, rows in results.items():
+        for name, row in rows.items():
+            lines.append(f"| {preset} | {loop_label(name, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
+                         f"| {row['successes']}/{row['problems']} | {row['median_ms']:.2f} ms | {row['p99_ms']:.2f} ms "
+                         f"| {row['largest_ms']:.1f} ms | {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
+    lines += ["", f"The {SLOWEST} slowest cycles of each loop (ms, workspace problem #, cycle):", ""]
+    for preset, rows in results.items():
+        for name, row in rows.items():
+            slow = "; ".join(f"{t:.1f} ms (#{p}, cycle {c})" for t, p, c in row["slowest"])
+            lines.append(f"- {preset}, {loop_label(name, row)}: {slow}")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--presets", default="franka_rest,planar,cartesian,human,human_cartesian")
+    parser.add_argument("--problems", type=int, default=20, help="problems per preset, spread over its workspace set")
+    parser.add_argument("--rate", type=float, default=100.0, help="control rate (Hz)")
+    parser.add_argument("--budget", type=float, default=None, help="wall budget per cycle (s); default 5 ms arms, 1 ms point masses")
+    parser.add_argument("--markdown", action="store_true", help="print the speed page's block")
+    args = parser.parse_args(argv)
+    results = {}
+    for preset in args.presets.split(","):
+        results[preset] = summary(run_preset(preset, args.problems, args.rate, args.budget,
+                                             lambda text: print(text, file=sys.stderr, flush=True)))
+        if not args.markdown:
+            for name, row in results[preset].items():
+                print(f"{preset:16s} {loop_label(name, row):28s} cost {100 * row['total']:+.3f} % (largest "
+                      f"{100 * row['largest']:+.3f} %) reached {row['successes']}/{row['problems']} cycles "
+                      f"{row['median_ms']:.2f} / {row['p99_ms']:.2f} / {row['largest_ms']:.1f} ms flagged "
+                      f"{100 * row['flagged']:.1f} %", flush=True)
+    if args.markdown:
+        print(markdown(results, args))
+
+
+if __name__ == "__main__":
+    main()
