@@ -6,8 +6,10 @@ Problems: ``--problems`` spread evenly over each preset's workspace set (``bench
 Panda from its ready pose to goals 0.1–0.3 m away, point masses from the origin to goals 0.05–0.8 m away, widths
 5–50 mm, starts at rest and moving); each problem's goal jumps once, at 30 % of the horizon H·h, by 5 cm (even
 problems) or 20 cm (odd) in a seeded random direction (for an arm, to a goal it reaches). Every loop runs
-1.5·H·h seconds at ``--rate`` Hz with motor noise, the same noise seed for every loop of a problem, its first plan a
-full (cold) solve from the start, every later cycle warm from the previous plan shifted by the cycle.
+1.5·H·h seconds at ``--rate`` Hz, its first plan a full (cold) solve from the start, every later cycle warm from the
+previous plan shifted by the cycle; once with motor noise (the same noise seed for every loop of a problem) and once
+without, where the loops differ by their replanning alone (with noise, one run's cost moves by percents with the
+noise it meets, so the noisy rows compare sums over many problems).
 
 Loops, taking turns problem by problem in one process:
 
@@ -40,6 +42,7 @@ import comanip
 from comanip.execution import execute_receding_horizon, executed_cost
 from comanip.optim import Progress
 from comanip.planning.replanner import Replan, Replanner, shifted_torques
+from comanip.planning.solver_options import SolverOptions
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import workspace  # noqa: E402  (the sampled problem sets beside this script)
@@ -104,9 +107,10 @@ def jumped_goal(planner: comanip.Planner, problem, size: float, rng: np.random.G
     raise RuntimeError(f"no reachable goal {size} m from {problem.goal}")
 
 
-def run_preset(preset: str, count: int, rate: float, budget: float | None, progress) -> dict[str, LoopRuns]:
+def run_preset(preset: str, count: int, rate: float, budget: float | None, progress) -> dict[tuple[str, bool], LoopRuns]:
+    """Every loop's runs on the preset's problems, with and without motor noise, keyed by (loop, noise)."""
     model = comanip.presets.load(preset)
-    planner = comanip.Planner(model)
+    planner = comanip.Planner(model, SolverOptions(compile=True))  # a long-lived point-mass planner's compiled terms
     kind = "point mass" if model.body.is_linear else "arm"
     budget = BUDGETS[kind] if budget is None else budget
     problems = workspace.load(preset)
@@ -116,15 +120,15 @@ def run_preset(preset: str, count: int, rate: float, budget: float | None, progr
     loops = {"converged": Replanner(planner, iterations=None), "1 iteration": Replanner(planner, iterations=1),
              "budget": Replanner(planner, iterations=None, max_wall_time=budget),
              "full solve, budget": BudgetedFullSolves(planner, budget)}
-    runs = {name: LoopRuns(budget=budget if "budget" in name else None) for name in loops}
+    runs = {(name, noise): LoopRuns(budget=budget if "budget" in name else None) for noise in (True, False) for name in loops}
     rng = np.random.default_rng(0)
     for number, index in enumerate(chosen):
         problem = problems[index]
         jump = [(JUMP_AT * model.H * model.h, jumped_goal(planner, problem, JUMPS[number % 2], rng))]
-        for name, replanning in loops.items():
-            run = execute_receding_horizon(replanning, problem.start, problem.goal, problem.width, steps=steps,
-                                           rng=np.random.default_rng(int(index)), period=period, goal_jumps=jump)
-            record = runs[name]
+        for (name, noise), record in runs.items():
+            run = execute_receding_horizon(loops[name], problem.start, problem.goal, problem.width, steps=steps,
+                                           rng=np.random.default_rng(int(index)), noise=noise, period=period,
+                                           goal_jumps=jump)
             record.costs.append(executed_cost(planner, run, problem.width))
             record.successes.append(bool(np.linalg.norm(run.ee[-1] - run.goals[-1]) <= problem.width))
             record.cycle_times.append(run.replan_times[1:])
@@ -136,47 +140,50 @@ def run_preset(preset: str, count: int, rate: float, budget: float | None, progr
     return runs
 
 
-def summary(runs: dict[str, LoopRuns]) -> dict[str, dict]:
-    """Per loop: relative costs, successes, cycle-time statistics (ms) and the slowest cycles."""
-    reference = np.array(runs["converged"].costs)
+def summary(runs: dict[tuple[str, bool], LoopRuns]) -> dict[tuple[str, bool], dict]:
+    """Per loop and noise: costs relative to the converged loop's with the same noise, successes, cycle-time
+    statistics (ms) and the slowest cycles."""
     out = {}
-    for name, record in runs.items():
+    for (name, noise), record in runs.items():
+        reference = np.array(runs["converged", noise].costs)
         costs = np.array(record.costs)
         relative = (costs - reference) / np.abs(reference)
         times = np.concatenate(record.cycle_times)
         slowest = sorted(((t, problem, cycle + 1) for problem, cycle_times in zip(record.problems, record.cycle_times)
                           for cycle, t in enumerate(cycle_times)), reverse=True)[:SLOWEST]
-        out[name] = {"total": float((costs.sum() - reference.sum()) / abs(reference.sum())),
-                     "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(costs),
-                     "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
-                     "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
-                     "flagged": record.flagged / record.cycles, "cycles": record.cycles,
-                     "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
+        out[name, noise] = {"total": float((costs.sum() - reference.sum()) / abs(reference.sum())),
+                            "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(costs),
+                            "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
+                            "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
+                            "flagged": record.flagged / record.cycles, "cycles": record.cycles,
+                            "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
     return out
 
 
-def loop_label(name: str, row: dict) -> str:
-    return f"{name} ({1e3 * row['budget']:g} ms)" if row["budget"] is not None else name
+def loop_label(key: tuple[str, bool], row: dict) -> str:
+    name, noise = key
+    name = f"{name} ({1e3 * row['budget']:g} ms)" if row["budget"] is not None else name
+    return f"{name}, {'motor noise' if noise else 'no noise'}"
 
 
-def markdown(results: dict[str, dict[str, dict]], args) -> str:
+def markdown(results: dict[str, dict], args) -> str:
     lines = [f"Measured by `benchmarks/realtime_loops.py --markdown --presets {args.presets} --problems {args.problems} "
-             f"--rate {args.rate:g}` ({args.rate:g} Hz loops of 1.5 H·h with motor noise, each problem's goal jumping by "
-             f"5 or 20 cm at 0.3 H·h; costs relative to the converged loop's, summed over the problems and the largest "
-             f"per problem; cycle times after the first plan; 1-minute load average {os.getloadavg()[0]:.1f} on "
-             f"{os.cpu_count()} cores at the end):", "",
-             "| preset | loop | executed cost vs converged, all / largest | reached | cycle median | p99 | largest | first plan (cold) | flagged |",
+             f"--rate {args.rate:g}` ({args.rate:g} Hz loops of 1.5 H·h, each problem's goal jumping by 5 or 20 cm at "
+             f"0.3 H·h; executed costs relative to the converged loop's with the same noise, summed over the problems "
+             f"and the largest per problem; cycle times after the first plan; 1-minute load average "
+             f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores at the end):", "",
+             "| preset | loop | executed cost vs converged, all / largest | reached | cycle median | p99 | largest | first plan (cold), median | flagged 'not_contracting' |",
              "|---|---|---|---|---|---|---|---|---|"]
     for preset, rows in results.items():
-        for name, row in rows.items():
-            lines.append(f"| {preset} | {loop_label(name, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
+        for key, row in rows.items():
+            lines.append(f"| {preset} | {loop_label(key, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
                          f"| {row['successes']}/{row['problems']} | {row['median_ms']:.2f} ms | {row['p99_ms']:.2f} ms "
                          f"| {row['largest_ms']:.1f} ms | {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
     lines += ["", f"The {SLOWEST} slowest cycles of each loop (ms, workspace problem #, cycle):", ""]
     for preset, rows in results.items():
-        for name, row in rows.items():
+        for key, row in rows.items():
             slow = "; ".join(f"{t:.1f} ms (#{p}, cycle {c})" for t, p, c in row["slowest"])
-            lines.append(f"- {preset}, {loop_label(name, row)}: {slow}")
+            lines.append(f"- {preset}, {loop_label(key, row)}: {slow}")
     return "\n".join(lines)
 
 
@@ -193,8 +200,8 @@ def main(argv=None) -> None:
         results[preset] = summary(run_preset(preset, args.problems, args.rate, args.budget,
                                              lambda text: print(text, file=sys.stderr, flush=True)))
         if not args.markdown:
-            for name, row in results[preset].items():
-                print(f"{preset:16s} {loop_label(name, row):28s} cost {100 * row['total']:+.3f} % (largest "
+            for key, row in results[preset].items():
+                print(f"{preset:16s} {loop_label(key, row):44s} cost {100 * row['total']:+.3f} % (largest "
                       f"{100 * row['largest']:+.3f} %) reached {row['successes']}/{row['problems']} cycles "
                       f"{row['median_ms']:.2f} / {row['p99_ms']:.2f} / {row['largest_ms']:.1f} ms flagged "
                       f"{100 * row['flagged']:.1f} %", flush=True)

@@ -146,9 +146,9 @@ def test_a_retargeted_plan_moves_its_mean_path_by_the_shift(preset):
     plan = planner.solve(start, goal, model.width)
     shift = np.linspace(0.03, -0.02, model.n)
     durations = np.array([12, 20, 0.75 * model.H]) * model.h
-    moved = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, durations)
+    moved = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, durations, linear_dynamics=planner.starts.linear_dynamics)
     for T, torque in zip(durations, moved):
-        alone = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, [T])[0]
+        alone = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, [T], linear_dynamics=planner.starts.linear_dynamics)[0]
         np.testing.assert_allclose(torque, alone, rtol=1e-12, atol=1e-12)
         if not model.activation:  # activation stages lag the move (an initial guess tolerates it)
             trajectory = planner.problem.trajectory(tau=np.ravel(torque), s0=start, goal=goal, width=model.width)

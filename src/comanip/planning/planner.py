@@ -40,6 +40,7 @@ from comanip.arguments import as_bounded_vector, as_goal_width, as_optional_posi
 from comanip.model import ReachingModel
 from comanip.plausibility import with_plausibility_warnings
 from comanip.optim import Evaluation
+from comanip.planning.body_kind import body_kind, end_effector_distance
 from comanip.planning.ipopt_reach_solver import IpoptReachSolver
 from comanip.planning.newton_reach_solver import NewtonReachSolver
 from comanip.planning.path_limits import PathLimits
@@ -49,14 +50,8 @@ from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.reach_solver import ReachSolver, rank
 from comanip.planning.single_thread_blas import SingleThreadBlas
 from comanip.planning.solver_options import SolverOptions
-from comanip.planning.starts import StartPolicy
+from comanip.planning.starts.start_policy import StartPolicy
 from comanip.planning.terms import Curvature
-
-WITNESS_STEPS = 3
-"""Damped least-squares steps from a warm-start plan's final position that may show a goal reachable without the
-full inverse kinematics (:meth:`Planner.goal_joints`); how close each step lands:
-studies/how_many_steps_does_the_arm_reachability_witness_need/."""
-
 
 class Planner:
     """Plans reaches for one :class:`ReachingModel`; build once, then call :meth:`solve` many times.
@@ -71,23 +66,23 @@ class Planner:
             raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")
         self.model = model
         self.options = options or SolverOptions()
-        if not model.body.is_linear and model.activation:
-            raise ValueError(f"activation stages are supported for point-mass bodies; the {model.body.name!r} "
-                             f"body needs activation=()")
-        if self.options.method == "ipopt" and not model.body.is_linear:
-            raise ValueError(f"method 'ipopt' (exact Hessian of the expanded problem) is for point masses; the "
-                             f"{model.body.name!r} body needs method 'newton'")
+        self.kind = body_kind(model)
+        """What planning does for this kind of body (:class:`~comanip.planning.body_kind.BodyKind`), chosen once."""
+        self.kind.check(self.options)
         self._build()
 
     def _build(self) -> None:
         problem = self.problem = ReachProblem(self.model)
-        limits, blas = PathLimits.of(self.model), SingleThreadBlas()
-        self.solver: ReachSolver = NewtonReachSolver(problem, self.options, blas, limits) \
-            if self.options.method == "newton" else IpoptReachSolver(problem, self.options, blas)
+        kind, options = self.kind, self.options
+        blas, limit = SingleThreadBlas(), kind.iteration_limit(options)
+        self.solver: ReachSolver = NewtonReachSolver(
+            problem, options, blas, limit, PathLimits.of(self.model), kind.curvature(problem, options),
+            kind.tolerance(options), kind.compiles_after_solving(options)) \
+            if options.method == "newton" else IpoptReachSolver(problem, options, blas, limit)
         """How each solve runs from its starts (:class:`~comanip.planning.reach_solver.ReachSolver`), chosen by
         ``SolverOptions.method``."""
-        self.starts = StartPolicy(self.model, self.options, problem, self.solver)
-        """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`)."""
+        self.starts: StartPolicy = kind.start_policy(options, problem, self.solver)
+        """Where each solve starts (:class:`~comanip.planning.starts.StartPolicy`, the body kind's)."""
 
     @property
     def curvature(self) -> Curvature | None:
@@ -126,7 +121,7 @@ class Planner:
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
         params = ReachParameters(start, goal, width)
-        goal_q = None if self.model.body.is_linear else self.goal_joints(start, goal, width, self._final_position(warm_start))
+        goal_q = self.goal_joints(start, goal, width, self._final_position(warm_start))
         unreachable = self._unreachable_plan(params, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
@@ -138,24 +133,17 @@ class Planner:
         self.solver.count_solving_time(plan.solve_time)
         return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
 
-    def goal_joints(self, start, goal, width: float, near: np.ndarray | None = None) -> np.ndarray:
-        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w (m) of
-        the goal (d,) if any does: the reachability witness of a solve.
-
-        Without ``near``: the inverse kinematics from the start (nx,) (a cold solve's guesses reach for it). With a
-        joint position ``near`` (n,), e.g. the final mean position of a plan to a nearby goal: ``WITNESS_STEPS``
-        damped least-squares steps from it (clipped to the limits), far cheaper, when they bring the hand within w of
-        the goal (a goal moved by a few cm: they do), else the inverse kinematics from ``near``."""
-        body = self.model.body
-        if near is None:
-            return body.inverse_kinematics(goal, start[: self.model.n])
-        witness = body.clip_to_limits(body.least_squares_inverse_kinematics(goal, near, WITNESS_STEPS))
-        return witness if _distance(body, witness, goal) <= width else body.inverse_kinematics(goal, near)
+    def goal_joints(self, start, goal, width: float, near: np.ndarray | None = None) -> np.ndarray | None:
+        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w (m) of the
+        goal (d,) if any does, the reachability witness of a solve from start (nx,), searched from the joint position
+        ``near`` (n,) when given (:meth:`Arm.goal_joints <comanip.planning.body_kind.Arm.goal_joints>`); None for a
+        point mass, which reaches every goal."""
+        return self.kind.goal_joints(start, goal, width, near)
 
     def reaches(self, goal_q: np.ndarray, goal, width: float) -> bool:
         """Whether the end effector at joint position ``goal_q`` (n,) lies within the goal width w (m) of the goal
         (d,)."""
-        return _distance(self.model.body, goal_q, goal) <= width
+        return end_effector_distance(self.model.body, goal_q, goal) <= width
 
     def _final_position(self, warm_start) -> np.ndarray | None:
         """The final mean joint position (n,) of a warm-start plan of this model, None for any other warm start."""
@@ -174,7 +162,7 @@ class Planner:
             return None
         if self.reaches(goal_q, goal, width):
             return None
-        residual = _distance(body, goal_q, goal)
+        residual = end_effector_distance(body, goal_q, goal)
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "
                    f"within its joint limits, beyond the goal width {width} m; no plan was solved (the arm holds still)")
         torque = np.zeros((model.H, model.n))
@@ -201,11 +189,6 @@ class Planner:
                                 solve_time=time.perf_counter() - t_begin, iterations=sum(result.nit for result in results))
         plan.goal_sensitivity = solver.sensitivity(best)
         return plan
-
-
-def _distance(body, q: np.ndarray, point: np.ndarray) -> float:
-    """Distance (m) of the body's end effector at joint position q (n,) from a point (d,)."""
-    return float(np.linalg.norm(np.asarray(body.kinematics_function(q)[0]).ravel() - point))
 
 
 class ReachInputs(NamedTuple):

@@ -6,7 +6,7 @@ A control loop replans every cycle from the state it measures. A :class:`Replann
    not only whole model steps);
 2. from them and the measured state, a fixed number of Newton iterations (``iterations``) or as many as fit a wall
    budget (``max_wall_time``, every cost of the cycle included: the shift, the checks, the evaluation at the shifted
-   plan and the iterations; an iteration starts only when the longest recent one still fits);
+   plan and the iterations; an iteration starts only when a recent iteration's time, its 90th percentile, still fits);
 3. the best plan comes back as a :class:`Replan` whose ``status`` says how the iterations stand
    (:class:`~comanip.optim.Progress`: 'converged', 'converging', 'not_contracting').
 
@@ -35,8 +35,11 @@ from comanip.planning.planner import Planner
 from comanip.planning.reach_parameters import ReachParameters
 
 RECENT_CYCLES = 50
-"""Cycles over which a budgeted replanner remembers its time per Newton iteration (it reserves the longest for the
-next iteration)."""
+"""Cycles over which a budgeted replanner remembers its time per Newton iteration."""
+RESERVE_QUANTILE = 0.9
+"""The quantile of the recent times per iteration that a budgeted cycle reserves for its next iteration: the
+longest would let one stalled iteration (the process descheduled) stop the iterations of the next RECENT_CYCLES
+cycles."""
 
 
 def shifted_torques(torque: np.ndarray, steps: float) -> np.ndarray:
@@ -151,8 +154,7 @@ class Replanner:
     def first_plan(self, start, goal, width: float | None = None) -> Replan:
         """The loop's first plan: a full solve from start (nx,) to goal (d,) of width w (m; the model's when None)."""
         plan = self.planner.solve(start, goal, width)
-        goal_q = None if self.planner.model.body.is_linear else \
-            self.planner.goal_joints(plan.start, plan.goal, plan.width, near=plan.mean[-1, : self.planner.model.n])
+        goal_q = self.planner.goal_joints(plan.start, plan.goal, plan.width, near=plan.mean[-1, : self.planner.model.n])
         return Replan.of_plan(plan, goal_q)
 
     def replan(self, previous: Replan, state, elapsed: float, goal=None, width: float | None = None) -> Replan:
@@ -175,7 +177,8 @@ class Replanner:
             if not planner.reaches(goal_q, params.goal, params.width):
                 return self._unreachable(guess, params, goal_q, began)
         if moved:
-            guess = self._moved_onto_goal(guess, ReachParameters(params.start, previous.params.goal, previous.params.width), params)
+            planned = ReachParameters(params.start, previous.params.goal, previous.params.width)
+            guess = planner.starts.moved_onto_goal(guess, planned, params)
         solver = planner.solver
         with solver.blas:
             solve = solver.newton_solve(guess, params, self._deadline(began), solver.curvature)
@@ -196,22 +199,13 @@ class Replanner:
         return Replan(progress_of(result), torque, params, result.status, result.message, result.nit, ended - began,
                       result.optimality, result.start_optimality, goal_q, build_plan)
 
-    def _moved_onto_goal(self, torque: np.ndarray, planned: ReachParameters, params: ReachParameters) -> np.ndarray:
-        """The shifted plan's torques (H, n) for ``planned``'s goal, or the same moved onto the cycle's goal by the start
-        policy's joint-space minimum-jerk corrections, whichever starts lower
-        (:meth:`StartPolicy.retargeted <comanip.planning.starts.StartPolicy.retargeted>`)."""
-        planner = self.planner
-        curvature, starts = planner.solver.curvature, planner.starts
-        mean = None if planner.model.body.is_linear else \
-            curvature.mean_path(curvature.value_and_data(np.ravel(torque), planned).data)
-        return starts.lowest_objective(starts.retargeted(torque, mean, planned.goal, params.goal), params)
-
     def _deadline(self, began: float) -> float:
-        """The time (perf_counter, s) after which no Newton iteration starts: the budget's end less the longest recent
-        time per iteration, so that the cycle ends within its budget (inf without a budget)."""
+        """The time (perf_counter, s) after which no Newton iteration starts: the budget's end less the RESERVE_QUANTILE
+        of the recent times per iteration, so that the cycle ends within its budget (inf without a budget)."""
         if self.max_wall_time is None:
             return np.inf
-        return began + self.max_wall_time - max(self._iteration_times, default=0.0)
+        reserve = float(np.quantile(self._iteration_times, RESERVE_QUANTILE)) if self._iteration_times else 0.0
+        return began + self.max_wall_time - reserve
 
     def _unreachable(self, guess: np.ndarray, params: ReachParameters, goal_q: np.ndarray, began: float) -> Replan:
         """The cycle of a goal out of the arm's reach: the shifted plan, status 'not_contracting'."""
