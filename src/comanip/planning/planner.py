@@ -126,8 +126,9 @@ class Planner:
         if unreachable is not None:
             return unreachable
         with self.solver.blas:  # the starts' small products too: one BLAS switch per solve
-            guesses = self.starts.guesses(params, warm_start, budgeted=max_wall_time is not None,
-                                          goal_q=goal_q if warm_start is None else None)
+            if warm_start is None and max_wall_time is None:  # a new library entry is a whole cold search: not on a budget
+                self.starts.fill_library(params)
+            guesses = self.starts.guesses(params, warm_start, goal_q=goal_q if warm_start is None else None)
             from_library = warm_start is None and self.starts.from_arm_library(start)
             plan = with_reach_check(self._solve_from(guesses, params, t_begin, max_wall_time, until_converged=from_library))
         self.solver.count_solving_time(plan.solve_time)

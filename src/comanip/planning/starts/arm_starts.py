@@ -54,7 +54,7 @@ class ArmStarts(StartPolicy):
         within 3e-9)."""
         return self.library_candidates(params, WARM_CANDIDATE_ENTRIES) if self.from_arm_library(params.start) else []
 
-    def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def cold_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """At the ready pose of its reach library: :meth:`arm_library_starts`; elsewhere, or with 'all':
         :meth:`searched_guesses`."""
         if self.from_arm_library(params.start):

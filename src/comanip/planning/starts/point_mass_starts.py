@@ -46,7 +46,7 @@ class PointMassStarts(StartPolicy):
         not needed)."""
         return self.task_to_joint_shift @ goal_move
 
-    def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def cold_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The guesses a cold solve runs (``SolverOptions.cold_search``).
 
 'all', or a point mass without a reach library (not symmetric): :meth:`searched_guesses`. 'ranked', for a
@@ -62,14 +62,12 @@ class PointMassStarts(StartPolicy):
         guess. The full search stays ``cold_search="all"``;
         benchmarks/cold_quality.py checks the ranked starts against it under the cold-search rule (within 1e-4 of
         its objective in at least 98 % of random problems, never 1e-3 worse, as many successes).
-        A ``budgeted`` solve (max_wall_time given) uses only library reaches solved before: solving a new one is a
-        whole cold search outside the budget; without them a narrow goal
-        runs every minimum-jerk guess.
+        The library's entries are those solved before (:meth:`fill_library`); without them a narrow goal runs every
+        minimum-jerk guess.
         """
-        start, goal, width = params.start, params.goal, params.width
         if self.library is None:
             return self.searched_guesses(params, goal_q)
-        motion = _motion(start, self.model.n)
+        motion = _motion(params.start, self.model.n)
         moving = bool(np.any(motion))
         narrow = self.narrow_after_stops(params, motion)
         if self._carries_on(motion, narrow):
@@ -79,11 +77,11 @@ class PointMassStarts(StartPolicy):
             # a new entry: studies/does_a_library_of_moving_start_reaches_pay_off/)
             return self.cold_guesses(params, self.options.n_starts)
         if moving:
-            candidates = self.stopped_reaches(params, motion, budgeted, every_optimum=narrow)
+            candidates = self.stopped_reaches(params, motion, every_optimum=narrow)
         elif narrow:
-            candidates = self.library.local_optima(start, goal, width, solve_missing=not budgeted)
+            candidates = self.library.local_optima(params)
         else:
-            turned = self.library.guess(start, goal, width, solve_missing=not budgeted)
+            turned = self.library.guess(params)
             candidates = [] if turned is None else [turned]
         if narrow:
             return [self.lowest_objective(candidates, params)] if candidates else self.cold_guesses(params, self.options.n_starts)
@@ -91,7 +89,7 @@ class PointMassStarts(StartPolicy):
         objectives = [self.objective(guess, params) for guess in guesses]
         first_best = min(range(len(guesses)), key=objectives.__getitem__)
         best_guess = guesses[first_best]
-        if not candidates:  # the goal at the start, or a budgeted solve without the entry: as without a library
+        if not candidates:  # the goal at the start, or an entry not solved: as without a library
             return [best_guess]
         scored = [(self.objective(candidate, params), candidate) for candidate in candidates] + \
             [(objectives[first_best], best_guess)]  # the guess's objective as evaluated above
@@ -109,33 +107,44 @@ class PointMassStarts(StartPolicy):
         after its stops (:meth:`narrow_after_stops`)."""
         return narrow and bool(np.any(motion)) and bool(self.stops(motion).any())
 
-    def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, budgeted: bool = False,
-                        every_optimum: bool = False) -> list[np.ndarray]:
+    def stopped_reaches(self, params: ReachParameters, motion: np.ndarray, every_optimum: bool = False) -> list[np.ndarray]:
         """A point mass's starts (H, n) from a moving start: for each minimum-jerk duration T, a stop from the start's
         velocity v0 superposed on the library's reach from where the stop ends to the goal (the mean is affine in the
         torques and the start, so the sum ends at the goal at rest); ``every_optimum``: on each of the library's plans
         near a local optimum (:meth:`ReachLibrary.local_optima`) instead. A lightly damped hand stops v0·T/2 on, where a
         minimum-jerk stop with a free end comes to rest (the quintic's t⁵ term vanishes); one whose damping alone
         would stop it sooner (D⁻¹ M v0 on) is braked back to its start position, the stop that serves strongly
-        damped hands better (benchmarks/cold_quality.py). Stops whose reach the library does not have for a
-        budgeted solve are left out. ``motion`` (nx,): the start with its position zeroed."""
-        model, start = self.model, params.start
-        n = model.n
+        damped hands better (benchmarks/cold_quality.py). Stops whose reach the library does not have yet are left
+        out. ``motion`` (nx,): the start with its position zeroed."""
+        model = self.model
         durations = guess_durations(model.duration, self.options.n_starts)
         stops = self.stops(motion)
         brakes = minimum_jerk_torques(model.body, model.h, model.H, motion, stops[:, None, :], durations, self.linear_dynamics)
-        at_rest = np.zeros(model.state_size - n)
+        reaches = {}  # one library reach per distinct stop (those braked back to the start share one)
+        for stop, reach in zip(map(tuple, stops), self.stopped_starts(params, stops)):
+            if stop not in reaches:
+                found = self.library.local_optima(reach) if every_optimum else [self.library.guess(reach)]
+                reaches[stop] = [torque for torque in found if torque is not None]
+        return [reach + brake for stop, brake in zip(map(tuple, stops), brakes) for reach in reaches[stop]]
 
-        def reaches_from(stop) -> list[np.ndarray]:
-            stopped = np.r_[start[:n] + stop, at_rest]
-            if every_optimum:
-                return self.library.local_optima(stopped, params.goal, params.width, solve_missing=not budgeted)
-            reach = self.library.guess(stopped, params.goal, params.width, solve_missing=not budgeted)
-            return [] if reach is None else [reach]
+    def stopped_starts(self, params: ReachParameters, stops: np.ndarray) -> list[ReachParameters]:
+        """The reaches from rest where each stop (k, n) of the start's motion ends, to the goal at its width."""
+        n, at_rest = self.model.n, np.zeros(self.model.state_size - self.model.n)
+        return [ReachParameters(np.r_[params.start[:n] + stop, at_rest], params.goal, params.width) for stop in stops]
 
-        back_at_start = reaches_from(np.zeros(n)) if not stops.any(axis=1).all() else None  # one reach for every such stop
-        reaches = [reaches_from(stop) if stop.any() else back_at_start for stop in stops]
-        return [reach + brake for found, brake in zip(reaches, brakes) for reach in found]
+    def fill_library(self, params: ReachParameters) -> None:
+        """Solve the reach-library entries that a cold solve of ``params`` starts from and the library lacks: the
+        entry nearest to the reach from rest (or, beyond ``narrow_ratio`` widths, the two around it), or to each reach
+        from where a stop of a moving start ends (:meth:`stopped_reaches`); none where the starts use no library."""
+        if self.library is None:
+            return
+        motion = _motion(params.start, self.model.n)
+        narrow = self.narrow_after_stops(params, motion)
+        if self._carries_on(motion, narrow):
+            return
+        reaches = self.stopped_starts(params, self.stops(motion)) if np.any(motion) else [params]
+        for reach in reaches:
+            self.library.fill(reach, bracket=narrow)
 
     def narrow_after_stops(self, params: ReachParameters, motion: np.ndarray) -> bool:
         """:meth:`narrow`, or the goal farther than ``narrow_ratio`` widths from where a stop of the start's motion

@@ -60,9 +60,13 @@ class StartPolicy(ABC):
         return False
 
     @abstractmethod
-    def cold_starts(self, params: ReachParameters, budgeted: bool = False, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
-        """The guesses (H, n) a cold solve runs (``SolverOptions.cold_search``); ``budgeted``: a solve with a wall
-        budget, which solves no reach-library entry; ``goal_q`` (n,): the goal's inverse kinematics, if known."""
+    def cold_starts(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+        """The guesses (H, n) a cold solve runs (``SolverOptions.cold_search``); ``goal_q`` (n,): the goal's inverse
+        kinematics, if known."""
+
+    def fill_library(self, params: ReachParameters) -> None:
+        """Solve the reach-library entries a cold solve of ``params`` would start from and its library lacks, before
+        the solve asks for its starts (a library the solves only read; none here)."""
 
     @abstractmethod
     def searched_guesses(self, params: ReachParameters, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
@@ -87,12 +91,11 @@ class StartPolicy(ABC):
         """Starts (H, n) that compete with a warm start to another goal besides its own moves (none here)."""
         return []
 
-    def guesses(self, params: ReachParameters, warm_start, budgeted: bool = False,
-                goal_q: np.ndarray | None = None) -> list[np.ndarray]:
+    def guesses(self, params: ReachParameters, warm_start, goal_q: np.ndarray | None = None) -> list[np.ndarray]:
         """The starts (H, n) of a solve; ``goal_q`` (n,): the goal's inverse kinematics from the start, if known."""
         model, goal, width = self.model, params.goal, params.width
         if warm_start is None:
-            return self.cold_starts(params, budgeted, goal_q)
+            return self.cold_starts(params, goal_q)
         torque = warm_start.torque if isinstance(warm_start, Plan) else warm_start
         torque = as_matrix("warm_start", torque, (model.H, model.n), "torques, N·m or N")
         if not (isinstance(warm_start, Plan) and warm_start.goal.shape == goal.shape
