@@ -41,6 +41,7 @@ import numpy as np
 import comanip
 from comanip.execution import execute_receding_horizon, executed_cost
 from comanip.optim import Progress
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.replanner import Replan, Replanner, shifted_torques
 from comanip.planning.solver_options import SolverOptions
 
@@ -102,7 +103,9 @@ def jumped_goal(planner: comanip.Planner, problem, size: float, rng: np.random.G
     for _ in range(100):
         direction = rng.normal(size=model.d)
         goal = problem.goal + size * direction / np.linalg.norm(direction)
-        if model.body.is_linear or planner.reaches(planner.goal_joints(problem.start, goal, problem.width), goal, problem.width):
+        reach = ReachParameters(problem.start, goal, problem.width)
+        goal_q = planner.goal_joints(reach)
+        if goal_q is None or planner.reaches(goal_q, reach):
             return goal
     raise RuntimeError(f"no reachable goal {size} m from {problem.goal}")
 

@@ -4,7 +4,10 @@ module of the package reads ``is_linear``. The check is tried on a source that d
 import ast
 from pathlib import Path
 
+import numpy as np
+
 import comanip
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.body_kind import Arm, PointMass, body_kind
 from comanip.planning.starts import ArmStarts, PointMassStarts
 
@@ -47,4 +50,4 @@ def test_each_kind_builds_its_own_start_policy(planar_planner):
     assert isinstance(body_kind(comanip.presets.load("franka_rest")), Arm)
     assert isinstance(planar_planner.kind, PointMass) and isinstance(planar_planner.starts, PointMassStarts)
     assert not isinstance(planar_planner.starts, ArmStarts)
-    assert planar_planner.goal_joints(None, [0.3, 0.0], 0.02) is None   # a point mass reaches every goal
+    assert planar_planner.goal_joints(ReachParameters(np.zeros(4), np.array([0.3, 0.0]), 0.02)) is None   # a point mass reaches every goal

@@ -378,7 +378,7 @@ def test_warm_solve_to_a_nearby_goal_needs_no_inverse_kinematics(franka_rest_pla
     outside = nearby.mean.copy()
     outside[-1, 3] = body.q_min[3] - 0.3  # joint 4 beyond its limit, the goal where that puts the hand
     goal = np.asarray(body.kinematics_function(outside[-1, :7])[0]).ravel()
-    witness = planner.goal_joints(start, goal, 0.05, near=outside[-1, :7])
+    witness = planner.goal_joints(ReachParameters(start, goal, 0.05), near=outside[-1, :7])
     assert np.all(witness >= body.q_min) and np.all(witness <= body.q_max)
 
 

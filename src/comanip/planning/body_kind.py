@@ -22,6 +22,7 @@ import numpy as np
 from comanip.model import ReachingModel
 from comanip.planning.curvature import ReachCurvature
 from comanip.planning.linearised_curvature import LinearisedCurvature
+from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.reach_solver import ReachSolver
 from comanip.planning.solver_options import SolverOptions
@@ -70,9 +71,9 @@ class BodyKind(ABC):
         """Where the planner's solves start."""
 
     @abstractmethod
-    def goal_joints(self, start: np.ndarray, goal: np.ndarray, width: float, near: np.ndarray | None = None) -> np.ndarray | None:
-        """A joint position (n,) within the limits whose end effector lies within w (m) of the goal (d,) if any does
-        (the reachability witness of a solve from start (nx,)); None where every goal is reachable."""
+    def goal_joints(self, params: ReachParameters, near: np.ndarray | None = None) -> np.ndarray | None:
+        """A joint position (n,) within the limits whose end effector lies within the goal width of the goal if any
+        does (the reachability witness of a solve of the reach ``params``); None where every goal is reachable."""
 
 
 class PointMass(BodyKind):
@@ -98,7 +99,7 @@ class PointMass(BodyKind):
     def start_policy(self, options: SolverOptions, problem: ReachProblem, solver: ReachSolver) -> StartPolicy:
         return PointMassStarts(self.model, options, problem, solver)
 
-    def goal_joints(self, start: np.ndarray, goal: np.ndarray, width: float, near: np.ndarray | None = None) -> None:
+    def goal_joints(self, params: ReachParameters, near: np.ndarray | None = None) -> None:
         return None
 
 
@@ -131,16 +132,16 @@ class Arm(BodyKind):
     def start_policy(self, options: SolverOptions, problem: ReachProblem, solver: ReachSolver) -> StartPolicy:
         return ArmStarts(self.model, options, problem, solver)
 
-    def goal_joints(self, start: np.ndarray, goal: np.ndarray, width: float, near: np.ndarray | None = None) -> np.ndarray:
+    def goal_joints(self, params: ReachParameters, near: np.ndarray | None = None) -> np.ndarray:
         """Without ``near``: the inverse kinematics from the start (a cold solve's guesses reach for it). With a joint
         position ``near`` (n,), e.g. the final mean position of a plan to a nearby goal: ``WITNESS_STEPS`` damped
         least-squares steps from it (clipped to the limits), far cheaper, when they bring the hand within w of the
         goal (a goal moved by a few cm: they do), else the inverse kinematics from ``near``."""
-        body = self.model.body
+        body, goal = self.model.body, params.goal
         if near is None:
-            return body.inverse_kinematics(goal, start[: self.model.n])
+            return body.inverse_kinematics(goal, params.start[: self.model.n])
         witness = body.clip_to_limits(body.least_squares_inverse_kinematics(goal, near, WITNESS_STEPS))
-        return witness if end_effector_distance(body, witness, goal) <= width else body.inverse_kinematics(goal, near)
+        return witness if end_effector_distance(body, witness, goal) <= params.width else body.inverse_kinematics(goal, near)
 
 
 def body_kind(model: ReachingModel) -> BodyKind:

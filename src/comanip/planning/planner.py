@@ -121,7 +121,7 @@ class Planner:
         max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         t_begin = time.perf_counter()
         params = ReachParameters(start, goal, width)
-        goal_q = self.goal_joints(start, goal, width, self._final_position(warm_start))
+        goal_q = self.goal_joints(params, self._final_position(warm_start))
         unreachable = self._unreachable_plan(params, goal_q, t_begin)
         if unreachable is not None:
             return unreachable
@@ -134,17 +134,17 @@ class Planner:
         self.solver.count_solving_time(plan.solve_time)
         return with_plausibility_warnings(self.model, plan)  # a point mass is a person's hand: name implausible reaches
 
-    def goal_joints(self, start, goal, width: float, near: np.ndarray | None = None) -> np.ndarray | None:
-        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width w (m) of the
-        goal (d,) if any does, the reachability witness of a solve from start (nx,), searched from the joint position
+    def goal_joints(self, params: ReachParameters, near: np.ndarray | None = None) -> np.ndarray | None:
+        """An arm's joint position (n,) within its joint limits that puts the hand within the goal width of the goal if
+        any does, the reachability witness of a solve of the reach ``params``, searched from the joint position
         ``near`` (n,) when given (:meth:`Arm.goal_joints <comanip.planning.body_kind.Arm.goal_joints>`); None for a
         point mass, which reaches every goal."""
-        return self.kind.goal_joints(start, goal, width, near)
+        return self.kind.goal_joints(params, near)
 
-    def reaches(self, goal_q: np.ndarray, goal, width: float) -> bool:
-        """Whether the end effector at joint position ``goal_q`` (n,) lies within the goal width w (m) of the goal
-        (d,)."""
-        return end_effector_distance(self.model.body, goal_q, goal) <= width
+    def reaches(self, goal_q: np.ndarray, params: ReachParameters) -> bool:
+        """Whether the end effector at joint position ``goal_q`` (n,) lies within the goal width of the goal of the
+        reach ``params``."""
+        return end_effector_distance(self.model.body, goal_q, params.goal) <= params.width
 
     def _final_position(self, warm_start) -> np.ndarray | None:
         """The final mean joint position (n,) of a warm-start plan of this model, None for any other warm start."""
@@ -161,7 +161,7 @@ class Planner:
         model, body, goal, width = self.model, self.model.body, params.goal, params.width
         if goal_q is None:
             return None
-        if self.reaches(goal_q, goal, width):
+        if self.reaches(goal_q, params):
             return None
         residual = end_effector_distance(body, goal_q, goal)
         message = (f"goal {np.round(goal, 4).tolist()} m is {residual:.3f} m from the nearest point the {body.name} reaches "

@@ -154,7 +154,7 @@ class Replanner:
     def first_plan(self, start, goal, width: float | None = None) -> Replan:
         """The loop's first plan: a full solve from start (nx,) to goal (d,) of width w (m; the model's when None)."""
         plan = self.planner.solve(start, goal, width)
-        goal_q = self.planner.goal_joints(plan.start, plan.goal, plan.width, near=plan.mean[-1, : self.planner.model.n])
+        goal_q = self.planner.goal_joints(ReachParameters(plan.start, plan.goal, plan.width), near=plan.mean[-1, : self.planner.model.n])
         return Replan.of_plan(plan, goal_q)
 
     def replan(self, previous: Replan, state, elapsed: float, goal=None, width: float | None = None) -> Replan:
@@ -173,8 +173,8 @@ class Replanner:
         goal_q = previous.goal_q
         moved = not (np.array_equal(params.goal, previous.params.goal) and params.width == previous.params.width)
         if goal_q is not None and moved:
-            goal_q = planner.goal_joints(params.start, params.goal, params.width, near=goal_q)
-            if not planner.reaches(goal_q, params.goal, params.width):
+            goal_q = planner.goal_joints(params, near=goal_q)
+            if not planner.reaches(goal_q, params):
                 return self._unreachable(guess, params, goal_q, began)
         if moved:
             planned = ReachParameters(params.start, previous.params.goal, previous.params.width)
