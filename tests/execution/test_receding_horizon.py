@@ -55,6 +55,6 @@ def test_a_loop_faster_than_the_model_step_reaches_a_goal_that_jumps(planar_plan
 def test_an_observation_model_needs_cycles_of_the_model_step(planar_planner):
     from comanip.execution import Observation
 
-    with pytest.raises(ValueError, match="period"):
+    with pytest.raises(ValueError, match="noisy or delayed observation"):
         execute_receding_horizon(planar_planner, np.zeros(4), [0.3, 0.0], 0.02, period=0.01,
                                  observation=Observation(0.005, 0.05, 0.1))

@@ -79,7 +79,8 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
             so far. None: no wall budget.
         observation: an Observation replans from the Kalman estimate made from measurements of [q; qdot] with
             its noise and delay (the start is known exactly; cycles of h only); None uses the model's ``observation``,
-            and replans from the actual state when the model has none. ``Observation(0, 0)`` forces the exact state.
+            and replans from the actual state when the model has none. ``Observation(0, 0)`` forces the exact state
+            (at any period).
         iterations: Newton iterations per replan (the real-time iteration: 1 or a few); None, and no
             ``max_wall_time``: each replan runs until it converges.
         period: the control cycle (s), h when None; need not be a whole number of model steps (100 Hz on a model of
@@ -99,7 +100,10 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     if observation is not None and not isinstance(observation, Observation):
         raise ValueError(f"observation must be None or a comanip.execution.Observation, got {type(observation).__name__}")
     if observation is not None and not np.isclose(period, model.h):
-        raise ValueError(f"an observation model needs cycles of the model's step h = {model.h} s, got period {period} s")
+        if observation.position_std or observation.velocity_std or observation.delay:
+            raise ValueError(f"a noisy or delayed observation needs cycles of the model's step h = {model.h} s, got "
+                             f"period {period} s (Observation(0, 0) replans from the exact state at any period)")
+        observation = None
     jumps = sorted((as_nonnegative("goal jump time", time, "s"), as_position("goal jump goal", to, model.d))
                    for time, to in goal_jumps)
     rng = rng if rng is not None else np.random.default_rng()
