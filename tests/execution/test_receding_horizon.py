@@ -58,3 +58,10 @@ def test_an_observation_model_needs_cycles_of_the_model_step(planar_planner):
     with pytest.raises(ValueError, match="noisy or delayed observation"):
         execute_receding_horizon(planar_planner, np.zeros(4), [0.3, 0.0], 0.02, period=0.01,
                                  observation=Observation(0.005, 0.05, 0.1))
+
+
+def test_a_replanner_brings_its_own_budget(planar_planner):
+    from comanip.planning import Replanner
+
+    with pytest.raises(ValueError, match="its own budget"):
+        execute_receding_horizon(Replanner(planar_planner), np.zeros(4), [0.3, 0.0], 0.02, iterations=2)

@@ -88,6 +88,8 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
         goal_jumps: (time (s), goal (d,)) pairs, in any order: from each time on, the replans aim at that goal (a
             target that jumps mid-reach).
     """
+    if not isinstance(planner, Planner) and (iterations is not None or max_wall_time is not None):
+        raise ValueError("iterations and max_wall_time go with a Planner; a Replanner has its own budget")
     replanning = planner if not isinstance(planner, Planner) else Replanner(planner, iterations, max_wall_time)
     planner = replanning.planner
     model = planner.model
