@@ -12,7 +12,8 @@ A control loop replans every cycle from the state it measures. A :class:`Replann
 
 What a solve sets up once per planner (the compiled terms, the torque bounds, the joint limits) the replanner
 reuses; what a full solve redoes every time (the start policy's candidates, the reachability witness by inverse
-kinematics) runs here only when the goal moves, and then from the last witness. The first plan of a loop is a full
+kinematics) runs here only when the goal moves: the witness from the last one, and the shifted plan competes with
+itself moved onto the new goal and with fresh minimum-jerk reaches to it. The first plan of a loop is a full
 solve (:meth:`Replanner.first_plan`), made before the loop's budget applies. The scheme is that of acados' SQP_RTI
 and of OCS2 and Crocoddyl's model-predictive control: one or a few iterations per cycle from the previous solution,
 so that the iterations converge along the loop rather than within a cycle.
@@ -178,7 +179,7 @@ class Replanner:
                 return self._unreachable(guess, params, goal_q, began)
         if moved:
             planned = ReachParameters(params.start, previous.params.goal, previous.params.width)
-            guess = planner.starts.moved_onto_goal(guess, planned, params)
+            guess = planner.starts.moved_onto_goal(guess, planned, params, goal_q)
         solver = planner.solver
         with solver.blas:
             solve = solver.newton_solve(guess, params, self._deadline(began), solver.curvature)

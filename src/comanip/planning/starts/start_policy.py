@@ -81,11 +81,14 @@ class StartPolicy(ABC):
         it (a linear body's do not: None)."""
         return None
 
-    def moved_onto_goal(self, torque: np.ndarray, planned: ReachParameters, params: ReachParameters) -> np.ndarray:
-        """Torques (H, n) of a plan for the reach ``planned``, or the same moved onto the goal of ``params`` by
-        :meth:`retargeted`, whichever starts ``params``' solve lowest (:meth:`lowest_objective`)."""
+    def moved_onto_goal(self, torque: np.ndarray, planned: ReachParameters, params: ReachParameters,
+                        goal_q: np.ndarray | None = None) -> np.ndarray:
+        """Torques (H, n) of a plan for the reach ``planned``, the same moved onto the goal of ``params`` by
+        :meth:`retargeted`, or a fresh minimum-jerk reach from the start to it (:meth:`cold_guesses`, to ``goal_q``
+        (n,) if given: a goal moved far lies where the plan's reward does not reach), whichever starts ``params``'
+        solve lowest (:meth:`lowest_objective`)."""
         moved = self.retargeted(torque, self.mean_path(torque, planned), planned.goal, params.goal)
-        return self.lowest_objective(moved, params)
+        return self.lowest_objective(moved + self.cold_guesses(params, self.options.n_starts, goal_q), params)
 
     def warm_candidates(self, params: ReachParameters) -> list[np.ndarray]:
         """Starts (H, n) that compete with a warm start to another goal besides its own moves (none here)."""
