@@ -1,7 +1,6 @@
 """Planning for the 7-DOF Panda: plans across the workspace within the joint limits, unreachable goals,
 and the derivatives the Newton method uses (exact gradient and mean sensitivities, approximate Hessian)."""
 
-from dataclasses import replace
 
 import casadi as ca
 import numpy as np

@@ -145,7 +145,7 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
 
 def executed_cost(planner: Planner, run: Execution, width: float | None = None) -> float:
     """J (docs/formulation.md §4) of what a run executed, on the model's steps t_i = i·h, i = 0..H, within it: the
-    discounted reward of the actual hand, at rest on no belief (Sigma = 0), at the goal its replans aimed at then;
+    discounted reward of the actual hand (no covariance: Sigma = 0) for the goal its replans aimed at then;
     the effort of the executed torques, nu Σ_k ||(I + E_k) tau_k||² · (cycle / h) (cycles of any length weigh as
     the model's steps do); and the model's speed cost, if it has one, on the actual velocities. Lower is better;
     two loops compare on the same run length and noise.
