@@ -25,7 +25,8 @@ same problem, in units of the objective's scale |J_best(w)| (the best attainable
 converged loop's own J can be near zero, where a ratio to it says nothing): the mean over the problems of
 (J - J_converged) / |J_best| and the largest (lower is better); reach
 successes (the hand within w of the final goal at the end); every cycle's wall time after the first plan (median, p99,
-largest) and the first plans' (cold, median); the share of cycles flagged 'not_contracting'; and the slowest cycles.
+largest), the wall time per Newton iteration of the cycles that iterated (their set-up included: median) and the first
+plans' (cold, median); the share of cycles flagged 'not_contracting'; and the slowest cycles.
 Wall times are of the machine this runs on, with its load (the 1-minute load average is printed).
 """
 
@@ -100,6 +101,8 @@ class LoopRuns:
     cycle_times: list[np.ndarray] = field(default_factory=list)
     """Per problem, its cycles' wall times after the first plan (s)."""
     first_times: list[float] = field(default_factory=list)
+    iteration_times: list[np.ndarray] = field(default_factory=list)
+    """Per problem, the wall time per Newton iteration (s) of its cycles after the first plan that iterated."""
     flagged: int = 0
     cycles: int = 0
     problems: list[int] = field(default_factory=list)
@@ -149,6 +152,8 @@ def run_preset(preset: str, count: int, rate: float, budget: float | None, progr
             record.successes.append(bool(np.linalg.norm(run.ee[-1] - run.goals[-1]) <= problem.width))
             record.cycle_times.append(run.replan_times[1:])
             record.first_times.append(float(run.replan_times[0]))
+            iterated = run.replan_iterations[1:] > 0
+            record.iteration_times.append(run.replan_times[1:][iterated] / run.replan_iterations[1:][iterated])
             record.flagged += sum(status == Progress.NOT_CONTRACTING for status in run.replan_statuses[1:])
             record.cycles += steps - 1
             record.problems.append(int(index))
@@ -170,6 +175,7 @@ def summary(runs: dict[tuple[str, bool], LoopRuns]) -> dict[tuple[str, bool], di
                             "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(relative),
                             "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
                             "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
+                            "iteration_ms": 1e3 * float(np.median(np.concatenate(record.iteration_times))),
                             "flagged": record.flagged / record.cycles, "cycles": record.cycles,
                             "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
     return out
@@ -187,13 +193,13 @@ def markdown(results: dict[str, dict], kinds: dict[str, str], args) -> str:
              f"0.3 H·h; executed cost minus the converged loop's with the same noise, over |J_best|, the mean over the "
              f"problems and the largest; cycle times after the first plan; 1-minute load average "
              f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores at the end):", "",
-             "| preset | loop | executed cost vs converged (of \\|J_best\\|), mean / largest | reached | cycle median | p99 | largest | first plan (cold), median | flagged 'not_contracting' |",
-             "|---|---|---|---|---|---|---|---|---|"]
+             "| preset | loop | executed cost vs converged (of \\|J_best\\|), mean / largest | reached | cycle median | p99 | largest | per iteration, median | first plan (cold), median | flagged 'not_contracting' |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
     for preset, rows in results.items():
         for key, row in rows.items():
             lines.append(f"| {preset} | {loop_label(key, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
                          f"| {row['successes']}/{row['problems']} | {row['median_ms']:.2f} ms | {row['p99_ms']:.2f} ms "
-                         f"| {row['largest_ms']:.1f} ms | {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
+                         f"| {row['largest_ms']:.1f} ms | {row['iteration_ms']:.2f} ms | {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
     lines += ["", f"Targets: every cycle within the budget at p99 ({', '.join(f'{1e3 * b:g} ms for {PLURALS[k]}' for k, b in BUDGETS.items())}), "
               f"the executed cost with motor noise no more than {100 * COST_TARGET:g} % of |J_best| above the converged loop's, as many "
               f"reaches:", ""]

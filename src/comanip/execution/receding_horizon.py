@@ -55,6 +55,8 @@ class Execution:
     """Wall time of each cycle's replan (K,), s; the first is the loop's first plan, a full solve."""
     replan_statuses: list[str] | None = None
     """Each cycle's :class:`~comanip.optim.Progress` ('converged', 'converging', 'not_contracting'), K of them."""
+    replan_iterations: np.ndarray | None = None
+    """Newton iterations of each cycle's replan (K,)."""
 
     @property
     def ee_speed(self) -> np.ndarray:
@@ -120,13 +122,13 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     states[0] = estimates[0] = start
     estimator = None if observation is None else DelayedKalmanFilter(model, observation, start)
     commanded, executed, goals = np.zeros((steps, n)), np.zeros((steps, n)), np.zeros((steps, model.d))
-    replan_times, statuses = np.zeros(steps), []
+    replan_times, iterations_done, statuses = np.zeros(steps), np.zeros(steps, dtype=int), []
     replan = None
     for k in range(steps):
         goals[k] = next((to for time, to in reversed(jumps) if time <= k * period + 1e-12), goal)
         replan = replanning.first_plan(estimates[k], goals[k], width) if replan is None else \
             replanning.replan(replan, estimates[k], period, goals[k], width)
-        replan_times[k] = replan.wall_time
+        replan_times[k], iterations_done[k] = replan.wall_time, replan.iterations
         statuses.append(str(replan.status))
         commanded[k] = replan.torque[0]
         error = sample_torque_error(commanded[k], model.kappa, model.noise, rng) if noise else 0.0
@@ -140,7 +142,7 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     return Execution(t=period * np.arange(steps + 1), states=states, commanded=commanded, executed=executed,
                      ee=ee, ee_velocity=ee_velocity, failed_replans=sum(status != "converged" for status in statuses),
                      estimates=None if observation is None else estimates, goals=goals, replan_times=replan_times,
-                     replan_statuses=statuses)
+                     replan_statuses=statuses, replan_iterations=iterations_done)
 
 
 def executed_cost(planner: Planner, run: Execution, width: float | None = None) -> float:
