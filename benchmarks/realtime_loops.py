@@ -168,17 +168,22 @@ def summary(runs: dict[tuple[str, bool], LoopRuns]) -> dict[tuple[str, bool], di
     for (name, noise), record in runs.items():
         reference = np.array(runs["converged", noise].costs)
         relative = (np.array(record.costs) - reference) / np.array(record.scales)
-        times = np.concatenate(record.cycle_times)
+        times, per_iteration = np.concatenate(record.cycle_times), np.concatenate(record.iteration_times)
         slowest = sorted(((t, problem, cycle + 1) for problem, cycle_times in zip(record.problems, record.cycle_times)
                           for cycle, t in enumerate(cycle_times)), reverse=True)[:SLOWEST]
         out[name, noise] = {"total": float(relative.mean()),
                             "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(relative),
                             "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
                             "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
-                            "iteration_ms": 1e3 * float(np.median(np.concatenate(record.iteration_times))),
+                            "iteration_ms": 1e3 * float(np.median(per_iteration)) if len(per_iteration) else None,
                             "flagged": record.flagged / record.cycles, "cycles": record.cycles,
                             "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
     return out
+
+
+def per_iteration_text(milliseconds: float | None) -> str:
+    """The time per iteration for the table: a dash for a loop none of whose cycles iterated."""
+    return "–" if milliseconds is None else f"{milliseconds:.2f} ms"
 
 
 def loop_label(key: tuple[str, bool], row: dict) -> str:
@@ -199,7 +204,8 @@ def markdown(results: dict[str, dict], kinds: dict[str, str], args) -> str:
         for key, row in rows.items():
             lines.append(f"| {preset} | {loop_label(key, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
                          f"| {row['successes']}/{row['problems']} | {row['median_ms']:.2f} ms | {row['p99_ms']:.2f} ms "
-                         f"| {row['largest_ms']:.1f} ms | {row['iteration_ms']:.2f} ms | {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
+                         f"| {row['largest_ms']:.1f} ms | {per_iteration_text(row['iteration_ms'])} "
+                         f"| {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
     lines += ["", f"Targets: every cycle within the budget at p99 ({', '.join(f'{1e3 * b:g} ms for {PLURALS[k]}' for k, b in BUDGETS.items())}), "
               f"the executed cost with motor noise no more than {100 * COST_TARGET:g} % of |J_best| above the converged loop's, as many "
               f"reaches:", ""]
