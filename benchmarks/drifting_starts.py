@@ -44,6 +44,8 @@ def chosen_results(planner, params: ReachParameters) -> dict[str, list]:
     solved = solver.results(guesses, params)
     motion = params.start.copy()
     motion[: planner.model.n] = 0.0
+    for reach in starts.stopped_starts(params, starts.stops(motion)):
+        starts.library.fill(reach, bracket=True)
     stopped = solver.results([starts.lowest_objective(starts.stopped_reaches(params, motion, every_optimum=True), params)], params)
     return dict(zip(STRATEGIES, ([solved[k] for k in order], [solved[order[0]]], [solved[k] for k in order[:2]],
                                  [solved[order[0]]] + stopped)))

@@ -51,6 +51,9 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
     "speed-workspace": ("solve times over the sampled workspace sets, this code beside the code before them, taking turns (about 5 min on a quiet machine)",
                         ["benchmarks/solve_times.py", "--markdown", "--repeats", "100", "--compare", "323f41c", "--only",
                          "planar_workspace_cold,planar_workspace_cold_moving,planar_workspace_warm,planar_workspace_warm_moving,cartesian_workspace_cold,cartesian_workspace_cold_moving,cartesian_workspace_warm,cartesian_workspace_warm_moving,human_workspace_cold,human_workspace_cold_moving,human_workspace_warm,human_workspace_warm_moving,human_cartesian_workspace_cold,human_cartesian_workspace_cold_moving,human_cartesian_workspace_warm,human_cartesian_workspace_warm_moving,franka_workspace_cold,franka_workspace_cold_moving,franka_workspace_warm,franka_workspace_warm_moving,franka_rest_workspace_cold,franka_rest_workspace_cold_moving,franka_rest_workspace_warm,franka_rest_workspace_warm_moving"]),
+    "realtime-loops": ("closed loops at 100 Hz replanned on a per-cycle budget against the same loops replanned to convergence, over the workspace sets (about 40 min loaded)",
+                       ["benchmarks/realtime_loops.py", "--markdown", "--presets", "franka_rest,planar,cartesian,human,human_cartesian",
+                        "--problems", "12"]),
     "panda-breakdown": ("where a Panda solve spends its time, piece by piece, beside the code before its functions were built for the processor (about 10 min)",
                         ["studies/where_does_a_panda_solve_spend_its_time/measure_breakdown.py", "--markdown", "--compare", "2400645"]),
     "moving-cold-starts-workspace": ("point-mass cold solves from moving starts over the sampled workspace sets: where the iterations go, and cheaper choices of starts (a minute)",
@@ -112,6 +115,7 @@ PAGES: dict[str, tuple[Path, ...]] = {
     "online-estimation-speed": (RESULTS / "speed.md",),
     "speed-workspace": (RESULTS / "speed.md",),
     "panda-breakdown": (RESULTS / "speed.md",),
+    "realtime-loops": (RESULTS / "speed.md",),
     "moving-cold-starts-workspace": (RESULTS / "speed.md",),
     "moving-cold-starts": (RESULTS / "speed.md",),
 }

@@ -212,10 +212,11 @@ def library_plans(problem: Problem, every: bool) -> list[np.ndarray]:
     nearest entry's best."""
     rest = problem.rest_params()
     library = problem.starts.library
+    library.fill(rest, bracket=every)
     if not every:
-        found = library.guess(rest.start, rest.goal, rest.width)
+        found = library.guess(rest)
         return [] if found is None else [found]
-    plans = library.local_optima(rest.start, rest.goal, rest.width)
+    plans = library.local_optima(rest)
     return plans[PACES.index(1.0)::len(PACES)]
 
 

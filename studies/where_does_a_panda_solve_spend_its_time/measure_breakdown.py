@@ -85,7 +85,7 @@ def instrument(clock: Clock) -> None:
                lambda result: "Cholesky (factored)" if result[1] == 0 else "Cholesky (indefinite attempt)")
     clock.wrap(hessian_models, "symmetric_rank_one_update", "secant update")
     clock.wrap(StartPolicy, "guesses", "starts")
-    clock.wrap(planner_module.Planner, "_goal_joints", "reachability witness")
+    clock.wrap(planner_module.Planner, "goal_joints", "reachability witness")
     clock.wrap(NewtonReachSolver, "make_plan", "building the plan")
     assert active_set_newton  # the loop's own time is the rest of the solve
 

@@ -9,7 +9,7 @@ from comanip.cli.main import main as comanip_main
 from comanip.planning.starts.arm_reach_library import (GRID_SPACING, SHELL, ArmReachLibrary, build_library, bundled_library,
                                                 grid_goals)
 from comanip.planning.starts.initial_guess import minimum_jerk, minimum_jerk_torques
-from comanip.planning.planner import SolverOptions
+from comanip.planning.solver_options import SolverOptions
 
 RELATIVE = 1e-6
 """Objectives of a cold solve from the library and of the full search agree to this (relative)."""

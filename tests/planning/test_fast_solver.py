@@ -10,7 +10,8 @@ import pytest
 
 import comanip
 from comanip.planning.curvature import ReachCurvature
-from comanip.planning.planner import Planner, SolverOptions
+from comanip.planning.planner import Planner
+from comanip.planning.solver_options import SolverOptions
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.reach_parameters import ReachParameters
 

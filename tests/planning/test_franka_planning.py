@@ -1,7 +1,6 @@
 """Planning for the 7-DOF Panda: plans across the workspace within the joint limits, unreachable goals,
 and the derivatives the Newton method uses (exact gradient and mean sensitivities, approximate Hessian)."""
 
-from dataclasses import replace
 
 import casadi as ca
 import numpy as np
@@ -217,7 +216,7 @@ def test_paper_franka_plan_ends_moving(franka_planner):
 def test_starts_solved_side_by_side_give_the_plan_solved_one_after_another(franka_planner, monkeypatch):
     """The paper preset's cold solve runs its three starts on threads; each thread evaluates with its own buffers,
     so the plan, its objective and its iterations are those of the starts solved in turn, bit for bit."""
-    from comanip.planning.planner import SolverOptions
+    from comanip.planning.solver_options import SolverOptions
     from comanip.planning.start_threads import StartThreads
 
     model = franka_planner.model
@@ -250,7 +249,7 @@ def test_a_ranked_cold_search_abandons_starts_a_converged_start_beats():
     """With abandon_after one past the shortest start's iterations, the starts still running then are worse than
     the converged one (all three end on the same optimum here) and are abandoned: fewer iterations than the full
     search, the same plan's objective. 'all' keeps every start to the end whatever abandon_after says."""
-    from comanip.planning.planner import SolverOptions
+    from comanip.planning.solver_options import SolverOptions
     from comanip.planning.reach_parameters import ReachParameters
 
     model = comanip.presets.franka()
@@ -273,7 +272,7 @@ def test_a_ranked_cold_search_abandons_starts_a_converged_start_beats():
 def test_a_ranked_cold_search_leaves_out_the_worst_guess_only_for_a_narrow_goal():
     """Beyond arm_narrow_ratio widths a ranked cold search from rest without a reach library runs every minimum-jerk
     guess but the one of highest objective; nearer, from a moving start, and for 'all', every guess."""
-    from comanip.planning.planner import SolverOptions
+    from comanip.planning.solver_options import SolverOptions
     from comanip.planning.reach_parameters import ReachParameters
 
     model = comanip.presets.franka()
@@ -378,7 +377,7 @@ def test_warm_solve_to_a_nearby_goal_needs_no_inverse_kinematics(franka_rest_pla
     outside = nearby.mean.copy()
     outside[-1, 3] = body.q_min[3] - 0.3  # joint 4 beyond its limit, the goal where that puts the hand
     goal = np.asarray(body.kinematics_function(outside[-1, :7])[0]).ravel()
-    witness = planner._goal_joints(start, goal, 0.05, replace(nearby, mean=outside))
+    witness = planner.goal_joints(ReachParameters(start, goal, 0.05), near=outside[-1, :7])
     assert np.all(witness >= body.q_min) and np.all(witness <= body.q_max)
 
 
@@ -387,7 +386,7 @@ def test_lazy_hessian_reaches_the_optimum_of_eager_assembly(franka_rest_planner,
     """The default solver (Hessian assembled every third iteration, arm tolerance 1e-6) and the Hessian assembled
     at every iteration with tolerance 1e-8 end at the same cold and warm plans: J within 1e-6 relative (measured:
     about 1e-9, studies/which_newton_options_suit_the_arm/compare_solver_options.py) and mean hand paths within 1 mm."""
-    from comanip.planning.planner import SolverOptions
+    from comanip.planning.solver_options import SolverOptions
 
     eager = comanip.Planner(franka_rest_planner.model, SolverOptions(hessian_refresh=1, arm_tolerance=None))
     body = eager.model.body

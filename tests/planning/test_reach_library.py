@@ -6,7 +6,7 @@ import pytest
 
 import comanip
 from comanip.planning.reach_parameters import ReachParameters
-from comanip.planning.planner import SolverOptions
+from comanip.planning.solver_options import SolverOptions
 from comanip.planning.starts.reach_library import is_symmetric, reflection_onto
 
 RELATIVE = 1e-6
@@ -146,9 +146,9 @@ def test_a_retargeted_plan_moves_its_mean_path_by_the_shift(preset):
     plan = planner.solve(start, goal, model.width)
     shift = np.linspace(0.03, -0.02, model.n)
     durations = np.array([12, 20, 0.75 * model.H]) * model.h
-    moved = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, durations)
+    moved = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, durations, linear_dynamics=planner.starts.linear_dynamics)
     for T, torque in zip(durations, moved):
-        alone = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, [T])[0]
+        alone = retargeted_torques(model.body, model.h, model.H, plan.torque, shift, [T], linear_dynamics=planner.starts.linear_dynamics)[0]
         np.testing.assert_allclose(torque, alone, rtol=1e-12, atol=1e-12)
         if not model.activation:  # activation stages lag the move (an initial guess tolerates it)
             trajectory = planner.problem.trajectory(tau=np.ravel(torque), s0=start, goal=goal, width=model.width)
@@ -191,8 +191,10 @@ def test_a_moving_start_is_stopped_where_the_hand_comes_to_rest(preset):
     for velocity in (np.array([0.2, -0.15, 0.1][:n]), np.array([-0.25, 0.05, 0.2][:n])):
         start, goal = np.r_[np.zeros(n), velocity], np.array([0.3, 0.1, 0.0][:n])
         params = ReachParameters(start, goal, model.width)
+        for reach in [params, *starts.stopped_starts(params, starts.stops(start))]:
+            starts.library.fill(reach, bracket=False)
         stopped = starts.stopped_reaches(params, start)
-        at_start = list(starts.library.guess(start, goal, model.width)
+        at_start = list(starts.library.guess(params)
                         + minimum_jerk_torques(model.body, model.h, model.H, start, np.zeros(n), durations, starts.linear_dynamics))
         if preset == "human":
             np.testing.assert_allclose(np.array(stopped), np.array(at_start), rtol=0, atol=1e-12)
@@ -213,7 +215,10 @@ def test_an_undamped_hand_from_a_moving_start_stops_where_a_free_end_stop_comes_
     velocity = np.array([0.2, -0.1])
     start, goal = np.r_[np.zeros(2), velocity], np.array([0.25, 0.05])
     assert planner.starts.damped_drift is None
-    candidates = planner.starts.stopped_reaches(ReachParameters(start, goal, model.width), start)
+    params = ReachParameters(start, goal, model.width)
+    for reach in planner.starts.stopped_starts(params, planner.starts.stops(start)):
+        planner.starts.library.fill(reach, bracket=False)
+    candidates = planner.starts.stopped_reaches(params, start)
     assert len(candidates) == planner.options.n_starts and all(np.all(np.isfinite(c)) for c in candidates)
     for candidate in candidates:
         rollout = planner.problem.trajectory(tau=np.ravel(candidate), s0=start, goal=goal, width=model.width)

@@ -251,10 +251,11 @@ def test_found_by_fuzzing_a_goal_whose_distance_overflows_is_a_value_error(small
 
 
 def test_the_reach_library_skips_a_distance_that_overflows():
+    from comanip.planning.reach_parameters import ReachParameters
     from comanip.planning.starts.reach_library import ReachLibrary
 
     library = ReachLibrary(None, lambda params: pytest.fail("no entry to solve"), 2, 4, 0.02)
-    assert library.guess(np.zeros(4), np.array([0.0, 1.35e154]), 0.02) is None
+    assert library.guess(ReachParameters(np.zeros(4), np.array([0.0, 1.35e154]), 0.02)) is None
 
 
 @pytest.mark.parametrize("h", [1e-300, 1e-5, 2.0, 1e12, math.nan])

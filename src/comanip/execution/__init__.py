@@ -3,6 +3,6 @@ latter from the actual state or from a Kalman estimate made from noisy, delayed 
 
 from comanip.execution.kalman_filter import DelayedKalmanFilter
 from comanip.execution.delayed_observation import Observation
-from comanip.execution.receding_horizon import Execution, execute_receding_horizon
+from comanip.execution.receding_horizon import Execution, execute_receding_horizon, executed_cost
 
-__all__ = ["DelayedKalmanFilter", "Execution", "Observation", "execute_receding_horizon"]
+__all__ = ["DelayedKalmanFilter", "Execution", "Observation", "execute_receding_horizon", "executed_cost"]

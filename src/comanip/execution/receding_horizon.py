@@ -1,11 +1,15 @@
-"""Closed-loop reaching: replan from the noisy state at every step, as a person with visual feedback does.
+"""Closed-loop reaching: replan from the noisy state at every control cycle, as a person with visual feedback does,
+or as a robot's controller does at its own rate.
 
-At step k the planner solves the full H-step problem from the state s_k (warm-started with the previous
-plan shifted by one step); the first torque tau_0 is executed with signal-dependent noise,
-s_{k+1} = f(s_k, (I + E_k) tau_0), E_k drawn as the model's noise form says. The receding window keeps its
-length H, so the person always looks H·h seconds ahead. By default the replan starts from the actual state;
-with an :class:`~comanip.execution.delayed_observation.Observation` it starts from the person's estimate of it,
-made from noisy, delayed measurements by :class:`~comanip.execution.kalman_filter.DelayedKalmanFilter`.
+Every cycle of ``period`` seconds (the model's h by default) the loop replans the full H-step problem from the state
+s_k, starting from the previous plan shifted to the cycle's time (:class:`~comanip.planning.replanner.Replanner`:
+until it converges, or on a budget of Newton iterations or wall time per cycle); the plan's first torque tau_0 is
+executed for the cycle with signal-dependent noise, s_{k+1} = f(s_k, (I + E_k) tau_0) with the forward-Euler step of
+the cycle's length, E_k drawn as the model's noise form says. The receding window keeps its length H, so the person
+always looks H·h seconds ahead. The first plan is a full solve from the start. By default the replan starts from the
+actual state; with an :class:`~comanip.execution.delayed_observation.Observation` it starts from the person's
+estimate of it, made from noisy, delayed measurements by :class:`~comanip.execution.kalman_filter.DelayedKalmanFilter`.
+A goal may jump mid-reach (``goal_jumps``): from then on the replans aim at the new goal.
 """
 
 from __future__ import annotations
@@ -15,15 +19,18 @@ from dataclasses import dataclass
 import casadi as ca
 import numpy as np
 
+from comanip.arguments import as_nonnegative, as_optional_positive, as_position
 from comanip.belief.noise import sample_torque_error
 from comanip.execution.kalman_filter import DelayedKalmanFilter
 from comanip.execution.delayed_observation import Observation
+from comanip.objectives.reach_objective import velocity_cost
 from comanip.planning.planner import Planner
+from comanip.planning.replanner import Replanner, Replanning
 
 
 @dataclass
 class Execution:
-    """One executed reach. Shapes: K executed steps, n degrees of freedom, d task dimensions."""
+    """One executed reach. Shapes: K executed cycles, n degrees of freedom, d task dimensions."""
 
     t: np.ndarray
     """Times (K+1,), s."""
@@ -42,40 +49,71 @@ class Execution:
     estimates: np.ndarray | None = None
     """The person's estimates of the states (K+1, nx), which the replans started from (the last one after
     the final step); None when the replans started from the actual states (no observation model)."""
+    goals: np.ndarray | None = None
+    """The goal each cycle's replan aimed at (K, d), m."""
+    replan_times: np.ndarray | None = None
+    """Wall time of each cycle's replan (K,), s; the first is the loop's first plan, a full solve."""
+    replan_statuses: list[str] | None = None
+    """Each cycle's :class:`~comanip.optim.Progress` ('converged', 'converging', 'not_contracting'), K of them."""
+    replan_iterations: np.ndarray | None = None
+    """Newton iterations of each cycle's replan (K,)."""
 
     @property
     def ee_speed(self) -> np.ndarray:
         return np.linalg.norm(self.ee_velocity, axis=1)
 
 
-def execute_receding_horizon(planner: Planner, start, goal, width: float | None = None, steps: int | None = None,
-                             rng: np.random.Generator | None = None, noise: bool = True,
-                             max_wall_time: float | None = None, observation: Observation | None = None) -> Execution:
-    """Execute a reach in closed loop with replanning every step.
+def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: float | None = None,
+                             steps: int | None = None, rng: np.random.Generator | None = None, noise: bool = True,
+                             max_wall_time: float | None = None, observation: Observation | None = None, *,
+                             iterations: int | None = None, period: float | None = None,
+                             goal_jumps=()) -> Execution:
+    """Execute a reach in closed loop, replanning every cycle.
 
     Args:
-        planner: a built :class:`Planner` (its model sets h, H, kappa and the noise form).
+        planner: a built :class:`Planner` (its model sets h, H, kappa and the noise form), or a replanning of one
+            (a :class:`~comanip.planning.replanner.Replanner`, which then sets the budget).
         start: start state [q; qdot] (2n,) or the full state (nx,); goal: (d,) m; width: m (model default when None).
-        steps: steps to execute (default H).
+        steps: cycles to execute (default: H·h / period, rounded; H for cycles of h).
         rng: random generator for the motor (and sensory) noise (default: a fresh unseeded one).
         noise: False executes the commands exactly (a deterministic closed loop).
-        max_wall_time: budget per replan (s); a late replan still yields its best plan so far.
+        max_wall_time: wall budget per replan (s), every cost of the cycle included; the cycle returns its best plan
+            so far. None: no wall budget.
         observation: an Observation replans from the Kalman estimate made from measurements of [q; qdot] with
-            its noise and delay (the start is known exactly); None uses the model's ``observation``, and replans
-            from the actual state when the model has none. ``Observation(0, 0)`` forces the exact state.
+            its noise and delay (the start is known exactly; cycles of h only); None uses the model's ``observation``,
+            and replans from the actual state when the model has none. ``Observation(0, 0)`` forces the exact state
+            (at any period).
+        iterations: Newton iterations per replan (the real-time iteration: 1 or a few); None, and no
+            ``max_wall_time``: each replan runs until it converges.
+        period: the control cycle (s), h when None; need not be a whole number of model steps (100 Hz on a model of
+            h = 0.035 s is 0.29 of a step).
+        goal_jumps: (time (s), goal (d,)) pairs, in any order: from each time on, the replans aim at that goal (a
+            target that jumps mid-reach).
     """
+    if not isinstance(planner, Planner) and (iterations is not None or max_wall_time is not None):
+        raise ValueError("iterations and max_wall_time go with a Planner; a Replanner has its own budget")
+    replanning = planner if not isinstance(planner, Planner) else Replanner(planner, iterations, max_wall_time)
+    planner = replanning.planner
     model = planner.model
     observation = Observation.of(model) if observation is None else observation
     start, goal, width = planner.check_inputs(start, goal, width)
-    steps = model.H if steps is None else int(steps)
+    period = model.h if period is None else as_optional_positive("period", period, "s")
+    steps = round(model.H * model.h / period) if steps is None else int(steps)
     if steps < 1:
         raise ValueError(f"steps must be ≥ 1, got {steps}")
     if observation is not None and not isinstance(observation, Observation):
         raise ValueError(f"observation must be None or a comanip.execution.Observation, got {type(observation).__name__}")
+    if observation is not None and not np.isclose(period, model.h):
+        if observation.position_std or observation.velocity_std or observation.delay:
+            raise ValueError(f"a noisy or delayed observation needs cycles of the model's step h = {model.h} s, got "
+                             f"period {period} s (Observation(0, 0) replans from the exact state at any period)")
+        observation = None
+    jumps = sorted((as_nonnegative("goal jump time", time, "s"), as_position("goal jump goal", to, model.d))
+                   for time, to in goal_jumps)
     rng = rng if rng is not None else np.random.default_rng()
     body, n = model.body, model.n
     s_sym, tau_sym = ca.SX.sym("s", model.state_size), ca.SX.sym("tau", n)
-    step = ca.Function("step", [s_sym, tau_sym], [body.discrete_step(s_sym, tau_sym, model.h)])
+    step = ca.Function("step", [s_sym, tau_sym], [body.discrete_step(s_sym, tau_sym, period)])
     velocity = ca.Function("ee_velocity", [s_sym], [ca.mtimes(body.jacobian(s_sym[:n]), s_sym[n:2 * n])])
 
     states = np.zeros((steps + 1, model.state_size))
@@ -83,15 +121,16 @@ def execute_receding_horizon(planner: Planner, start, goal, width: float | None 
     estimates = states if observation is None else np.zeros_like(states)
     states[0] = estimates[0] = start
     estimator = None if observation is None else DelayedKalmanFilter(model, observation, start)
-    commanded = np.zeros((steps, n))
-    executed = np.zeros((steps, n))
-    failed = 0
-    plan = None
+    commanded, executed, goals = np.zeros((steps, n)), np.zeros((steps, n)), np.zeros((steps, model.d))
+    replan_times, iterations_done, statuses = np.zeros(steps), np.zeros(steps, dtype=int), []
+    replan = None
     for k in range(steps):
-        warm = None if plan is None else np.vstack([plan.torque[1:], plan.torque[-1:]])
-        plan = planner.solve(estimates[k], goal, width, warm_start=warm, max_wall_time=max_wall_time)
-        failed += not plan.converged
-        commanded[k] = plan.torque[0]
+        goals[k] = next((to for time, to in reversed(jumps) if time <= k * period + 1e-12), goal)
+        replan = replanning.first_plan(estimates[k], goals[k], width) if replan is None else \
+            replanning.replan(replan, estimates[k], period, goals[k], width)
+        replan_times[k], iterations_done[k] = replan.wall_time, replan.iterations
+        statuses.append(str(replan.status))
+        commanded[k] = replan.torque[0]
         error = sample_torque_error(commanded[k], model.kappa, model.noise, rng) if noise else 0.0
         executed[k] = commanded[k] + error
         states[k + 1] = np.asarray(step(states[k], executed[k])).ravel()
@@ -100,6 +139,41 @@ def execute_receding_horizon(planner: Planner, start, goal, width: float | None 
             estimates[k + 1] = estimator.update(commanded[k], seen)
     ee = np.array([np.asarray(body.kinematics_function(s[:n])[0]).ravel() for s in states])
     ee_velocity = np.array([np.asarray(velocity(s)).ravel() for s in states])
-    return Execution(t=model.h * np.arange(steps + 1), states=states, commanded=commanded, executed=executed,
-                     ee=ee, ee_velocity=ee_velocity, failed_replans=failed,
-                     estimates=None if observation is None else estimates)
+    return Execution(t=period * np.arange(steps + 1), states=states, commanded=commanded, executed=executed,
+                     ee=ee, ee_velocity=ee_velocity, failed_replans=sum(status != "converged" for status in statuses),
+                     estimates=None if observation is None else estimates, goals=goals, replan_times=replan_times,
+                     replan_statuses=statuses, replan_iterations=iterations_done)
+
+
+def executed_cost(planner: Planner, run: Execution, width: float | None = None) -> float:
+    """J (docs/formulation.md §4) of what a run executed, on the model's steps t_i = i·h, i = 0..H, within it: the
+    discounted reward of the actual hand (no covariance: Sigma = 0) for the goal its replans aimed at then;
+    the effort of the executed torques, nu Σ_k ||(I + E_k) tau_k||² · (cycle / h) (cycles of any length weigh as
+    the model's steps do); and the model's speed cost, if it has one, on the actual velocities. Lower is better;
+    two loops compare on the same run length and noise.
+
+    Args:
+        planner: the run's planner (its problem's reward, discount weights and |J_best|).
+        run: an :class:`Execution` of :func:`execute_receding_horizon`; width: the goal width w (m), the model's
+            when None.
+    """
+    problem, model = planner.problem, planner.model
+    width = model.width if width is None else width
+    period = float(run.t[1] - run.t[0])
+    times = model.h * np.arange(model.H + 1)
+    times = times[times <= run.t[-1] + 1e-9]
+    hand = np.stack([np.interp(times, run.t, axis) for axis in run.ee.T], axis=1)
+    cycles = np.minimum((times / period + 1e-9).astype(int), len(run.goals) - 1)
+    at_rest = np.zeros((model.d, model.d))
+    reward = sum(-w * problem.reward.expected(x, at_rest, g, width)
+                 for w, x, g in zip(problem.weights, hand, run.goals[cycles]))
+    within = run.t[:-1] < times[-1] - 1e-9
+    effort = model.nu * float(np.sum(np.square(run.executed[within]))) * period / model.h
+    if not model.has_velocity_cost:
+        return float(reward + effort)
+    n = model.n
+    velocities = np.stack([np.interp(times[1:], run.t, column) for column in run.states[:, n:2 * n].T], axis=1)
+    at_rest_velocity = np.zeros((len(velocities), n, n))
+    speed = problem.normaliser(width) * velocity_cost(velocities, at_rest_velocity, model.stop_weight,
+                                                      model.joint_velocity_weight)
+    return float(reward + effort + speed)

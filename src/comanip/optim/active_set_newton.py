@@ -73,7 +73,7 @@ from comanip.optim.hessian_models import ExactHessian, SecantHessian
 from comanip.optim.line_search import Backtracked, backtrack
 from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, never
 from comanip.optim.result import LocalModel, SolverResult
-from comanip.optim.status import Status
+from comanip.optim.status import BUDGET_SPENT, Status
 
 _BACKTRACKS = 30
 """Step lengths tried by one line search."""
@@ -83,7 +83,6 @@ _RECOVERIES = 3
 """Attempts after a failed line search (each with a stronger shift, :mod:`comanip.optim.hessian_models`)."""
 _STALL_WINDOW, _STALL_DECREASE, _STALL_GRADIENT = 5, 1e-8, 1e-4
 """Iterations, relative decrease of f over them, and gradient for the stagnation test."""
-_BUDGET = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
 _NO_STEP = Backtracked(0.0, None)
 """A line search that accepted no step length."""
 
@@ -149,6 +148,12 @@ def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
     return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
 
 
+def _lagrangian_optimality(point: Iterate, working: np.ndarray, multipliers: np.ndarray) -> float:
+    """max |∇f + A_Wᵀ multipliers| at the point, A_W the rows of the working set ``working``."""
+    gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
+    return float(np.abs(gradient).max())
+
+
 @dataclass(slots=True)
 class SQPState:
     """The iterate and what the method remembers between iterations."""
@@ -170,6 +175,12 @@ class SQPState:
     """No constraint in the working set at the iterate."""
     optimality: float = np.inf
     """max |gradient of the Lagrangian| at the iterate, once known."""
+    start_optimality: float = np.nan
+    """``optimality`` at the start point, once known."""
+    working: np.ndarray = field(default_factory=lambda: NO_ROWS)
+    """The working set of the last direction computed."""
+    multipliers: np.ndarray = field(default_factory=lambda: NO_MULTIPLIERS)
+    """The working set's multipliers of the last direction computed."""
     repeat: bool = False
     """The pass retries the iteration (a chord step failed): it is not counted again."""
 
@@ -222,6 +233,8 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         point needs no Hessian (the last iteration of a warm solve)."""
         state.free = state.point.largest <= -self.margin
         state.optimality = state.point.steepest if state.free else np.inf
+        if state.free and np.isnan(state.start_optimality):
+            state.start_optimality = state.optimality
         return self._converged(state) if state.free else None
 
     def direction(self, state: SQPState) -> SQPDirection | Stop:
@@ -240,8 +253,10 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         else:
             step, multipliers, working, correct = constrained_step(solve, point.g, point.c, point.rows, self.margin,
                                                                    self.constraint_tolerance)
-            lagrangian_gradient = point.g + point.rows(working).T @ multipliers if len(working) else point.g
-            state.optimality = float(np.abs(lagrangian_gradient).max())
+            state.optimality = _lagrangian_optimality(point, working, multipliers)
+            if np.isnan(state.start_optimality):
+                state.start_optimality = state.optimality
+        state.working, state.multipliers = working, multipliers
         self.hessians.stepped(factor, state.optimality, state.free)
         if len(multipliers):
             state.merit_weight = max(state.merit_weight, 2 * float(np.max(multipliers)))
@@ -286,10 +301,14 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         return self._final_status(state)
 
     def result(self, state: SQPState, stop: Stop) -> SolverResult[np.ndarray, LocalModel]:
-        point = state.point
-        optimality = np.inf if stop.status in _BUDGET else state.optimality
+        """The result at the iterate. A solve its budget stopped at an iterate with constraints in the working set
+        reports the Lagrangian's gradient there estimated with the last direction's multipliers (the exact ones need
+        the next direction)."""
+        point, optimality = state.point, state.optimality
+        if stop.status in BUDGET_SPENT and not state.free:
+            optimality = _lagrangian_optimality(point, state.working, state.multipliers) if point.g is not None else np.inf
         return SolverResult(point.x, point.f, stop.status, stop.message, state.iterations, optimality, point.violation,
-                            LocalModel(state.stepped_with, point.data))
+                            LocalModel(state.stepped_with, point.data), state.start_optimality)
 
     def _converged(self, state: SQPState) -> Stop | None:
         """A stop when the point is a solution (module docstring, Convergence), else None."""

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Generic, TypeVar
 
@@ -46,6 +47,9 @@ class SolverResult(Generic[X, M]):
     local_model: M | None = None
     """What the solver knows of the objective at and around x, for callers that build on it (the active-set Newton
     method: a :class:`LocalModel`); None when it has nothing."""
+    start_optimality: float = math.nan
+    """``optimality`` at the point the solve started from, where the solver knows it (NaN otherwise): with
+    ``optimality`` it says whether the iterations contracted (:func:`~comanip.optim.progress.progress_of`)."""
 
     @property
     def success(self) -> bool:

@@ -29,3 +29,6 @@ class Status(StrEnum):
 
 CONVERGED = frozenset({Status.SOLVED, Status.SOLVED_ACCEPTABLE})
 """The solver outcomes that count as success."""
+
+BUDGET_SPENT = frozenset({Status.MAX_ITERATIONS, Status.MAX_WALL_TIME})
+"""The solver outcomes of a solve its iteration or time budget stopped."""

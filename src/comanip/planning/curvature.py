@@ -42,8 +42,9 @@ from comanip.planning.terms import GoalDerivatives, ReachTerms
 
 
 class ReachCurvature:
-    """f, its gradient and its Hessian for one model's reaching problem (linear bodies: exact); a
-    :class:`~comanip.planning.terms.Curvature`.
+    """f, its gradient and its Hessian for one model's reaching problem, exact for a linear body (a point mass: the
+    planner's :class:`~comanip.planning.body_kind.PointMass` builds it; an arm's is
+    :class:`~comanip.planning.linearised_curvature.LinearisedCurvature`); a :class:`~comanip.planning.terms.Curvature`.
 
     Parameters p = [s0 (2n,), goal (d,), width] as in the planner; x = tau flattened (H·n,).
 
@@ -68,8 +69,6 @@ class ReachCurvature:
 
     def __init__(self, problem: ReachProblem, compile: bool | None = False):
         model = self.model = problem.model
-        if not model.body.is_linear:
-            raise ValueError(f"ReachCurvature needs a linear body (point mass), got {model.body.name!r}")
         self.problem = problem
         n, d, H = model.n, model.d, model.H
         self.size = n * H

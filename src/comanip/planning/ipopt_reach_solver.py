@@ -18,8 +18,8 @@ class IpoptReachSolver(ReachSolver):
     """IPOPT with CasADi's exact Hessian of the expanded problem, built once; ``SolverOptions.tolerance`` is its
     ``tol`` and ``SolverOptions.ipopt`` its extra options."""
 
-    def __init__(self, problem: ReachProblem, options, blas: SingleThreadBlas):
-        super().__init__(problem, options, blas)
+    def __init__(self, problem: ReachProblem, options, blas: SingleThreadBlas, max_iterations: int):
+        super().__init__(problem, options, blas, max_iterations)
         params = ca.vertcat(problem.s0, problem.goal, problem.width)
         ipopt = {"print_level": 0, "sb": "yes", "max_iter": self.max_iterations, "tol": options.tolerance, **options.ipopt}
         deadline = IpoptDeadline(problem.tau.numel(), params.shape[0])

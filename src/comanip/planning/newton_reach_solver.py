@@ -12,7 +12,6 @@ import numpy as np
 from comanip.optim import CONVERGED, Evaluation, LocalModel, NewtonSolve, SolverResult
 from comanip.optim.active_set_newton import newton_solve
 from comanip.optim.newton_loop import never
-from comanip.planning.curvature import ReachCurvature
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
 from comanip.planning.path_limits import LIMIT_TOLERANCE, PathLimits
@@ -29,20 +28,19 @@ class NewtonReachSolver(ReachSolver):
     """The Newton method on the reach problem's own Hessian terms (:attr:`curvature`).
 
     Args:
-        problem, options, blas: as for :class:`~comanip.planning.reach_solver.ReachSolver`; limits: the joint limits
-            on the mean path.
+        problem, options, blas, max_iterations: as for :class:`~comanip.planning.reach_solver.ReachSolver`; limits: the
+            joint limits on the mean path; curvature: the terms (the body kind's); tolerance: the convergence tolerance
+            on the gradient of the normalised objective; compiles_after_solving: compile the terms in the background
+            once the planner has solved ``options.compile_after`` seconds.
     """
 
-    def __init__(self, problem: ReachProblem, options, blas: SingleThreadBlas, limits: PathLimits):
-        super().__init__(problem, options, blas)
+    def __init__(self, problem: ReachProblem, options, blas: SingleThreadBlas, max_iterations: int, limits: PathLimits,
+                 curvature: Curvature, tolerance: float, compiles_after_solving: bool = False):
+        super().__init__(problem, options, blas, max_iterations)
         model = problem.model
-        self.limits = limits
-        self.curvature = ReachCurvature(problem, compile=options.compile) if model.body.is_linear \
-            else LinearisedCurvature(problem, compile=options.compile is not False)
+        self.limits, self.curvature, self.tolerance = limits, curvature, tolerance
         self.torque_bounds = (np.tile(-model.body.tau_max, model.H), np.tile(model.body.tau_max, model.H))
-        self.tolerance = options.tolerance if model.body.is_linear or options.arm_tolerance is None else options.arm_tolerance
-        """The convergence tolerance: ``arm_tolerance`` for nonlinear bodies, if set."""
-        self._solving_time = 0.0 if options.compile is None and model.body.is_linear else None
+        self._solving_time = 0.0 if compiles_after_solving else None
         threads = min(options.n_starts, usable_cores()) if options.threads is None else options.threads
         self._start_threads = StartThreads(self.curvature, threads) \
             if threads > 1 and isinstance(self.curvature, LinearisedCurvature) else None

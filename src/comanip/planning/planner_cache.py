@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 from comanip.caching.model_cache import ModelCache
-from comanip.planning.planner import Planner, SolverOptions
+from comanip.planning.planner import Planner
+from comanip.planning.solver_options import SolverOptions
 
 
 class PlannerCache(ModelCache[Planner]):

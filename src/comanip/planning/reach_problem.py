@@ -8,6 +8,8 @@ which are parameters is the caller's choice (the estimator makes the goal a deci
 
 from __future__ import annotations
 
+from functools import cached_property
+
 import casadi as ca
 import numpy as np
 
@@ -70,16 +72,20 @@ class ReachProblem:
         # NumPy in and out without CasADi's DM conversions (they cost more than a point mass's rollout itself)
         self._trajectory = BufferedFunction(self.trajectory)
         self._trajectory_outputs = self.trajectory.name_out()
-        # a linear body's plan in one call: the trajectory with the end effector's mean velocity J(mu_q) mu_qdot, every
-        # output column by column in one vector (make_plan slices it)
+        self._ee_belief = BufferedFunction(ee.map(H + 1))
+
+    @cached_property
+    def _plan_rollout(self) -> tuple[BufferedFunction, list[slice]]:
+        """A plan in one call, built on first use (a plan without a belief computed by the solver: a point mass's,
+        whose expanded rollout is cheap): the trajectory with the end effector's mean velocity J(mu_q) mu_qdot, every
+        output column by column in one vector, and the slice of each output in it."""
+        n, body = self.model.n, self.model.body
         rollout = self.trajectory.call([ca.vec(self.tau), self.s0, self.goal, self.width]) \
             + [ca.horzcat(*[ca.mtimes(body.jacobian(m[:n]), m[n:2 * n]) for m in self.means])]
         ends = np.cumsum([0] + [piece.numel() for piece in rollout])
-        self._plan_pieces = [slice(a, b) for a, b in zip(ends[:-1], ends[1:])]
-        self._plan_rollout = BufferedFunction(ca.Function(
-            "plan_rollout", [ca.vec(self.tau), self.s0, self.goal, self.width],
-            [ca.densify(ca.vertcat(*[ca.vec(piece) for piece in rollout]))])) if body.is_linear else None
-        self._ee_belief = BufferedFunction(ee.map(H + 1))
+        function = BufferedFunction(ca.Function("plan_rollout", [ca.vec(self.tau), self.s0, self.goal, self.width],
+                                                [ca.densify(ca.vertcat(*[ca.vec(piece) for piece in rollout]))]))
+        return function, [slice(a, b) for a, b in zip(ends[:-1], ends[1:])]
 
     def normaliser(self, width: float) -> float:
         """|J_best(w)| (> 0) for a goal width w (m): the solvers divide J by it, so their tolerances mean the same
@@ -110,21 +116,17 @@ class ReachProblem:
         start, goal, width = params.start, params.goal, params.width  # the compiled rollouts take them apart
         n2, d, H = model.state_size, model.d, model.H
         torque = np.asarray(torque, dtype=float).reshape(H, model.n)
-        if belief is None and self._plan_rollout is not None:
-            out = self._plan_rollout.vector(np.ravel(torque), start, goal, width)
-            mean, cov, ee_mean, ee_cov, J, ee_velocity = (out[piece] for piece in self._plan_pieces)
+        if belief is None:
+            rollout, pieces = self._plan_rollout
+            out = rollout.vector(np.ravel(torque), start, goal, width)
+            mean, cov, ee_mean, ee_cov, J, ee_velocity = (out[piece] for piece in pieces)
             # (rows, H+1) matrices column by column are their transposes row by row; the covariances' blocks alike
             mean, ee_mean, ee_velocity = mean.reshape(H + 1, n2), ee_mean.reshape(H + 1, d), ee_velocity.reshape(H + 1, d)
             cov, ee_cov = cov.reshape(H + 1, n2, n2).transpose(0, 2, 1), ee_cov.reshape(H + 1, d, d).transpose(0, 2, 1)
         else:
-            if belief is None:
-                rollout = self._rollout(torque, start, goal, width)
-                ee_mean, ee_cov, J = rollout["ee_mean"], rollout["ee_cov"], rollout["J"]
-                mean, cov = rollout["mean"].T, rollout["cov"].reshape(n2, H + 1, n2).transpose(1, 0, 2)
-            else:
-                mean, cov = belief.mean, belief.cov
-                ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
-                J = np.asarray(objective, dtype=float)
+            mean, cov = belief.mean, belief.cov
+            ee_mean, ee_cov = (np.asarray(v) for v in self._ee_belief(mean.T, cov.transpose(1, 0, 2).reshape(n2, -1)))
+            J = np.asarray(objective, dtype=float)
             ee_mean, ee_cov = ee_mean.T, ee_cov.reshape(d, H + 1, d).transpose(1, 0, 2)
             ee_velocity = self._ee_velocity(mean[:, : model.n].T, mean[:, model.n:2 * model.n].T)[0].T
         return Plan(

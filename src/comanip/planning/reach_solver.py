@@ -19,11 +19,11 @@ from comanip.planning.plan import Plan
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
 from comanip.planning.single_thread_blas import SingleThreadBlas
+from comanip.planning.solver_options import SolverOptions
 from comanip.planning.terms import Curvature
 
 if TYPE_CHECKING:
     from comanip.planning.goal_sensitivity import GoalSensitivity
-    from comanip.planning.planner import SolverOptions
 
 
 class Rank(NamedTuple):
@@ -39,28 +39,22 @@ def rank(result: SolverResult) -> Rank:
     return Rank(result.status == Status.CONSTRAINTS_VIOLATED, result.fun)
 
 
-def iteration_limit(problem: ReachProblem, options: SolverOptions) -> int:
-    """The iteration limit per start: ``options.max_iterations``, else the point masses' or the arms' default."""
-    if options.max_iterations is not None:
-        return options.max_iterations
-    return options.point_mass_iterations if problem.model.body.is_linear else options.arm_iterations
-
-
 class ReachSolver(ABC):
     """Solves the reach problem from given starts (torques (H, n)), each result's x the torques (H, n) and fun the
     objective normalised by |J_best(w)|.
 
     Args:
         problem: the reach problem; options: the planner's ``SolverOptions``; blas: the planner's one-thread BLAS
-            context, in which every solve runs.
+            context, in which every solve runs; max_iterations: the iteration limit per start (the body kind's,
+            :meth:`BodyKind.iteration_limit <comanip.planning.body_kind.BodyKind.iteration_limit>`).
     """
 
     curvature: Curvature | None = None
     """The Newton method's objective, gradient and Hessian terms; None where the strategy has none."""
 
-    def __init__(self, problem: ReachProblem, options: SolverOptions, blas: SingleThreadBlas):
+    def __init__(self, problem: ReachProblem, options: SolverOptions, blas: SingleThreadBlas, max_iterations: int):
         self.problem, self.options, self.blas = problem, options, blas
-        self.max_iterations = iteration_limit(problem, options)
+        self.max_iterations = max_iterations
 
     @abstractmethod
     def run(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:

@@ -92,16 +92,15 @@ def minimum_jerk_torques(body: Body, h: float, H: int, start: np.ndarray, goal_q
     (through the body's activation stages, if it has them); for durations (m,), one per duration (m, H, n), to
     goal_q (n,) or to a goal per duration (m, 1, n).
 
-    ``linear_dynamics``: a linear body's constant M and G from :func:`linear_dynamics_of`, evaluated
-    once by a caller that makes many guesses; None evaluates them here."""
+    ``linear_dynamics``: a linear body's constant M and G from :func:`linear_dynamics_of` (its start policy's); None
+    for a nonlinear body, whose M(q) and G(q) are evaluated along the path."""
     durations = np.asarray(duration, dtype=float)
     q, qdot, qddot = _quintic(start[: body.n], start[body.n:2 * body.n], goal_q,
-                              _step_times(tuple(durations.ravel().tolist()), h, H), positions=not body.is_linear)
+                              _step_times(tuple(durations.ravel().tolist()), h, H), positions=linear_dynamics is None)
     if not durations.ndim:
         q, qdot, qddot = None if q is None else q[0], qdot[0], qddot[0]
-    if body.is_linear:  # constant M and G: inverse dynamics of all steps (and durations) at once
-        dynamics = linear_dynamics or linear_dynamics_of(body)
-        force = qddot @ dynamics.mass.T + qdot @ body.damping.T + dynamics.gravity
+    if linear_dynamics is not None:  # constant M and G: inverse dynamics of all steps (and durations) at once
+        force = qddot @ linear_dynamics.mass.T + qdot @ body.damping.T + linear_dynamics.gravity
         return np.array([body.command_for_force(f, h) for f in force]) if force.ndim == 3 else body.command_for_force(force, h)
     if q.ndim == 3:
         return np.array([_arm_torques(body, h, H, *profile) for profile in zip(q, qdot, qddot)])
@@ -144,8 +143,8 @@ def retargeted_torques(body: Body, h: float, H: int, torque: np.ndarray, shift_q
     body (M evaluated along ``mean``, required then) it holds to first order. ``linear_dynamics``: as for
     :func:`minimum_jerk_torques`.
     """
-    if body.is_linear:
-        inertia = np.broadcast_to((linear_dynamics or linear_dynamics_of(body)).mass, (H, body.n, body.n))
+    if linear_dynamics is not None:
+        inertia = np.broadcast_to(linear_dynamics.mass, (H, body.n, body.n))
     elif mean is None:
         raise ValueError(f"retargeting a plan of a nonlinear body ({body.name!r}) needs its mean path")
     else:

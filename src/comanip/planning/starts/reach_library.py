@@ -94,7 +94,7 @@ def is_symmetric(problem: ReachProblem, seed: int = 0) -> bool:
 
 
 class ReachLibrary:
-    """Rest-to-goal reaches of one symmetric point-mass model, solved on demand (module docstring).
+    """Rest-to-goal reaches of one symmetric point-mass model, solved when asked to (:meth:`fill`; module docstring).
 
     An entry keeps every distinct plan its cold search converged to, lowest objective first: past
     ``narrow_ratio`` widths several local optima compete, and which is lowest changes between grid points.
@@ -114,48 +114,61 @@ class ReachLibrary:
         self._entries: dict[tuple[int, int], list[list[np.ndarray]]] = {}
         """Per grid point, its plans (lowest objective first), each at every pace of :data:`PACES`."""
 
-    def guess(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> np.ndarray | None:
-        """Torques (H, n) of the nearest entry's best plan turned towards goal (n,) and scaled to its distance from
+    def guess(self, params: ReachParameters) -> np.ndarray | None:
+        """Torques (H, n) of the nearest entry's best plan turned towards the goal (n,) and scaled to its distance from
         the start's position, for the start at rest there (a moving start adds its own correction); None when the
-        goal is at the start (or its distance overflows), or when the entry is not solved yet and not ``solve_missing``."""
-        found = self._near_entries(start, goal, width, solve_missing, bracket=False)
+        goal is at the start (or its distance overflows), or when the entry is not solved yet (:meth:`fill`)."""
+        found = self._near_entries(params, bracket=False)
         return found[0] if found else None
 
-    def local_optima(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool = True) -> list[np.ndarray]:
+    def local_optima(self, params: ReachParameters) -> list[np.ndarray]:
         """Every plan of the two entries whose D/w bracket the goal's (at the nearest width), turned and scaled as
         :meth:`guess` does, each also run at the other :data:`PACES`: torques (H, n) near each local optimum the
         goal's problem has where several compete. Empty when the goal is at the start, or an entry is not solved
-        yet and not ``solve_missing``."""
-        return self._near_entries(start, goal, width, solve_missing, bracket=True)
+        yet (:meth:`fill`)."""
+        return self._near_entries(params, bracket=True)
 
-    def _near_entries(self, start: np.ndarray, goal: np.ndarray, width: float, solve_missing: bool,
-                      bracket: bool) -> list[np.ndarray]:
-        """The plans (H, n) of the nearest entry (its best only), or of both bracketing entries (all of them, each at
-        every pace of :data:`PACES`), turned and scaled onto the goal; empty as :meth:`local_optima` says."""
-        offset = np.asarray(goal, dtype=float) - start[: self.n]
-        with np.errstate(over="ignore"):
-            distance = float(np.linalg.norm(offset))
-        if not 0.0 < distance < np.inf:  # at the start, or so far that the distance overflows: no entry
-            return []
-        ratio_index = np.log(distance / width) / np.log(GRID_RATIO)
-        width_index = int(np.round(np.log(width / self.width) / np.log(WIDTH_RATIO)))
-        ratio_indices = sorted({int(np.floor(ratio_index)), int(np.ceil(ratio_index))}) if bracket \
-            else [int(np.round(ratio_index))]
-        turn = reflection_onto(offset / distance).T
-        plans = []
-        for key in ((index, width_index) for index in ratio_indices):
-            entry_width = WIDTH_RATIO**key[1] * self.width
-            entry_distance = GRID_RATIO**key[0] * entry_width
+    def fill(self, params: ReachParameters, bracket: bool) -> None:
+        """Solve the entries that :meth:`local_optima` (``bracket``) or :meth:`guess` needs for the reach ``params``
+        and does not have yet, each by the planner's cold search (:func:`distinct_optima`); the lookups never solve."""
+        for key, _ in self._entry_keys(params, bracket):
             if key not in self._entries:
-                if not solve_missing:
-                    return []
-                entry = ReachParameters(np.zeros(self.state_size), entry_distance * np.eye(self.n)[0], entry_width)
+                entry_width = WIDTH_RATIO**key[1] * self.width
+                entry = ReachParameters(np.zeros(self.state_size), GRID_RATIO**key[0] * entry_width * np.eye(self.n)[0],
+                                        entry_width)
                 optima = distinct_optima(self.solver, self.starts, entry)
                 # each plan at every pace, computed once: turning and scaling commute with the change of pace
                 self._entries[key] = [[plan if pace == 1.0 else at_pace(plan, pace) for pace in PACES] for plan in optima]
+
+    def _entry_keys(self, params: ReachParameters, bracket: bool) -> list[tuple[tuple[int, int], float]]:
+        """The grid points (D/w index, width index) of the nearest entry, or of both bracketing entries, for the reach
+        ``params``, each with the goal's distance over the entry's (the plans' scale); empty when the goal is at the
+        start or so far that its distance overflows."""
+        offset = params.goal - params.start[: self.n]
+        with np.errstate(over="ignore"):
+            distance = float(np.linalg.norm(offset))
+        if not 0.0 < distance < np.inf:
+            return []
+        ratio_index = np.log(distance / params.width) / np.log(GRID_RATIO)
+        width_index = int(np.round(np.log(params.width / self.width) / np.log(WIDTH_RATIO)))
+        ratio_indices = sorted({int(np.floor(ratio_index)), int(np.ceil(ratio_index))}) if bracket \
+            else [int(np.round(ratio_index))]
+        return [((index, width_index), distance / (GRID_RATIO**index * WIDTH_RATIO**width_index * self.width))
+                for index in ratio_indices]
+
+    def _near_entries(self, params: ReachParameters, bracket: bool) -> list[np.ndarray]:
+        """The plans (H, n) of the nearest entry (its best only), or of both bracketing entries (all of them, each at
+        every pace of :data:`PACES`), turned and scaled onto the goal; empty as :meth:`local_optima` says."""
+        keys = self._entry_keys(params, bracket)
+        if not keys or any(key not in self._entries for key, _ in keys):
+            return []
+        offset = params.goal - params.start[: self.n]
+        turn = reflection_onto(offset / np.linalg.norm(offset)).T
+        plans = []
+        for key, scale in keys:
             kept = [paced for plan in self._entries[key] for paced in plan] if bracket \
                 else [self._entries[key][0][PACES.index(1.0)]]
-            plans += [(distance / entry_distance) * torque @ turn for torque in kept]
+            plans += [scale * torque @ turn for torque in kept]
         return plans
 
 

@@ -1,0 +1,253 @@
+"""Closed loops at a robot's rate, replanned on a per-cycle budget, against the same loops replanned to convergence.
+
+    .venv/bin/python benchmarks/realtime_loops.py [--presets franka_rest,planar] [--problems 20] [--rate 100] [--markdown]
+
+Problems: ``--problems`` spread evenly over each preset's workspace set (``benchmarks/workspace/<preset>.json``: the
+Panda from its ready pose to goals 0.1–0.3 m away, point masses from the origin to goals 0.05–0.8 m away, widths
+5–50 mm, starts at rest and moving); each problem's goal jumps once, at 30 % of the horizon H·h, by 5 cm (even
+problems) or 20 cm (odd) in a seeded random direction (for an arm, to a goal it reaches). Every loop runs
+1.5·H·h seconds at ``--rate`` Hz, its first plan a full (cold) solve from the start, every later cycle warm from the
+previous plan shifted by the cycle; once with motor noise (the same noise seed for every loop of a problem) and once
+without, where the loops differ by their replanning alone (with noise, one run's cost moves by percents with the
+noise it meets, so the noisy rows compare sums over many problems).
+
+Loops, taking turns problem by problem in one process:
+
+- ``converged``: every cycle's replan runs until it converges (the reference);
+- ``1 iteration``: one Newton iteration per cycle (``Replanner(planner, iterations=1)``);
+- ``budget``: as many iterations as a wall budget per cycle allows, every cost in it (``--budget``: 5 ms for arms,
+  1 ms for point masses);
+- ``full solve, budget``: the code before the real-time replanner, ``Planner.solve`` warm from the shifted plan with
+  ``max_wall_time`` the same budget, its per-solve set-up (the reachability witness, the start policy) in every cycle.
+
+Per preset and loop: the executed cost (:func:`comanip.execution.executed_cost`) against the converged loop's on the
+same problem, in units of the objective's scale |J_best(w)| (the best attainable J, the solver's normaliser; the
+converged loop's own J can be near zero, where a ratio to it says nothing): the mean over the problems of
+(J - J_converged) / |J_best| and the largest (lower is better); reach
+successes (the hand within w of the final goal at the end); every cycle's wall time after the first plan (median, p99,
+largest), the wall time per Newton iteration of the cycles that iterated (their set-up included: median) and the first
+plans' (cold, median); the share of cycles flagged 'not_contracting'; and the slowest cycles.
+Wall times are of the machine this runs on, with its load (the 1-minute load average is printed).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+import comanip
+from comanip.execution import Observation, execute_receding_horizon, executed_cost
+from comanip.optim import Progress
+from comanip.planning.reach_parameters import ReachParameters
+from comanip.planning.replanner import Replan, Replanner, shifted_torques
+from comanip.planning.solver_options import SolverOptions
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import workspace  # noqa: E402  (the sampled problem sets beside this script)
+
+JUMPS = (0.05, 0.2)
+"""Goal jumps (m), alternating over the problems."""
+JUMP_AT = 0.3
+"""When the goal jumps, as a share of the horizon H·h."""
+RUN_LENGTH = 1.5
+"""A loop's duration in horizons H·h."""
+BUDGETS = {"arm": 0.005, "point mass": 0.001}
+"""Default wall budget per cycle (s), and the target of every cycle's p99 wall time."""
+COST_TARGET = 0.001
+"""The target of a real-time loop's executed cost: no more than this above the converged loop's (in units of |J_best|,
+the mean over the problems, with motor noise)."""
+REAL_TIME_LOOPS = ("1 iteration", "budget")
+PLURALS = {"arm": "arms", "point mass": "point masses"}
+SLOWEST = 3
+EXACT_STATE = Observation(0.0, 0.0)
+"""The loops replan from the state itself, as a robot that measures its joints (a model's own observation model, the
+person's delayed sight, is left out)."""
+
+
+class BudgetedFullSolves:
+    """The replanning before :class:`Replanner`: a full warm :meth:`Planner.solve` per cycle from the previous plan
+    shifted to the cycle, with ``max_wall_time``."""
+
+    def __init__(self, planner: comanip.Planner, max_wall_time: float):
+        self.planner, self.max_wall_time = planner, max_wall_time
+
+    def first_plan(self, start, goal, width=None) -> Replan:
+        return Replan.of_plan(self.planner.solve(start, goal, width))
+
+    def replan(self, previous: Replan, state, elapsed: float, goal=None, width=None) -> Replan:
+        began = time.perf_counter()
+        warm = shifted_torques(previous.torque, elapsed / self.planner.model.h)
+        plan = self.planner.solve(state, goal, width, warm_start=warm, max_wall_time=self.max_wall_time)
+        replan = Replan.of_plan(plan, wall_time=time.perf_counter() - began)
+        if not plan.converged:  # a budgeted full solve says nothing of contraction: flagged as not converged
+            replan.status = Progress.NOT_CONTRACTING
+        return replan
+
+
+@dataclass
+class LoopRuns:
+    """One loop's runs over a preset's problems."""
+
+    costs: list[float] = field(default_factory=list)
+    scales: list[float] = field(default_factory=list)
+    """|J_best(w)| of each problem (the objective's scale at its width)."""
+    successes: list[bool] = field(default_factory=list)
+    cycle_times: list[np.ndarray] = field(default_factory=list)
+    """Per problem, its cycles' wall times after the first plan (s)."""
+    first_times: list[float] = field(default_factory=list)
+    iteration_times: list[np.ndarray] = field(default_factory=list)
+    """Per problem, the wall time per Newton iteration (s) of its cycles after the first plan that iterated."""
+    flagged: int = 0
+    cycles: int = 0
+    problems: list[int] = field(default_factory=list)
+    """The workspace set's numbers of the problems."""
+    budget: float | None = None
+    """The wall budget per cycle (s), for the budgeted loops."""
+
+
+def jumped_goal(planner: comanip.Planner, problem, size: float, rng: np.random.Generator) -> np.ndarray:
+    """The problem's goal moved by ``size`` (m) in a random direction; for an arm, one it reaches from the start."""
+    model = planner.model
+    for _ in range(100):
+        direction = rng.normal(size=model.d)
+        goal = problem.goal + size * direction / np.linalg.norm(direction)
+        reach = ReachParameters(problem.start, goal, problem.width)
+        goal_q = planner.goal_joints(reach)
+        if goal_q is None or planner.reaches(goal_q, reach):
+            return goal
+    raise RuntimeError(f"no reachable goal {size} m from {problem.goal}")
+
+
+def run_preset(preset: str, count: int, rate: float, budget: float | None, progress) -> tuple[str, dict[tuple[str, bool], LoopRuns]]:
+    """The preset's kind of body ('arm' or 'point mass') and every loop's runs on its problems, with and without
+    motor noise, keyed by (loop, noise)."""
+    model = comanip.presets.load(preset)
+    planner = comanip.Planner(model, SolverOptions(compile=True))  # a long-lived point-mass planner's compiled terms
+    kind = planner.kind.name
+    budget = BUDGETS[kind] if budget is None else budget
+    problems = workspace.load(preset)
+    chosen = np.unique(np.linspace(0, len(problems) - 1, count).round().astype(int))
+    period = 1.0 / rate
+    steps = round(RUN_LENGTH * model.H * model.h / period)
+    loops = {"converged": Replanner(planner, iterations=None), "1 iteration": Replanner(planner, iterations=1),
+             "budget": Replanner(planner, iterations=None, max_wall_time=budget),
+             "full solve, budget": BudgetedFullSolves(planner, budget)}
+    runs = {(name, noise): LoopRuns(budget=budget if "budget" in name else None) for noise in (True, False) for name in loops}
+    rng = np.random.default_rng(0)
+    for number, index in enumerate(chosen):
+        problem = problems[index]
+        jump = [(JUMP_AT * model.H * model.h, jumped_goal(planner, problem, JUMPS[number % 2], rng))]
+        for (name, noise), record in runs.items():
+            run = execute_receding_horizon(loops[name], problem.start, problem.goal, problem.width, steps=steps,
+                                           rng=np.random.default_rng(int(index)), noise=noise, period=period,
+                                           observation=EXACT_STATE, goal_jumps=jump)
+            record.costs.append(executed_cost(planner, run, problem.width))
+            record.scales.append(planner.problem.normaliser(problem.width))
+            record.successes.append(bool(np.linalg.norm(run.ee[-1] - run.goals[-1]) <= problem.width))
+            record.cycle_times.append(run.replan_times[1:])
+            record.first_times.append(float(run.replan_times[0]))
+            iterated = run.replan_iterations[1:] > 0
+            record.iteration_times.append(run.replan_times[1:][iterated] / run.replan_iterations[1:][iterated])
+            record.flagged += sum(status == Progress.NOT_CONTRACTING for status in run.replan_statuses[1:])
+            record.cycles += steps - 1
+            record.problems.append(int(index))
+        progress(f"{preset} problem {number + 1}/{len(chosen)} (#{index}, {problem.describe()})")
+    return kind, runs
+
+
+def summary(runs: dict[tuple[str, bool], LoopRuns]) -> dict[tuple[str, bool], dict]:
+    """Per loop and noise: costs relative to the converged loop's with the same noise, successes, cycle-time
+    statistics (ms) and the slowest cycles."""
+    out = {}
+    for (name, noise), record in runs.items():
+        reference = np.array(runs["converged", noise].costs)
+        relative = (np.array(record.costs) - reference) / np.array(record.scales)
+        times, per_iteration = np.concatenate(record.cycle_times), np.concatenate(record.iteration_times)
+        slowest = sorted(((t, problem, cycle + 1) for problem, cycle_times in zip(record.problems, record.cycle_times)
+                          for cycle, t in enumerate(cycle_times)), reverse=True)[:SLOWEST]
+        out[name, noise] = {"total": float(relative.mean()),
+                            "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(relative),
+                            "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
+                            "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
+                            "iteration_ms": 1e3 * float(np.median(per_iteration)) if len(per_iteration) else None,
+                            "flagged": record.flagged / record.cycles, "cycles": record.cycles,
+                            "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
+    return out
+
+
+def per_iteration_text(milliseconds: float | None) -> str:
+    """The time per iteration for the table: a dash for a loop none of whose cycles iterated."""
+    return "–" if milliseconds is None else f"{milliseconds:.2f} ms"
+
+
+def loop_label(key: tuple[str, bool], row: dict) -> str:
+    name, noise = key
+    name = f"{name} ({1e3 * row['budget']:g} ms)" if row["budget"] is not None else name
+    return f"{name}, {'motor noise' if noise else 'no noise'}"
+
+
+def markdown(results: dict[str, dict], kinds: dict[str, str], args) -> str:
+    lines = [f"Measured by `benchmarks/realtime_loops.py --markdown --presets {args.presets} --problems {args.problems} "
+             f"--rate {args.rate:g}` ({args.rate:g} Hz loops of 1.5 H·h, each problem's goal jumping by 5 or 20 cm at "
+             f"0.3 H·h; executed cost minus the converged loop's with the same noise, over |J_best|, the mean over the "
+             f"problems and the largest; cycle times after the first plan; 1-minute load average "
+             f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores at the end):", "",
+             "| preset | loop | executed cost vs converged (of \\|J_best\\|), mean / largest | reached | cycle median | p99 | largest | per iteration, median | first plan (cold), median | flagged 'not_contracting' |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for preset, rows in results.items():
+        for key, row in rows.items():
+            lines.append(f"| {preset} | {loop_label(key, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
+                         f"| {row['successes']}/{row['problems']} | {row['median_ms']:.2f} ms | {row['p99_ms']:.2f} ms "
+                         f"| {row['largest_ms']:.1f} ms | {per_iteration_text(row['iteration_ms'])} "
+                         f"| {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
+    lines += ["", f"Targets: every cycle within the budget at p99 ({', '.join(f'{1e3 * b:g} ms for {PLURALS[k]}' for k, b in BUDGETS.items())}), "
+              f"the executed cost with motor noise no more than {100 * COST_TARGET:g} % of |J_best| above the converged loop's, as many "
+              f"reaches:", ""]
+    for preset, rows in results.items():
+        target = BUDGETS[kinds[preset]]
+        for name in REAL_TIME_LOOPS:
+            row, converged = rows[name, True], rows["converged", True]
+            misses = [f"p99 {row['p99_ms']:.2f} ms > {1e3 * target:g} ms" for _ in [0] if row["p99_ms"] > 1e3 * target] + \
+                [f"cost {100 * row['total']:+.3f} %" for _ in [0] if row["total"] > COST_TARGET] + \
+                [f"{row['successes']} reached against {converged['successes']}" for _ in [0]
+                 if row["successes"] < converged["successes"]]
+            lines.append(f"- {preset}, {loop_label((name, True), row).removesuffix(', motor noise')}: "
+                         + ("met" if not misses else "missed: " + "; ".join(misses)))
+    lines += ["", f"The {SLOWEST} slowest cycles of each loop (ms, workspace problem #, cycle):", ""]
+    for preset, rows in results.items():
+        for key, row in rows.items():
+            slow = "; ".join(f"{t:.1f} ms (#{p}, cycle {c})" for t, p, c in row["slowest"])
+            lines.append(f"- {preset}, {loop_label(key, row)}: {slow}")
+    return "\n".join(lines)
+
+
+def main(argv=None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--presets", default="franka_rest,planar,cartesian,human,human_cartesian")
+    parser.add_argument("--problems", type=int, default=20, help="problems per preset, spread over its workspace set")
+    parser.add_argument("--rate", type=float, default=100.0, help="control rate (Hz)")
+    parser.add_argument("--budget", type=float, default=None, help="wall budget per cycle (s); default 5 ms arms, 1 ms point masses")
+    parser.add_argument("--markdown", action="store_true", help="print the speed page's block")
+    args = parser.parse_args(argv)
+    results, kinds = {}, {}
+    for preset in args.presets.split(","):
+        kinds[preset], runs = run_preset(preset, args.problems, args.rate, args.budget,
+                                         lambda text: print(text, file=sys.stderr, flush=True))
+        results[preset] = summary(runs)
+        for key, row in results[preset].items():  # with --markdown on stderr, as progress
+            print(f"{preset:16s} {loop_label(key, row):44s} cost {100 * row['total']:+.3f} % (largest "
+                  f"{100 * row['largest']:+.3f} %) reached {row['successes']}/{row['problems']} cycles "
+                  f"{row['median_ms']:.2f} / {row['p99_ms']:.2f} / {row['largest_ms']:.1f} ms flagged "
+                  f"{100 * row['flagged']:.1f} %", file=sys.stderr if args.markdown else sys.stdout, flush=True)
+    if args.markdown:
+        print(markdown(results, kinds, args))
+
+
+if __name__ == "__main__":
+    main()

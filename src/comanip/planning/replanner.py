@@ -1,0 +1,223 @@
+"""Replanning at a controller's rate: the real-time iteration of model-predictive control on the reach problem.
+
+A control loop replans every cycle from the state it measures. A :class:`Replanner` does it on a budget:
+
+1. the previous plan's torques are moved to the current time (:func:`shifted_torques`: a cycle of any length,
+   not only whole model steps);
+2. from them and the measured state, a fixed number of Newton iterations (``iterations``) or as many as fit a wall
+   budget (``max_wall_time``, every cost of the cycle included: the shift, the checks, the evaluation at the shifted
+   plan and the iterations; an iteration starts only when a recent iteration's time, its 90th percentile, still fits);
+3. the best plan comes back as a :class:`Replan` whose ``status`` says how the iterations stand
+   (:class:`~comanip.optim.Progress`: 'converged', 'converging', 'not_contracting').
+
+What a solve sets up once per planner (the compiled terms, the torque bounds, the joint limits) the replanner
+reuses; what a full solve redoes every time (the start policy's candidates, the reachability witness by inverse
+kinematics) runs here only when the goal moves: the witness from the last one, and the shifted plan competes with
+itself moved onto the new goal and with fresh minimum-jerk reaches to it. The first plan of a loop is a full
+solve (:meth:`Replanner.first_plan`), made before the loop's budget applies. The scheme is that of acados' SQP_RTI
+and of OCS2 and Crocoddyl's model-predictive control: one or a few iterations per cycle from the previous solution,
+so that the iterations converge along the loop rather than within a cycle.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from functools import cached_property
+from typing import Callable, Protocol
+
+import numpy as np
+
+from comanip.arguments import as_count, as_nonnegative, as_optional_positive
+from comanip.optim import Evaluation, Progress, contraction, progress_of
+from comanip.planning.newton_reach_solver import NewtonReachSolver
+from comanip.planning.plan import Plan, PlanStatus, with_reach_check
+from comanip.planning.planner import Planner
+from comanip.planning.reach_parameters import ReachParameters
+
+RECENT_CYCLES = 50
+"""Cycles over which a budgeted replanner remembers its time per Newton iteration."""
+RESERVE_QUANTILE = 0.9
+"""The quantile of the recent times per iteration that a budgeted cycle reserves for its next iteration: the
+longest would let one stalled iteration (the process descheduled) stop the iterations of the next RECENT_CYCLES
+cycles."""
+
+
+def shifted_torques(torque: np.ndarray, steps: float) -> np.ndarray:
+    """A plan's torques (H, n) moved ``steps`` (≥ 0, any fraction) model steps later: the torque over each step is
+    the mean of the plan's piecewise-constant torque over that step moved by steps·h, so the new plan applies
+    from its start what the old one applied from steps·h on; past the old plan's end its last torque holds.
+    Whole steps drop the first ``steps`` rows."""
+    H = len(torque)
+    whole = min(int(np.floor(steps)), H)
+    fraction = steps - whole if whole < H else 0.0
+    padded = np.concatenate([torque, np.repeat(torque[-1:], whole + 1, axis=0)])
+    return (1.0 - fraction) * padded[whole:whole + H] + fraction * padded[whole + 1:whole + 1 + H]
+
+
+@dataclass
+class Replan:
+    """One cycle's plan and how its iterations stand. Shapes: H steps, n degrees of freedom."""
+
+    status: Progress
+    """'converged' (the plan is optimal for the cycle's state), 'converging' (the budget ran out with the first-order
+    optimality lower than at the shifted plan), 'not_contracting' (neither: the budget allowed no iteration, the
+    iterations did not lower the optimality, the solve failed, or the goal is out of reach)."""
+    torque: np.ndarray
+    """The plan's commands tau_i (H, n), N·m (N for point masses); tau_0 is the one to send now."""
+    params: ReachParameters
+    """The cycle's start (the measured state), goal and width."""
+    solver_status: str
+    """The solver's word for how the cycle ended (:class:`~comanip.optim.Status`: 'solved', 'solved_acceptable',
+    'max_iterations', 'max_wall_time', 'failed', ...), or 'unreachable' for a goal out of an arm's reach."""
+    message: str
+    """The solver's status in words."""
+    iterations: int
+    """Newton iterations of the cycle."""
+    wall_time: float
+    """Wall time of the cycle (s): everything from the call to the return."""
+    optimality: float = np.nan
+    """max |gradient of the Lagrangian| of the normalised objective at the plan (NaN where not known)."""
+    start_optimality: float = np.nan
+    """The same at the shifted plan the cycle started from."""
+    goal_q: np.ndarray | None = None
+    """An arm's joint position (n,) within its limits that reaches the goal (the reachability witness); None for point
+    masses."""
+    build_plan: Callable[[], Plan] | None = field(default=None, repr=False, compare=False)
+    """Makes :attr:`plan` on first use (a loop that sends only tau_0 never pays for the belief's rollout)."""
+
+    @property
+    def success(self) -> bool:
+        """True when the cycle's iterations converged or contract."""
+        return self.status in (Progress.CONVERGED, Progress.CONVERGING)
+
+    @property
+    def contraction(self) -> float:
+        """``optimality`` over ``start_optimality`` (< 1: the cycle's iterations contracted; NaN where unknown)."""
+        return contraction(self.start_optimality, self.optimality)
+
+    @cached_property
+    def plan(self) -> Plan:
+        """The cycle's :class:`Plan` (its belief rolled out from the cycle's state; its status the solver's)."""
+        return self.build_plan()
+
+    @classmethod
+    def of_plan(cls, plan: Plan, goal_q: np.ndarray | None = None, wall_time: float | None = None) -> "Replan":
+        """The Replan of a full solve's :class:`Plan` (converged or not by its own status)."""
+        status = Progress.CONVERGED if plan.converged else Progress.NOT_CONTRACTING
+        replan = cls(status, plan.torque, ReachParameters(plan.start, plan.goal, plan.width), plan.status, plan.message,
+                     plan.iterations, plan.solve_time if wall_time is None else wall_time, goal_q=goal_q)
+        replan.plan = plan  # the cached property's value
+        return replan
+
+
+class Replanning(Protocol):
+    """What a control loop asks of its replanning (:func:`comanip.execution.execute_receding_horizon`): the planner,
+    a first plan, and a plan for each cycle from the last one."""
+
+    planner: Planner
+
+    def first_plan(self, start, goal, width: float | None = None) -> Replan:
+        """The loop's first plan from start (nx,) to goal (d,) of width w (m), before any budget applies."""
+
+    def replan(self, previous: Replan, state, elapsed: float, goal=None, width: float | None = None) -> Replan:
+        """The cycle's plan from the measured state (nx,), ``elapsed`` seconds after ``previous`` started."""
+
+
+class Replanner:
+    """Replans a reach of one planner once per control cycle on a budget (module docstring).
+
+    Args:
+        planner: a built :class:`Planner` with the Newton method (``SolverOptions.method="newton"``).
+        iterations: Newton iterations per cycle (≥ 1); None: as many as the wall budget allows, or, without one, until
+            the solve converges (the planner's iteration limit).
+        max_wall_time: wall budget of a cycle (s), every cost included; None: no budget. With both, a cycle stops at
+            whichever comes first.
+
+    >>> replanner = Replanner(comanip.Planner(comanip.presets.load("franka_rest")), iterations=1)
+    >>> replan = replanner.first_plan(start, goal, 0.02)
+    >>> replan = replanner.replan(replan, measured_state, elapsed=0.01)   # every cycle; send replan.torque[0]
+    """
+
+    def __init__(self, planner: Planner, iterations: int | None = 1, max_wall_time: float | None = None):
+        if not isinstance(planner, Planner):
+            raise ValueError(f"planner must be a comanip.Planner, got {type(planner).__name__}")
+        if not isinstance(planner.solver, NewtonReachSolver):
+            raise ValueError(f"real-time replanning runs the Newton method in stages; this planner uses method "
+                             f"{planner.options.method!r}, build it with SolverOptions(method='newton')")
+        self.planner = planner
+        self.iterations = as_count("iterations", iterations, optional=True, unit="Newton iterations")
+        self.max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
+        self._iteration_limit = self.iterations if self.iterations is not None else planner.solver.max_iterations
+        self._iteration_times: list[float] = []
+        """Seconds per Newton iteration of each of the last RECENT_CYCLES budgeted cycles (0 for a cycle without one)."""
+
+    def first_plan(self, start, goal, width: float | None = None) -> Replan:
+        """The loop's first plan: a full solve from start (nx,) to goal (d,) of width w (m; the model's when None)."""
+        plan = self.planner.solve(start, goal, width)
+        goal_q = self.planner.goal_joints(ReachParameters(plan.start, plan.goal, plan.width), near=plan.mean[-1, : self.planner.model.n])
+        return Replan.of_plan(plan, goal_q)
+
+    def replan(self, previous: Replan, state, elapsed: float, goal=None, width: float | None = None) -> Replan:
+        """The cycle's plan from the measured ``state`` (nx,), ``elapsed`` (s, ≥ 0) after ``previous`` started, to
+        ``goal`` (d,, m) of width ``width`` (m); both default to the previous plan's. Never raises for a failed solve:
+        the status says how it went, and the plan is the best the cycle found (the shifted plan at worst)."""
+        began = time.perf_counter()
+        if not isinstance(previous, Replan):
+            raise ValueError(f"previous must be the Replan of the last cycle (first_plan or replan), got {type(previous).__name__}")
+        elapsed = as_nonnegative("elapsed", elapsed, "s")
+        planner, model = self.planner, self.planner.model
+        goal = previous.params.goal if goal is None else goal
+        width = previous.params.width if width is None else width
+        params = ReachParameters(*planner.check_inputs(state, goal, width))
+        guess = shifted_torques(previous.torque, elapsed / model.h)
+        goal_q = previous.goal_q
+        moved = not (np.array_equal(params.goal, previous.params.goal) and params.width == previous.params.width)
+        if goal_q is not None and moved:
+            goal_q = planner.goal_joints(params, near=goal_q)
+            if not planner.reaches(goal_q, params):
+                return self._unreachable(guess, params, goal_q, began)
+        if moved:
+            planned = ReachParameters(params.start, previous.params.goal, previous.params.width)
+            guess = planner.starts.moved_onto_goal(guess, planned, params, goal_q)
+        solver = planner.solver
+        with solver.blas:
+            solve = solver.newton_solve(guess, params, self._deadline(began), solver.curvature)
+            set_up = time.perf_counter()
+            result = solver.finite(solve.advance(self._iteration_limit), guess, params)
+        ended = time.perf_counter()
+        if self.max_wall_time is not None:  # a cycle without iterations counts too, so that old times age out
+            self._iteration_times = [*self._iteration_times[1 - RECENT_CYCLES:], (ended - set_up) / result.nit if result.nit else 0.0]
+        torque = np.reshape(result.x, (model.H, model.n))
+        solver.count_solving_time(ended - began)
+        data = None if result.local_model is None else result.local_model.data
+
+        def build_plan() -> Plan:
+            evaluation = None if data is None else Evaluation(result.fun, None, data)
+            return with_reach_check(solver.make_plan(torque, params, evaluation, status=result.status, success=result.success,
+                                                     message=result.message, solve_time=ended - began, iterations=result.nit))
+
+        return Replan(progress_of(result), torque, params, result.status, result.message, result.nit, ended - began,
+                      result.optimality, result.start_optimality, goal_q, build_plan)
+
+    def _deadline(self, began: float) -> float:
+        """The time (perf_counter, s) after which no Newton iteration starts: the budget's end less the RESERVE_QUANTILE
+        of the recent times per iteration, so that the cycle ends within its budget (inf without a budget)."""
+        if self.max_wall_time is None:
+            return np.inf
+        reserve = float(np.quantile(self._iteration_times, RESERVE_QUANTILE)) if self._iteration_times else 0.0
+        return began + self.max_wall_time - reserve
+
+    def _unreachable(self, guess: np.ndarray, params: ReachParameters, goal_q: np.ndarray, began: float) -> Replan:
+        """The cycle of a goal out of the arm's reach: the shifted plan, status 'not_contracting'."""
+        planner = self.planner
+        message = (f"goal {np.round(params.goal, 4).tolist()} m is out of the {planner.model.body.name}'s reach within its "
+                   f"joint limits (goal width {params.width} m); the shifted plan is kept")
+        wall_time = time.perf_counter() - began
+
+        def build_plan() -> Plan:
+            return planner.solver.make_plan(guess, params, status=PlanStatus.UNREACHABLE, success=False, message=message,
+                                            solve_time=wall_time, iterations=0)
+
+        return Replan(Progress.NOT_CONTRACTING, guess, params, PlanStatus.UNREACHABLE, message, 0, wall_time,
+                      goal_q=goal_q, build_plan=build_plan)

@@ -1,0 +1,111 @@
+"""Replanning on a budget (comanip.planning.replanner): the shift to a cycle's time against the plan it moves, the
+statuses of cycles whose answer is known, and a one-iteration loop's executed cost against the converged loop's."""
+
+import numpy as np
+import pytest
+
+import comanip
+from comanip.execution import execute_receding_horizon, executed_cost
+from comanip.optim import Progress
+from comanip.planning.replanner import Replan, Replanner, shifted_torques
+from comanip.planning.solver_options import SolverOptions
+
+GOAL, WIDTH = np.array([0.3, 0.1]), 0.02
+
+
+def test_a_whole_step_shift_drops_the_first_steps_and_holds_the_last_torque():
+    torque = np.arange(12.0).reshape(6, 2)
+    np.testing.assert_array_equal(shifted_torques(torque, 2.0), np.vstack([torque[2:], torque[-1:], torque[-1:]]))
+    np.testing.assert_array_equal(shifted_torques(torque, 0.0), torque)
+    np.testing.assert_array_equal(shifted_torques(torque, 9.5), np.repeat(torque[-1:], 6, axis=0))
+
+
+def test_a_fractional_shift_is_the_plan_at_the_shifted_time():
+    # torques sampled from a line at the steps' midpoints: the mean over a step moved by 0.3 of a step is the line at
+    # the moved midpoint, and the integral of the shifted plan over its first steps is the old plan's from 0.3 on
+    h, H = 0.02, 8
+    line = lambda t: np.stack([1.0 + 5.0 * t, -2.0 * t], axis=-1)
+    torque = line(h * (np.arange(H) + 0.5))
+    shifted = shifted_torques(torque, 0.3)
+    np.testing.assert_allclose(shifted[:-1], line(h * (np.arange(H - 1) + 0.8)), atol=1e-12)
+    np.testing.assert_allclose(shifted[:-1].sum(axis=0), torque.sum(axis=0) - 0.3 * torque[0] - 0.7 * torque[-1], atol=1e-12)
+
+
+def test_replanning_from_the_optimum_at_its_own_start_is_converged(planar_planner):
+    replanner = Replanner(planar_planner, iterations=1)
+    first = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    again = replanner.replan(first, np.zeros(4), elapsed=0.0)
+    assert first.status is Progress.CONVERGED and again.status is Progress.CONVERGED
+    np.testing.assert_allclose(again.torque, first.torque, atol=1e-6)
+    assert again.plan.success and again.plan.torque.shape == (planar_planner.model.H, 2)
+
+
+def test_one_iteration_from_a_disturbed_state_contracts_and_later_cycles_converge(planar_planner):
+    replanner = Replanner(planar_planner, iterations=1)
+    replan = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    disturbed = np.array([0.001, -0.001, 0.01, 0.005])
+    statuses = []
+    for _ in range(3):  # the same disturbed state every cycle: the iterations converge along the cycles
+        replan = replanner.replan(replan, disturbed, elapsed=0.0)
+        statuses.append(replan.status)
+    assert statuses == [Progress.CONVERGING, Progress.CONVERGING, Progress.CONVERGED]
+    converged = planar_planner.solve(disturbed, GOAL, WIDTH)
+    assert replan.plan.objective == pytest.approx(converged.objective, rel=1e-8)
+
+
+def test_far_from_the_optimum_the_iterations_do_not_contract(planar_planner):
+    # a start moving at 0.1 m/s the plan does not expect: where the shifted plan lies the Hessian is indefinite, the
+    # regularised steps are short, and the gradient grows step after step while the objective falls
+    replanner = Replanner(planar_planner, iterations=1)
+    first = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    pushed = np.array([0.01, -0.01, 0.1, 0.05])
+    once = replanner.replan(first, pushed, elapsed=0.0)
+    twice = replanner.replan(once, pushed, elapsed=0.0)
+    assert once.status is Progress.NOT_CONTRACTING and twice.status is Progress.NOT_CONTRACTING
+    assert once.contraction > 1 and twice.plan.objective < once.plan.objective
+    assert once.plan.objective < planar_planner.problem.objective_value(first.torque, pushed, GOAL, WIDTH)
+
+
+def test_a_one_iteration_loop_costs_what_the_converged_loop_costs(planar_planner):
+    # 100 Hz on h = 0.02 s (half a step per cycle), the goal jumping 5 cm mid-reach, no motor noise: what differs is
+    # the replanning alone (with noise one run's cost moves by percents with the noise it meets)
+    loops = {}
+    for name, iterations in (("converged", None), ("one iteration", 1)):
+        replanner = Replanner(planar_planner, iterations=iterations)
+        run = execute_receding_horizon(replanner, np.zeros(4), GOAL, WIDTH, noise=False, period=0.01, steps=90,
+                                       goal_jumps=[(0.18, GOAL + [0.0, 0.05])])
+        loops[name] = (run, executed_cost(planar_planner, run, WIDTH))
+    (converged, cost), (fast, fast_cost) = loops["converged"], loops["one iteration"]
+    assert converged.replan_statuses[1:] == ["converged"] * (len(converged.replan_statuses) - 1)
+    assert "converging" in fast.replan_statuses and fast.failed_replans > 0
+    assert abs(fast_cost - cost) <= 5e-3 * abs(cost)
+    for run in (converged, fast):
+        np.testing.assert_allclose(run.goals[-1], GOAL + [0.0, 0.05])
+        assert np.linalg.norm(run.ee[-1] - run.goals[-1]) <= 0.5 * WIDTH
+
+
+def test_a_budget_too_small_for_an_iteration_keeps_the_shifted_plan(planar_planner):
+    replanner = Replanner(planar_planner, iterations=None, max_wall_time=1e-9)
+    first = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    late = replanner.replan(first, np.array([0.01, 0.0, 0.2, 0.0]), elapsed=0.01)
+    assert late.iterations == 0 and late.solver_status == "max_wall_time"
+    assert late.status is Progress.NOT_CONTRACTING and not late.success
+    np.testing.assert_allclose(late.torque, shifted_torques(first.torque, 0.5))
+    assert np.isfinite(late.plan.objective)
+
+
+def test_bad_arguments_are_named_before_any_work(planar_planner):
+    ipopt = comanip.Planner(planar_planner.model, SolverOptions(method="ipopt"))
+    with pytest.raises(ValueError, match="method 'ipopt'"):
+        Replanner(ipopt)
+    with pytest.raises(ValueError, match="iterations"):
+        Replanner(planar_planner, iterations=0)
+    replanner = Replanner(planar_planner)
+    first = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    with pytest.raises(ValueError, match="elapsed"):
+        replanner.replan(first, np.zeros(4), elapsed=-0.01)
+    with pytest.raises(ValueError, match="previous must be the Replan"):
+        replanner.replan(first.torque, np.zeros(4), elapsed=0.01)
+    with pytest.raises(ValueError, match="start"):
+        replanner.replan(first, np.zeros(3), elapsed=0.01)
+    assert isinstance(first, Replan)
