@@ -240,7 +240,7 @@ def test_a_budgeted_cold_search_on_threads_returns_its_best_plan_so_far(franka_p
     model = franka_planner.model
     start = np.r_[model.body.home_position, np.zeros(7)]
     goal = np.asarray(model.body.kinematics_function(model.body.home_position)[0]).ravel() + [0.15, 0.1, -0.1]
-    plan = franka_planner.solve(start, goal, max_wall_time=0.05)
+    plan = franka_planner.solve(start, goal, max_wall_time=0.1)   # set-up alone can take most of 50 ms on a loaded machine
     assert plan.status == "max_wall_time" and not plan.success
     assert np.all(np.isfinite(plan.torque)) and np.isfinite(plan.objective) and plan.iterations > 0
 
