@@ -16,9 +16,11 @@ from pathlib import Path
 README = Path(__file__).resolve().parents[1] / "README.md"
 
 CLAIMS = {
-    "tests": re.compile(r"set up and run the tests \(about (?P<value>\d+(?:\.\d+)?) (?P<unit>min|s) on 2 cores"),
+    "tests_cpu": re.compile(r"set up and run the tests \(about (?P<value>\d+(?:\.\d+)?) (?P<unit>min|s) on 2 cores"),
 }
-"""measurement name: the README's statement of it (a number and its unit, min or s)"""
+"""measurement name: the README's statement of it (a number and its unit, min or s). The README states the time
+of its test command on two cores; ``tests_cpu``, the CPU time of that command, is its wall time on an idle two-core
+machine (the suite runs mostly on one core) and, unlike the wall time, does not grow when the machine is shared."""
 
 TOLERANCE = 0.5
 """The largest relative difference between a stated time and its measurement."""

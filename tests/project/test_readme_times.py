@@ -7,16 +7,16 @@ STATED = "# 2. set up and run the tests (about 10 min on 2 cores, compiling incl
 
 
 def test_a_time_within_half_its_measurement_passes_and_one_beyond_fails():
-    assert stated_seconds(STATED, CLAIMS["tests"]) == 600.0
-    assert disagreements(STATED, {"tests": 700.0}) == []
-    assert disagreements(STATED, {"tests": 401.0}) == []
-    [too_slow] = disagreements(STATED, {"tests": 1300.0})
-    [too_fast] = disagreements(STATED, {"tests": 300.0})
+    assert stated_seconds(STATED, CLAIMS["tests_cpu"]) == 600.0
+    assert disagreements(STATED, {"tests_cpu": 700.0}) == []
+    assert disagreements(STATED, {"tests_cpu": 401.0}) == []
+    [too_slow] = disagreements(STATED, {"tests_cpu": 1300.0})
+    [too_fast] = disagreements(STATED, {"tests_cpu": 300.0})
     assert "10.0 min" in too_slow and "21.7 min" in too_slow and "5.0 min" in too_fast
 
 
 def test_a_missing_statement_or_measurement_fails():
-    assert "no longer states" in disagreements("set up and run the tests (quickly)", {"tests": 600.0})[0]
+    assert "no longer states" in disagreements("set up and run the tests (quickly)", {"tests_cpu": 600.0})[0]
     assert "no measurement" in disagreements(STATED, {})[0]
 
 
