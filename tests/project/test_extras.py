@@ -143,3 +143,22 @@ def test_ci_runs_the_readme_test_command_with_the_constraints():
     command = next(line for line in readme.splitlines() if "python -m pytest" in line and line.startswith("python3"))
     assert "-c constraints.txt" in command
     assert command in (ROOT / ".ci" / "run").read_text(encoding="utf-8").splitlines()
+
+
+def test_the_lower_bounds_are_the_oldest_set():
+    """Every lower bound in pyproject.toml (the core and every extra but 'data', whose cursory needs a newer numpy) is
+    the version constraints-oldest.txt pins, the set CI runs the fast tests against."""
+    import re
+    import tomllib
+
+    def name(text: str) -> str:
+        return text.lower().replace("_", "-")
+
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    extras = {extra: specs for extra, specs in project["optional-dependencies"].items() if extra not in ("data", "docs")}
+    bounds = {name(match[1]): match[2] for spec in [*project["dependencies"], *sum(extras.values(), [])]
+              if (match := re.match(r"([A-Za-z0-9_.-]+)(?:\[[^]]*\])?>=([0-9][^,;\s]*)", spec))}
+    oldest = {name(pin): version for pin, version in
+              re.findall(r"^([A-Za-z0-9_.-]+)==(\S+)$", (ROOT / "constraints-oldest.txt").read_text(), re.M)}
+    assert "numpy" in bounds and "mujoco" in bounds
+    assert {package: version for package, version in bounds.items() if oldest.get(package) != version} == {}
