@@ -3,7 +3,7 @@
 
     .venv/bin/python benchmarks/goal_estimation_times.py [--reaches 20] [--only cartesian,planar] [--markdown]
 
-``--markdown`` prints the block ``online-estimation-speed`` of docs/results/speed.md (studies/regenerate_results.py) instead.
+``--markdown`` prints the block ``online-estimation-speed`` of docs/results/speed.md (tools/regenerate_results.py) instead.
 
 Each reach goes from rest to a goal 0.15–0.45 m away in a random direction, sampled from the model's own
 noisy dynamics (open loop) and observed every 10 ms from 10 ms to 0.5 s with the default observation noise

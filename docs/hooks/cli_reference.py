@@ -11,6 +11,7 @@ page is stale (a failure under ``--strict``).
 from __future__ import annotations
 
 import argparse
+import inspect
 import logging
 import re
 import sys
@@ -62,7 +63,8 @@ def parser_markdown(parser: argparse.ArgumentParser, level: int = 2) -> str:
     formatter = parser._get_formatter()
     lines = [f"{'#' * level} `{parser.prog}`", ""]
     if parser.description:
-        lines += ["```text", parser.description.replace("``", "'").strip(), "```", ""]
+        # cleaned as Python 3.13 cleans a docstring at compile time, so that every Python writes the same page
+        lines += ["```text", inspect.cleandoc(parser.description).replace("``", "'").strip(), "```", ""]
     usage = formatter._format_usage(parser.usage, parser._actions, parser._mutually_exclusive_groups, "")
     lines += ["```text", " ".join(usage.split()), "```", ""]
     rows = [action for action in parser._actions

@@ -1,6 +1,6 @@
 """CasADi's structure-exploiting solvers on the Franka reach, multiple shooting over the belief state .
 
-    nice .venv/bin/python studies/are_structured_solvers_faster_on_the_arm_reach/compare_structured_solvers.py [--repeats 10] [--only fatrop,sqp_hpipm,ipopt]
+    nice .venv/bin/python -m studies.are_structured_solvers_faster_on_the_arm_reach.compare_structured_solvers [--repeats 10] [--only fatrop,sqp_hpipm,ipopt]
 
 Notation (docs/formulation.md §2–4): stage state y_k = (mu_k (2n,), vech Sigma_k (n2(n2+1)/2,)), n2 = 2n, control tau_k (n,),
 k = 0..H. The OCP, in the planner's normalised units (J / |J_best(w)|, same minimiser):

@@ -1,6 +1,6 @@
 """Print the results page's block on Peternel & Babič's trends: the shipped transition data and the GP fitted to it.
 
-    PYTHONPATH=src python studies/are_the_published_transition_trends_reproduced/print_transition_trends.py [--data transition.csv]
+    PYTHONPATH=src python -m studies.are_the_published_transition_trends_reproduced.print_transition_trends [--data transition.csv]
 
 The same numbers as ``comanip transition fit`` writes to ``trends.json`` (:func:`comanip.multicomponent.trends.trend_report`),
 as a markdown table.

@@ -2,7 +2,7 @@
 against the presets' mean reaches: when the speed peaks (t_peak / MT), how long a movement of a given
 distance takes (MT against D), and the speed profile normalised in time and amplitude.
 
-    PYTHONPATH=src python studies/do_the_presets_move_like_people/compare.py [--markdown]
+    PYTHONPATH=src python -m studies.do_the_presets_move_like_people.compare [--markdown]
 
 Writes ``speed_profiles.png`` and ``comparison.json`` beside this script; prints the markdown table.
 """

@@ -1,7 +1,7 @@
 """Fit the `people` preset: the `human` preset's motor noise (kappa) and discount (gamma) fitted to recorded
 people's movement times against distance (the cursory development split, arm scale).
 
-    PYTHONPATH=src python studies/do_the_presets_move_like_people/fit_people_preset.py [--out PATH]
+    PYTHONPATH=src python -m studies.do_the_presets_move_like_people.fit_people_preset [--out PATH]
 
 The recordings carry no target width, so every condition takes the human preset's width (an effective
 width); the median movement time of the development movements in four ranges of distance is the table fitted

@@ -1,7 +1,7 @@
 """Do two versions of the code plan the same Panda reaches? Per goal, J, iterations, status and torques of both.
 
-    .venv/bin/python studies/do_two_checkouts_plan_the_same_arm_reaches/compare_checkouts.py --compare REF [--presets franka_rest,franka] [--goals 8]
-    .venv/bin/python studies/do_two_checkouts_plan_the_same_arm_reaches/compare_checkouts.py --compare . --perturb 2.2e-16
+    .venv/bin/python -m studies.do_two_checkouts_plan_the_same_arm_reaches.compare_checkouts --compare REF [--presets franka_rest,franka] [--goals 8]
+    .venv/bin/python -m studies.do_two_checkouts_plan_the_same_arm_reaches.compare_checkouts --compare . --perturb 2.2e-16
 
 Goals as in franka_rest.py (``--goals`` points 0.15–0.3 m from the ready pose in uniformly drawn directions, seed
 0): per goal one cold solve from rest at the ready pose, then one warm solve to the goal moved by up to 5 cm per
@@ -32,8 +32,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 def plans(presets: list[str], goals: int, perturb: float) -> dict:
     """{"preset/goal/cold|warm": {J, iterations, status, torque}} with this process's comanip."""
-    sys.path.insert(0, str(ROOT / "benchmarks"))  # franka_rest.py
-    from franka_rest import goal_offsets
+    from benchmarks.franka_rest import goal_offsets
 
     if perturb:
         from comanip.planning.linearised_curvature import LinearisedCurvature
@@ -59,9 +58,9 @@ def plans(presets: list[str], goals: int, perturb: float) -> dict:
 
 
 def run(src: Path, presets: list[str], goals: int, perturb: float) -> subprocess.Popen:
-    return subprocess.Popen([sys.executable, __file__, "--presets", ",".join(presets), "--goals", str(goals),
+    return subprocess.Popen([sys.executable, "-m", __spec__.name, "--presets", ",".join(presets), "--goals", str(goals),
                              "--perturb", repr(perturb), "--plans"], env={**os.environ, "PYTHONPATH": str(src)},
-                            stdout=subprocess.PIPE, text=True)
+                            cwd=ROOT, stdout=subprocess.PIPE, text=True)
 
 
 def main(argv=None) -> None:

@@ -2,7 +2,7 @@
 open-loop one (a deviation from the plan persists) and a person who corrects (comanip.estimation.
 corrected_deviation: correction time tau, speed-scaled deviations sigma_t). Writes studies/does_a_correcting_person_belief_stop_the_drift/online_drift.md.
 
-    PYTHONPATH=src python studies/does_a_correcting_person_belief_stop_the_drift/measure_online_drift.py [--trials 3]
+    PYTHONPATH=src python -m studies.does_a_correcting_person_belief_stop_the_drift.measure_online_drift [--trials 3]
 
 Prints, per (tau, sigma_t) and goal, the median over the trials of the goal error at t_o, its mean from t_o to
 MT and at the end (mm), and the goal error over time of one trial (far goal, person seed 0).
@@ -62,7 +62,7 @@ def main() -> None:
     finally:
         POLICIES["continuous"] = original
     text = (f"# The continuous goal estimate against a person who corrects\n\n"
-            f"Measured by `PYTHONPATH=src python studies/does_a_correcting_person_belief_stop_the_drift/measure_online_drift.py --trials {args.trials}` "
+            f"Measured by `PYTHONPATH=src python -m studies.does_a_correcting_person_belief_stop_the_drift.measure_online_drift --trials {args.trials}` "
             f"({time.time() - t_begin:.0f} s; sync scenario, person seeds 0–{args.trials - 1}, the continuous policy "
             "with the online estimator's belief set as in the first two columns; "
             "`comanip.estimation.corrected_deviation`). Medians over the trials:\n\n" + "\n".join(lines) +

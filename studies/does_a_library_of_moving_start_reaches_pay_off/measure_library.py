@@ -1,7 +1,7 @@
 """Does a library of solved moving-start reaches pay off for the point masses' cold solves that a start's motion
 carries on? How close its starts come to the full search, and whether it ever fills.
 
-    PYTHONPATH=src python studies/does_a_library_of_moving_start_reaches_pay_off/measure_library.py \
+    PYTHONPATH=src python -m studies.does_a_library_of_moving_start_reaches_pay_off.measure_library \
         [--presets planar,cartesian] [--steps 0.025,0.05,0.1,0.2] [--fresh 400]
 
 A symmetric point mass plans the same reach for every start and goal that an orthogonal map and a shift take onto
@@ -25,8 +25,6 @@ full search twice over before its own.
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -36,9 +34,8 @@ from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_solver import ReachSolver
 from comanip.planning.starts.reach_library import WIDTH_RATIO, distinct_optima
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # the workspace sets
-import workspace  # noqa: E402
-from drifting_starts import spread  # noqa: E402
+from benchmarks import workspace  # noqa: E402  (the workspace sets)
+from benchmarks.drifting_starts import spread  # noqa: E402
 
 GRID_RATIO = 1.15
 """Ratio of successive entries' D/w."""

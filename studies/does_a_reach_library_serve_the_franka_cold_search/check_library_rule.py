@@ -2,7 +2,7 @@
 
     comanip library --preset franka --out /tmp/reach_library_franka.npz                       # ~3 min here
     PYTHONPATH=src .venv/bin/python benchmarks/cold_quality.py --presets franka --problems 200   # the full search
-    PYTHONPATH=src .venv/bin/python studies/does_a_reach_library_serve_the_franka_cold_search/check_library_rule.py /tmp/reach_library_franka.npz \\
+    PYTHONPATH=src .venv/bin/python -m studies.does_a_reach_library_serve_the_franka_cold_search.check_library_rule /tmp/reach_library_franka.npz \\
         benchmarks/results/cold_quality.csv [--strategy library|library+guess]
 
 The rule for cold solves: on ≥ 200 random cold problems (a tenth from moving starts; :func:`cold_quality.arm_problems`),
@@ -24,15 +24,13 @@ from __future__ import annotations
 
 import argparse
 import csv
-import sys
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
 
 import comanip  # noqa: E402
-from cold_quality import arm_problems  # noqa: E402
+from benchmarks.cold_quality import arm_problems  # noqa: E402
 from comanip.planning.planner import Planner, SolverOptions  # noqa: E402
 from comanip.planning.starts import StartPolicy  # noqa: E402
 

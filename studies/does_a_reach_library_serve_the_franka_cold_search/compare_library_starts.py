@@ -1,7 +1,7 @@
 """Cold arm solves from a reach library: would a search cheaper than every minimum-jerk guess match the full one?
 
     .venv/bin/comanip library --preset franka --out /tmp/reach_library_franka.npz   # ~500 s, once
-    .venv/bin/python studies/does_a_reach_library_serve_the_franka_cold_search/compare_library_starts.py --preset franka --library /tmp/reach_library_franka.npz [--problems 40]
+    .venv/bin/python -m studies.does_a_reach_library_serve_the_franka_cold_search.compare_library_starts --preset franka --library /tmp/reach_library_franka.npz [--problems 40]
 
 On cold_quality.py's arm problems, solves from each start separately: the library start (the lowest-objective
 candidate among the nearest entries' plans, their retargeted variants and the minimum-jerk guesses, as
@@ -15,7 +15,6 @@ library start does not end 'solved' at the goal).
 from __future__ import annotations
 
 import argparse
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -27,8 +26,7 @@ from comanip.planning.planner import SolverOptions
 from comanip.planning.reach_solver import rank as _rank
 from comanip.planning.reach_parameters import ReachParameters
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
-from cold_quality import RELATIVE, problems  # noqa: E402
+from benchmarks.cold_quality import RELATIVE, problems  # noqa: E402
 
 
 def main(argv=None) -> None:

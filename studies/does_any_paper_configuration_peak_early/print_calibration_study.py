@@ -1,7 +1,7 @@
 """Print the calibration-study block of docs/results/calibration.md: every configuration of the planar preset's family over the
 Fitts grid, with its t_peak/MT range, movement times, Fitts and Shannon R², and the two verdicts.
 
-    PYTHONPATH=src python studies/does_any_paper_configuration_peak_early/print_calibration_study.py [--workers N] [--seed 0]
+    PYTHONPATH=src python -m studies.does_any_paper_configuration_peak_early.print_calibration_study [--workers N] [--seed 0]
 
 The same study, settings and rows as ``comanip validate`` (full run; ``report.md``, "Calibration study"),
 as a shorter table; the verdicts' definitions are in :mod:`comanip.analysis.calibration`.

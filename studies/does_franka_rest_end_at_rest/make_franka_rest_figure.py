@@ -1,7 +1,7 @@
 """Joint velocities of one Franka reach before and after the speed cost: the paper's ``franka`` preset
 (left) and ``franka_rest`` (right), each solved cold from rest at the ready pose to the same goal.
 
-    PYTHONPATH=src python studies/does_franka_rest_end_at_rest/make_franka_rest_figure.py [--offset 0.15 0.1 -0.1]
+    PYTHONPATH=src python -m studies.does_franka_rest_end_at_rest.make_franka_rest_figure [--offset 0.15 0.1 -0.1]
 
 Writes docs/figures/franka_joint_velocities.png: every joint's mean speed as a fraction of its limit
 (qdot / qdot_max, ±1 dashed), MT (docs/formulation.md §6, the hand has stopped) dotted; prints each plan's largest final joint

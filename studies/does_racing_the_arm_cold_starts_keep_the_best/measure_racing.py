@@ -1,7 +1,7 @@
 """Racing the minimum-jerk starts of an arm's cold solve: would a few Newton iterations from each start pick the
 start the full search would have kept?
 
-    PYTHONPATH=src .venv/bin/python studies/does_racing_the_arm_cold_starts_keep_the_best/measure_racing.py [--preset franka] [--problems 200] [--budgets 2,3,5,8]
+    PYTHONPATH=src .venv/bin/python -m studies.does_racing_the_arm_cold_starts_keep_the_best.measure_racing [--preset franka] [--problems 200] [--budgets 2,3,5,8]
 
 On cold_quality.py's random cold problems of an arm (from the ready pose, every tenth start moving), each
 minimum-jerk start is solved to convergence (the full search, ``cold_search="all"``, keeps the best) and, for
@@ -16,16 +16,14 @@ search's. Writes every problem's row to studies/does_racing_the_arm_cold_starts_
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
 
 import comanip  # noqa: E402
-from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
+from benchmarks.cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
 from comanip.optim import Status  # noqa: E402
 from comanip.planning.planner import SolverOptions  # noqa: E402
 from comanip.planning.reach_parameters import ReachParameters  # noqa: E402

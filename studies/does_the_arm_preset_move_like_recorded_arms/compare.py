@@ -13,7 +13,7 @@ closed-loop executions at their end; Fitts' law of the plans on the validation g
 normalised in time (by MT, from the onset) and amplitude (by the peak), the model over the people's
 10–90 % band.
 
-    PYTHONPATH=src python studies/does_the_arm_preset_move_like_recorded_arms/compare.py [--preset arm] [--figure PATH]
+    PYTHONPATH=src python -m studies.does_the_arm_preset_move_like_recorded_arms.compare [--preset arm] [--figure PATH]
 """
 
 from __future__ import annotations

@@ -1,9 +1,9 @@
 """Where the simulated person's reach turns from the fast sub-movement to the corrective one, against the
 handover's predicted transition T.
 
-    PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py [--trials 20] [--transition-data CSV]
+    PYTHONPATH=src python -m studies.does_the_predicted_handover_match_the_person.measure_handover_transition [--trials 20] [--transition-data CSV]
         [--passive PKL ...]
-    PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py --release [--trials 10]
+    PYTHONPATH=src python -m studies.does_the_predicted_handover_match_the_person.measure_handover_transition --release [--trials 10]
 
 For the near and far goals: the transition distance T the handover predicts (:class:`TransitionModel` on the
 shipped planar data, or on --transition-data, e.g. made by ``comanip transition generate --preset
@@ -80,7 +80,7 @@ def release_table(trials: int, seed: int) -> str:
                          f"{_median_iqr(m['rms_force_N'], 1, 1)}; {_median_iqr(m['rms_force_change_N'], 1, 1)}"])
     table = "\n".join(["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)] +
                       ["| " + " | ".join(row) + " |" for row in rows])
-    command = f"PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py --release --trials {trials}"
+    command = f"PYTHONPATH=src python -m studies.does_the_predicted_handover_match_the_person.measure_handover_transition --release --trials {trials}"
     return (f"{RELEASE_BEGIN}\nMedian [quartiles] over {trials} trials per goal (seeds {seed}–{seed + trials - 1}, the same "
             f"for both triggers); measured by `{command}`.\n\n{table}\n{RELEASE_END}")
 
@@ -135,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
                 "person alone: handle spread peak (m, peak spread)", "person alone: intention spread peak (m)"]
     table = "\n".join(["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)] +
                       ["| " + " | ".join(row) + " |" for row in rows]) + "\n"
-    command = f"PYTHONPATH=src python studies/does_the_predicted_handover_match_the_person/measure_handover_transition.py --trials {args.trials}" + \
+    command = f"PYTHONPATH=src python -m studies.does_the_predicted_handover_match_the_person.measure_handover_transition --trials {args.trials}" + \
               (f" --transition-data {args.transition_data}" if args.transition_data else "")
     text = f"Distances from the goal; measured by `{command}` (seeds {args.seed}–{args.seed + args.trials - 1}).\n\n{table}"
     suffix = "" if args.transition_data is None else "_" + args.transition_data.stem

@@ -20,14 +20,13 @@ people model fitted on the other half of the split (the reaches of the other par
 Printed as a markdown block (progress on stderr): error / D, median, at 25/50/75/90 % of the movement time,
 and each shape fit's misfit (chi² per observed number; the estimator accepts at most 0.05).
 
-    PYTHONPATH=src python studies/does_the_reaching_model_add_to_the_arm_estimate/measure_model_share.py [--limit N]
+    PYTHONPATH=src python -m studies.does_the_reaching_model_add_to_the_arm_estimate.measure_model_share [--limit N]
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -39,8 +38,7 @@ from comanip.estimation.people_model import (FEATURES, KINDS, PeopleModel, _alon
 from comanip.estimation.profile_fit import detected_onset
 from comanip.estimation.reach_profile import ReachProfile
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # arm_reaches.py
-from arm_reaches import streamed_arm_reaches  # noqa: E402
+from studies.arm_reaches import streamed_arm_reaches  # noqa: E402
 
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 BLENDS = (0.1, 0.2, 0.3, 0.5)

@@ -2,8 +2,8 @@
 model on the development split of the cursory mouse recordings, the arm model on the motion-capture arm
 reaches of a TAT-HUM data folder (its development split); never on held-out data.
 
-    PYTHONPATH=src python studies/how_far_beyond_the_hand_do_people_stop/fit_people_model.py --kind mouse
-    PYTHONPATH=src python studies/how_far_beyond_the_hand_do_people_stop/fit_people_model.py --kind arm \
+    PYTHONPATH=src python -m studies.how_far_beyond_the_hand_do_people_stop.fit_people_model --kind mouse
+    PYTHONPATH=src python -m studies.how_far_beyond_the_hand_do_people_stop.fit_people_model --kind arm \
         --arms ../shared/data/arm_reaches/tathum/data_3d
 
 The mouse model needs the data extra (pip install -e ".[data]"); each fit takes about a minute.

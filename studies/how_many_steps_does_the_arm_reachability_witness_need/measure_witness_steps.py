@@ -1,6 +1,6 @@
 """How far a warm Panda solve's reachability witness lands from the goal after 1, 2 and 3 damped least-squares steps.
 
-    .venv/bin/python studies/how_many_steps_does_the_arm_reachability_witness_need/measure_witness_steps.py [--goals 30]
+    .venv/bin/python -m studies.how_many_steps_does_the_arm_reachability_witness_need.measure_witness_steps [--goals 30]
 
 Goals as in solve_times.py's ``franka_rest`` warm row (within ±5 cm per axis of [0.15, 0.1, -0.1] m from the ready
 pose's hand, seed 0), each solved warm from the plan before; per goal the distance (mm) of the previous plan's

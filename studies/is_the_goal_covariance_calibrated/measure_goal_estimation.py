@@ -15,10 +15,10 @@
    the one-shot estimate and the online estimator with the default prior, and of the one-shot estimate with
    the paper's weighting (prior_std="width").
 
-    PYTHONPATH=src python studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py [--reaches 200] [--presets cartesian,planar] [--markdown]
-    PYTHONPATH=src python studies/is_the_goal_covariance_calibrated/measure_goal_estimation.py --belief robot [--reaches 200] [--seed 0]   # only 2.
+    PYTHONPATH=src python -m studies.is_the_goal_covariance_calibrated.measure_goal_estimation [--reaches 200] [--presets cartesian,planar] [--markdown]
+    PYTHONPATH=src python -m studies.is_the_goal_covariance_calibrated.measure_goal_estimation --belief robot [--reaches 200] [--seed 0]   # only 2.
 
-``--markdown`` prints the results page's block ``goal-calibration`` (studies/regenerate_results.py) instead.
+``--markdown`` prints the results page's block ``goal-calibration`` (tools/regenerate_results.py) instead.
 """
 
 from __future__ import annotations

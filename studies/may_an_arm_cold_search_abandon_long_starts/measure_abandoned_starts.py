@@ -1,7 +1,7 @@
 """Abandoning a cold search's long starts: would a start still running after K Newton iterations, beaten by then
 by a start that has converged, have ended best?
 
-    PYTHONPATH=src .venv/bin/python studies/may_an_arm_cold_search_abandon_long_starts/measure_abandoned_starts.py [--preset franka] [--problems 100] [--checkpoints 60,80,100,150]
+    PYTHONPATH=src .venv/bin/python -m studies.may_an_arm_cold_search_abandon_long_starts.measure_abandoned_starts [--preset franka] [--problems 100] [--checkpoints 60,80,100,150]
 
 On cold_quality.py's random cold problems of an arm (from the ready pose, every tenth start moving), each
 minimum-jerk start is solved to the end in stages (``NewtonSolve.advance``), its objective read at every checkpoint
@@ -16,16 +16,14 @@ RULE_CLOSE, RULE_SHARE, RULE_WORST). Writes every start's row to studies/may_an_
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # cold_quality.py
 
 import comanip  # noqa: E402
-from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
+from benchmarks.cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
 from comanip.optim import CONVERGED  # noqa: E402
 from comanip.planning.path_limits import LIMIT_TOLERANCE  # noqa: E402
 from comanip.planning.planner import SolverOptions  # noqa: E402

@@ -1,8 +1,8 @@
 """Leaving out an arm's worst cold guess: would the minimum-jerk start of highest objective, left out of a cold
 search for goals beyond T widths, have ended best?
 
-    PYTHONPATH=src .venv/bin/python studies/may_an_arm_cold_search_leave_out_its_worst_guess/measure_left_out_guess.py [--preset franka] [--problems 200] [--seed 0] [--ratios 0,2,3,4,6,8]
-    PYTHONPATH=src .venv/bin/python studies/may_an_arm_cold_search_leave_out_its_worst_guess/measure_left_out_guess.py --summarise left_out_franka_seed0.csv
+    PYTHONPATH=src .venv/bin/python -m studies.may_an_arm_cold_search_leave_out_its_worst_guess.measure_left_out_guess [--preset franka] [--problems 200] [--seed 0] [--ratios 0,2,3,4,6,8]
+    PYTHONPATH=src .venv/bin/python -m studies.may_an_arm_cold_search_leave_out_its_worst_guess.measure_left_out_guess --summarise left_out_franka_seed0.csv
 
 On cold_quality.py's random cold problems of an arm (from the ready pose, every tenth start moving; goals 0.15–0.3 m
 away, widths 2.5–10 cm), each minimum-jerk start is solved to the end in stages, its objective read at the planner's
@@ -29,14 +29,12 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE.parents[1] / "benchmarks"))  # cold_quality.py
-sys.path.insert(0, str(HERE.parent / "may_an_arm_cold_search_abandon_long_starts"))
 
 import comanip  # noqa: E402
-from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
+from benchmarks.cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, arm_problems, write_rows  # noqa: E402
 from comanip.planning.planner import SolverOptions  # noqa: E402
 from comanip.planning.reach_parameters import ReachParameters  # noqa: E402
-from measure_abandoned_starts import abandoning, staged_starts  # noqa: E402
+from studies.may_an_arm_cold_search_abandon_long_starts.measure_abandoned_starts import abandoning, staged_starts  # noqa: E402
 
 
 def scored(starts: list[dict], leave_out: bool, checkpoint: int) -> tuple[dict, int]:

@@ -12,21 +12,19 @@ other half of the split (the reaches of the other parity).
 Printed as a markdown block (progress on stderr): per time constant, error / D (median) at 25/50/75/90 % of
 the movement time and the share of updates after a quarter of it that move the goal by more than 0.1 D.
 
-    PYTHONPATH=src python studies/what_does_a_smoother_arm_goal_cost/measure_smoothing.py [--limit N]
+    PYTHONPATH=src python -m studies.what_does_a_smoother_arm_goal_cost.measure_smoothing [--limit N]
 """
 
 from __future__ import annotations
 
 import math
 import sys
-from pathlib import Path
 
 import numpy as np
 
 from comanip.estimation.people_model import PeopleModel
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # arm_reaches.py
-from arm_reaches import streamed_arm_reaches  # noqa: E402
+from studies.arm_reaches import streamed_arm_reaches  # noqa: E402
 
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 TIME_CONSTANTS_S = (0.0, 0.008, 0.016, 0.032, 0.064)

@@ -6,7 +6,7 @@ once from the exact state and once from the Kalman estimate made with noisy, del
 the RMS error of the estimated hand position (per run over its steps, then averaged over runs) and the
 wall time of a reach (median; depends on the machine's load).
 
-    PYTHONPATH=src python studies/what_does_noisy_delayed_feedback_cost/measure_feedback.py [--seeds 10] [--markdown]
+    PYTHONPATH=src python -m studies.what_does_noisy_delayed_feedback_cost.measure_feedback [--seeds 10] [--markdown]
 
 ``--markdown`` prints the block ``feedback-cost`` of docs/results/calibration.md instead.
 """

@@ -1,7 +1,7 @@
 """What starts a point mass's cold solve from a start whose motion carries the hand on, as well as the full search
 and in about as few Newton iterations as a warm solve?
 
-    PYTHONPATH=src python studies/what_starts_a_carried_on_cold_solve/measure_starts.py \
+    PYTHONPATH=src python -m studies.what_starts_a_carried_on_cold_solve.measure_starts \
         [--presets planar,cartesian] [--sets workspace,random] [--seed 0] [--problems 200] [--markdown]
 
 A 'ranked' cold solve from a moving start whose stop ends away from the start, to a goal beyond ``narrow_ratio``
@@ -38,7 +38,6 @@ from __future__ import annotations
 import argparse
 import sys
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Callable
 
 import casadi as ca
@@ -50,8 +49,7 @@ from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.starts.initial_guess import minimum_jerk_torques
 from comanip.planning.starts.reach_library import PACES, at_pace
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-from cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, problems, workspace_problems  # noqa: E402
+from benchmarks.cold_quality import RULE_CLOSE, RULE_SHARE, RULE_WORST, problems, workspace_problems  # noqa: E402
 
 SCAN_FRACTIONS = np.linspace(0.15, 0.95, 17)
 """Durations of the scanned minimum-jerk guesses, as fractions of the horizon (the planner's three: 0.25, 0.5,

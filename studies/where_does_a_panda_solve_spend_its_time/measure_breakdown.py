@@ -1,6 +1,6 @@
 """Where does a Panda solve spend its time? Per Newton iteration and per solve, piece by piece, on the workspace sets.
 
-    PYTHONPATH=src .venv/bin/python studies/where_does_a_panda_solve_spend_its_time/measure_breakdown.py [--problems 45] [--compare REF] [--markdown]
+    PYTHONPATH=src .venv/bin/python -m studies.where_does_a_panda_solve_spend_its_time.measure_breakdown [--problems 45] [--compare REF] [--markdown]
 
 The sampled sets of ``benchmarks/workspace.py`` (starts at rest): ``franka_rest`` warm (the plan to the problem's
 goal, untimed, then the solve to its warm goal from it) and cold, and the paper's ``franka`` cold with its starts
@@ -93,11 +93,10 @@ def instrument(clock: Clock) -> None:
 def measure(preset: str, kind: str, count: int) -> dict:
     """The case's median solve time (ms), median iterations, total iterations and solve time (s), and per piece its
     calls and seconds."""
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import workspace
     from threadpoolctl import threadpool_limits
 
     import comanip
+    from benchmarks import workspace
     from comanip.planning.planner import SolverOptions
 
     model = comanip.presets.load(preset)
@@ -185,8 +184,8 @@ def markdown(rows: dict, references: dict, command: str) -> str:
 
 def measured_elsewhere(src: Path, preset: str, kind: str, count: int) -> dict:
     """measure(...) in a fresh process importing comanip from ``src``."""
-    done = subprocess.run([sys.executable, __file__, "--row", preset, kind, "--problems", str(count)],
-                          env={**os.environ, "PYTHONPATH": str(src)}, check=True, capture_output=True, text=True)
+    done = subprocess.run([sys.executable, "-m", __spec__.name, "--row", preset, kind, "--problems", str(count)],
+                          env={**os.environ, "PYTHONPATH": str(src)}, cwd=ROOT, check=True, capture_output=True, text=True)
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
@@ -201,8 +200,7 @@ def main(argv=None) -> None:
     if args.row is not None:
         print(json.dumps(measure(*args.row, args.problems)))
         return
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    from solve_times import reference_source
+    from benchmarks.solve_times import reference_source
 
     reference, clean_up = reference_source(args.compare) if args.compare else (None, lambda: None)
     rows, references = {}, {}

@@ -1,6 +1,6 @@
 """How many Newton iterations would a Panda solve take with the exact Hessian instead of the planner's approximation?
 
-    PYTHONPATH=src .venv/bin/python studies/where_does_a_panda_solve_spend_its_time/measure_exact_newton.py [--problems 3] [--cold]
+    PYTHONPATH=src .venv/bin/python -m studies.where_does_a_panda_solve_spend_its_time.measure_exact_newton [--problems 3] [--cold]
 
 On the first problems of the ``franka_rest`` workspace set (benchmarks/workspace.py, starts at rest): the planner's
 start for the warm solve (the plan to the problem's goal, then its start for the warm goal) or, with ``--cold``, for
@@ -13,7 +13,6 @@ Prints per problem both iteration counts, objectives and statuses, and the time 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 
@@ -27,10 +26,8 @@ def main(argv=None) -> None:
     parser.add_argument("--problems", type=int, default=3)
     parser.add_argument("--cold", action="store_true", help="the cold solves' starts instead of the warm ones'")
     args = parser.parse_args(argv)
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    import workspace
-
     import comanip
+    from benchmarks import workspace
     from comanip.optim.active_set_newton import newton_minimize
     from comanip.planning.path_limits import LIMIT_TOLERANCE
     from comanip.planning.planner import SolverOptions

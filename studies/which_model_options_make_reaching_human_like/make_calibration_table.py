@@ -1,7 +1,7 @@
-"""Print the human-likeness block of docs/results/calibration.md from a fresh measurement (``studies/regenerate_results.py
+"""Print the human-likeness block of docs/results/calibration.md from a fresh measurement (``tools/regenerate_results.py
 human-targets`` puts it on its results page).
 
-    PYTHONPATH=src python studies/which_model_options_make_reaching_human_like/make_calibration_table.py [PRESET ...] [--samples 2000] [--seed 0] [--trials 20]
+    PYTHONPATH=src python -m studies.which_model_options_make_reaching_human_like.make_calibration_table [PRESET ...] [--samples 2000] [--seed 0] [--trials 20]
 
 Scores each preset (a built-in name or a model YAML; default: ``human`` when that preset exists, then
 ``planar``) on the human-likeness targets (:func:`comanip.analysis.measure_human_targets`, the grid

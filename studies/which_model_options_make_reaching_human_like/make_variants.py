@@ -1,7 +1,7 @@
 """Write the one-option variants of the ``human`` preset that the trade-off table of docs/results/calibration.md scores
 (studies/which_model_options_make_reaching_human_like/variants/*.yaml), so that every configuration in it can be rebuilt and rerun.
 
-    PYTHONPATH=src python studies/which_model_options_make_reaching_human_like/make_variants.py
+    PYTHONPATH=src python -m studies.which_model_options_make_reaching_human_like.make_variants
 
 Each variant is ``human`` planned open loop (its ``observation`` removed: the variants show what each option
 does to the plan a robot predicts) with one change.

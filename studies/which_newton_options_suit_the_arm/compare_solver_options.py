@@ -1,6 +1,6 @@
 """How the arm's Newton options trade solve time against the plan: ``hessian_refresh`` and ``arm_tolerance``.
 
-    .venv/bin/python studies/which_newton_options_suit_the_arm/compare_solver_options.py [--goals 16] [--preset franka_rest]
+    .venv/bin/python -m studies.which_newton_options_suit_the_arm.compare_solver_options [--goals 16] [--preset franka_rest]
         [--variants "1,1e-8 3,1e-8 1,1e-6 3,1e-6 3,1e-5"]
 
 Problems as in studies/do_two_checkouts_plan_the_same_arm_reaches/compare_checkouts.py (``--goals`` points 0.15–0.3 m from the ready pose in uniformly drawn
@@ -17,16 +17,13 @@ largest distance (mm) between the two plans' mean hand positions at the same ste
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
 
 import numpy as np
 
 import comanip
 from comanip.planning.planner import SolverOptions
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))  # franka_rest.py
-from franka_rest import goal_offsets  # noqa: E402
+from benchmarks.franka_rest import goal_offsets  # noqa: E402
 
 
 def counting_planner(model, refresh: int, tolerance: float) -> tuple[comanip.Planner, list]:

@@ -1,7 +1,7 @@
 """Print the people-comparison block of docs/results/policy_comparison.md: the robot policies on the sync scenario
-with simulated people who are not the model (``studies/regenerate_results.py policy-people`` puts it on its page).
+with simulated people who are not the model (``tools/regenerate_results.py policy-people`` puts it on its page).
 
-    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py [--trials 10] [--seed 0]
+    PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison [--trials 10] [--seed 0]
 
 Needs the mouse recordings (``pip install -e ".[data]"``) and the motion-capture arm reaches (a TAT-HUM data
 folder, ``--arm-reaches``; default ``../shared/data/arm_reaches/tathum/data_3d`` beside the clone). On a busy machine the people can run in separate processes
@@ -42,8 +42,8 @@ from comanip.simulation.policies import POLICIES  # noqa: E402
 from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE, compare_with_people, people_rows, people_table  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from make_policy_comparison import GOALS, add_run_arguments, load_runs, save_run  # noqa: E402  (a sibling script, not a package)
+from studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison import (  # noqa: E402
+    GOALS, add_run_arguments, load_runs, save_run)
 
 ARM_REACHES = HERE.parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
 
@@ -108,7 +108,7 @@ def main(argv: list[str] | None = None) -> int:
     more_work = [row for row in rows if row.get("work_above")]
     above_passive = [row for row in rows if "passive" in row.get("work_above", [])]
     presets_text = "; ".join(f"{label}: `{preset}`" for label, preset in ONLINE_PRESETS.items() if label in results)
-    block = (f"Measured by `PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py "
+    block = (f"Measured by `PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison "
              f"--trials {trials} --seed {seed}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
              f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; the continuous policy's estimator "
              f"preset: `cartesian`{'; ' + presets_text if presets_text else ''}; {wall / 60:.0f} min of simulation, "

@@ -1,13 +1,13 @@
 """Print the robot-policy comparison block of docs/results/policy_comparison.md (sync scenario) from a fresh simulation
-(``studies/regenerate_results.py policy-comparison`` puts it on its results page).
+(``tools/regenerate_results.py policy-comparison`` puts it on its results page).
 
-    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py [--trials 20] [--seed 0]
+    PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison [--trials 20] [--seed 0]
 
 On a busy machine the goals can run in separate processes and be merged afterwards:
 
-    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --goals near,far --save /tmp/a.pkl
-    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --goals right,high --save /tmp/b.pkl
-    PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --load /tmp/a.pkl /tmp/b.pkl
+    PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison --goals near,far --save /tmp/a.pkl
+    PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison --goals right,high --save /tmp/b.pkl
+    PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison --load /tmp/a.pkl /tmp/b.pkl
 
 (--policies re-runs some policies only; a later pickle's runs replace an earlier one's for the same goal and policy.)
 
@@ -116,7 +116,7 @@ def main(argv: list[str] | None = None) -> int:
     files = write_comparison(rows, DOCS / "policy_comparison_sync")
     figure = plot_policy_comparison(results, DOCS.parents[1] / "docs" / "figures" / "policy_comparison_sync.png")
     goals = "; ".join(f"{label} {np.round(s.goal, 2).tolist()}" for label, s in settings.items())
-    block = (f"Measured by `PYTHONPATH=src python studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py --trials {trials} --seed {seed}` "
+    block = (f"Measured by `PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison --trials {trials} --seed {seed}` "
              f"({trials} trials per goal and policy, person seeds {seed}–{seed + trials - 1} for every "
              f"policy; goals (m): {goals}; prior goal {list(next(iter(settings.values())).prior_goal)} m; "
              f"{wall / 60:.0f} min of simulation on the shared, loaded 2-core machine). Each cell: median [q25, q75] over "

@@ -1,6 +1,6 @@
 """Why the continuous goal estimate lags in the middle of a sync reach: writes studies/why_does_the_online_estimate_lag_mid_reach/online_lag.md.
 
-    PYTHONPATH=src python studies/why_does_the_online_estimate_lag_mid_reach/measure_online_lag.py [--trials 5] [--seed 20]
+    PYTHONPATH=src python -m studies.why_does_the_online_estimate_lag_mid_reach.measure_online_lag [--trials 5] [--seed 20]
 
 Runs the constant-velocity and continuous robots on the sync scenario's four goals (``--trials`` person seeds
 from ``--seed``; by default seeds the README's table does not use), then prints, as medians over the trials:
@@ -99,7 +99,7 @@ def main() -> None:
     model = setup.model
     planner = OnlineGoalEstimator(model, np.zeros(model.state_size)).planner
     out = ["# Why the continuous goal estimate lags mid-reach\n",
-           f"Measured by `PYTHONPATH=src python studies/why_does_the_online_estimate_lag_mid_reach/measure_online_lag.py --trials {args.trials} --seed {args.seed}` "
+           f"Measured by `PYTHONPATH=src python -m studies.why_does_the_online_estimate_lag_mid_reach.measure_online_lag --trials {args.trials} --seed {args.seed}` "
            f"(sync scenario, person seeds {args.seed}–{args.seed + args.trials - 1}, medians over the trials; "
            "{wall} s).\n"]
     for label, by_policy in results.items():

@@ -7,13 +7,12 @@ updates after a quarter of the movement in which it says it explains the hand (a
 the model at its own pace with its misfit and timing checks, the model at the person's pace with its misfit
 and settling checks). Printed as a markdown block (progress on stderr).
 
-    PYTHONPATH=src python studies/why_does_the_reaching_model_not_explain_arm_reaches/measure_explanations.py [--limit N]
+    PYTHONPATH=src python -m studies.why_does_the_reaching_model_not_explain_arm_reaches.measure_explanations [--limit N]
 """
 
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 
@@ -23,8 +22,7 @@ from comanip.estimation.explanations import Explained, HandAtRest, ModelAtOwnPac
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.people_model import shipped_people_model
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # arm_reaches.py
-from arm_reaches import streamed_arm_reaches  # noqa: E402
+from studies.arm_reaches import streamed_arm_reaches  # noqa: E402
 
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 

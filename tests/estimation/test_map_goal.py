@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 import scipy.optimize
 
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation_whitening import ObservationWhitening
 from comanip.estimation.reach_family import ReachFamily
@@ -95,3 +96,28 @@ def test_map_newton_finds_the_minimum_a_search_of_minus_log_p_finds(family, rng)
     assert result.fun <= search.fun + 1e-9
     for shift in 1e-3 * np.r_[np.eye(2), -np.eye(2)]:
         assert objective(result.x + shift) > result.fun
+
+
+def test_map_newton_says_when_its_goal_is_the_end_of_the_familys_range(family):
+    """Observations of a reach to a goal beyond the family's largest distance: the MAP goal stops at the range's end
+    and says so (status at_range_end, no success); to a goal inside the range it does not."""
+    far = TRUE_GOAL * (1.5 * family.distances[-1] / np.linalg.norm(TRUE_GOAL))
+    problem, whitening = _problem(family, prior_std=10.0)
+    start = np.zeros(2)
+    weights = np.eye(family.H + 1)[STEPS]
+    beyond = MapProblem(family, problem.predict, start, problem.prior_mean, problem.prior_precision, STEPS,
+                        weights @ _stretched_mean(family, start, far)[:, :problem.m], weights)
+    result = MapNewton(beyond, whitening, tolerance=1e-10, step_fraction=0.5, width=WIDTH).solve(TRUE_GOAL, 50)
+    assert result.status == EstimateStatus.AT_RANGE_END and not result.success
+    assert np.linalg.norm(result.x) == pytest.approx(family.distances[-1], rel=1e-6)
+    inside = MapNewton(problem, whitening, tolerance=1e-10, step_fraction=0.5, width=WIDTH).solve(TRUE_GOAL, 50)
+    assert inside.status != EstimateStatus.AT_RANGE_END and inside.success
+
+
+def _stretched_mean(family, start, goal):
+    """The mean of the family's plan to the range's end on ``goal``'s direction, its positions and velocities scaled
+    out to ``goal``: a hand moving farther than any plan of the family."""
+    end = goal * (family.distances[-1] / np.linalg.norm(goal))
+    mean = family.prediction(start, end, order=0, covariance=False).mean.copy()
+    mean[:, :2 * family.n] *= np.linalg.norm(goal) / family.distances[-1]
+    return mean

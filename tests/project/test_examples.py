@@ -20,6 +20,7 @@ ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples"
 SCRIPTS = sorted(path for path in EXAMPLES.glob("*.py") if not path.name.startswith("_"))
 NEEDS_ROS = {"ros_node_replay.py"}
+NEEDS_DATA = {"predict_recorded_reaches.py"}
 
 
 def test_there_are_five_to_eight_examples():
@@ -30,6 +31,8 @@ def test_there_are_five_to_eight_examples():
 def test_example_runs_and_saves_its_figure(script, tmp_path):
     if script.name in NEEDS_ROS and importlib.util.find_spec("rclpy") is None:
         pytest.skip("needs the ros extra (pip install -e '.[ros]')")
+    if script.name in NEEDS_DATA and importlib.util.find_spec("cursory") is None:
+        pytest.skip("needs the data extra (pip install -e '.[data]')")
     env = {**os.environ, "COMANIP_EXAMPLES_SMALL": "1", "COMANIP_EXAMPLES_OUT": str(tmp_path), "MPLBACKEND": "Agg",
            "PYTHONPATH": os.pathsep.join(filter(None, [str(ROOT / "src"), os.environ.get("PYTHONPATH")]))}
     run = subprocess.run([sys.executable, str(script)], cwd=tmp_path, env=env, capture_output=True, text=True,

@@ -7,16 +7,31 @@ some directions, so rounding that differs between processors (BLAS kernels) move
 objective stays equal to 1e-9 (planar: 1.6e-5 of their size; the paper Panda preset's last warm steps, in a
 flat valley: 2.4e-4). Iteration counts may fall, and rise by at
 most a tenth (the same rounding changes the Panda's cold path: 174 instead of 169 iterations on one processor).
+Those tolerances hold for the tested versions of the numerical libraries (constraints.txt); with others (the oldest
+supported set, constraints-oldest.txt) their own rounding moves the converged points further, and objectives, goals
+and probabilities agree to 1e-6.
 """
 
 import importlib.util
+import re
+from importlib import metadata
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 DATA = Path(__file__).parents[1] / "data"
-TOLERANCE = 1e-9
+NUMERICAL_LIBRARIES = ("numpy", "scipy", "casadi")
+"""The libraries whose rounding the stored results were made with."""
+
+
+def _tested_versions() -> bool:
+    """Whether :data:`NUMERICAL_LIBRARIES` are installed at the versions constraints.txt pins."""
+    pins = dict(re.findall(r"^([A-Za-z0-9_.-]+)==(\S+)$", (DATA.parents[1] / "constraints.txt").read_text(), re.M))
+    return all(metadata.version(name) == pins[name] for name in NUMERICAL_LIBRARIES)
+
+
+TOLERANCE = 1e-9 if _tested_versions() else 1e-6
 TORQUE_TOLERANCE = 1e-3
 
 

@@ -18,7 +18,7 @@ w is the goal radius and ID = log2(2D/w) (bits).
 from __future__ import annotations
 
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.stats import linregress
@@ -29,7 +29,7 @@ from comanip.analysis.fitts import FittsFit, fit_fitts, index_of_difficulty
 from comanip.analysis.minimum_jerk_baseline import minimum_jerk_speed_fraction
 from comanip.analysis.profile_shape import profile_shape
 from comanip.analysis.reach_grid import ReachOutcome, open_loop_grid
-from comanip.analysis.target_verdicts import HumanTargets, TargetVerdict, target_verdicts
+from comanip.analysis.target_verdicts import ConditionTargets, HumanTargets, TargetVerdict, target_verdicts
 from comanip.model import ReachingModel
 from comanip.planning.planner import Planner
 
@@ -37,54 +37,6 @@ TARGET_DISTANCES = (0.15, 0.3, 0.45)
 """The grid of the targets: distances D (m)."""
 TARGET_WIDTHS = (0.005, 0.01, 0.02, 0.04)
 """... and goal radii w (m)."""
-
-
-@dataclass(frozen=True)
-class ConditionTargets:
-    """Every number of one condition the targets use. Lengths in m, times in s, ratios dimensionless."""
-
-    distance: float
-    width: float
-    """Goal radius w."""
-    index_of_difficulty: float
-    """log2(2D/w), bits."""
-    movement_time: float
-    """docs/formulation.md §6 MT (NaN when the reach never settles)."""
-    t_peak: float
-    asymmetry: float
-    """t_peak/MT."""
-    peak_speed: float
-    """m/s."""
-    peak_speed_ratio: float
-    """Peak speed / (D/MT)."""
-    onset: float
-    """Speed at the targets' onset time over the peak speed."""
-    onset_minimum_jerk: float
-    """The same for the minimum-jerk reach with this MT (a reference: small only for slow reaches)."""
-    peaks: int
-    reversal: float
-    """Most negative along-path velocity over the peak speed."""
-    end_speed: float
-    """Speed at the end of the horizon over the peak speed."""
-    endpoint_time: float
-    """Time of the step at which the hand is scored (s)."""
-    hit_rate_closed_form: float
-    hit_rate_monte_carlo: float
-    sd_along: float
-    """Monte Carlo SD of the hand along the reach at endpoint_time (m)."""
-    sd_across: float
-    """Monte Carlo SD across the reach (m)."""
-    sd_along_predicted: float
-    """Closed-form SD along the reach (m)."""
-    sd_across_predicted: float
-    """Closed-form SD across the reach (m)."""
-    samples: int
-    """Monte Carlo executions."""
-    success: bool
-    """The plan's solve converged."""
-
-    def to_dict(self) -> dict:
-        return asdict(self)
 
 
 @dataclass(frozen=True)

@@ -19,14 +19,59 @@ Every plan must also have converged and settled (finite MT); that check is liste
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass
-from typing import TYPE_CHECKING, Callable
+from typing import Callable
 
 import numpy as np
 
 from comanip.analysis.fitts import FittsFit
 
-if TYPE_CHECKING:
-    from comanip.analysis.human_targets import ConditionTargets
+
+@dataclass(frozen=True)
+class ConditionTargets:
+    """Every number of one condition the targets use. Lengths in m, times in s, ratios dimensionless."""
+
+    distance: float
+    width: float
+    """Goal radius w."""
+    index_of_difficulty: float
+    """log2(2D/w), bits."""
+    movement_time: float
+    """docs/formulation.md §6 MT (NaN when the reach never settles)."""
+    t_peak: float
+    asymmetry: float
+    """t_peak/MT."""
+    peak_speed: float
+    """m/s."""
+    peak_speed_ratio: float
+    """Peak speed / (D/MT)."""
+    onset: float
+    """Speed at the targets' onset time over the peak speed."""
+    onset_minimum_jerk: float
+    """The same for the minimum-jerk reach with this MT (a reference: small only for slow reaches)."""
+    peaks: int
+    reversal: float
+    """Most negative along-path velocity over the peak speed."""
+    end_speed: float
+    """Speed at the end of the horizon over the peak speed."""
+    endpoint_time: float
+    """Time of the step at which the hand is scored (s)."""
+    hit_rate_closed_form: float
+    hit_rate_monte_carlo: float
+    sd_along: float
+    """Monte Carlo SD of the hand along the reach at endpoint_time (m)."""
+    sd_across: float
+    """Monte Carlo SD across the reach (m)."""
+    sd_along_predicted: float
+    """Closed-form SD along the reach (m)."""
+    sd_across_predicted: float
+    """Closed-form SD across the reach (m)."""
+    samples: int
+    """Monte Carlo executions."""
+    success: bool
+    """The plan's solve converged."""
+
+    def to_dict(self) -> dict:
+        return asdict(self)
 
 
 @dataclass(frozen=True)

@@ -24,7 +24,6 @@ and a compiler still running when Python exits is stopped and its scratch folder
 from __future__ import annotations
 
 import atexit
-import functools
 import hashlib
 import os
 import shlex
@@ -42,7 +41,7 @@ from typing import Callable
 import casadi as ca
 
 from comanip.caching.module_imports import PACKAGE, import_closure, module_files, names_imported_from
-from comanip.caching.process_caches import PROCESS_CACHES
+from comanip.caching.process_caches import PROCESS_CACHES, memoised
 from comanip.progress import elapsed
 
 COMPILE_FLAGS = ("-O1", "-fPIC", "-shared")
@@ -141,7 +140,7 @@ def _flags(for_this_processor: bool) -> list[str]:
     return [*PROCESSOR_FLAGS, f"-DCOMANIP_PROCESSOR={processor}"]
 
 
-@functools.lru_cache(maxsize=1)
+@memoised(maxsize=1)
 def _processor() -> str | None:
     """A fingerprint of what ``-march=native`` means to the compiler here: the processor it names and the instruction
     sets it enables (a virtual machine may hide some of a processor's); None where the compiler does not say (then
@@ -172,7 +171,7 @@ def compiling_modules(package: Path = PACKAGE) -> set[str]:
             if __name__ in path.read_text() and set(BUILDERS) & names_imported_from(path, __name__)}
 
 
-@functools.lru_cache(maxsize=4)
+@memoised(maxsize=4)
 def _source_fingerprint(package: Path = PACKAGE) -> str:
     """SHA-256 of the source of :func:`compiling_modules` and every module they import in ``package``, and of the
     versions of :data:`FUNCTION_SOURCES` (a changed formulation or library is a changed fingerprint): editing a

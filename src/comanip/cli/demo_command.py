@@ -17,7 +17,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.extras import missing
 

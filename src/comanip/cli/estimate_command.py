@@ -16,7 +16,7 @@ import json
 import numpy as np
 
 from comanip.arguments import as_optional_positive, as_vector
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import (add_bag_arguments, add_model_arguments, add_reach_arguments, add_unit_check_argument,
                                  input_file_or_bag, load_model, vector)
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest

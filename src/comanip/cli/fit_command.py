@@ -5,7 +5,7 @@ per condition (least squares); write fit.json (values, standard errors, residual
 from __future__ import annotations
 
 from comanip.arguments import as_count
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import (add_bag_arguments, add_model_arguments, add_unit_check_argument, input_file,
                                  input_file_or_folder, load_model, scheduler_address)
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest

@@ -14,7 +14,7 @@ import warnings
 import numpy as np
 
 from comanip.arguments import as_optional_positive, as_positive
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import add_model_arguments, input_file, load_model, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, point_text, report, warn, write_manifest
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments, plan_handover

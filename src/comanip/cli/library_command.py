@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import add_model_arguments, load_model
 from comanip.planning.starts.arm_reach_library import FILE_PREFIX, GRID_SPACING, SHELL, build_library, grid_goals
 from comanip.planning.planner import Planner, SolverOptions

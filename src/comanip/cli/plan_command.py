@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import add_model_arguments, add_reach_arguments, load_model, vector
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 

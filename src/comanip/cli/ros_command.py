@@ -13,7 +13,7 @@ from __future__ import annotations
 import argparse
 
 from comanip.arguments import as_positive
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import add_bag_arguments, add_unit_check_argument, input_file, input_file_or_bag
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.extras import missing

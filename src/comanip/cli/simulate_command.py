@@ -13,7 +13,7 @@ import json
 from dataclasses import dataclass
 from pathlib import Path
 
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 
 

@@ -17,7 +17,7 @@ import sys
 import time
 from pathlib import Path
 
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import add_model_arguments, input_file, load_model, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.multicomponent.transition_csv import read_transition_metadata, shipped_dataset_path, write_transition_csv

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from comanip.cli.commands import command_help
+from comanip.cli.command_help import command_help
 from comanip.cli.options import add_model_arguments, load_model
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 

@@ -16,6 +16,9 @@ class EstimateStatus(StrEnum):
     PEOPLE_MODEL = "people_model"
     """A goal estimate from the model fitted to recorded people (:mod:`comanip.estimation.people_model`): the
     reaching model at its own pace does not explain the observed hand."""
+    AT_RANGE_END = "at_range_end"
+    """The online MAP goal sits at the largest distance its reach family covers: the observations point farther
+    than the model's plans reach, so the goal found is the range's end, not a solution."""
     PLANS_NOT_CONVERGED = "plans_not_converged"
     """A goal posterior some of whose candidates' plans did not converge."""
 

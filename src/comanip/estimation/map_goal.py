@@ -22,6 +22,7 @@ from typing import Callable
 
 import numpy as np
 
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.estimation.observation_whitening import ObservationWhitening
 from comanip.estimation.reach_family import ReachFamily, ReachPrediction
 from comanip.optim import CholeskyFactor, SolverResult, Status, backtrack, shifted_cholesky
@@ -282,7 +283,7 @@ class MapNewton(NewtonMethod[MapState, np.ndarray]):
         distance the estimate is not a solution."""
         state.goal = self.problem.projected(state.goal + state.terms.step)
         if self.problem.at_range_end(state.goal):
-            return Stop(Status.MAX_ITERATIONS, self.problem.range_message())
+            return Stop(EstimateStatus.AT_RANGE_END, self.problem.range_message())
         return stop
 
     def direction(self, state: MapState) -> np.ndarray:
@@ -311,13 +312,16 @@ class MapNewton(NewtonMethod[MapState, np.ndarray]):
     def recover(self, state: MapState, step: np.ndarray) -> Stop:
         """No step lowers -log p: converged to rounding when the decrement is that small, else failed."""
         if self.problem.at_range_end(state.goal):
-            return Stop(Status.MAX_ITERATIONS, self.problem.range_message())
+            return Stop(EstimateStatus.AT_RANGE_END, self.problem.range_message())
         decrement = state.terms.decrement
         if decrement <= ACCEPTABLE_DECREMENT * max(1.0, abs(state.terms.objective)):
             return Stop(Status.SOLVED_ACCEPTABLE, f"no Newton step lowers the objective any more (decrement {decrement:.2g})")
         return Stop(Status.FAILED, f"no Newton step lowers the objective, though it predicts a decrease of {decrement:.2g}")
 
     def result(self, state: MapState, stop: Stop) -> SolverResult[np.ndarray, MapTerms]:
+        """The goal found; a budget run out with the goal at the family's largest distance is that range's end."""
+        if stop.status == Status.MAX_ITERATIONS and self.problem.at_range_end(state.goal):
+            stop = Stop(EstimateStatus.AT_RANGE_END, self.problem.range_message())
         return SolverResult(state.goal, state.terms.objective, stop.status, stop.message, state.iterations,
                             float(np.abs(state.terms.descent).max()), local_model=state.terms)
 

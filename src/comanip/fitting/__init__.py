@@ -7,10 +7,10 @@ from importlib import import_module
 _EXPORTS = {"fit_model": "comanip.fitting.fit", "recordings_nll": "comanip.fitting.fit",
             "fit_movement_times": "comanip.fitting.movement_times", "MovementTimeTable": "comanip.fitting.movement_times",
             "Trial": "comanip.recordings.trial_files", "load_recordings": "comanip.recordings.trial_files",
-            "FitResult": "comanip.fitting.fit_result"}
+            "FitResult": "comanip.fitting.fit_result", "FitStatus": "comanip.fitting.fit_result"}
 """the public names and their modules, imported on first use (the CLI reads DEFAULT_PARAMETERS without scipy)"""
 
-__all__ = ["fit_model", "recordings_nll", "fit_movement_times", "MovementTimeTable", "Trial", "load_recordings", "FitResult"]
+__all__ = ["fit_model", "recordings_nll", "fit_movement_times", "MovementTimeTable", "Trial", "load_recordings", "FitResult", "FitStatus"]
 
 
 def __getattr__(name: str):

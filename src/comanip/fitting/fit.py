@@ -25,7 +25,7 @@ from comanip.fitting.parameters import DEFAULT_PARAMETERS, ParameterSpace
 from comanip.recordings.trial_files import Trial, load_recordings
 from comanip.fitting.residuals import condition_curves, condition_residuals, trial_residuals
 from comanip.fitting.evaluation_progress import ProgressBar
-from comanip.fitting.fit_result import FitResult, failed_result, fitted_model, identification, outcome_message
+from comanip.fitting.fit_result import FitResult, FitStatus, failed_result, fitted_model, identification, outcome_message
 from comanip.fitting.uncertainty import curvature
 from comanip.model import ReachingModel
 
@@ -88,9 +88,9 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
     unidentified = identification(values, space.start_values, std_errors, sum(row["samples_used"] for row in trial_rows))
     message = outcome_message(message, bounded, unidentified)
     if unidentified:
-        status = "unidentified"
+        status = FitStatus.UNIDENTIFIED
     return FitResult(
-        success=status == "converged" and all(plan.converged for plan in plans), status=status,
+        success=status == FitStatus.CONVERGED and all(plan.converged for plan in plans), status=status,
         message=message, model=fitted, values=values, initial_values=space.start_values, std_errors=std_errors,
         laplace_std_errors=space.natural_std_errors(u, spread.laplace_std(), bounded),
         objective=objective(u), objective_kind=NLL_KIND, evaluations=objective.evaluations,
@@ -143,7 +143,7 @@ def unconstrained_by_bounds(objective, space: ParameterSpace, u) -> list[str]:
     return names
 
 
-def _minimise(objective, space: ParameterSpace, max_evaluations: int) -> tuple[np.ndarray, str, str]:
+def _minimise(objective, space: ParameterSpace, max_evaluations: int) -> tuple[np.ndarray, FitStatus, str]:
     """Bounded Nelder-Mead from the start values: (best u, status 'converged' or 'max_evaluations', SciPy's
     message when it did not converge, else "")."""
     u0 = space.initial
@@ -156,5 +156,5 @@ def _minimise(objective, space: ParameterSpace, max_evaluations: int) -> tuple[n
         simplex.append(vertex)
     result = minimize(objective, u0, method="Nelder-Mead", bounds=space.bounds,
                       options={"initial_simplex": np.array(simplex), "xatol": 1e-3, "fatol": 1e-2, "maxfev": max_evaluations})
-    status = "converged" if result.success else "max_evaluations"
+    status = FitStatus.CONVERGED if result.success else FitStatus.MAX_EVALUATIONS
     return np.asarray(result.x), status, "" if result.success else str(result.message)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from enum import StrEnum
 from pathlib import Path
 
 import numpy as np
@@ -12,11 +13,22 @@ from comanip import presets
 from comanip.fitting.parameters import ParameterSpace
 from comanip.model import ReachingModel
 
-FIT_STATUSES = ("converged", "unidentified", "max_evaluations", "failed")
-"""Statuses: 'converged' (the optimiser met its tolerances and the data determine every parameter), 'unidentified'
-(the optimiser stopped, but no recorded sample was scored, or a parameter stayed at its start value without a
-standard error: the data say nothing about it), 'max_evaluations' (it ran out of evaluations; the values are the best
-found), 'failed' (an error stopped the fit; values are the start)."""
+class FitStatus(StrEnum):
+    """How a fit ended. A ``str``, like :class:`comanip.optim.Status`: it prints and serialises as its value."""
+
+    CONVERGED = "converged"
+    """The optimiser met its tolerances and the data determine every parameter."""
+    UNIDENTIFIED = "unidentified"
+    """The optimiser stopped, but no recorded sample was scored, or a parameter stayed at its start value without a
+    standard error: the data say nothing about it."""
+    MAX_EVALUATIONS = "max_evaluations"
+    """The optimiser ran out of evaluations; the values are the best found."""
+    FAILED = "failed"
+    """An error stopped the fit; the values are the start."""
+
+
+FIT_STATUSES = tuple(FitStatus)
+"""Every :class:`FitStatus`, in order."""
 
 
 @dataclass
@@ -25,8 +37,8 @@ class FitResult:
 
     success: bool
     """True when the fit converged (status 'converged') and every condition's plan at the fitted values succeeded."""
-    status: str
-    """One of :data:`FIT_STATUSES`."""
+    status: FitStatus
+    """How the fit ended (:class:`FitStatus`)."""
     message: str
     """What happened, in words, where the status does not say it all ("" for a plain convergence)."""
     model: ReachingModel
@@ -115,7 +127,7 @@ def failed_result(model: ReachingModel, space: ParameterSpace, message: str, eva
                   kind: str) -> FitResult:
     """A result with status 'failed': the start model and values, NaN errors and objective."""
     nan = {name: np.nan for name in space.names}
-    return FitResult(success=False, status="failed", message=message, model=model, values=dict(space.start_values),
+    return FitResult(success=False, status=FitStatus.FAILED, message=message, model=model, values=dict(space.start_values),
                      initial_values=space.start_values, std_errors=nan, laplace_std_errors=dict(nan),
                      objective=np.nan, objective_kind=kind, evaluations=evaluations, fit_time=fit_time)
 

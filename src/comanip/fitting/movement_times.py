@@ -26,7 +26,7 @@ from comanip.recordings.csv_table import read_table
 from comanip.fitting.parameters import MT_DEFAULT_PARAMETERS, ParameterSpace
 from comanip.fitting.evaluation_progress import ProgressBar
 from comanip.fitting.residuals import movement_time
-from comanip.fitting.fit_result import FitResult, failed_result, fitted_model, identification, outcome_message
+from comanip.fitting.fit_result import FitResult, FitStatus, failed_result, fitted_model, identification, outcome_message
 from comanip.model import ReachingModel
 
 MT_COLUMNS = ("distance_m", "width_m", "mt_s")
@@ -93,17 +93,17 @@ def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTab
             return failed_result(model, space, f"{type(error).__name__}: {error}", residuals.evaluations,
                                  time.perf_counter() - t_begin, SSE_KIND)
     std = _least_squares_std(result.fun, result.jac)
-    status = "converged" if result.status > 0 else "max_evaluations"
+    status = FitStatus.CONVERGED if result.status > 0 else FitStatus.MAX_EVALUATIONS
     values, std_errors = space.values(result.x), space.natural_std_errors(result.x, std)
     unidentified = identification(values, space.start_values, std_errors)
     message = outcome_message("" if result.status > 0 else str(result.message), space.at_bounds(result.x), unidentified)
     if unidentified:
-        status = "unidentified"
+        status = FitStatus.UNIDENTIFIED
     rows = [{"condition": c, "distance_m": float(D), "width_m": float(w), "mt_recorded_s": float(mt),
              "mt_predicted_s": movement_time(plan.t, plan.ee_speed), "plan_status": plan.status, "plan_success": plan.success}
             for c, (D, w, mt, plan) in enumerate(zip(table.distance, table.width, table.mt, plans))]
     return FitResult(
-        success=status == "converged" and all(plan.converged for plan in plans), status=status,
+        success=status == FitStatus.CONVERGED and all(plan.converged for plan in plans), status=status,
         message=message, model=fitted_model(space.model_for(result.x), model, f"movement times of {len(table.mt)} conditions"),
         values=values, initial_values=space.start_values, std_errors=std_errors, laplace_std_errors=dict(std_errors),
         objective=float(np.sum(result.fun**2)), objective_kind=SSE_KIND, evaluations=residuals.evaluations,

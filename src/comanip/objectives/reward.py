@@ -30,7 +30,7 @@ Gaussian overlap, precision beyond the goal's size earns nothing.
 
 from __future__ import annotations
 
-from functools import lru_cache
+from functools import cached_property
 
 import casadi as ca
 import numpy as np
@@ -106,6 +106,11 @@ class GoalReward:
         self.d, self.form = d, check_reward_form(form)
         self.goal_covariance_form, self.effective_k = check_goal_covariance_form(goal_covariance), effective_k
 
+    @cached_property
+    def hit_function(self) -> ca.Function:
+        """``(e (d,), Sigma_x (d, d), w) -> E[K]`` of the hit form (:func:`hit_kernel_function`), built once per reward."""
+        return hit_kernel_function(self.d)
+
     @classmethod
     def of(cls, model) -> "GoalReward":
         """The reward a :class:`comanip.ReachingModel` asks for."""
@@ -120,8 +125,8 @@ class GoalReward:
         if self.form == "gaussian":
             return expected_reward(mu_x, Sigma_x, goal, self.covariance(width))
         if any(isinstance(v, (ca.SX, ca.MX)) for v in (mu_x, Sigma_x, goal, width)):
-            return _hit_function(self.d)(mu_x - goal, Sigma_x, width)
-        return float(_hit_function(self.d)(np.asarray(mu_x, float) - np.asarray(goal, float), np.asarray(Sigma_x, float), float(width)))
+            return self.hit_function(mu_x - goal, Sigma_x, width)
+        return float(self.hit_function(np.asarray(mu_x, float) - np.asarray(goal, float), np.asarray(Sigma_x, float), float(width)))
 
     def peak(self, width):
         """R of a noiseless hand on the goal: 1/sqrt(det(2π W)) (Gaussian) or 1 (hit); a CasADi expression of
@@ -133,9 +138,9 @@ class GoalReward:
         return (2 * np.pi * goal_variance(float(width), self.goal_covariance_form, self.effective_k)) ** (-self.d / 2)
 
 
-@lru_cache(maxsize=8)
-def _hit_function(d: int) -> ca.Function:
-    """``(e (d,), Sigma_x (d, d), w) -> E[K]`` of the flat-topped hit kernel (module docstring)."""
+def hit_kernel_function(d: int) -> ca.Function:
+    """``(e (d,), Sigma_x (d, d), w) -> E[K]`` of the flat-topped hit kernel (module docstring), for a task space of
+    dimension d."""
     m = HIT_KERNEL_ORDER
     e, Sigma, width, t = ca.SX.sym("e", d), ca.SX.sym("Sigma", d, d), ca.SX.sym("w"), ca.SX.sym("t")
     s2 = width**2 / (2 * float(gammaincinv(m + 1, 0.5)))  # K(w) = 1/2

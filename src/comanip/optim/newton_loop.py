@@ -28,6 +28,7 @@ stages it does not need: ``settle`` keeps the stop, ``solved_along`` finds nothi
 from __future__ import annotations
 
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Callable, Generic, Protocol, TypeVar
 
 from comanip.optim.result import SolverResult
@@ -39,9 +40,10 @@ D = TypeVar("D")
 
 @dataclass(frozen=True)
 class Stop:
-    """Why a solve ends: its status and the status in words."""
+    """Why a solve ends: its status (a :class:`Status`, or a ``str`` enum of the layer whose hooks stop the solve)
+    and the status in words."""
 
-    status: Status
+    status: StrEnum
     message: str
 
 

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from enum import StrEnum
 from typing import Generic, TypeVar
 
 from comanip.optim.factorisation import CholeskyFactor
-from comanip.optim.status import CONVERGED, Status
+from comanip.optim.status import CONVERGED
 
 X = TypeVar("X")
 D = TypeVar("D")
@@ -35,7 +36,8 @@ class SolverResult(Generic[X, M]):
     """The best point found (an array (N,), or the solver's own point type)."""
     fun: float
     """The objective there."""
-    status: Status
+    status: StrEnum
+    """A :class:`~comanip.optim.status.Status`, or a status of the layer whose hooks stopped the solve (a ``str`` enum too)."""
     message: str
     """The status in words."""
     nit: int

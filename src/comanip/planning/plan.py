@@ -37,8 +37,10 @@ class Plan:
     success: bool
     """True when the solver converged (to its tolerance or an acceptable level) to a finite plan whose mean
     end effector ends within the goal width w of the goal."""
-    status: str
-    """'solved', 'solved_acceptable' (converged and reaching), 'goal_not_reached' (converged, but the mean end
+    status: StrEnum
+    """How the solve ended: a :class:`comanip.optim.Status` or a :class:`PlanStatus` (a plan made by a layer above
+    carries that layer's status, e.g. a goal estimate's :class:`comanip.estimation.estimate_status.EstimateStatus`): 'solved',
+    'solved_acceptable' (converged and reaching), 'goal_not_reached' (converged, but the mean end
     effector ends farther than w from the goal: e.g. a goal too far for the horizon, or not worth the effort;
     ``extras['solver_status']`` keeps the solver's word), 'max_iterations', 'max_wall_time', 'unreachable'
     (goal out of the arm's reach), 'constraints_violated' (joint limits could not be met) or 'failed'.

@@ -64,6 +64,7 @@ from comanip.estimation.reach_stream import ReachSegmenter, SegmentationSettings
 from comanip.estimation.model_families import FamilyCache
 from comanip.estimation.online_options import CORRECTING_PERSON
 from comanip.estimation.estimation_planner import estimation_planner
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.planner import Planner
@@ -338,7 +339,7 @@ class GoalNode(Node):
             self._last["solve_status"] = f"refused: {error}"
             self.get_logger().info(f"observation at t = {job.t:.3f} s not used: {error}")
             return float("nan")
-        if estimate.status == "uninformative":  # the hand has not moved yet: nothing to estimate, nothing failed
+        if estimate.status == EstimateStatus.UNINFORMATIVE:  # the hand has not moved yet: nothing to estimate, nothing failed
             self._last.update(solve_status=estimate.status, event=f"waiting for movement at t = {job.t:.3f} s")
             return float("nan")
         ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.ee_mean)))

@@ -16,6 +16,8 @@ velocity mean ± std against the distance to the goal, with the transition marke
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from dataclasses import dataclass
 
 import numpy as np
@@ -29,6 +31,7 @@ from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule,
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan
 from comanip.progress import progress_bar
+from comanip.simulation.rest_trajectory import RestTarget
 from comanip.simulation.handover_release import (DEFAULT_SETTLE_FRACTION, EstimateRelease, GoalDistanceRelease,
                                                  check_release_trigger)
 from comanip.simulation.measures import trial_measures
@@ -88,7 +91,7 @@ class HandoverRobot:
         self.goal_estimate = self.trigger.goal_estimate
         self.controller.translational_stiffness = np.full(3, schedule.leading_stiffness)
 
-    def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
+    def command(self, t: float, state: RobotState) -> RestTarget:
         schedule = self.schedule
         if self.switch_time is None and self.trigger.due(t, state):
             self.switch_time, self.switch_position = t, state.position.copy()
@@ -97,7 +100,7 @@ class HandoverRobot:
             stiffness = float(stiffness_profile(t, self.switch_time, schedule.ramp_time, schedule.leading_stiffness))
             self.controller.translational_stiffness = np.full(3, stiffness)
         k = min(int(round((t - schedule.t[0]) / self.dt)), len(schedule.t) - 1)
-        return schedule.rest_position[k], schedule.rest_velocity[k]
+        return RestTarget(schedule.rest_position[k], schedule.rest_velocity[k])
 
 
 @dataclass
@@ -175,14 +178,23 @@ def handover_metrics(record: TrialRecord, robot: HandoverRobot, width: float) ->
     } | robot.trigger.metrics(record.goal)
 
 
-def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+class SpeedProfile(NamedTuple):
+    """The hand's speed over trials at each progress value along the reach."""
+
+    mean: np.ndarray
+    """Mean speed (P,), m/s."""
+    std: np.ndarray
+    """Standard deviation over trials (P,), m/s."""
+
+
+def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid: np.ndarray) -> SpeedProfile:
     """Mean and std over trials (P,), m/s, of the speed (N, K) at the first passage of each progress value
     grid (P,), m, along the line from the common start paths[:, 0] (N, K, 3) to goal (3,)."""
     start = paths[0, 0]
     u = (goal - start) / np.linalg.norm(goal - start)
     along = (paths - start) @ u
     at_grid = np.stack([values_at_first_passage(a, v[:, None], grid)[:, 0] for a, v in zip(along, speeds)])
-    return np.nanmean(at_grid, axis=0), np.nanstd(at_grid, axis=0, ddof=1)
+    return SpeedProfile(np.nanmean(at_grid, axis=0), np.nanstd(at_grid, axis=0, ddof=1))
 
 
 def release_trigger(settings: HandoverSettings, setup: ScenarioSetup, start: np.ndarray, transition_model: TransitionModel,

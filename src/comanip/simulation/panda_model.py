@@ -18,13 +18,13 @@ from __future__ import annotations
 
 import hashlib
 import xml.etree.ElementTree as ET
-from functools import lru_cache
 from pathlib import Path
 
 import numpy as np
 
 from comanip.bodies.panda import PANDA_ARMATURE, READY_POSE
 from comanip.bodies.panda_urdf import ARM_JOINTS, TCP_LINK, panda_urdf_path, reduced_panda_urdf
+from comanip.caching.process_caches import memoised
 from comanip.extras import require
 
 mujoco = require("mujoco", "sim")
@@ -66,7 +66,7 @@ def build_panda_model(object_mass: float = 0.0, object_size=(0.20, 0.10, 0.05), 
     return mujoco.MjModel.from_xml_string(xml)
 
 
-@lru_cache(maxsize=8)
+@memoised(maxsize=8)
 def _model_xml(urdf_sha256: str, object_mass: float, object_size: tuple, timestep: float, table: bool) -> str:
     """MJCF text of the model (cached per URDF hash and options; the hash only keys the cache)."""
     spec = mujoco.MjSpec.from_string(_urdf_for_mujoco())

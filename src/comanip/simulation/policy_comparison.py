@@ -16,6 +16,8 @@ person's efforts (force change, work beyond holding), with the candidate policy'
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import csv
 from dataclasses import replace
 from pathlib import Path
@@ -141,25 +143,41 @@ def people_table(rows: list[dict], policies, effort: str = "force_change", goal_
     return "\n".join(lines) + "\n"
 
 
-def _mean_std(trials: list[SyncTrial], key: str, scale: float) -> tuple[float, float]:
+class MeanStd(NamedTuple):
+    """A measure over trials, in the shown unit."""
+
+    mean: float
+    std: float
+    """Standard deviation (ddof 1; 0 for one trial)."""
+
+
+class PairedDifference(NamedTuple):
+    """A measure's difference between two policies over trials paired by person seed, in the shown unit."""
+
+    mean: float
+    standard_error: float
+
+
+def _mean_std(trials: list[SyncTrial], key: str, scale: float) -> MeanStd:
     """(mean, standard deviation (ddof 1; 0 for one trial)) of a trial metric over the trials where it is
     finite, in the shown unit; (NaN, NaN) when none is."""
     values = np.array([trial.metrics[key] for trial in trials], dtype=float) * scale
     values = values[np.isfinite(values)]
     if not len(values):
-        return float("nan"), float("nan")
-    return float(np.mean(values)), float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
+        return MeanStd(float("nan"), float("nan"))
+    return MeanStd(float(np.mean(values)), float(np.std(values, ddof=1)) if len(values) > 1 else 0.0)
 
 
-def _paired(trials: list[SyncTrial], others: list[SyncTrial], key: str, scale: float) -> tuple[float, float]:
+def _paired(trials: list[SyncTrial], others: list[SyncTrial], key: str, scale: float) -> PairedDifference:
     """(mean, standard error) of a trial metric's difference trials[k] - others[k] over the trials paired by
     index (the same person seed) where both are finite, in the shown unit; (NaN, NaN) when none are."""
     values = [np.array([trial.metrics[key] for trial in group], dtype=float) for group in (trials, others)]
     difference = scale * (values[0] - values[1])
     difference = difference[np.isfinite(difference)]
     if not len(difference):
-        return float("nan"), float("nan")
-    return float(np.mean(difference)), float(np.std(difference, ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else 0.0
+        return PairedDifference(float("nan"), float("nan"))
+    return PairedDifference(float(np.mean(difference)),
+                            float(np.std(difference, ddof=1) / np.sqrt(len(difference))) if len(difference) > 1 else 0.0)
 
 
 def _pm(value: tuple[float, float] | None, signed: bool = False) -> str:

@@ -42,6 +42,8 @@ corrects toward the goal beyond what the recording did.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from scipy.interpolate import make_interp_spline
 from scipy.signal import butter, sosfiltfilt
@@ -85,7 +87,27 @@ def usable_for_reach(recording: Recording) -> bool:
             and recording.distance >= MIN_DISTANCE and recording.movement_time <= MAX_MOVEMENT_TIME)
 
 
-def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarray, np.ndarray]:
+class RecordedReach(NamedTuple):
+    """A recording mapped onto a reach."""
+
+    t: np.ndarray
+    """Times (K,), s, from the playback's start."""
+    position: np.ndarray
+    """Hand positions (K, 3), m, from the reach's start to its goal."""
+
+
+class IntendedMotion(NamedTuple):
+    """Where a recorded person's intention is along their path at one instant."""
+
+    displacement: np.ndarray
+    """From the path's start (3,), m."""
+    velocity: np.ndarray
+    """(3,), m/s."""
+    acceleration: np.ndarray
+    """(3,), m/s²."""
+
+
+def recorded_reach(recording: Recording, start, goal, up=None) -> RecordedReach:
     """The recording mapped onto the reach from start (3,) m to goal (3,) m (module docstring).
 
     up: the recording's upward direction (3,), for a 3-D recording (:func:`surface_normal`); a planar one lies
@@ -119,7 +141,7 @@ def recorded_reach(recording: Recording, start, goal, up=None) -> tuple[np.ndarr
     components = displacement @ _chord_frame(recorded[-1] - recorded[0], up).T        # (K, 3): along, across, upward
     position = start + (distance / length) * components @ _chord_frame(reach, np.array([0.0, 0.0, 1.0]))
     position[-1] = goal   # equal up to rounding
-    return t, position
+    return RecordedReach(t, position)
 
 
 def _low_passed(recording: Recording) -> tuple[np.ndarray, np.ndarray]:
@@ -190,13 +212,13 @@ class RecordedPerson:
         """Always empty: this person does not plan (the scenario's records count re-plans from it)."""
         self.replan_times: list[float] = []
 
-    def intended_motion(self, t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    def intended_motion(self, t: float) -> IntendedMotion:
         """The path's displacement from its start (3,) m, its velocity (3,) m/s and acceleration (3,) m/s² at
         t (s) since the onset; at rest at the goal after the path's end."""
         if t >= self.duration:
-            return self._path(self.duration), np.zeros(3), np.zeros(3)
+            return IntendedMotion(self._path(self.duration), np.zeros(3), np.zeros(3))
         t = max(t, 0.0)
-        return self._path(t), self._path(t, 1), self._path(t, 2)
+        return IntendedMotion(self._path(t), self._path(t, 1), self._path(t, 2))
 
     def start(self, intended_position, t: float = 0.0) -> None:
         """Begin the reach at time t (s), the intention at rest at intended_position (3,) m (where the person

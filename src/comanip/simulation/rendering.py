@@ -10,6 +10,8 @@ skipped with the reason, and the simulation's results are unaffected.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import ctypes.util
 import os
 import subprocess
@@ -36,15 +38,24 @@ def headless_backend() -> str | None:
     return "glfw" if has_display() else None
 
 
-def frame_strip(object_mass: float, qpos: np.ndarray, path: str | Path, markers=(), frames: int = 6) -> tuple[Path | None, str]:
+class FrameStrip(NamedTuple):
+    """A drawn strip of postures, or why none was drawn."""
+
+    path: Path | None
+    """The PNG written; None when none could be."""
+    reason: str
+    """Why none was drawn ("" when one was)."""
+
+
+def frame_strip(object_mass: float, qpos: np.ndarray, path: str | Path, markers=(), frames: int = 6) -> FrameStrip:
     """Draw `frames` evenly spaced postures of qpos (K, 7) of the Panda carrying object_mass (kg) side by
     side into a PNG at path, green spheres at the markers (each (3,), m), in a child process.
 
-    Returns (path, "") on success or (None, reason) when offscreen rendering is not available here.
+    Returns the strip's path, or None and the reason when offscreen rendering is not available here.
     """
     backend = headless_backend()
     if backend is None:
-        return None, "no offscreen OpenGL backend (EGL or OSMesa) and no display"
+        return FrameStrip(None, "no offscreen OpenGL backend (EGL or OSMesa) and no display")
     with tempfile.TemporaryDirectory() as folder:
         inputs = Path(folder) / "frames.npz"
         np.savez(inputs, object_mass=object_mass, qpos=np.asarray(qpos)[np.linspace(0, len(qpos) - 1, frames).astype(int)],
@@ -53,8 +64,8 @@ def frame_strip(object_mass: float, qpos: np.ndarray, path: str | Path, markers=
                                env=os.environ | {"MUJOCO_GL": backend}, capture_output=True, text=True, timeout=300)
     if child.returncode != 0 or not Path(path).exists():
         lines = (child.stderr or child.stdout).strip().splitlines()
-        return None, f"offscreen rendering with MUJOCO_GL={backend} failed: {lines[-1] if lines else f'exit {child.returncode}'}"
-    return Path(path), ""
+        return FrameStrip(None, f"offscreen rendering with MUJOCO_GL={backend} failed: {lines[-1] if lines else f'exit {child.returncode}'}")
+    return FrameStrip(Path(path), "")
 
 
 def render_frames(model, qpos: np.ndarray, path: str | Path, markers=(), size: tuple[int, int] = (240, 320)) -> Path:

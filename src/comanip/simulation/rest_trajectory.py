@@ -11,10 +11,21 @@ and last points.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 from scipy.interpolate import CubicSpline
 
 from comanip.planning.plan import Plan
+
+
+class RestTarget(NamedTuple):
+    """Where the impedance controller's rest point is, and how it moves, at one instant."""
+
+    position: np.ndarray
+    """Rest position (3,), m, robot base frame."""
+    velocity: np.ndarray | None
+    """Rest velocity (3,), m/s; None: not given."""
 
 
 class RestTrajectory:
@@ -57,8 +68,8 @@ class RestTrajectory:
         velocity = np.where(((tau >= t[0]) & (tau <= t[-1]))[:, None], spline(inside, 1), 0.0)
         return cls(spline(inside), velocity, time_offset, dt)
 
-    def __call__(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """(rest position (3,) m, rest velocity (3,) m/s) at real time t (s), held at the ends."""
+    def __call__(self, t: float) -> RestTarget:
+        """The rest position and velocity at real time t (s), held at the ends."""
         k = int(round((t - self.time_offset) / self.dt))
         k = min(max(k, 0), len(self.position) - 1)
-        return self.position[k], self.velocity[k]
+        return RestTarget(self.position[k], self.velocity[k])

@@ -19,6 +19,7 @@ from comanip.control.impedance import ImpedanceGains, RobotState
 from comanip.simulation.panda_model import TABLE_HEIGHT
 from comanip.simulation.person import PersonParameters, SimulatedPerson
 from comanip.simulation.recorded_person import RecordedPerson
+from comanip.simulation.rest_trajectory import RestTarget
 from comanip.simulation.world import CoManipulationWorld
 
 #: Named goals (m, robot base frame) on a table whose placing height (z = 0.2 m) is fixed and known, as in
@@ -128,8 +129,8 @@ class RobotBehaviour(Protocol):
     goal_estimate: np.ndarray | None
     """Where the robot currently thinks the goal is (3,), m; None while it has no estimate."""
 
-    def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray | None]:
-        """(rest position (3,) m, rest velocity (3,) m/s or None) at time t (s) for the arm in ``state``."""
+    def command(self, t: float, state: RobotState) -> RestTarget:
+        """The rest position and velocity at time t (s) for the arm in ``state``."""
 
 
 @dataclass

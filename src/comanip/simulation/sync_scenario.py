@@ -19,6 +19,8 @@ measures of :mod:`comanip.simulation.measures` (interaction force, work, synchro
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -29,6 +31,7 @@ from comanip.arguments import as_positive, as_vector
 from comanip.control.impedance import CartesianImpedanceController, RobotState
 from comanip.planning.plan import Plan
 from comanip.progress import progress_bar
+from comanip.simulation.rest_trajectory import RestTarget
 from comanip.simulation.measures import trial_measures
 from comanip.simulation.policies import POLICIES, PolicyContext, Prediction, RobotPolicy, check_policy
 from comanip.simulation.policies.protocol import DEFAULT_UPDATE_INTERVAL
@@ -85,7 +88,7 @@ class PolicyRobot:
         self._next_update = settings.observation_time
         self.controller.translational_stiffness = np.zeros(3)
 
-    def command(self, t: float, state: RobotState) -> tuple[np.ndarray, np.ndarray]:
+    def command(self, t: float, state: RobotState) -> RestTarget:
         position, velocity = state.position, state.velocity
         self.policy.observe(t, position, velocity)
         if t >= self._next_update - 1e-9:
@@ -99,11 +102,11 @@ class PolicyRobot:
                 self.predictions += 1
                 self.controller.translational_stiffness = [0.0, 0.0, self.settings.robot_stiffness]
         if self.prediction is None:
-            return position, velocity            # no stiffness: the rest follows the handle
+            return RestTarget(position, velocity)            # no stiffness: the rest follows the handle
         rest_position, rest_velocity = self.prediction.rest(t)
         position, velocity = position.copy(), velocity.copy()
         position[2], velocity[2] = rest_position[2], rest_velocity[2]
-        return position, velocity
+        return RestTarget(position, velocity)
 
 
 def end_at_height(rest: RestTrajectory, height: float) -> None:
@@ -139,8 +142,19 @@ class SyncTrial:
     """Predicted trajectory minus handle position on that grid (P, 3), m."""
 
 
+class SyncMetrics(NamedTuple):
+    """The measures of one sync trial and its tracking error over normalised time."""
+
+    metrics: dict
+    """Scalar measures by name (:func:`comanip.simulation.measures.trial_measures` and the paper's Fig. 7 errors)."""
+    grid: np.ndarray
+    """Normalised time t / MT (P,)."""
+    error: np.ndarray
+    """Tracking error on the grid (P, 3), m."""
+
+
 def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimated_position: np.ndarray, width: float,
-                 observation_time: float) -> tuple[dict, np.ndarray, np.ndarray]:
+                 observation_time: float) -> SyncMetrics:
     """Measures of one trial (:func:`comanip.simulation.measures.trial_measures` and the paper's Fig. 7
     errors), and the tracking error on the normalised-time grid (P,), (P, 3).
 
@@ -176,7 +190,7 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
         "iteration_capped_replans": record.iteration_capped_replans,
         **measures,
     }
-    return metrics, grid, error
+    return SyncMetrics(metrics, grid, error)
 
 
 def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledStart) -> PolicyContext:

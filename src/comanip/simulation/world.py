@@ -8,6 +8,8 @@ integrates the arm, the object and gravity.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from comanip.arguments import as_vector
@@ -17,6 +19,15 @@ from comanip.simulation.kinematics import MujocoKinematics
 from comanip.simulation.panda_model import OBJECT_BODY, READY_POSTURE, build_panda_model
 
 mujoco = require("mujoco", "sim")
+
+
+class JointState(NamedTuple):
+    """The arm's joints at one instant."""
+
+    qpos: np.ndarray
+    """Joint positions (7,), rad."""
+    qvel: np.ndarray
+    """Joint velocities (7,), rad/s."""
 
 
 class CoManipulationWorld:
@@ -60,9 +71,9 @@ class CoManipulationWorld:
         mujoco.mj_forward(self.model, self.data)
         self.controller.reset()
 
-    def joint_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """Copies of (qpos (7,), qvel (7,)), e.g. to restore a settled state with :meth:`reset`."""
-        return self.data.qpos.copy(), self.data.qvel.copy()
+    def joint_state(self) -> JointState:
+        """Copies of the joints' positions and velocities, e.g. to restore a settled state with :meth:`reset`."""
+        return JointState(self.data.qpos.copy(), self.data.qvel.copy())
 
     def observe(self) -> RobotState:
         """The controller's view of the arm now: TCP pose, Jacobian, inertia, gravity torque."""

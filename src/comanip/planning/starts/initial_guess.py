@@ -7,7 +7,6 @@ the solver where the reward is felt; the duration selects among the local optima
 
 from __future__ import annotations
 
-import functools
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -16,6 +15,7 @@ import numpy as np
 
 from comanip.bodies.body import Body
 from comanip.caching.buffered_function import BufferedFunction
+from comanip.caching.process_caches import memoised
 
 
 class Quintic(NamedTuple):
@@ -58,7 +58,7 @@ _DERIVATIVE_FACTORS = np.array([[3.0, 6.0], [4.0, 12.0]]).reshape(2, 2, 1, 1, 1)
 """The factors of a3 (first row) and a4 (second row) in the velocity and the acceleration."""
 
 
-@functools.lru_cache(maxsize=32)
+@memoised(maxsize=32)
 def _step_times(durations: tuple[float, ...], h: float, H: int) -> _QuinticTimes:
     """:class:`_QuinticTimes` of the durations (s) at the steps t_i = h·i, i < H, built once per arguments."""
     return _QuinticTimes(np.array(durations), h * np.arange(H))
@@ -177,7 +177,7 @@ def brake_durations(horizon_s: float) -> np.ndarray:
     return np.array([1 / 6, 1 / 3]) * horizon_s
 
 
-@functools.lru_cache(maxsize=32)
+@memoised(maxsize=32)
 def guess_durations(horizon_s: float, count: int) -> np.ndarray:
     """Reach durations (s) to try as initial guesses: spread over 25 %–75 % of the horizon (read only: one
     array per arguments, shared by every caller)."""
@@ -201,7 +201,7 @@ def _mass_matrices(body: Body, q: np.ndarray) -> np.ndarray:
     return _along(body.mass_matrix_function, K)(q.T)[0].reshape(n, K, n).transpose(1, 0, 2)
 
 
-@functools.lru_cache(maxsize=32)
+@memoised(maxsize=32)
 def _along(function: ca.Function, steps: int) -> BufferedFunction:
     """``function`` mapped over ``steps`` columns, built once per (function, steps) and called without DM
     conversions (building the map and converting cost ~1 ms a call on the Panda, more than the evaluation)."""

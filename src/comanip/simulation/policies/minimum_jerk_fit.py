@@ -45,18 +45,17 @@ def fit_minimum_jerk(start, times, positions, prior_goal, *, observation_std: fl
     offsets, prior_offset = positions - start, prior_goal - start
     a, b = 1.0 / observation_std**2, 1.0 / prior_std**2
 
-    def solve(duration: float) -> tuple[np.ndarray, float]:
+    def solve(duration: float) -> MinimumJerkFit:
         sigma = minimum_jerk(0.0, 0.0, 1.0, duration, times)[0][:, 0]        # the unit profile (K,)
         offset = (a * sigma @ offsets + b * prior_offset) / (a * sigma @ sigma + b)
         residual = offsets - np.outer(sigma, offset)
-        return offset, float(a * np.sum(residual**2) + b * np.sum((offset - prior_offset) ** 2))
+        return MinimumJerkFit(start + offset, duration, float(a * np.sum(residual**2) + b * np.sum((offset - prior_offset) ** 2)))
 
     grid = np.geomspace(low, high, 25)
-    k = int(np.argmin([solve(T)[1] for T in grid]))
+    k = int(np.argmin([solve(T).objective for T in grid]))
     bracket = (grid[max(k - 1, 0)], grid[min(k + 1, len(grid) - 1)])
-    best = minimize_scalar(lambda T: solve(T)[1], bounds=bracket, method="bounded", options={"xatol": 1e-4})
-    offset, objective = solve(float(best.x))
-    return MinimumJerkFit(start + offset, float(best.x), objective)
+    best = minimize_scalar(lambda T: solve(T).objective, bounds=bracket, method="bounded", options={"xatol": 1e-4})
+    return solve(float(best.x))
 
 
 class MinimumJerkPolicy:

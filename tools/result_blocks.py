@@ -1,5 +1,5 @@
 """Marked blocks of the results pages (docs/results/*.md): the text between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` lines, which
-``studies/regenerate_results.py`` rewrites from the output of the script that measures them."""
+``tools/regenerate_results.py`` rewrites from the output of the script that measures them."""
 
 from __future__ import annotations
 

@@ -1,10 +1,12 @@
 """Rewrite the measured blocks of the results pages (docs/results/*.md), so that no number in them is typed by hand.
 
-    PYTHONPATH=src python studies/regenerate_results.py [NAME ...] [--list]
+    PYTHONPATH=src python -m tools.regenerate_results [NAME ...] [--list]
 
 Each block between ``<!-- NAME:begin -->`` and ``<!-- NAME:end -->`` has one page and one script below that
 measures it and prints the block's markdown on stdout; this runs the scripts of the blocks named (default: all,
-in order; the slow ones take minutes) and replaces each block's text in its page with the output.
+in order; the slow ones take minutes), each as a module from the repository root (``python -m studies.<question>.<script>``,
+so that a study imports the benchmarks' problem sets as ``benchmarks.<script>``), and replaces each block's text in
+its page with the output.
 ``tests/project/test_docs.py`` checks that every table of numbers on a results page sits in such a block and that
 every block has its script here.
 """
@@ -18,13 +20,11 @@ import sys
 import time
 from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
-sys.path.insert(0, str(HERE))
+from tools.result_blocks import block_names, replace_block
 
-from result_blocks import block_names, replace_block  # noqa: E402  (a sibling script, not a package)
+ROOT = Path(__file__).resolve().parents[1]
 
-#: block name: (what it shows, the command that prints it, run from the repository root)
+#: block name: (what it shows, the script that prints it and its arguments, run from the repository root)
 BLOCKS: dict[str, tuple[str, list[str]]] = {
     "calibration-study": ("the calibration study of the planar preset's family (about 10 min)",
                           ["studies/does_any_paper_configuration_peak_early/print_calibration_study.py"]),
@@ -121,6 +121,13 @@ PAGES: dict[str, tuple[Path, ...]] = {
 }
 
 
+def module_command(script_and_arguments: list[str]) -> list[str]:
+    """The command that runs a block's script (a path from the repository root, ``studies/x/y.py``) as the module
+    ``studies.x.y``, with its arguments."""
+    script, *arguments = script_and_arguments
+    return [sys.executable, "-m", ".".join(Path(script).with_suffix("").parts), *arguments]
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("names", nargs="*", help=f"blocks to rewrite (default: all): {', '.join(BLOCKS)}")
@@ -128,7 +135,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if args.list:
         for name, (what, command) in BLOCKS.items():
-            print(f"{name}: {what}\n    {' '.join(command)}")
+            print(f"{name}: {what}\n    python {' '.join(module_command(command)[1:])}")
         return 0
     unknown = sorted(set(args.names) - set(BLOCKS))
     if unknown:
@@ -138,9 +145,9 @@ def main(argv: list[str] | None = None) -> int:
             if name not in block_names(page.read_text(encoding="utf-8")):
                 parser.error(f"{page} lacks the block {name}")
     for name in args.names or list(BLOCKS):
-        command = [sys.executable, *BLOCKS[name][1]]
+        command = module_command(BLOCKS[name][1])
         began = time.perf_counter()
-        print(f"{name}: {' '.join(BLOCKS[name][1])} …", file=sys.stderr, flush=True)
+        print(f"{name}: python {' '.join(command[1:])} …", file=sys.stderr, flush=True)
         # the script's progress goes to stderr, shown as it runs; its stdout is the block
         block = subprocess.run(command, cwd=ROOT, check=True, stdout=subprocess.PIPE, text=True,
                                env={**os.environ, "PYTHONPATH": str(ROOT / "src")}).stdout
