@@ -24,6 +24,7 @@ from comanip.belief.noise import sample_torque_error
 from comanip.execution.kalman_filter import DelayedKalmanFilter
 from comanip.execution.delayed_observation import Observation
 from comanip.objectives.reach_objective import velocity_cost
+from comanip.optim import Progress
 from comanip.planning.planner import Planner
 from comanip.planning.replanner import Replanner, Replanning
 
@@ -140,7 +141,7 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     ee = np.array([np.asarray(body.kinematics_function(s[:n])[0]).ravel() for s in states])
     ee_velocity = np.array([np.asarray(velocity(s)).ravel() for s in states])
     return Execution(t=period * np.arange(steps + 1), states=states, commanded=commanded, executed=executed,
-                     ee=ee, ee_velocity=ee_velocity, failed_replans=sum(status != "converged" for status in statuses),
+                     ee=ee, ee_velocity=ee_velocity, failed_replans=sum(status != Progress.CONVERGED for status in statuses),
                      estimates=None if observation is None else estimates, goals=goals, replan_times=replan_times,
                      replan_statuses=statuses, replan_iterations=iterations_done)
 
