@@ -69,7 +69,7 @@ def forecast_markdown(rows, name: str) -> str:
     """Median error / D per forecaster, start fraction and lead, the forecast's coverage, and whether it is below
     every kinematic forecaster."""
     header = " | ".join(f"{int(100 * f)} % +{s:.1f} s" for f in FROM for s in LEADS)
-    lines = [f"Where the hand will be, error / D (median over movements), from 25 % and 50 % of MT:", "",
+    lines = ["Where the hand will be, error / D (median over movements), from 25 % and 50 % of MT:", "",
              f"| forecaster | {header} |", "|---|" + "---|" * (len(FROM) * len(LEADS))]
     medians = {}
     for forecaster in (*KINEMATIC, name):

@@ -36,7 +36,6 @@ Shapes: d task dimensions (= n, a point mass), nx = blocks · n state entries, M
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -107,8 +106,9 @@ class HandForecast:
         return self.mean[:, self.d:2 * self.d]
 
     def at(self, times) -> ForecastPoint:
-        """The forecast at ``times`` (M,) s (a number: M = 1): the continuation's Hermite curve, the rest of the hand's velocity and acceleration in closed form, the
-        covariance linearly between grid times. Before t_now it is the hand now; after the stop, at rest on it."""
+        """The forecast at ``times`` (M,) s (a number: M = 1): the continuation's Hermite curve, the rest of the
+        hand's velocity and acceleration in closed form, the covariance linearly between grid times. Before t_now it
+        is the hand now; after the stop, at rest on it."""
         times = np.atleast_1d(np.asarray(times, dtype=float))
         if times.ndim != 1 or not np.all(np.isfinite(times)):
             raise ValueError(f"times must be finite times in s, a number or a 1-D array; got shape {times.shape}")
