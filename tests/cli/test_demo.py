@@ -98,6 +98,7 @@ def test_demo_refuses_a_negative_seed_in_one_line(tmp_path, capsys):
 
 
 def test_demo_without_the_shipped_arm_reaches_says_where_they_are_before_any_work(tmp_path, capsys, monkeypatch):
+    pytest.importorskip("cursory", reason="the demo reads the recorded people of the 'data' extra first")
     import comanip.simulation.people as people
 
     monkeypatch.setattr(people, "SHIPPED_ARM_REACHES", tmp_path / "absent")
