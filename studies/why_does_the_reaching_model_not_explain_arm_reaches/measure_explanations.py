@@ -13,14 +13,17 @@ and settling checks). Printed as a markdown block (progress on stderr).
 from __future__ import annotations
 
 import sys
+from dataclasses import replace
 
 import numpy as np
 
 import comanip
 from comanip.estimation import OnlineOptions
-from comanip.estimation.explanations import Explained, HandAtRest, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople
+from comanip.estimation.explanations import (HandAtRest, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople, Verdict,
+                                             vetoed_own_pace)
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.people_model import shipped_people_model
+from comanip.optim import Status
 
 from studies.arm_reaches import streamed_arm_reaches  # noqa: E402
 
@@ -39,7 +42,7 @@ class Heard:
     def explain(self, hand, latest):
         explained = self.inner.explain(hand, latest)
         self.said.append((hand.last_time, explained.explains))
-        return Explained(explained.goal, explained.covariance, True, explained.status, explained.message, explained.iterations)
+        return replace(explained, verdict=Verdict.EXPLAINS, status=explained.status or Status.SOLVED)
 
 
 def explanations(model, options, family):
@@ -50,7 +53,7 @@ def explanations(model, options, family):
 
     return {
         "the model at its own pace (never ruled out)": (lambda: ModelAtOwnPace(model, options), True),
-        "the model at its own pace, as the estimator asks it": (lambda: ModelAtOwnPace(model, options, (person_pace(),)), False),
+        "the model at its own pace, as the estimator asks it": (lambda: vetoed_own_pace(model, options, person_pace()), False),
         "the model at the person's pace": (person_pace, True),
         "recorded people (the arm people model)": (lambda: RecordedPeople(shipped_people_model("arm")), True),
     }

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.explanations import Explained, HandAtRest, HandTrace, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople
+from comanip.estimation.explanations import (Explained, HandAtRest, HandTrace, MisfitAbove, ModelAtOwnPace, ModelAtPersonPace,
+                                             PaceContradiction, RecordedPeople, Verdict, Vetoed)
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 
@@ -21,7 +22,9 @@ class FixedGoal:
 
     def explain(self, hand, latest):
         self.asked += 1
-        return Explained(self.goal, 1e-4 * np.eye(3), self.explains, Status.SOLVED, f"fixed at {self.goal.tolist()}")
+        if self.explains:
+            return Explained.explaining(self.goal, 1e-4 * np.eye(3), Status.SOLVED, f"fixed at {self.goal.tolist()}")
+        return Explained(self.goal, 1e-4 * np.eye(3), Verdict.MISFITS, f"fixed at {self.goal.tolist()}")
 
 
 def reach_samples(planner, goal):
@@ -36,8 +39,10 @@ def planner(cartesian_planner):
 
 
 def test_the_default_explanations_in_order(planner):
-    kinds = [type(e) for e in OnlineGoalEstimator(planner, np.zeros(6)).explanations]
-    assert kinds == [HandAtRest, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople]
+    chain = OnlineGoalEstimator(planner, np.zeros(6)).explanations
+    assert [type(e) for e in chain] == [HandAtRest, Vetoed, ModelAtPersonPace, RecordedPeople]
+    assert type(chain[1].explanation) is ModelAtOwnPace
+    assert [type(v) for v in chain[1].vetoes] == [PaceContradiction, MisfitAbove] and chain[1].vetoes[0].paced is chain[2]
     assert [type(e) for e in OnlineGoalEstimator(planner, np.zeros(6), options=OnlineOptions(timing="model")).explanations] == [ModelAtOwnPace]
 
 
@@ -79,3 +84,57 @@ def test_the_hand_trace_grows_past_its_first_block():
     np.testing.assert_array_equal(trace.position[:, 0], np.arange(200))
     np.testing.assert_array_equal(trace.last_observation, [199, -199, 1, 2])
 
+
+
+class ScriptedMisfit:
+    """An explanation that always explains the hand, with the misfit its script gives at each update."""
+
+    def __init__(self, misfits, contestable=True):
+        self.misfits, self.contestable, self.asked = list(misfits), contestable, 0
+
+    def reset(self, reach):
+        self.asked = 0
+
+    def explain(self, hand, latest):
+        misfit = self.misfits[min(self.asked, len(self.misfits) - 1)]
+        self.asked += 1
+        return Explained.explaining(np.array([0.3, 0.0, 0.0]), 1e-4 * np.eye(3), Status.SOLVED, "scripted",
+                                    misfit=misfit, contestable=self.contestable)
+
+
+def moving_hand(count):
+    hand = HandTrace(3)
+    for k in range(count):
+        hand.append(0.01 * k, np.array([0.01 * k, 0.0, 0.0]), np.array([1.0, 0.0, 0.0]))
+    return hand
+
+
+def test_a_veto_rules_an_explanation_out_for_the_rest_of_the_reach(planner):
+    reach = OnlineGoalEstimator(planner, np.zeros(6)).reach
+    stage = Vetoed(ScriptedMisfit([1.0, 1.0, 20.0, 1.0, 1.0]), (MisfitAbove(9.0, "the script"),))
+    stage.reset(reach)
+    verdicts = [stage.explain(moving_hand(k + 5), None).verdict for k in range(5)]
+    assert verdicts == [Verdict.EXPLAINS, Verdict.EXPLAINS, Verdict.RULED_OUT, Verdict.RULED_OUT, Verdict.RULED_OUT]
+    assert stage.explanation.asked == 3 and "misfit 20 per observed number" in stage.ruled_out
+    stage.reset(reach)                                   # a new reach: in again
+    assert stage.explain(moving_hand(5), None).explains
+
+
+def test_an_account_that_cannot_be_contested_or_a_hand_at_rest_is_not_vetoed(planner):
+    reach = OnlineGoalEstimator(planner, np.zeros(6)).reach
+    uncontested = Vetoed(ScriptedMisfit([50.0], contestable=False), (MisfitAbove(9.0, "the script"),))
+    uncontested.reset(reach)
+    assert uncontested.explain(moving_hand(8), None).explains
+    resting = HandTrace(3)
+    for k in range(8):
+        resting.append(0.01 * k, np.zeros(3), np.zeros(3))
+    before_onset = Vetoed(ScriptedMisfit([50.0]), (MisfitAbove(9.0, "the script"),))
+    before_onset.reset(reach)
+    assert before_onset.explain(resting, None).explains and before_onset.ruled_out is None
+
+
+def test_an_account_gives_a_status_exactly_when_it_explains_the_hand():
+    with pytest.raises(ValueError, match="status"):
+        Explained(np.zeros(3), np.eye(3), Verdict.MISFITS, "no", Status.SOLVED)
+    with pytest.raises(ValueError, match="status"):
+        Explained(np.zeros(3), np.eye(3), Verdict.EXPLAINS, "yes")

@@ -9,8 +9,10 @@ estimate** (none: the prior, status ``uninformative``). With ``OnlineOptions(tim
 
 1. the hand has not left its start: the prior (:class:`~comanip.estimation.explanations.HandAtRest`);
 2. the reaching model at its own pace, the reach starting at t = 0: the MAP goal under the model's belief
-   (:class:`~comanip.estimation.explanations.ModelAtOwnPace`), while its misfit stays small and the model's reach at
-   the person's pace does not contradict its timing; once it does not, it stays out for the rest of the reach;
+   (:class:`~comanip.estimation.explanations.ModelAtOwnPace`), vetoed for the rest of the reach
+   (:class:`~comanip.estimation.explanations.Vetoed`) once its misfit exceeds ``OnlineOptions.mismatch_threshold``
+   (:class:`~comanip.estimation.explanations.MisfitAbove`) or the model's reach at the person's pace contradicts
+   its timing (:class:`~comanip.estimation.explanations.PaceContradiction`);
 3. the model's reach at the person's own pace and onset, where that fits and pins the goal's distance
    (:class:`~comanip.estimation.explanations.ModelAtPersonPace`);
 4. the model fitted to recorded people (:class:`~comanip.estimation.explanations.RecordedPeople`, status
@@ -18,7 +20,8 @@ estimate** (none: the prior, status ``uninformative``). With ``OnlineOptions(tim
 
 ``timing="model"`` asks only the second, which then always explains the hand (exact for the model's own
 reaches). Pass ``explanations=`` to compose your own (each an object with ``reset(reach)`` and
-``explain(hand, latest)``: :class:`~comanip.estimation.explanations.Explanation`).
+``explain(hand, latest)`` returning an :class:`~comanip.estimation.explanations.Explained` with its
+:class:`~comanip.estimation.explanations.Verdict`: :class:`~comanip.estimation.explanations.Explanation`).
 
 The plans come from a :class:`~comanip.estimation.reach_family.ReachFamily` of the model, built once per model
 and width: for a rotation-invariant point mass from rest, the plan to any goal is a 1-D reach turned onto its
@@ -38,12 +41,11 @@ import warnings
 from collections.abc import Sequence
 
 import numpy as np
-from threadpoolctl import ThreadpoolController
 
 from comanip.arguments import as_vector
 from comanip.estimation.estimation_planner import checked_model
-from comanip.estimation.explanations import (Explained, Explanation, HandAtRest, HandTrace, ModelAtOwnPace,
-                                             ModelAtPersonPace, Reach, RecordedPeople)
+from comanip.estimation.explanations import (Explained, Explanation, HandAtRest, HandTrace, ModelAtOwnPace, ModelAtPersonPace,
+                                             Reach, RecordedPeople, vetoed_own_pace)
 from comanip.estimation.explanations.base import grid_position
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.goal_estimate import GoalEstimate
@@ -61,6 +63,7 @@ from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
+from comanip.planning.single_thread_blas import SingleThreadBlas
 from comanip.units import MAX_REACH_DURATION_S, MAX_REACH_SPAN_M
 
 
@@ -109,7 +112,7 @@ class OnlineGoalEstimator:
         self.transition = np.asarray(linearised_step_function(model.body, model.h)(
             np.zeros(model.state_size), np.zeros(model.n))[1])
         """A (nx, nx): the model's one-step state map (linear dynamics), for the forecast's belief."""
-        self._blas = ThreadpoolController()
+        self._blas = SingleThreadBlas()
         self._hand = HandTrace(d)
         self.reset(start)
 
@@ -122,7 +125,7 @@ class OnlineGoalEstimator:
         if d == 3 and people.kind == "mouse":
             raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: fit one "
                              "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
-        return [HandAtRest(), ModelAtOwnPace(self.model, self.options, (person_pace,)), person_pace, RecordedPeople(people)]
+        return [HandAtRest(), vetoed_own_pace(self.model, self.options, person_pace), person_pace, RecordedPeople(people)]
 
     def reset(self, start=None) -> None:
         """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:
@@ -188,8 +191,8 @@ class OnlineGoalEstimator:
             # a sample the tracker lost: skipped, the estimate stands until the next good one
             if self.latest is None:
                 self._last_time = time_s
-                return self._result(Explained(self.prior_mean, self.prior_cov, True, EstimateStatus.UNINFORMATIVE,
-                                              "no tracked sample yet: the estimate is the prior"), t_begin)
+                return self._result(Explained.explaining(self.prior_mean, self.prior_cov, EstimateStatus.UNINFORMATIVE,
+                                                         "no tracked sample yet: the estimate is the prior"), t_begin)
             return self.latest
         position = as_vector("position", position, model.d, "hand position, m")
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
@@ -199,7 +202,7 @@ class OnlineGoalEstimator:
         self._check_plausible(time_s, position, velocity)
         self._last_time = time_s
         self._hand.append(time_s, position, velocity)
-        with self._blas.limit(limits=1, user_api="blas"):   # threads only slow products of this size down
+        with self._blas:                                    # threads only slow products of this size down
             self.latest = self._estimate(t_begin)
         return self.latest
 
@@ -231,8 +234,8 @@ class OnlineGoalEstimator:
             if explained.explains:
                 return self._result(explained, t_begin, reasons)
             reasons.append(explained.message)
-        return self._result(Explained(self.prior_mean, self.prior_cov, True, EstimateStatus.UNINFORMATIVE,
-                                      "the estimate is the prior"), t_begin, reasons)
+        return self._result(Explained.explaining(self.prior_mean, self.prior_cov, EstimateStatus.UNINFORMATIVE,
+                                                 "the estimate is the prior"), t_begin, reasons)
 
     def _person_acceleration(self) -> np.ndarray:
         """The hand's acceleration (d,) m/s² from its last velocities, NaN on the axes a robot leads

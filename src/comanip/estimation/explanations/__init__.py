@@ -1,10 +1,14 @@
-"""Explanations of a reach in progress, each giving a goal, its covariance and whether it explains the hand: a hand
-still at its start, the reaching model at its own pace, at the person's pace, and the model of recorded people."""
+"""Explanations of a reach in progress, each giving a goal, its covariance and its verdict on the hand: a hand
+still at its start, the reaching model at its own pace, at the person's pace, and the model of recorded people;
+vetoes that rule an explanation out for the rest of the reach."""
 
 from comanip.estimation.explanations.at_rest import HandAtRest
-from comanip.estimation.explanations.base import Explained, Explanation, HandTrace, Reach
-from comanip.estimation.explanations.own_pace import ModelAtOwnPace
+from comanip.estimation.explanations.base import Explained, Explanation, HandTrace, Reach, Verdict
+from comanip.estimation.explanations.own_pace import ModelAtOwnPace, vetoed_own_pace
 from comanip.estimation.explanations.people import RecordedPeople
-from comanip.estimation.explanations.person_pace import ModelAtPersonPace
+from comanip.estimation.explanations.person_pace import ModelAtPersonPace, PaceContradiction
+from comanip.estimation.explanations.vetoed import MisfitAbove, Veto, Vetoed
 
-__all__ = ["Explained", "Explanation", "HandAtRest", "HandTrace", "ModelAtOwnPace", "ModelAtPersonPace", "Reach", "RecordedPeople"]
+__all__ = ["Explained", "Explanation", "HandAtRest", "HandTrace", "MisfitAbove", "ModelAtOwnPace", "ModelAtPersonPace",
+           "PaceContradiction", "Reach", "RecordedPeople", "Verdict", "Veto", "Vetoed",
+           "vetoed_own_pace"]

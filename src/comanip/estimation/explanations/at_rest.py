@@ -7,7 +7,7 @@ status ``uninformative``."""
 
 from __future__ import annotations
 
-from comanip.estimation.explanations.base import Explained, HandTrace, Reach
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach, Verdict
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_rest import REST_RADIUS_M
 from comanip.estimation.estimate_status import EstimateStatus
@@ -21,7 +21,7 @@ class HandAtRest:
 
     def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
         reach = self.reach
-        resting = not hand.has_left(reach.start_position)
-        return Explained(reach.prior_mean, reach.prior_cov, resting, EstimateStatus.UNINFORMATIVE,
-                         f"the hand has not left its start (within {1e3 * REST_RADIUS_M:g} mm): the estimate is the prior"
-                         if resting else "the hand has left its start")
+        if hand.has_left(reach.start_position):
+            return Explained.not_explaining(reach, Verdict.MISFITS, "the hand has left its start")
+        return Explained.explaining(reach.prior_mean, reach.prior_cov, EstimateStatus.UNINFORMATIVE, "the hand has not "
+                                    f"left its start (within {1e3 * REST_RADIUS_M:g} mm): the estimate is the prior")

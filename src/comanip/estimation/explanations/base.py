@@ -2,14 +2,15 @@
 
 An explanation is one account of the hand's movement so far, e.g. the reaching model at its own pace. Given
 the observations of the reach (:class:`HandTrace`) and the estimator's latest estimate, it gives a goal, its
-covariance and whether it explains the hand (:class:`Explained`). The online estimator asks its explanations in
-order and takes the first that explains the hand (:mod:`comanip.estimation.online_estimator`).
+covariance and its :class:`Verdict` on the hand (:class:`Explained`). The online estimator asks its explanations in
+order and takes the first whose verdict is :attr:`Verdict.EXPLAINS` (:mod:`comanip.estimation.online_estimator`).
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from enum import Enum
 from typing import NamedTuple, Protocol
 
 import numpy as np
@@ -119,6 +120,22 @@ class Reach:
         return replace(fitted, goal=goal, covariance=combined)
 
 
+class Verdict(str, Enum):
+    """What an explanation says of the hand so far."""
+
+    EXPLAINS = "explains"
+    """It explains the hand: its goal is the estimate."""
+    UNDECIDED = "undecided"
+    """It cannot tell yet (no movement seen, a fit that does not pin the goal yet): asked again next update."""
+    MISFITS = "misfits"
+    """The hand does not move as it says, now."""
+    RULED_OUT = "ruled_out"
+    """It is out for the rest of the reach (:class:`~comanip.estimation.explanations.vetoed.Vetoed`)."""
+
+    def __str__(self) -> str:
+        return self.value
+
+
 @dataclass(frozen=True)
 class Explained:
     """One explanation's account of the hand so far."""
@@ -127,12 +144,12 @@ class Explained:
     """Goal (d,), m."""
     covariance: np.ndarray
     """Its covariance (d, d), m²."""
-    explains: bool
-    """Whether this explanation explains the hand (else the next one is asked)."""
-    status: Status | EstimateStatus
-    """The estimate's status when this explanation gives it."""
+    verdict: Verdict
+    """Whether it explains the hand (else the next explanation is asked), and if not, why not."""
     message: str
     """What it found: why it explains the hand, or why not."""
+    status: Status | EstimateStatus | None = None
+    """The estimate's status when this explanation gives it (verdict EXPLAINS); None otherwise."""
     iterations: int = 0
     """Newton iterations spent."""
     misfit: float | None = None
@@ -140,6 +157,31 @@ class Explained:
     timing: ReachTiming | None = None
     """When the reach moves, where this explanation says (the estimate's predicted reach is played at it);
     None: at the model's own pace from t = 0."""
+    contestable: bool = True
+    """Whether a veto may rule it out (:mod:`~comanip.estimation.explanations.vetoed`); False where no other
+    explanation can do better, e.g. beyond the reach family's distances or a person's hand speeds."""
+
+    def __post_init__(self):
+        if (self.verdict is Verdict.EXPLAINS) != (self.status is not None):
+            raise ValueError(f"an explanation that explains the hand gives the estimate's status, and only one that does; "
+                             f"got verdict {self.verdict} with status {self.status}")
+
+    @property
+    def explains(self) -> bool:
+        """Whether its verdict is :attr:`Verdict.EXPLAINS`."""
+        return self.verdict is Verdict.EXPLAINS
+
+    @classmethod
+    def explaining(cls, goal, covariance, status: Status | EstimateStatus, message: str, **fields) -> "Explained":
+        """An account that explains the hand with ``goal`` (d,) m, ``covariance`` (d, d) m² and ``status``."""
+        return cls(goal, covariance, Verdict.EXPLAINS, message, status, **fields)
+
+    @classmethod
+    def not_explaining(cls, reach: "Reach", verdict: Verdict, message: str, **fields) -> "Explained":
+        """An account that does not explain the hand (``verdict`` other than EXPLAINS), with the reach's prior
+        as its goal unless ``fields`` give one."""
+        goal, covariance = fields.pop("goal", reach.prior_mean), fields.pop("covariance", reach.prior_cov)
+        return cls(goal, covariance, verdict, message, **fields)
 
 
 class Explanation(Protocol):

@@ -16,28 +16,30 @@ goal's covariance is the Laplace approximation with a 1-D quadrature along the r
 still poorly known (:meth:`~comanip.estimation.map_goal.MapProblem.distance_spread`). Axes someone else moves
 (``OnlineOptions.led_axes``) count for less while they move.
 
-It explains the hand while its whitened misfit stays at most ``OnlineOptions.mismatch_threshold`` and no other
-explanation contradicts it (by default the model's reach at the person's pace, where it contradicts its timing:
-:mod:`comanip.estimation.explanations.person_pace`); once it does not, it stays out for the rest of the reach. Beyond the reach family's distances or a person's hand
-speeds no other explanation does better, so there it explains the hand whatever its misfit.
+It always explains the hand, and says how well: its misfit is the mean squared whitened residual per observed
+number. The estimator's default chain rules it out for the rest of the reach once that misfit exceeds
+``OnlineOptions.mismatch_threshold`` or its reach at the person's pace contradicts its timing
+(:mod:`comanip.estimation.explanations.vetoed`). Beyond the reach family's distances or a person's hand speeds
+no other explanation does better, so there its account cannot be contested.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import replace
-from collections.abc import Sequence
-from typing import Protocol
 
 import numpy as np
 
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
 from comanip.estimation.explanations.base import Explained, HandTrace, Reach, grid_position
+from comanip.estimation.explanations.person_pace import ModelAtPersonPace, PaceContradiction
+from comanip.estimation.explanations.vetoed import MisfitAbove, Vetoed
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import observation_covariance
 from comanip.estimation.observation_whitening import ObservationWhitening
+from comanip.estimation.online_options import OnlineOptions
 from comanip.model import ReachingModel
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
@@ -47,29 +49,16 @@ COVARIANCE_ROUNDS = 3
 """Whitenings rebuilt per update at most (each at the goal the previous round ended at)."""
 
 
-class Contradicting(Protocol):
-    """An explanation that can contradict another's estimate."""
-
-    def reset(self, reach: Reach) -> None:
-        """Start a new reach."""
-
-    def contradiction(self, hand: HandTrace, estimate: Explained) -> str | None:
-        """Why ``estimate`` is contradicted by this explanation of the observations so far, or None."""
-
-
 class ModelAtOwnPace:
     """The reaching model at its own pace (module docstring).
 
     Args:
         model: the point-mass model of the reach family.
-        options: the estimator's :class:`~comanip.estimation.online_options.OnlineOptions`.
-        contradicted_by: explanations that may contradict this one (each with ``contradiction(hand, estimate)``,
-            a reason or None), asked in order; empty: this explanation always explains the hand
-            (``OnlineOptions.timing == "model"``).
+        options: the estimator's options.
     """
 
-    def __init__(self, model: ReachingModel, options, contradicted_by: Sequence[Contradicting] = ()):
-        self.model, self.options, self.contradicted_by = model, options, tuple(contradicted_by)
+    def __init__(self, model: ReachingModel, options: OnlineOptions):
+        self.model, self.options = model, options
         n = model.n
         _, A, _ = linearised_step_function(model.body, model.h)(np.zeros(model.state_size), np.zeros(n))
         self._A = np.asarray(A)
@@ -83,11 +72,9 @@ class ModelAtOwnPace:
         self._deviation_times[np.ix_(led_steps, list(options.led_axes))] = options.led_deviation_time
 
     def reset(self, reach: Reach) -> None:
-        """Start a new reach (the explanations that may contradict this one too)."""
+        """Start a new reach."""
         H, n = self.model.H, self.model.n
         self.reach = reach
-        for check in self.contradicted_by:
-            check.reset(reach)
         self._counts = np.zeros(H + 1)
         self._fractions = np.zeros(H + 1)          # per step: summed fractions of a step of its observations
         self._sums = np.zeros((H + 1, 2 * n))
@@ -97,23 +84,11 @@ class ModelAtOwnPace:
         self._whitening_goal = np.zeros(self.model.d)
         self._whitened = 0                          # observations the whitening holds
         self._last: Explained | None = None         # the last estimate this explanation gave
-        self._ruled_out: str | None = None          # why it no longer explains the hand
 
     def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
-        if self._ruled_out is not None:
-            return Explained(self.reach.prior_mean, self.reach.prior_cov, False, Status.FAILED, self._ruled_out)
         self._add(hand)
-        estimate = self._estimate(hand)
-        misfit = estimate.misfit
-        self._last = estimate
-        if not self.contradicted_by or misfit is None or not self._humanlike(hand) or hand.onset() is None:
-            return estimate
-        contradiction = next((why for check in self.contradicted_by if (why := check.contradiction(hand, estimate))), None)
-        if misfit <= self.options.mismatch_threshold and contradiction is None:
-            return estimate
-        self._ruled_out = contradiction or (f"the model at its own pace does not explain the hand (misfit {misfit:.3g} "
-                                            "per observed number)")
-        return replace(estimate, explains=False, message=self._ruled_out)
+        self._last = estimate = self._estimate(hand)
+        return estimate if self._humanlike(hand) else replace(estimate, contestable=False)
 
     def _add(self, hand: HandTrace) -> None:
         """Average the observations not yet added into their grid steps."""
@@ -151,8 +126,8 @@ class ModelAtOwnPace:
             if previous is None or previous.status in (EstimateStatus.UNINFORMATIVE, Status.FAILED):
                 goal = problem.cold_goal(hand.last_observation, options.observation_std, self._R[None] / counts[:, None, None])
                 if goal is None:
-                    return Explained(reach.prior_mean, reach.prior_cov, True, EstimateStatus.UNINFORMATIVE,
-                                     "no observation shows movement: the estimate is the prior")
+                    return Explained.explaining(reach.prior_mean, reach.prior_cov, EstimateStatus.UNINFORMATIVE,
+                                                "no observation shows movement: the estimate is the prior")
             else:
                 goal = previous.goal
             iterations = 0
@@ -171,9 +146,10 @@ class ModelAtOwnPace:
         except np.linalg.LinAlgError as error:
             self._whitening = None
             goal, covariance = (reach.prior_mean, reach.prior_cov) if previous is None else (previous.goal, previous.covariance)
-            return Explained(goal, covariance, True, Status.FAILED, f"the Newton iteration failed ({error}); "
-                             "the previous estimate is kept", misfit=math.inf)
-        return Explained(goal, 0.5 * (covariance + covariance.T), True, solved.status, solved.message, iterations, misfit)
+            return Explained.explaining(goal, covariance, Status.FAILED, f"the Newton iteration failed ({error}); "
+                                        "the previous estimate is kept", misfit=math.inf)
+        return Explained.explaining(goal, 0.5 * (covariance + covariance.T), solved.status, solved.message,
+                                    iterations=iterations, misfit=misfit)
 
     def _stale(self, goal: np.ndarray, observations: int) -> bool:
         """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance, or
@@ -220,3 +196,11 @@ class ModelAtOwnPace:
             A = self._powers[1]
             noise = noise + mean_fraction**2 * (cov[i + 1] - A @ cov[i] @ A.T)[:m, :m]
         return noise
+
+
+def vetoed_own_pace(model: ReachingModel, options: OnlineOptions, person_pace: ModelAtPersonPace) -> Vetoed:
+    """The model at its own pace as the estimator's default chain asks it: ruled out for the rest of the reach
+    where ``person_pace`` contradicts its timing (:class:`PaceContradiction`) or its misfit exceeds
+    ``options.mismatch_threshold`` (:class:`MisfitAbove`)."""
+    return Vetoed(ModelAtOwnPace(model, options),
+                  (PaceContradiction(person_pace), MisfitAbove(options.mismatch_threshold, "the model at its own pace")))

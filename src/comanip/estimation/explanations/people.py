@@ -5,12 +5,11 @@ hand's onset to when the people model says it stops (a model that does not say w
 
 from __future__ import annotations
 
-from comanip.estimation.explanations.base import Explained, HandTrace, Reach
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach, Verdict
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.people_model import PeopleModel
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.estimation.reach_timing import ReachTiming
-from comanip.optim import Status
 
 
 class RecordedPeople:
@@ -26,8 +25,8 @@ class RecordedPeople:
         reach = self.reach
         predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
         if predicted is None:
-            return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED, "no onset the people model sees")
+            return Explained.not_explaining(reach, Verdict.UNDECIDED, "no onset the people model sees")
         onset = hand.onset()
         timing = None if predicted.end_time is None else ReachTiming(onset, max(predicted.end_time, hand.t[-1]) - onset)
-        return reach.landed(Explained(predicted.goal, predicted.covariance, True, EstimateStatus.PEOPLE_MODEL,
-                                      "the goal is the people model's", timing=timing), hand.position[-1])
+        return reach.landed(Explained.explaining(predicted.goal, predicted.covariance, EstimateStatus.PEOPLE_MODEL,
+                                                 "the goal is the people model's", timing=timing), hand.position[-1])

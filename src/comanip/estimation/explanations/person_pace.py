@@ -4,6 +4,9 @@ It explains the hand where that fit does (misfit at most ``OnlineOptions.paced_t
 distance (:meth:`ModelAtPersonPace.settled`). Its goal is combined with the prior and never lies behind a hand
 that has moved past it; its covariance is the fit's plus the spread of the model's reach around its goal at
 the end (where the hand stops spreads as the model's own reach to it does).
+
+Where it pins the goal at a pace or onset far from the model's own, it contradicts the model at its own pace
+(:class:`PaceContradiction`, a veto of :mod:`comanip.estimation.explanations.vetoed`).
 """
 
 from __future__ import annotations
@@ -13,8 +16,9 @@ import math
 import numpy as np
 from scipy.stats import chi2
 
-from comanip.estimation.explanations.base import Explained, HandTrace, Reach
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach, Verdict
 from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedFit, PacedModel
 from comanip.optim import Status
 
@@ -29,7 +33,7 @@ PACE_TOLERANCE = 0.14
 class ModelAtPersonPace:
     """The model's reach at the person's pace (module docstring), fitted once per observation."""
 
-    def __init__(self, paced: PacedModel, options):
+    def __init__(self, paced: PacedModel, options: OnlineOptions):
         self.paced, self.options = paced, options
 
     def reset(self, reach: Reach) -> None:
@@ -58,16 +62,20 @@ class ModelAtPersonPace:
     def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
         reach = self.reach
         if hand.onset() is None:
-            return Explained(reach.prior_mean, reach.prior_cov, False, Status.FAILED,
-                             "nor does it at the person's pace (no movement seen)")
+            return Explained.not_explaining(reach, Verdict.UNDECIDED, "nor does it at the person's pace (no movement seen)")
         fitted = self.fit(hand, None if latest is None else latest.goal)
-        if fitted.misfit > self.options.paced_threshold or not self.settled(fitted):
-            return Explained(fitted.goal, fitted.covariance, False, Status.FAILED,
-                             f"nor does it clearly at the person's pace (misfit {fitted.misfit:.3g})", misfit=fitted.misfit)
+        if fitted.misfit > self.options.paced_threshold:
+            return Explained.not_explaining(reach, Verdict.MISFITS, f"nor does it at the person's pace (misfit "
+                                            f"{fitted.misfit:.3g})", goal=fitted.goal, covariance=fitted.covariance,
+                                            misfit=fitted.misfit)
+        if not self.settled(fitted):
+            return Explained.not_explaining(reach, Verdict.UNDECIDED, f"nor does it clearly at the person's pace (misfit "
+                                            f"{fitted.misfit:.3g}, the goal's distance not pinned yet)", goal=fitted.goal,
+                                            covariance=fitted.covariance, misfit=fitted.misfit)
         landing = reach.prediction(fitted.goal, order=0).cov[-1, :reach.model.n, :reach.model.n]
-        return reach.landed(Explained(fitted.goal, fitted.covariance + landing, True, Status.SOLVED, "the model's reach "
-                                      f"at the person's pace (×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does",
-                                      misfit=fitted.misfit, timing=fitted.timing), hand.position[-1])
+        return reach.landed(Explained.explaining(fitted.goal, fitted.covariance + landing, Status.SOLVED, "the model's reach "
+                                                 f"at the person's pace (×{fitted.pace:.3g}, onset {fitted.onset:.3g} s) does",
+                                                 misfit=fitted.misfit, timing=fitted.timing), hand.position[-1])
 
     def settled(self, fitted: PacedFit) -> bool:
         """Whether a paced fit pins the goal's distance: its relative std along the reach at most
@@ -79,17 +87,29 @@ class ModelAtPersonPace:
         distance = float(np.linalg.norm(offset))
         return distance > 0 and math.sqrt(float(offset @ fitted.covariance @ offset)) / distance**2 <= SETTLED_SPREAD
 
-    def contradiction(self, hand: HandTrace, estimate: Explained) -> str | None:
-        """Why the model at its own pace (``estimate``) is contradicted by its reach at the person's pace, or
-        None: the paced fit explains the hand, pins the goal, finds a pace off the model's by more than
-        :data:`PACE_TOLERANCE` (as a log) or an onset off the model's by more than that fraction of the movement
-        time, and a goal the estimate's 99.9 % region (with the paced fit's) does not hold."""
-        fitted = self.fit(hand, estimate.goal)
+
+
+class PaceContradiction:
+    """A veto of the model at its own pace by its reach at the person's pace (``paced``, whose fit it shares).
+
+    It rules the account out where the paced fit explains the hand, pins the goal, finds a pace off the model's
+    by more than :data:`PACE_TOLERANCE` (as a log) or an onset off the model's by more than that fraction of the
+    movement time, and a goal the account's 99.9 % region (with the paced fit's) does not hold."""
+
+    def __init__(self, paced: ModelAtPersonPace):
+        self.paced = paced
+
+    def reset(self, reach: Reach) -> None:
+        self.paced.reset(reach)
+
+    def veto(self, hand: HandTrace, explained: Explained) -> str | None:
+        paced = self.paced
+        fitted = paced.fit(hand, explained.goal)
         on_time = abs(math.log(fitted.pace)) <= PACE_TOLERANCE and abs(fitted.delay) <= PACE_TOLERANCE * fitted.duration
-        if fitted.misfit > self.options.paced_threshold or not self.settled(fitted) or on_time:
+        if fitted.misfit > paced.options.paced_threshold or not paced.settled(fitted) or on_time:
             return None
-        difference = fitted.goal - estimate.goal
-        distance2 = float(difference @ np.linalg.solve(fitted.covariance + estimate.covariance, difference))
+        difference = fitted.goal - explained.goal
+        distance2 = float(difference @ np.linalg.solve(fitted.covariance + explained.covariance, difference))
         if distance2 <= chi2.ppf(0.999, len(difference)):
             return None
         return (f"the model at its own pace is contradicted by its reach at the person's pace (×{fitted.pace:.3g}, "
