@@ -47,6 +47,11 @@ class GoalEstimate(Plan):
     'paper': the Gauss–Newton curvature of the observation's negative log-likelihood under the model's belief,
     plus the prior's; 'online': the inverse Hessian, its spread along the reach from a quadrature early on,
     :mod:`comanip.estimation.online_estimator`)."""
+    unsmoothed_goal: np.ndarray | None = None
+    """'online': the goal the explanation gave (d,), m, before the smoothing that gives ``goal``
+    (``OnlineOptions.goal_smoothing``, :mod:`comanip.estimation.goal_smoothing`); the same as ``goal`` without it."""
+    unsmoothed_goal_covariance: np.ndarray | None = None
+    """'online': that goal's covariance (d, d), m²; ``goal_covariance`` adds the smoothed goal's offset from it."""
     forecast: "HandForecast | None" = None
     """'online': the forecast of the rest of the reach from the hand's state at t_obs
     (:class:`~comanip.estimation.hand_forecast.HandForecast`; ``forecast.at(t)`` gives the hand's mean position,

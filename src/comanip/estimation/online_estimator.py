@@ -52,6 +52,7 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_forecast import continued_reach
 from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
+from comanip.estimation.goal_smoothing import GoalSmoother
 from comanip.estimation.hand_rest import lost_sample
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
@@ -144,6 +145,8 @@ class OnlineGoalEstimator:
         self.start_position = start[:n].copy()
         self.prior_mean = self.start_position.copy() if self.prior_goal is None else self.prior_goal
         self.reach = Reach(self.family, start, self.prior_mean, self.prior_cov)
+        smoothing = self.options.goal_smoothing
+        self._smoother = None if smoothing is None else GoalSmoother(smoothing, self.start_position)
         for explanation in self.explanations:
             explanation.reset(self.reach)
         self._hand = HandTrace(model.d)
@@ -248,19 +251,24 @@ class OnlineGoalEstimator:
         """The estimate of ``explained``, with the model's predicted reach to its goal; its message follows
         why the explanations asked before it did not explain the hand."""
         model, n = self.model, self.model.n
-        goal, status = explained.goal, explained.status
+        status, observed = explained.status, self._hand.last_observation
+        unsmoothed = np.array(explained.goal, dtype=float), np.array(explained.covariance, dtype=float)
+        goal, covariance = unsmoothed
+        if self._smoother is not None:
+            if status == EstimateStatus.UNINFORMATIVE:      # the prior: not where the hand heads
+                self._smoother.reset()
+            else:
+                goal, covariance = self._smoother.smooth(self._last_time, goal, covariance, observed[:n])
         prediction = self.reach.prediction(goal, order=0)
         timed = timed_plan(prediction.mean, prediction.cov, prediction.torque, model.h, n, explained.timing)
         before, fraction = grid_position(max(self._last_time - timed.t[0], 0.0), timed.t[1] - timed.t[0], model.H)
         predicted = (1 - fraction) * timed.mean[before, :2 * n] + fraction * timed.mean[min(before + 1, model.H), :2 * n]
-        observed = self._hand.last_observation
-        covariance = np.array(explained.covariance, dtype=float)
         forecast = None
         t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
         if self._hand.count:
             stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
             forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
-                                       observed[n:], np.asarray(goal, dtype=float), covariance, stop,
+                                       observed[n:], goal, covariance, stop,
                                        self._person_acceleration())
             t, mean, cov = forecast.t, forecast.mean, forecast.cov
             torque = np.zeros((len(t) - 1, n))
@@ -268,7 +276,8 @@ class OnlineGoalEstimator:
                     objective=prediction.objective, solve_time=time.perf_counter() - t_begin, iterations=explained.iterations,
                     t=t, mean=mean, cov=cov, torque=torque, ee_mean=mean[:, :n].copy(),
                     ee_cov=cov[:, :n, :n].copy(), ee_velocity=mean[:, n:2 * n].copy(), start=self.start.copy(),
-                    goal=np.array(goal, dtype=float), width=self.width, model_name=model.name)
+                    goal=goal, width=self.width, model_name=model.name)
         return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=before, observed_state=observed,
                                observation_residual=predicted - observed, prior_goal=self.prior_goal, method="online",
-                               goal_covariance=covariance, forecast=forecast, timed_reach=timed)
+                               goal_covariance=covariance, unsmoothed_goal=unsmoothed[0],
+                               unsmoothed_goal_covariance=unsmoothed[1], forecast=forecast, timed_reach=timed)

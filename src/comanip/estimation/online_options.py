@@ -9,6 +9,7 @@ import numpy as np
 
 from comanip.arguments import as_count, as_positive
 from comanip.estimation.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
+from comanip.estimation.goal_smoothing import GoalSmoothing
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.people_model import PeopleModel
 
@@ -83,9 +84,15 @@ class OnlineOptions:
     paced_threshold: float = 0.05
     """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
+    goal_smoothing: GoalSmoothing | None = GoalSmoothing()
+    """How the estimate's ``goal`` is smoothed over updates for a robot to follow
+    (:mod:`comanip.estimation.goal_smoothing`; the explanation's own goal stays as ``unsmoothed_goal``); None: not
+    smoothed."""
 
     def __post_init__(self):
         observation_covariance(self.observation_std, 1)
+        if self.goal_smoothing is not None and not isinstance(self.goal_smoothing, GoalSmoothing):
+            raise ValueError(f"goal_smoothing must be a GoalSmoothing or None, got {type(self.goal_smoothing).__name__}")
         if self.timing not in TIMINGS:
             raise ValueError(f"timing must be one of {TIMINGS}, got {self.timing!r}")
         as_positive("mismatch_threshold", self.mismatch_threshold, "mean squared whitened residual")
