@@ -222,7 +222,7 @@ def aims_markdown(name, summary, latency, diagnosed) -> str:
     yes = lambda ok: "yes" if ok else "no"
     errors = " / ".join(f"{mine[f]['median']:.3f}" for f in AIMS)
     lines = [f"`{name}` against its aims on these reaches:", "", "| aim | measured | met |", "|---|---|---|",
-             f"| below every other predictor at 25 / 50 / 75 / 90 % of MT | as good or better: "
+             "| below every other predictor at 25 / 50 / 75 / 90 % of MT | as good or better: "
              + "; ".join(f"{int(100 * f)} %: {', '.join(b) or 'none'}" for f, b in beaten.items())
              + f" | {yes(not any(beaten.values()))} |",
              f"| ≤ {' / '.join(f'{a:g}' for a in AIMS.values())} D | {errors} D | "
