@@ -30,7 +30,9 @@ import numpy as np
 from scipy.stats import chi2
 
 from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
-from forecast_scores import forecast_figure, forecast_markdown, forecast_rows
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402  (beside this script)
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
