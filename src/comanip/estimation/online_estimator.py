@@ -53,12 +53,14 @@ from comanip.estimation.hand_forecast import continued_reach
 from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.goal_smoothing import GoalSmoother
+from comanip.estimation.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.hand_rest import lost_sample
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.reach_timing import timed_plan
 from comanip.estimation.people_model import shipped_people_model
+from comanip.estimation.person_calibration import FinishedReach, PersonCalibration, ReachFactors
 from comanip.model import ReachingModel
 from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
@@ -85,11 +87,18 @@ class OnlineGoalEstimator:
             :func:`~comanip.estimation.model_families.default_families`, when None). Building it takes a second
             or so once per model and width, in the constructor.
         explanations: the explanations asked in order (module docstring); None: those ``options.timing`` names.
+        person: what is known of the person (:class:`~comanip.estimation.person_calibration.PersonCalibration`),
+            learned from each finished reach (:meth:`finish_reach`, which :meth:`reset` calls) and applied to the
+            estimates; pass one to several estimators to share it. None: a person not seen yet.
     """
 
     def __init__(self, model: ReachingModel | Planner, start, *, prior_goal=None, prior_std=None, width: float | None = None,
                  options: OnlineOptions | None = None, cache: FamilyCache | None = None,
-                 explanations: Sequence[Explanation] | None = None):
+                 explanations: Sequence[Explanation] | None = None, person: PersonCalibration | None = None):
+        if person is not None and not isinstance(person, PersonCalibration):
+            raise ValueError(f"person must be a PersonCalibration or None, got {type(person).__name__}")
+        self.person = person if person is not None else PersonCalibration()
+        """What the estimator has learned of the person (:mod:`comanip.estimation.person_calibration`)."""
         self.options = options or OnlineOptions()
         if not isinstance(self.options, OnlineOptions):
             raise ValueError(f"options must be an OnlineOptions, got {type(self.options).__name__}")
@@ -130,9 +139,12 @@ class OnlineGoalEstimator:
 
     def reset(self, start=None) -> None:
         """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:
-        at rest where the hand was last seen, or where the last reach started). The model, width, prior std,
-        options and reach family stay; a prior goal given at construction stays, else the prior mean is the new
-        start."""
+        at rest where the hand was last seen, or where the last reach started). The reach before is learned from
+        first (:meth:`finish_reach`); what is known of the person stays (:meth:`forget_person` forgets it). The
+        model, width, prior std, options and reach family stay; a prior goal given at construction stays, else
+        the prior mean is the new start."""
+        if hasattr(self, "_history"):                       # not on the first reach, from the constructor
+            self.finish_reach()
         model, n = self.model, self.model.n
         if start is None:
             position = self._hand.last_observation[:n] if self._hand.count else self.start_position
@@ -150,10 +162,32 @@ class OnlineGoalEstimator:
         for explanation in self.explanations:
             explanation.reset(self.reach)
         self._hand = HandTrace(model.d)
+        self._history: list[tuple[float, np.ndarray, np.ndarray, float]] = []    # (t, goal, covariance, stop) uncalibrated
         self._last_time = -math.inf
         self._warned = False
         self.latest: GoalEstimate | None = None
         """The last estimate, None before the first update."""
+
+    def finish_reach(self) -> ReachFactors | None:
+        """Learn from the reach so far as a finished one (:meth:`PersonCalibration.learn`) where its hand came to
+        rest away from its start: its last position is the endpoint, the last time it moved faster than 5 % of its
+        peak speed the stop. Once per reach; None where nothing was learned."""
+        hand, history = self._hand, self._history
+        self._history = []
+        if not history or hand.count < 3 or not hand.has_left(self.start_position):
+            return None
+        speed = np.linalg.norm(hand.velocity, axis=1)
+        onset = hand.onset()
+        if onset is None or speed[-1] > MOVING_SPEED or speed.max() <= 0:
+            return None
+        end_s = float(hand.t[np.flatnonzero(speed >= 0.05 * speed.max())[-1]])
+        t, goals, covariances, stops = (np.array(column) for column in zip(*history))
+        return self.person.learn(FinishedReach(self.start_position, hand.position[-1].copy(), onset, end_s, t, goals,
+                                               covariances, stops))
+
+    def forget_person(self) -> None:
+        """Forget what was learned of the person: the next reaches are a new person's."""
+        self.person.forget()
 
     @property
     def observation_count(self) -> int:
@@ -252,8 +286,13 @@ class OnlineGoalEstimator:
         why the explanations asked before it did not explain the hand."""
         model, n = self.model, self.model.n
         status, observed = explained.status, self._hand.last_observation
-        unsmoothed = np.array(explained.goal, dtype=float), np.array(explained.covariance, dtype=float)
-        goal, covariance = unsmoothed
+        stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
+        goal, covariance = np.array(explained.goal, dtype=float), np.array(explained.covariance, dtype=float)
+        if status != EstimateStatus.UNINFORMATIVE:
+            self._history.append((self._last_time, goal, covariance, math.nan if stop is None else stop))
+            goal, covariance = self.person.goal(self.start_position, goal, covariance)
+            stop = None if stop is None else self.person.stop(self._last_time, stop)
+        unsmoothed = goal, covariance
         if self._smoother is not None:
             if status == EstimateStatus.UNINFORMATIVE:      # the prior: not where the hand heads
                 self._smoother.reset()
@@ -266,7 +305,6 @@ class OnlineGoalEstimator:
         forecast = None
         t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
         if self._hand.count:
-            stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
             forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
                                        observed[n:], goal, covariance, stop,
                                        self._person_acceleration())

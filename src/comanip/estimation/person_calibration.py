@@ -1,0 +1,208 @@
+"""What the online estimator learns of one person from their finished reaches.
+
+Explanations are fitted to other people (or to the model). A person moves their own way: they may stop
+consistently farther or shorter than the estimate says, end their reaches sooner or later, and be harder to
+predict than the people the estimates were fitted on. Once a reach is over, its endpoint and when the hand
+stopped are known, so each of its estimates can be scored. :class:`PersonCalibration` keeps three factors of
+one person, each the geometric mean of what their finished reaches show, shrunk towards the factor for a
+person not seen yet with the weight of ``prior_reaches`` reaches:
+
+- **amplitude** a: the endpoint's distance from the start along each estimate's direction over the estimate's
+  (the median over a reach's estimates from 25 % to 90 % of its movement time); the estimate's goal
+  becomes x_0 + a (g - x_0);
+- **pace** p: the time the hand still moved after each estimate over the time the estimate gave it (the
+  median, over those that gave one); the estimate's stop becomes t + p (t_stop - t);
+- **spread** c: the factor on the goal's covariance (amplitude applied) that makes its 95 % region hold the
+  endpoint at 95 % of the estimates of the person's last ``REMEMBERED`` reaches (the 95th percentile of their
+  squared Mahalanobis distances over the chi² 95 % quantile, at the person's amplitude); the covariance
+  becomes c a² P. A person not seen yet gets ``new_person_spread``.
+
+A reach is learned from when it is over (:meth:`PersonCalibration.learn`): the online estimator does it in
+``reset()`` when the hand had come to rest away from its start, and :meth:`PersonCalibration.forget` starts
+over with a new person.
+
+Shapes: d task dimensions, K estimates.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.stats import chi2
+
+from comanip.arguments import as_nonnegative, as_positive
+
+SCORED_SPAN = (0.25, 0.9)
+"""The part of a finished reach whose estimates are scored (fractions of its movement time from the onset)."""
+NEW_PERSON_SPREAD = 1.0
+"""The spread of a person not seen yet: the factor on the goal's covariance."""
+FACTOR_RANGE = (0.2, 5.0)
+"""A reach's amplitude and pace factors are clipped to this range (a reach they say more of is another task)."""
+SPREAD_RANGE = (0.01, 1e4)
+"""The spread factor stays in this range (exact observations of a reach would drive it to zero)."""
+REMEMBERED = 20
+"""The spread is read from the estimates of the person's last this many finished reaches."""
+
+
+@dataclass(frozen=True)
+class CalibrationSettings:
+    """How :class:`PersonCalibration` learns (module docstring)."""
+
+    prior_reaches: float = 1.0
+    """Weight, in reaches, of the factors of a person not seen yet against what the person's reaches show."""
+    new_person_spread: float = NEW_PERSON_SPREAD
+    """The spread factor of a person not seen yet (on the goal's covariance)."""
+
+    def __post_init__(self):
+        as_nonnegative("prior_reaches", self.prior_reaches, "reaches")
+        as_positive("new_person_spread", self.new_person_spread, "factor on the goal's covariance")
+
+
+@dataclass(frozen=True)
+class FinishedReach:
+    """One finished reach and the estimates made during it (before calibration)."""
+
+    start: np.ndarray
+    """Where it started (d,), m."""
+    end: np.ndarray
+    """Where the hand came to rest (d,), m."""
+    onset_s: float
+    """When the hand set off (s, the estimator's clock)."""
+    end_s: float
+    """When it stopped (s)."""
+    t: np.ndarray
+    """Times of the estimates (K,), s."""
+    goals: np.ndarray
+    """Their goals (K, d), m."""
+    covariances: np.ndarray
+    """Their goals' covariances (K, d, d), m²."""
+    stops: np.ndarray
+    """The stop times they gave (K,), s; NaN where none."""
+
+
+@dataclass(frozen=True)
+class ReachFactors:
+    """What one finished reach shows (module docstring); None where it shows nothing."""
+
+    amplitude: float | None
+    pace: float | None
+
+
+@dataclass(frozen=True)
+class ScoredEstimates:
+    """A finished reach's estimates from 25 % to 90 % of its movement time, scored against its endpoint."""
+
+    offsets: np.ndarray
+    """Goals minus the start (K, d), m."""
+    covariances: np.ndarray
+    """Their covariances (K, d, d), m²."""
+    end: np.ndarray
+    """The endpoint minus the start (d,), m."""
+
+    def spread(self, amplitude: float) -> np.ndarray:
+        """The estimates' squared Mahalanobis distances to the endpoint (K,), goals and covariances scaled by
+        ``amplitude``."""
+        errors = self.end - amplitude * self.offsets
+        return np.einsum("ki,ki->k", errors, np.linalg.solve(amplitude**2 * self.covariances, errors[:, :, None])[:, :, 0])
+
+
+def scored_estimates(reach: FinishedReach) -> ScoredEstimates | None:
+    """The estimates of ``reach`` its factors are read from (those from 25 % to 90 % of its movement time, with
+    a goal away from the start), or None."""
+    duration = reach.end_s - reach.onset_s
+    scored = (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
+    offsets = reach.goals - reach.start
+    scored &= np.linalg.norm(offsets, axis=1) > 1e-6
+    if duration <= 0 or not scored.any():
+        return None
+    return ScoredEstimates(offsets[scored], reach.covariances[scored], reach.end - reach.start)
+
+
+def reach_factors(reach: FinishedReach) -> ReachFactors:
+    """The amplitude and pace factors (module docstring) one finished reach shows."""
+    scored = scored_estimates(reach)
+    if scored is None:
+        return ReachFactors(None, None)
+    lengths = np.linalg.norm(scored.offsets, axis=1)
+    amplitude = float(np.clip(np.median((scored.offsets @ scored.end) / lengths**2), *FACTOR_RANGE))
+    duration = reach.end_s - reach.onset_s
+    within = (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
+    left = reach.stops[within] - reach.t[within]
+    timed = np.isfinite(left) & (left > 0.02)
+    pace = None
+    if timed.any():
+        pace = float(np.clip(np.median((reach.end_s - reach.t[within][timed]) / left[timed]), *FACTOR_RANGE))
+    return ReachFactors(amplitude, pace)
+
+
+class PersonCalibration:
+    """The amplitude, pace and spread factors of one person (module docstring), learned from their reaches."""
+
+    def __init__(self, settings: CalibrationSettings | None = None):
+        self.settings = settings or CalibrationSettings()
+        if not isinstance(self.settings, CalibrationSettings):
+            raise ValueError(f"settings must be a CalibrationSettings, got {type(self.settings).__name__}")
+        self.forget()
+
+    def forget(self) -> None:
+        """Start over with a person not seen yet."""
+        self._amplitudes: list[float] = []          # logs
+        self._paces: list[float] = []               # logs
+        self._scored: list[ScoredEstimates] = []    # the last REMEMBERED reaches
+        self.spread = self.settings.new_person_spread
+        """The factor on the goal's covariance (besides the amplitude's square)."""
+
+    @property
+    def reaches(self) -> int:
+        """Finished reaches learned from."""
+        return len(self._amplitudes)
+
+    def _shrunk(self, logs: list[float], new_person: float) -> float:
+        weight = self.settings.prior_reaches
+        if not logs:
+            return new_person
+        return math.exp((weight * math.log(new_person) + sum(logs)) / (weight + len(logs)))
+
+    @property
+    def amplitude(self) -> float:
+        """The factor on the goal's distance from the start."""
+        return self._shrunk(self._amplitudes, 1.0)
+
+    @property
+    def pace(self) -> float:
+        """The factor on the time the hand still moves."""
+        return self._shrunk(self._paces, 1.0)
+
+    def learn(self, reach: FinishedReach) -> ReachFactors:
+        """Learn from a finished reach; returns what it showed. The spread is read again from the person's last
+        :data:`REMEMBERED` reaches at the amplitude learned now."""
+        shown = reach_factors(reach)
+        if shown.amplitude is None:
+            return shown
+        self._amplitudes.append(math.log(shown.amplitude))
+        if shown.pace is not None:
+            self._paces.append(math.log(shown.pace))
+        self._scored = [*self._scored, scored_estimates(reach)][-REMEMBERED:]
+        try:
+            distances = np.concatenate([scored.spread(self.amplitude) for scored in self._scored])
+        except np.linalg.LinAlgError:
+            return shown
+        seen = float(np.percentile(distances, 95) / chi2.ppf(0.95, len(reach.end)))
+        if math.isfinite(seen):
+            seen = min(max(seen, SPREAD_RANGE[0]), SPREAD_RANGE[1])
+            weight = self.settings.prior_reaches
+            self.spread = math.exp((weight * math.log(self.settings.new_person_spread) + self.reaches * math.log(seen))
+                                   / (weight + self.reaches))
+        return shown
+
+    def goal(self, start: np.ndarray, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(goal (d,) m, covariance (d, d) m²) of an estimate for this person."""
+        a, factor = self.amplitude, self.spread * self.amplitude**2
+        return (goal if a == 1.0 else start + a * (goal - start)), (covariance if factor == 1.0 else factor * covariance)
+
+    def stop(self, t_now: float, stop_s: float) -> float:
+        """The stop time (s) of an estimate made at ``t_now`` (s) that said ``stop_s`` (s)."""
+        pace = self.pace
+        return stop_s if pace == 1.0 else t_now + pace * max(stop_s - t_now, 0.0)
