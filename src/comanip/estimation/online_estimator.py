@@ -54,7 +54,7 @@ from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.goal_smoothing import GoalSmoother
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.hand_rest import lost_sample
+from comanip.estimation.hand_rest import lost_sample, resting_position
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
@@ -162,7 +162,7 @@ class OnlineGoalEstimator:
         for explanation in self.explanations:
             explanation.reset(self.reach)
         self._hand = HandTrace(model.d)
-        self._history: list[tuple[float, np.ndarray, np.ndarray, float]] = []    # (t, goal, covariance, stop) uncalibrated
+        self._history: list[tuple] = []    # (t, hand, goal, covariance, stop) of each estimate, before calibration
         self._last_time = -math.inf
         self._warned = False
         self.latest: GoalEstimate | None = None
@@ -170,20 +170,21 @@ class OnlineGoalEstimator:
 
     def finish_reach(self) -> ReachFactors | None:
         """Learn from the reach so far as a finished one (:meth:`PersonCalibration.learn`) where its hand came to
-        rest away from its start: its last position is the endpoint, the last time it moved faster than 5 % of its
-        peak speed the stop. Once per reach; None where nothing was learned."""
+        rest away from its start (:func:`~comanip.estimation.hand_rest.resting_position`): where it rests is the
+        endpoint, the last time it moved faster than 5 % of its peak speed the stop. Once per reach; None where
+        nothing was learned."""
         hand, history = self._hand, self._history
         self._history = []
-        if not history or hand.count < 3 or not hand.has_left(self.start_position):
+        if not history or not hand.has_left(self.start_position):
             return None
-        speed = np.linalg.norm(hand.velocity, axis=1)
+        end = resting_position(hand.t, hand.position, creep=MOVING_SPEED)
         onset = hand.onset()
-        if onset is None or speed[-1] > MOVING_SPEED or speed.max() <= 0:
+        speed = np.linalg.norm(hand.velocity, axis=1)
+        if end is None or onset is None or speed.max() <= 0:
             return None
         end_s = float(hand.t[np.flatnonzero(speed >= 0.05 * speed.max())[-1]])
-        t, goals, covariances, stops = (np.array(column) for column in zip(*history))
-        return self.person.learn(FinishedReach(self.start_position, hand.position[-1].copy(), onset, end_s, t, goals,
-                                               covariances, stops))
+        t, hands, goals, covariances, stops = (np.array(column) for column in zip(*history))
+        return self.person.learn(FinishedReach(self.start_position, end, onset, end_s, t, hands, goals, covariances, stops))
 
     def forget_person(self) -> None:
         """Forget what was learned of the person: the next reaches are a new person's."""
@@ -289,8 +290,8 @@ class OnlineGoalEstimator:
         stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
         goal, covariance = np.array(explained.goal, dtype=float), np.array(explained.covariance, dtype=float)
         if status != EstimateStatus.UNINFORMATIVE:
-            self._history.append((self._last_time, goal, covariance, math.nan if stop is None else stop))
-            goal, covariance = self.person.goal(self.start_position, goal, covariance)
+            self._history.append((self._last_time, observed[:n].copy(), goal, covariance, math.nan if stop is None else stop))
+            goal, covariance = self.person.goal(observed[:n], goal, covariance)
             stop = None if stop is None else self.person.stop(self._last_time, stop)
         unsmoothed = goal, covariance
         if self._smoother is not None:

@@ -7,9 +7,9 @@ stopped are known, so each of its estimates can be scored. :class:`PersonCalibra
 one person, each the geometric mean of what their finished reaches show, shrunk towards the factor for a
 person not seen yet with the weight of ``prior_reaches`` reaches:
 
-- **amplitude** a: the endpoint's distance from the start along each estimate's direction over the estimate's
-  (the median over a reach's estimates from 25 % to 90 % of its movement time); the estimate's goal
-  becomes x_0 + a (g - x_0);
+- **amplitude** a: how far beyond the hand the endpoint lay, along what each estimate said was still to go,
+  over that (the median over a reach's estimates from 25 % to 90 % of its movement time); the estimate's
+  goal becomes x + a (g - x), x the hand, so a hand that has stopped keeps its goal;
 - **pace** p: the time the hand still moved after each estimate over the time the estimate gave it (the
   median, over those that gave one); the estimate's stop becomes t + p (t_stop - t);
 - **spread** c: the factor on the goal's covariance (amplitude applied) that makes its 95 % region hold the
@@ -74,6 +74,8 @@ class FinishedReach:
     """When it stopped (s)."""
     t: np.ndarray
     """Times of the estimates (K,), s."""
+    hands: np.ndarray
+    """Where the hand was at each (K, d), m."""
     goals: np.ndarray
     """Their goals (K, d), m."""
     covariances: np.ndarray
@@ -95,29 +97,29 @@ class ScoredEstimates:
     """A finished reach's estimates from 25 % to 90 % of its movement time, scored against its endpoint."""
 
     offsets: np.ndarray
-    """Goals minus the start (K, d), m."""
+    """Goals minus the hand (K, d), m: what the estimates said was still to go."""
     covariances: np.ndarray
     """Their covariances (K, d, d), m²."""
-    end: np.ndarray
-    """The endpoint minus the start (d,), m."""
+    ends: np.ndarray
+    """The endpoint minus the hand (K, d), m: what was still to go."""
 
     def spread(self, amplitude: float) -> np.ndarray:
-        """The estimates' squared Mahalanobis distances to the endpoint (K,), goals and covariances scaled by
-        ``amplitude``."""
-        errors = self.end - amplitude * self.offsets
+        """The estimates' squared Mahalanobis distances to the endpoint (K,), what they said was still to go and
+        their covariances scaled by ``amplitude``."""
+        errors = self.ends - amplitude * self.offsets
         return np.einsum("ki,ki->k", errors, np.linalg.solve(amplitude**2 * self.covariances, errors[:, :, None])[:, :, 0])
 
 
 def scored_estimates(reach: FinishedReach) -> ScoredEstimates | None:
     """The estimates of ``reach`` its factors are read from (those from 25 % to 90 % of its movement time, with
-    a goal away from the start), or None."""
+    a goal away from the hand), or None."""
     duration = reach.end_s - reach.onset_s
     scored = (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
-    offsets = reach.goals - reach.start
+    offsets = reach.goals - reach.hands
     scored &= np.linalg.norm(offsets, axis=1) > 1e-6
     if duration <= 0 or not scored.any():
         return None
-    return ScoredEstimates(offsets[scored], reach.covariances[scored], reach.end - reach.start)
+    return ScoredEstimates(offsets[scored], reach.covariances[scored], reach.end - reach.hands[scored])
 
 
 def reach_factors(reach: FinishedReach) -> ReachFactors:
@@ -126,7 +128,8 @@ def reach_factors(reach: FinishedReach) -> ReachFactors:
     if scored is None:
         return ReachFactors(None, None)
     lengths = np.linalg.norm(scored.offsets, axis=1)
-    amplitude = float(np.clip(np.median((scored.offsets @ scored.end) / lengths**2), *FACTOR_RANGE))
+    along = np.einsum("ki,ki->k", scored.offsets, scored.ends)
+    amplitude = float(np.clip(np.median(along / lengths**2), *FACTOR_RANGE))
     duration = reach.end_s - reach.onset_s
     within = (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
     left = reach.stops[within] - reach.t[within]
@@ -197,10 +200,10 @@ class PersonCalibration:
                                    / (weight + self.reaches))
         return shown
 
-    def goal(self, start: np.ndarray, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(goal (d,) m, covariance (d, d) m²) of an estimate for this person."""
+    def goal(self, hand: np.ndarray, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(goal (d,) m, covariance (d, d) m²) of an estimate for this person, the hand at ``hand`` (d,) m."""
         a, factor = self.amplitude, self.spread * self.amplitude**2
-        return (goal if a == 1.0 else start + a * (goal - start)), (covariance if factor == 1.0 else factor * covariance)
+        return (goal if a == 1.0 else hand + a * (goal - hand)), (covariance if factor == 1.0 else factor * covariance)
 
     def stop(self, t_now: float, stop_s: float) -> float:
         """The stop time (s) of an estimate made at ``t_now`` (s) that said ``stop_s`` (s)."""

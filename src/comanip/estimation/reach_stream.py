@@ -18,7 +18,10 @@ make move):
 :class:`ReachStream` gives each reach its own :class:`~comanip.estimation.online_estimator.OnlineGoalEstimator`
 and feeds it the reach's samples; its estimates are the stream's, numbered by the reach. Each reach's
 estimator sees only its own samples, so the cost of an update is bounded by the longest reach, not by the
-length of the stream. The ROS node shares the segmenter and estimates at its own rate.
+length of the stream. They share what is learned of the person (:attr:`ReachStream.person`,
+:mod:`comanip.estimation.person_calibration`): each reach is learned from when the hand rests again, and
+:meth:`ReachStream.forget_person` starts over with a new person. The ROS node shares the segmenter and
+estimates at its own rate.
 """
 
 from __future__ import annotations
@@ -168,7 +171,7 @@ class ReachStream:
         model: a ReachingModel or Planner of a point mass, as :class:`OnlineGoalEstimator` takes.
         settings: :class:`SegmentationSettings`.
         estimator_options: keyword arguments for each reach's :class:`OnlineGoalEstimator` (``prior_std``,
-            ``width``, ``options``, ``cache``; the start comes from the stream).
+            ``width``, ``options``, ``cache``, ``person``; the start comes from the stream).
 
     The model's reach family is built here (a second or so, once per model and width, kept in the cache), so
     that the first reach of the stream starts as fast as the others; bad options are refused here too.
@@ -177,9 +180,11 @@ class ReachStream:
     def __init__(self, model, settings: SegmentationSettings | None = None, **estimator_options):
         self.model = model
         self.segmenter = ReachSegmenter(settings)
-        self._options = estimator_options
         body_model = getattr(model, "model", model)
-        OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
+        checked = OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
+        self.person = checked.person
+        """What the stream's reaches have taught of the person (shared by every reach's estimator)."""
+        self._options = {**estimator_options, "person": self.person}
         self.reset()
 
     def reset(self) -> None:
@@ -188,6 +193,10 @@ class ReachStream:
         self._reach: OnlineGoalEstimator | None = None
         self._last_time = -np.inf
         self.latest = StreamEstimate(0, False, None, None)
+
+    def forget_person(self) -> None:
+        """Forget what was learned of the person: the next reaches are a new person's."""
+        self.person.forget()
 
     @property
     def estimator(self) -> OnlineGoalEstimator | None:
@@ -217,7 +226,8 @@ class ReachStream:
         elif self._reach is not None:
             latest = StreamEstimate(latest.reach, True, self._reach.update(time_s - latest.reach_start, position, velocity),
                                     latest.reach_start)
-        if not self.segmenter.moving:
+        if not self.segmenter.moving and self._reach is not None:
+            self._reach.finish_reach()                   # the hand rests: the reach is over
             self._reach = None
         self.latest = StreamEstimate(latest.reach, self.segmenter.moving, latest.estimate, latest.reach_start)
         return self.latest
