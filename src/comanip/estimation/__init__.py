@@ -4,9 +4,12 @@ from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.goal_estimator import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
 from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
 from comanip.estimation.online_estimator import OnlineGoalEstimator
+from comanip.estimation.goal_smoothing import GoalSmoothing
 from comanip.estimation.online_options import OnlineOptions
+from comanip.estimation.person_calibration import CalibrationSettings, PersonCalibration
 from comanip.estimation.recorded_trials import estimate_recordings
 from comanip.estimation.reach_stream import ReachSegmenter, ReachStart, ReachStream, SegmentationSettings, StreamEstimate
 
-__all__ = ["EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior", "estimate_goal", "estimate_recordings", "goal_posterior", "OnlineGoalEstimator", "OnlineOptions",
-           "ReachSegmenter", "ReachStart", "ReachStream", "SegmentationSettings", "StreamEstimate"]
+__all__ = ["CalibrationSettings", "EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior",
+           "GoalSmoothing", "estimate_goal", "estimate_recordings", "goal_posterior", "OnlineGoalEstimator", "OnlineOptions",
+           "PersonCalibration", "ReachSegmenter", "ReachStart", "ReachStream", "SegmentationSettings", "StreamEstimate"]

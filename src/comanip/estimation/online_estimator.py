@@ -54,7 +54,7 @@ from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.goal_smoothing import GoalSmoother
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.hand_rest import lost_sample, resting_position
+from comanip.estimation.hand_rest import REST_WINDOW_S, lost_sample, resting_position
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
@@ -170,19 +170,19 @@ class OnlineGoalEstimator:
 
     def finish_reach(self) -> ReachFactors | None:
         """Learn from the reach so far as a finished one (:meth:`PersonCalibration.learn`) where its hand came to
-        rest away from its start (:func:`~comanip.estimation.hand_rest.resting_position`): where it rests is the
-        endpoint, the last time it moved faster than 5 % of its peak speed the stop. Once per reach; None where
-        nothing was learned."""
+        rest away from its start (:func:`~comanip.estimation.hand_rest.resting_position`): the last time it moved
+        faster than 5 % of its peak speed is the stop, its mean position over the rest window from then the
+        endpoint (so more samples at rest change neither). Once per reach; None where nothing was learned."""
         hand, history = self._hand, self._history
         self._history = []
         if not history or not hand.has_left(self.start_position):
             return None
-        end = resting_position(hand.t, hand.position, creep=MOVING_SPEED)
         onset = hand.onset()
         speed = np.linalg.norm(hand.velocity, axis=1)
-        if end is None or onset is None or speed.max() <= 0:
+        if resting_position(hand.t, hand.position, creep=MOVING_SPEED) is None or onset is None or speed.max() <= 0:
             return None
         end_s = float(hand.t[np.flatnonzero(speed >= 0.05 * speed.max())[-1]])
+        end = hand.position[(hand.t >= end_s) & (hand.t <= end_s + REST_WINDOW_S)].mean(axis=0)
         t, hands, goals, covariances, stops = (np.array(column) for column in zip(*history))
         return self.person.learn(FinishedReach(self.start_position, end, onset, end_s, t, hands, goals, covariances, stops))
 

@@ -54,8 +54,12 @@ class CalibrationSettings:
     """Weight, in reaches, of the factors of a person not seen yet against what the person's reaches show."""
     new_person_spread: float = NEW_PERSON_SPREAD
     """The spread factor of a person not seen yet (on the goal's covariance)."""
+    learns: bool = True
+    """False: nothing is learned, every reach is a person not seen yet's (calibration off)."""
 
     def __post_init__(self):
+        if not isinstance(self.learns, bool):
+            raise ValueError(f"learns must be True or False, got {self.learns!r}")
         as_nonnegative("prior_reaches", self.prior_reaches, "reaches")
         as_positive("new_person_spread", self.new_person_spread, "factor on the goal's covariance")
 
@@ -182,7 +186,7 @@ class PersonCalibration:
         """Learn from a finished reach; returns what it showed. The spread is read again from the person's last
         :data:`REMEMBERED` reaches at the amplitude learned now."""
         shown = reach_factors(reach)
-        if shown.amplitude is None:
+        if shown.amplitude is None or not self.settings.learns:
             return shown
         self._amplitudes.append(math.log(shown.amplitude))
         if shown.pace is not None:

@@ -63,6 +63,7 @@ from comanip.estimation import GoalEstimate, OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.reach_stream import ReachSegmenter, SegmentationSettings
 from comanip.estimation.model_families import FamilyCache
 from comanip.estimation.online_options import CORRECTING_PERSON
+from comanip.estimation.person_calibration import CalibrationSettings, PersonCalibration
 from comanip.estimation.estimation_planner import estimation_planner
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
@@ -78,11 +79,14 @@ RATE_WINDOW = 1.0
 """Input time (s) over which the status's achieved rate and median latency are taken."""
 
 
-def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded") -> OnlineGoalEstimator:
+def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded",
+                    calibration: PersonCalibration | None = None) -> OnlineGoalEstimator:
     """The goal estimator of one reach from ``start`` (2n,), at rest, for the ``person`` of
-    :attr:`NodeSettings.person`: the one place that names the estimator."""
+    :attr:`NodeSettings.person`, with what is known of them (``calibration``, shared by the node's reaches): the
+    one place that names the estimator."""
     options = CORRECTING_PERSON if person == "correcting" else OnlineOptions()
-    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=options)
+    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=options,
+                               person=calibration)
 
 
 @dataclass
@@ -145,6 +149,7 @@ class GoalNode(Node):
         self._transition = transition_model if transition_model is not None else TransitionModel()
         self._reach: Reach | None = None
         self._reach_estimator = None
+        self._person = PersonCalibration(CalibrationSettings(learns=s.learn_person))   # shared by the node's reaches
         self._segmenter = ReachSegmenter(SegmentationSettings(radius=s.rest_radius, window=s.rest_window))
         self._prior = None if s.prior_goal is None else np.array(s.prior_goal)
         self._last_pose: float | None = None
@@ -327,7 +332,10 @@ class GoalNode(Node):
         the publication, NaN when nothing was published."""
         s = self.settings
         if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
-            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width, s.person)
+            if self._reach_estimator is not None:
+                self._reach_estimator[1].finish_reach()  # the reach before is over: learn from it
+            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width,
+                                        s.person, self._person)
             for stamp, position, velocity in job.reach.lead:
                 if stamp - job.reach.start_stamp < job.t:
                     estimator.update(stamp - job.reach.start_stamp, position, velocity)

@@ -79,6 +79,9 @@ class NodeSettings:
     model at its own pace, at the person's, and the model of recorded people:
     :class:`comanip.estimation.OnlineOptions` as it comes); "correcting", the model's own plan with deviations
     corrected (the simulated scenarios' person, :data:`comanip.estimation.online_options.CORRECTING_PERSON`)."""
+    learn_person: bool = True
+    """Learn the person's amplitude, pace and spread from each finished reach and apply them to the next
+    (:mod:`comanip.estimation.person_calibration`); false: every reach is a person not seen yet."""
     twist_tolerance: float = 0.005
     """Largest stamp difference (s) between a pose and the twist paired with it."""
     ramp_time: float = DEFAULT_RAMP_TIME
@@ -109,6 +112,8 @@ class NodeSettings:
         object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
         if self.person not in PERSONS:
             raise ValueError(f"person must be one of {PERSONS}, got {self.person!r}")
+        if not isinstance(self.learn_person, bool):
+            raise ValueError(f"learn_person must be true or false, got {self.learn_person!r}")
         check_schedule_arguments(self.ramp_time, self.leading_stiffness, None)
         quaternion = as_vector("equilibrium_orientation", self.equilibrium_orientation, 4, "quaternion x, y, z, w")
         if abs(float(quaternion @ quaternion) - 1.0) > 1e-6:
