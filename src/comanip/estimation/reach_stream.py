@@ -15,12 +15,12 @@ make move):
 3. **The reach ends** when the hand rests again (as in 1, over a window that lies after the sample that
    started the reach), and the stream is at rest again (1).
 
-:class:`ReachStream` gives each reach its own :class:`~comanip.estimation.online_estimator.OnlineGoalEstimator`
-and feeds it the reach's samples; its estimates are the stream's, numbered by the reach. Each reach's
-estimator sees only its own samples, so the cost of an update is bounded by the longest reach, not by the
-length of the stream. They share what is learned of the person (:attr:`ReachStream.person`,
-:mod:`comanip.estimation.person_calibration`): each reach is learned from when the hand rests again, and
-:meth:`ReachStream.forget_person` starts over with a new person. The ROS node shares the segmenter and
+:class:`ReachStream` starts its :class:`~comanip.estimation.online_estimator.OnlineGoalEstimator` anew at each
+reach (``reset``) and feeds it the reach's samples; its estimates are the stream's, numbered by the reach. The
+estimator holds only the reach's own samples, so the cost of an update is bounded by the longest reach, not by
+the length of the stream. What it learns of the person (:attr:`ReachStream.person`,
+:mod:`comanip.estimation.person_calibration`) carries over: each reach is learned from when the hand rests
+again, and :meth:`ReachStream.forget_person` starts over with a new person. The ROS node shares the segmenter and
 estimates at its own rate.
 """
 
@@ -170,8 +170,8 @@ class ReachStream:
     Args:
         model: a ReachingModel or Planner of a point mass, as :class:`OnlineGoalEstimator` takes.
         settings: :class:`SegmentationSettings`.
-        estimator_options: keyword arguments for each reach's :class:`OnlineGoalEstimator` (``prior_std``,
-            ``width``, ``options``, ``cache``, ``person``; the start comes from the stream).
+        estimator_options: keyword arguments for the stream's :class:`OnlineGoalEstimator` (``prior_std``,
+            ``width``, ``options``, ``cache``, ``person``; each reach's start comes from the stream).
 
     The model's reach family is built here (a second or so, once per model and width, kept in the cache), so
     that the first reach of the stream starts as fast as the others; bad options are refused here too.
@@ -181,10 +181,9 @@ class ReachStream:
         self.model = model
         self.segmenter = ReachSegmenter(settings)
         body_model = getattr(model, "model", model)
-        checked = OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
-        self.person = checked.person
-        """What the stream's reaches have taught of the person (shared by every reach's estimator)."""
-        self._options = {**estimator_options, "person": self.person}
+        self._estimator = OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
+        self.person = self._estimator.person
+        """What the stream's reaches have taught of the person."""
         self.reset()
 
     def reset(self) -> None:
@@ -218,8 +217,8 @@ class ReachStream:
         started = self.segmenter.update(time_s, position, velocity)
         if started is not None:
             model = getattr(self.model, "model", self.model)
-            start = np.r_[started.start, np.zeros(model.state_size - len(started.start))]
-            self._reach = OnlineGoalEstimator(self.model, start, **self._options)
+            self._estimator.reset(np.r_[started.start, np.zeros(model.state_size - len(started.start))])
+            self._reach = self._estimator
             for t, p, v in started.samples:
                 estimate = self._reach.update(t - started.clock, p, v)
             latest = StreamEstimate(started.number, True, estimate, started.clock)
