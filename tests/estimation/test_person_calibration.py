@@ -108,3 +108,15 @@ def test_bad_calibration_settings_are_refused_in_one_line():
         CalibrationSettings(new_person_spread=0.0)
     with pytest.raises(ValueError, match="person must be a PersonCalibration"):
         comanip.OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6), person="alice")
+
+
+def test_reset_sets_a_new_prior_goal_or_keeps_the_one_before(cartesian_planner):
+    estimator = comanip.OnlineGoalEstimator(cartesian_planner, np.zeros(6), prior_goal=[0.3, 0.0, 0.0])
+    estimator.reset(np.zeros(6))
+    np.testing.assert_array_equal(estimator.prior_mean, [0.3, 0.0, 0.0])              # kept
+    estimator.reset(np.r_[0.1, 0.0, 0.0, np.zeros(3)], prior_goal=[0.0, 0.4, 0.0])
+    np.testing.assert_array_equal(estimator.update(0.01, [0.1, 0.0, 0.0], np.zeros(3)).goal, [0.0, 0.4, 0.0])
+    estimator.reset(np.r_[0.1, 0.0, 0.0, np.zeros(3)], prior_goal=None)              # the start's position
+    np.testing.assert_array_equal(estimator.prior_mean, [0.1, 0.0, 0.0])
+    with pytest.raises(ValueError, match="prior_goal"):
+        estimator.reset(np.zeros(6), prior_goal=[0.1, 0.2])

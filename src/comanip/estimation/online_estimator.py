@@ -54,7 +54,7 @@ from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.goal_smoothing import GoalSmoother
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.hand_rest import REST_WINDOW_S, lost_sample, resting_position
+from comanip.estimation.hand_rest import lost_sample, resting_position
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
@@ -68,6 +68,10 @@ from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 from comanip.planning.single_thread_blas import SingleThreadBlas
 from comanip.units import MAX_REACH_DURATION_S, MAX_REACH_SPAN_M
+
+
+_SAME = object()
+"""reset()'s default prior goal: the one before."""
 
 
 class OnlineGoalEstimator:
@@ -137,14 +141,17 @@ class OnlineGoalEstimator:
                              "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
         return [HandAtRest(), vetoed_own_pace(self.model, self.options, person_pace), person_pace, RecordedPeople(people)]
 
-    def reset(self, start=None) -> None:
+    def reset(self, start=None, *, prior_goal=_SAME) -> None:
         """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:
         at rest where the hand was last seen, or where the last reach started). The reach before is learned from
         first (:meth:`finish_reach`); what is known of the person stays (:meth:`forget_person` forgets it). The
-        model, width, prior std, options and reach family stay; a prior goal given at construction stays, else
-        the prior mean is the new start."""
+        model, width, prior std, options and reach family stay. ``prior_goal``: the prior goal g_bar (d,) m from
+        this reach on, or None for the start's hand position; left out, the one before stays."""
         if hasattr(self, "_history"):                       # not on the first reach, from the constructor
             self.finish_reach()
+        if prior_goal is not _SAME:
+            self.prior_goal = None if prior_goal is None else as_vector("prior_goal", prior_goal, self.model.d,
+                                                                        "task-space position, m")
         model, n = self.model, self.model.n
         if start is None:
             position = self._hand.last_observation[:n] if self._hand.count else self.start_position
@@ -170,19 +177,18 @@ class OnlineGoalEstimator:
 
     def finish_reach(self) -> ReachFactors | None:
         """Learn from the reach so far as a finished one (:meth:`PersonCalibration.learn`) where its hand came to
-        rest away from its start (:func:`~comanip.estimation.hand_rest.resting_position`): the last time it moved
-        faster than 5 % of its peak speed is the stop, its mean position over the rest window from then the
-        endpoint (so more samples at rest change neither). Once per reach; None where nothing was learned."""
+        rest away from its start (:func:`~comanip.estimation.hand_rest.resting_position`): where it rests is the
+        endpoint, the last time it moved faster than 5 % of its peak speed the stop. Once per reach; None where
+        nothing was learned."""
         hand, history = self._hand, self._history
         self._history = []
         if not history or not hand.has_left(self.start_position):
             return None
-        onset = hand.onset()
+        end, onset = resting_position(hand.t, hand.position, creep=MOVING_SPEED), hand.onset()
         speed = np.linalg.norm(hand.velocity, axis=1)
-        if resting_position(hand.t, hand.position, creep=MOVING_SPEED) is None or onset is None or speed.max() <= 0:
+        if end is None or onset is None or speed.max() <= 0:
             return None
         end_s = float(hand.t[np.flatnonzero(speed >= 0.05 * speed.max())[-1]])
-        end = hand.position[(hand.t >= end_s) & (hand.t <= end_s + REST_WINDOW_S)].mean(axis=0)
         t, hands, goals, covariances, stops = (np.array(column) for column in zip(*history))
         return self.person.learn(FinishedReach(self.start_position, end, onset, end_s, t, hands, goals, covariances, stops))
 

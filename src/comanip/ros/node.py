@@ -332,10 +332,12 @@ class GoalNode(Node):
         the publication, NaN when nothing was published."""
         s = self.settings
         if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
-            if self._reach_estimator is not None:
-                self._reach_estimator[1].finish_reach()  # the reach before is over: learn from it
-            estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width,
-                                        s.person, self._person)
+            if self._reach_estimator is None:
+                estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width,
+                                            s.person, self._person)
+            else:                                        # learns from the reach before (what it knows of the person)
+                estimator = self._reach_estimator[1]
+                estimator.reset(job.reach.start, prior_goal=job.reach.prior_goal)
             for stamp, position, velocity in job.reach.lead:
                 if stamp - job.reach.start_stamp < job.t:
                     estimator.update(stamp - job.reach.start_stamp, position, velocity)
