@@ -1,6 +1,6 @@
 """What the estimator learns of a person from their finished reaches: on the model's own reaches played at a
-wrong pace (a person who is not the model), the calibrated estimates come nearer the endpoint and their 95 %
-regions hold it more often; on the model's own reaches nothing is invented; forgetting the person starts over."""
+wrong pace (a person who is not the model), the calibrated estimates come nearer the endpoint, their 95 %
+regions hold it more often and the forecast's hold the hand; on the model's own reaches nothing is invented; forgetting the person starts over."""
 
 import numpy as np
 import pytest
@@ -28,21 +28,25 @@ def played(plan, pace):
 
 
 def person_run(planner, reaches, pace, person, timing="model"):
-    """Per reach: (median error / D, share of 95 % regions holding the endpoint), from 25 % to 90 % of it, each
-    reach's estimator sharing ``person`` (None: a new person every reach)."""
+    """Per reach: (median error / D, share of 95 % regions holding the endpoint, share of the forecast's 95 %
+    regions at +0.2 s holding the hand), from 25 % to 90 % of it, each reach's estimator sharing ``person``
+    (None: a new person every reach)."""
     out = []
     for plan in reaches:
         estimator = comanip.OnlineGoalEstimator(planner, np.zeros(6), options=OnlineOptions(timing=timing), person=person)
         t, x, v = played(plan, pace)
-        end, errors, held = x[-1], [], []
+        end, errors, held, ahead = x[-1], [], [], []
         for k in range(1, len(t)):
             estimate = estimator.update(t[k], x[k], v[k])
             if 0.25 <= k / len(plan.t) <= 0.9:
                 e = estimate.goal - end
                 errors.append(np.linalg.norm(e) / np.linalg.norm(end))
                 held.append(e @ np.linalg.solve(estimate.goal_covariance, e) <= chi2.ppf(0.95, 3))
+                point = estimate.forecast.at([t[k] + 0.2])
+                e = point.position[0] - np.array([np.interp(t[k] + 0.2, t, column) for column in x.T])
+                ahead.append(e @ np.linalg.solve(point.covariance[0], e) <= chi2.ppf(0.95, 3))
         estimator.finish_reach()
-        out.append((np.median(errors), np.mean(held)))
+        out.append((np.median(errors), np.mean(held), np.mean(ahead)))
     return np.array(out)
 
 
@@ -53,6 +57,7 @@ def test_calibration_converges_on_the_models_people_at_a_wrong_pace(cartesian_pl
     later = slice(4, None)                                             # from the person's 5th reach on
     assert np.median(calibrated[later, 0]) < 0.6 * np.median(uncalibrated[later, 0]), (calibrated, uncalibrated)
     assert np.mean(calibrated[later, 1]) > np.mean(uncalibrated[later, 1]) + 0.15, (calibrated, uncalibrated)
+    assert np.mean(calibrated[later, 2]) >= 0.8 > np.mean(uncalibrated[later, 2]) + 0.5, (calibrated, uncalibrated)
     assert person.reaches == len(reaches) and person.amplitude < 0.8    # ahead of the model's pace, less to go than it says
     np.testing.assert_allclose(calibrated[0], uncalibrated[0])                # the first reach: a person not seen yet
 
@@ -94,7 +99,8 @@ def test_the_factors_of_a_reach_that_stops_farther_and_later():
     hands = np.zeros((101, 3))
     hands[:, 0] = 0.1 * t                                            # the hand at 0.1 t m: still to go 0.3 - 0.1 t m, said 0.2 - 0.1 t
     reach = FinishedReach(np.zeros(3), np.array([0.3, 0.0, 0.0]), 0.0, 1.0, t, hands, goals,
-                          np.tile(1e-4 * np.eye(3), (101, 1, 1)), np.full(101, 0.8))
+                          np.tile(1e-4 * np.eye(3), (101, 1, 1)), np.full(101, 0.8), np.zeros((101, 3, 3)),
+                          np.tile(np.eye(3), (101, 3, 1, 1)), t, hands)
     shown = reach_factors(reach)
     scored = t[(t >= 0.25) & (t <= 0.9)]
     assert shown.amplitude == pytest.approx(np.median((0.3 - 0.1 * scored) / (0.2 - 0.1 * scored)))

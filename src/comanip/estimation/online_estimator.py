@@ -35,6 +35,7 @@ an update needs no plan solve.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 import warnings
@@ -60,7 +61,7 @@ from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
 from comanip.estimation.reach_timing import timed_plan
 from comanip.estimation.people_model import shipped_people_model
-from comanip.estimation.person_calibration import FinishedReach, PersonCalibration, ReachFactors
+from comanip.estimation.person_calibration import FORECAST_LEADS, FinishedReach, PersonCalibration, ReachFactors
 from comanip.model import ReachingModel
 from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
@@ -170,6 +171,7 @@ class OnlineGoalEstimator:
             explanation.reset(self.reach)
         self._hand = HandTrace(model.d)
         self._history: list[tuple] = []    # (t, hand, goal, covariance, stop) of each estimate, before calibration
+        self._forecasts: list[tuple] = []  # (positions (L, d), covariances (L, d, d)) of its forecast at the leads
         self._last_time = -math.inf
         self._warned = False
         self.latest: GoalEstimate | None = None
@@ -180,9 +182,9 @@ class OnlineGoalEstimator:
         rest away from its start (:func:`~comanip.estimation.hand_rest.resting_position`): where it rests is the
         endpoint, the last time it moved faster than 5 % of its peak speed the stop. Once per reach; None where
         nothing was learned."""
-        hand, history = self._hand, self._history
-        self._history = []
-        if not history or not hand.has_left(self.start_position):
+        hand, history, forecasts = self._hand, self._history, self._forecasts
+        self._history, self._forecasts = [], []
+        if not history or len(forecasts) != len(history) or not hand.has_left(self.start_position):
             return None
         end, onset = resting_position(hand.t, hand.position, creep=MOVING_SPEED), hand.onset()
         speed = np.linalg.norm(hand.velocity, axis=1)
@@ -190,7 +192,9 @@ class OnlineGoalEstimator:
             return None
         end_s = float(hand.t[np.flatnonzero(speed >= 0.05 * speed.max())[-1]])
         t, hands, goals, covariances, stops = (np.array(column) for column in zip(*history))
-        return self.person.learn(FinishedReach(self.start_position, end, onset, end_s, t, hands, goals, covariances, stops))
+        ahead, ahead_covariances = (np.array(column) for column in zip(*forecasts))
+        return self.person.learn(FinishedReach(self.start_position, end, onset, end_s, t, hands, goals, covariances, stops,
+                                               ahead, ahead_covariances, hand.t.copy(), hand.position.copy()))
 
     def forget_person(self) -> None:
         """Forget what was learned of the person: the next reaches are a new person's."""
@@ -315,6 +319,11 @@ class OnlineGoalEstimator:
             forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
                                        observed[n:], goal, covariance, stop,
                                        self._person_acceleration())
+            if status != EstimateStatus.UNINFORMATIVE:
+                ahead = forecast.at(self._last_time + np.array(FORECAST_LEADS))
+                self._forecasts.append((ahead.position, ahead.covariance))
+            if self.person.forecast_spread != 1.0:
+                forecast = dataclasses.replace(forecast, cov=self.person.forecast_spread * forecast.cov)
             t, mean, cov = forecast.t, forecast.mean, forecast.cov
             torque = np.zeros((len(t) - 1, n))
         plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),

@@ -15,7 +15,10 @@ person not seen yet with the weight of ``prior_reaches`` reaches:
 - **spread** c: the factor on the goal's covariance (amplitude applied) that makes its 95 % region hold the
   endpoint at 95 % of the estimates of the person's last ``REMEMBERED`` reaches (the 95th percentile of their
   squared Mahalanobis distances over the chi² 95 % quantile, at the person's amplitude); the covariance
-  becomes c a² P. A person not seen yet gets ``new_person_spread``.
+  becomes c a² P. A person not seen yet gets ``new_person_spread``;
+- **forecast spread** c_f: the same for the forecast of the hand at :data:`FORECAST_LEADS` after each estimate
+  (its covariance at those times against where the hand was); the forecast's covariance becomes c_f times its
+  own. A person not seen yet gets 1.
 
 A reach is learned from when it is over (:meth:`PersonCalibration.learn`): the online estimator does it in
 ``reset()`` when the hand had come to rest away from its start, and :meth:`PersonCalibration.forget` starts
@@ -42,6 +45,8 @@ FACTOR_RANGE = (0.2, 5.0)
 """A reach's amplitude and pace factors are clipped to this range (a reach they say more of is another task)."""
 SPREAD_RANGE = (0.01, 1e4)
 """The spread factor stays in this range (exact observations of a reach would drive it to zero)."""
+FORECAST_LEADS = (0.1, 0.2, 0.3)
+"""Leads (s) after an estimate at which its forecast of the hand is scored."""
 REMEMBERED = 20
 """The spread is read from the estimates of the person's last this many finished reaches."""
 
@@ -86,6 +91,14 @@ class FinishedReach:
     """Their goals' covariances (K, d, d), m²."""
     stops: np.ndarray
     """The stop times they gave (K,), s; NaN where none."""
+    forecasts: np.ndarray
+    """Their forecasts' positions at t + :data:`FORECAST_LEADS` (K, L, d), m."""
+    forecast_covariances: np.ndarray
+    """And those positions' covariances (K, L, d, d), m²."""
+    hand_t: np.ndarray
+    """Times of the hand's observations (M,), s."""
+    hand_position: np.ndarray
+    """The hand's positions (M, d), m: where the forecasts are scored (held at the last after it)."""
 
 
 @dataclass(frozen=True)
@@ -106,6 +119,8 @@ class ScoredEstimates:
     """Their covariances (K, d, d), m²."""
     ends: np.ndarray
     """The endpoint minus the hand (K, d), m: what was still to go."""
+    forecast_distances: np.ndarray
+    """The forecasts' squared Mahalanobis distances to where the hand was at the leads (K·L,)."""
 
     def spread(self, amplitude: float) -> np.ndarray:
         """The estimates' squared Mahalanobis distances to the endpoint (K,), what they said was still to go and
@@ -123,7 +138,15 @@ def scored_estimates(reach: FinishedReach) -> ScoredEstimates | None:
     scored &= np.linalg.norm(offsets, axis=1) > 1e-6
     if duration <= 0 or not scored.any():
         return None
-    return ScoredEstimates(offsets[scored], reach.covariances[scored], reach.end - reach.hands[scored])
+    times = reach.t[scored, None] + np.array(FORECAST_LEADS)
+    truth = np.stack([np.interp(times, reach.hand_t, column) for column in reach.hand_position.T], axis=-1)
+    errors = (reach.forecasts[scored] - truth).reshape(-1, reach.end.size)
+    covariances = reach.forecast_covariances[scored].reshape(-1, reach.end.size, reach.end.size)
+    try:
+        distances = np.einsum("ki,ki->k", errors, np.linalg.solve(covariances, errors[:, :, None])[:, :, 0])
+    except np.linalg.LinAlgError:
+        distances = np.zeros(0)
+    return ScoredEstimates(offsets[scored], reach.covariances[scored], reach.end - reach.hands[scored], distances)
 
 
 def reach_factors(reach: FinishedReach) -> ReachFactors:
@@ -160,6 +183,8 @@ class PersonCalibration:
         self._scored: list[ScoredEstimates] = []    # the last REMEMBERED reaches
         self.spread = self.settings.new_person_spread
         """The factor on the goal's covariance (besides the amplitude's square)."""
+        self.forecast_spread = 1.0
+        """The factor on the forecast's covariance."""
 
     @property
     def reaches(self) -> int:
@@ -193,16 +218,25 @@ class PersonCalibration:
             self._paces.append(math.log(shown.pace))
         self._scored = [*self._scored, scored_estimates(reach)][-REMEMBERED:]
         try:
-            distances = np.concatenate([scored.spread(self.amplitude) for scored in self._scored])
+            self.spread = self._pooled([scored.spread(self.amplitude) for scored in self._scored],
+                                       self.settings.new_person_spread, len(reach.end), self.spread)
         except np.linalg.LinAlgError:
-            return shown
-        seen = float(np.percentile(distances, 95) / chi2.ppf(0.95, len(reach.end)))
-        if math.isfinite(seen):
-            seen = min(max(seen, SPREAD_RANGE[0]), SPREAD_RANGE[1])
-            weight = self.settings.prior_reaches
-            self.spread = math.exp((weight * math.log(self.settings.new_person_spread) + self.reaches * math.log(seen))
-                                   / (weight + self.reaches))
+            pass
+        self.forecast_spread = self._pooled([scored.forecast_distances for scored in self._scored], 1.0, len(reach.end),
+                                            self.forecast_spread)
         return shown
+
+    def _pooled(self, distances: list[np.ndarray], new_person: float, d: int, before: float) -> float:
+        """The factor that makes 95 % regions hold 95 % of the pooled squared Mahalanobis ``distances`` (d-dimensional),
+        within :data:`SPREAD_RANGE` and shrunk towards ``new_person``; ``before`` where there are none."""
+        pooled = np.concatenate(distances)
+        if not pooled.size:
+            return before
+        seen = float(np.percentile(pooled, 95) / chi2.ppf(0.95, d))
+        if not math.isfinite(seen):
+            return before
+        seen, weight = min(max(seen, SPREAD_RANGE[0]), SPREAD_RANGE[1]), self.settings.prior_reaches
+        return math.exp((weight * math.log(new_person) + self.reaches * math.log(seen)) / (weight + self.reaches))
 
     def goal(self, hand: np.ndarray, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(goal (d,) m, covariance (d, d) m²) of an estimate for this person, the hand at ``hand`` (d,) m."""
