@@ -215,7 +215,7 @@ def test_people_rows_weigh_every_effort_of_the_candidate_against_each_baseline()
     def trials(goal_error, forecast_error, force, work, peak):
         return [SimpleNamespace(metrics={"goal_error_mean_m": goal_error + 0.001 * k, "forecast_error_mean_m": forecast_error,
                                          "rms_force_change_N": force + k, "person_work_J": work + 0.1 * k,
-                                         "peak_force_N": peak}) for k in range(3)]
+                                         "peak_force_change_N": peak}) for k in range(3)]
 
     nan = float("nan")
     results = {"arm": {"near": {"passive": trials(nan, nan, 10.0, 2.0, 30.0), "constant-velocity": trials(0.05, 0.02, 12.0, 0.5, 40.0),

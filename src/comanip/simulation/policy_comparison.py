@@ -80,14 +80,14 @@ ERRORS = {"goal_error": "goal_error_mean_m", "forecast_error": "forecast_error_m
 EFFORTS = {
     "force_change": ("rms_force_change_N", "RMS force change", "N"),
     "work": ("person_work_J", "person's work beyond holding", "J"),
-    "peak_force": ("peak_force_N", "peak force", "N"),
+    "peak_force": ("peak_force_change_N", "peak force change", "N"),
 }
 
 
 def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> list[dict]:
     """One row per person and goal (results of :func:`compare_with_people`): the candidate's and the goal-error
     baseline's mean goal and forecast errors from t_o to MT (:data:`ERRORS`, mm) and every policy's efforts
-    (:data:`EFFORTS`: RMS force change, N, the person's work beyond holding, J, and the peak force, N), each as
+    (:data:`EFFORTS`: RMS force change, N, the person's work beyond holding, J, and the peak force change, N), each as
     mean and standard deviation over the trials, with the verdicts: ``goal_error_below`` and
     ``forecast_error_below`` (candidate's mean below the baseline's) and, per effort,
     ``<effort>_above`` (the policies whose mean effort is below the candidate's); and, over the trials paired

@@ -12,8 +12,9 @@ x_f(t) the forecast and g the estimate's goal, the rest's z is
 h the placing height when the scenario knows it (else g_z), P_xy the goal covariance's x–y block: the forecast's
 distance covered in x–y over the distance the estimate expects, trusted as far as its covariance says (an
 uncertain goal spreads the expected distance, so the lead descends no faster than the estimate is sure of). The
-rest's x–y are the forecast's (the robot does not lead them). The robot gives way (:data:`LEAD_SHARE`: its rest goes
-that share of the way from the handle to the lead), and leads only once the estimate explains the hand
+rest's x–y are the forecast's (the robot does not lead them). The robot gives way: its rest goes a share of the
+way from the handle to the lead, :data:`LEAD_SHARE` once the person's hand has covered :data:`RAMP_DISTANCE` in x–y
+and in proportion to the distance covered before; and it leads only once the estimate explains the hand
 (``estimate.success``).
 """
 
@@ -26,9 +27,14 @@ from comanip.simulation.policies.protocol import Prediction
 
 LEAD_SHARE = 0.3
 """The share of the way from the handle to the lead the robot's rest goes (:attr:`Prediction.lead_share`): its
-spring and damper pull with 0.3 of their force. Chosen on person seeds 20–22 (near and far goals, the arm person
-played 2.5 times slower) among 0.25, 0.3, 0.5 and 1 by the person's RMS force change, not on the seeds of the
-results page (docs/results/policy_comparison.md, "How the forecast policy's constants were chosen")."""
+spring and damper pull with 0.3 of their force. Chosen by the person's RMS force change on person seeds 20–22, not
+the results page's (docs/results/policy_comparison.md, "How the forecast policy's constants were chosen")."""
+
+RAMP_DISTANCE = 0.1
+"""The person's x–y distance from the start (m) by which the share reaches :data:`LEAD_SHARE`, growing in proportion
+to it before: early in a reach the estimate rests on little motion (an estimate that explains a hand barely under
+way may put the goal about the hand, confidently), and a full lead to the height would pull the handle down ahead
+of the person. Chosen with LEAD_SHARE, on the same seeds."""
 
 
 def height_along(positions: np.ndarray, start: np.ndarray, goal: np.ndarray, goal_covariance: np.ndarray,
@@ -64,4 +70,6 @@ class ForecastPolicy(ContinuousPolicy):
         _, position[:, 2] = height_along(position, c.start[:3], goal, np.asarray(estimate.goal_covariance), height,
                                          person_axes)
         velocity[:, 2] = np.gradient(position[:, 2], c.dt)
-        return Prediction(goal, c.rest_from(t, position, velocity), estimate, lead_share=LEAD_SHARE)
+        covered = float(np.linalg.norm(position[0, person_axes] - c.start[person_axes]))
+        share = LEAD_SHARE * min(1.0, covered / RAMP_DISTANCE)
+        return Prediction(goal, c.rest_from(t, position, velocity), estimate, lead_share=share)
