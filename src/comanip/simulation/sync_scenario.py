@@ -5,7 +5,9 @@ a robot policy (:mod:`comanip.simulation.policies`) predicts the goal and a rest
 motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. The default policy,
 ``one-shot``, is the paper's: it estimates the goal and the person's whole trajectory once, at t_o
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
-baselines (prior goal only, constant velocity, minimum-jerk fit) and the passive robot.
+baselines (prior goal only, constant velocity, minimum-jerk fit), the passive robot, and comanip's online
+estimate, leading along the model's reach to its goal (``continuous``) or along its forecast of the hand
+(``forecast``).
 
 The person is the model's own by default; ``SyncSettings.person`` (:class:`comanip.simulation.person.PersonParameters`) makes them
 move at another pace (``pace``) or along a recorded movement (``hand_path="recorded"``), so that a robot is not
@@ -76,8 +78,9 @@ class SyncSettings(ScenarioSettings):
 
 
 class PolicyRobot:
-    """Zero stiffness until t_o; then leads z along the rest motion of the policy's latest prediction (x and
-    y stay free: the rest follows the handle there), asking the policy again every update_interval."""
+    """Zero stiffness until t_o; then leads z along the rest motion of the policy's latest prediction, its
+    ``lead_share`` of the way from the handle (x and y stay free: the rest follows the handle there), asking the
+    policy again every update_interval."""
 
     def __init__(self, controller: CartesianImpedanceController, policy: RobotPolicy, settings: SyncSettings):
         self.controller, self.policy, self.settings = controller, policy, settings
