@@ -41,7 +41,7 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                                 ["benchmarks/goal_estimation_times.py", "--markdown", "--reaches", "20"]),
     "policy-comparison": ("robot policies compared on the sync scenario, 20 trials × 4 goals (about 10 min idle, an hour loaded)",
                           ["studies/which_robot_policy_helps_the_person_in_sync/make_policy_comparison.py", "--trials", "20"]),
-    "policy-people": ("robot policies on the sync scenario with people who are not the model: off-pace, recorded mouse movements and recorded arm reaches, 10 trials × 4 goals × 7 people (about 40 min in one process; --people, --save and --load split it)",
+    "policy-people": ("robot policies on the sync scenario with people who are not the model: off-pace, recorded mouse movements and recorded arm reaches, the forecast policy's errors and the person's efforts against every baseline's, 10 trials × 4 goals × 7 people (about 40 min in one process; --people, --save and --load split it)",
                       ["studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py", "--trials", "10"]),
     "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",

@@ -9,8 +9,8 @@
    hold and the arm recordings of step 3 do not);
 3. **run the robot beside a person guiding the handle** in the synchronisation scenario
    (:mod:`comanip.simulation.sync_scenario`): a simulated Panda and a person whose hand follows a recorded arm
-   reach (:data:`SYNC_PERSON`), the robot leading the height along its online estimate of the person's goal (the
-   ``continuous`` policy). What the robot believed along the way is read back by :func:`robot_forecasts`: the
+   reach (:data:`SYNC_PERSON`), the robot leading the height along its online estimate's forecast of the person's
+   hand (the ``forecast`` policy). What the robot believed along the way is read back by :func:`robot_forecasts`: the
    goal estimate over time and, at :data:`FORECAST_FRACTIONS` of the movement, its forecast of the hand's path.
 
 Needs the ``data`` extra (step 2's recording), the ``sim`` extra (step 3) and the arm reaches of
@@ -37,8 +37,8 @@ FRACTIONS = (0.2, 0.4, 0.6, 0.8, 1.0)
 """Fractions of the recorded movement time at which the online estimate's error is reported."""
 SYNC_GOAL = "near"
 """The sync scenario's goal (a name of :data:`comanip.simulation.NAMED_GOALS`)."""
-SYNC_POLICY = "continuous"
-"""The sync robot's policy: the online goal estimate, updated as the hand moves."""
+SYNC_POLICY = "forecast"
+"""The sync robot's policy: the online goal estimate's forecast of the hand, updated as the hand moves."""
 SYNC_PERSON = "arm-x2.5"
 """The sync scenario's person (:func:`comanip.simulation.people.choose_person`): a recorded arm reach played 2.5
 times slower. A fingertip pointing 0.22 m takes 0.42 s (the median of the recorded arm reaches); a person moving
@@ -158,7 +158,7 @@ def run_sync_beside(seed: int = 0):
 
 
 def robot_forecasts(result) -> list[Forecast]:
-    """The continuous robot's forecasts of the hand in the sync trial of ``result`` (:func:`run_sync_beside`) at
+    """The robot's forecasts of the hand in the sync trial of ``result`` (:func:`run_sync_beside`) at
     :data:`FORECAST_FRACTIONS` of its movement time: the robot's estimator fed again the handle states the robot
     saw (the same samples at the same times give the same estimates), read at the last update at or before each
     fraction."""

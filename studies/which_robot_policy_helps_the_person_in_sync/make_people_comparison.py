@@ -13,8 +13,8 @@ and be merged afterwards:
 
 Every policy of :data:`comanip.simulation.policies.POLICIES` meets every person of PEOPLE at every goal of GOALS,
 ``--trials`` trials each (trial k: person seed + k for every policy; a recorded person's seed picks its
-recording of the development split; the continuous policy's goal estimator uses the person's ONLINE_PRESETS
-entry). Prints, per person and goal, the continuous policy's mean goal error from t_o to MT against constant
+recording of the development split; the continuous and forecast policies' goal estimator uses the person's ONLINE_PRESETS
+entry). Prints, per person and goal, the forecast policy's (CANDIDATE's) mean goal and forecast errors from t_o to MT against constant
 velocity's and every policy's RMS force change and the person's work beyond holding (mean ± std over the
 trials), with the verdicts; writes the table's CSV beside this script and docs/figures/policy_comparison_people.png (progress on
 stderr).
@@ -42,6 +42,7 @@ from comanip.simulation.policies import POLICIES  # noqa: E402
 from comanip.simulation.policy_comparison import CANDIDATE, GOAL_ERROR_BASELINE, compare_with_people, people_rows, people_table  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
+from comanip.demo import GUIDING_FORCE_N  # noqa: E402
 from studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison import (  # noqa: E402
     GOALS, add_run_arguments, load_runs, save_run)
 
@@ -61,7 +62,7 @@ PEOPLE = {
     "arm-x2.5": PersonParameters(hand_path="recorded-arm", pace=2.5),
 }
 
-#: label -> the preset of the continuous policy's online goal estimator with that person (SyncSettings.online_preset;
+#: label -> the preset of the continuous and forecast policies' online goal estimator with that person (SyncSettings.online_preset;
 #: absent: the scenario's Cartesian preset): the arm preset, made for a person's hand in 3-D, with the arm reaches.
 ONLINE_PRESETS = {"arm": "arm", "arm-x2.5": "arm"}
 
@@ -104,23 +105,34 @@ def main(argv: list[str] | None = None) -> int:
     figure = _figure(rows, policies, HERE.parents[1] / "docs" / "figures" / "policy_comparison_people.png")
     goal_text = "; ".join(f"{label} {np.round(SyncSettings(goal=GOALS[label]).goal, 2).tolist()}" for label in goals)
     misses = [row for row in rows if not row.get("goal_error_below", True)]
+    forecast_misses = [row for row in rows if not row.get("forecast_error_below", True)]
+    low, high = GUIDING_FORCE_N
+    peaks = [row[f"peak_force_{CANDIDATE}_N"][0] for row in rows if f"peak_force_{CANDIDATE}_N" in row]
+    within = [peak for peak in peaks if low <= peak <= high]
+    people_option = "" if list(results) == list(PEOPLE) else f" --people {','.join(results)}"
     heavier = [row for row in rows if row.get("force_change_above")]
     more_work = [row for row in rows if row.get("work_above")]
     above_passive = [row for row in rows if "passive" in row.get("work_above", [])]
     presets_text = "; ".join(f"{label}: `{preset}`" for label, preset in ONLINE_PRESETS.items() if label in results)
     block = (f"Measured by `PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison "
-             f"--trials {trials} --seed {seed}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
-             f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; the continuous policy's estimator "
+             f"--trials {trials} --seed {seed}{people_option}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
+             f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; the continuous and forecast policies' estimator "
              f"preset: `cartesian`{'; ' + presets_text if presets_text else ''}; {wall / 60:.0f} min of simulation, "
              f"summed over processes, on the shared 2-core machine). Each cell: mean ± standard deviation over the "
-             f"trials; goal error averaged from t_o = 0.2 s to the movement time MT, force change from t_o on. Paired "
+             f"trials; goal error averaged from t_o = 0.2 s to the movement time MT, forecast error the RMS distance of each "
+             f"prediction's rest motion from the handle until MT averaged over the predictions from t_o to MT, force "
+             f"change from t_o on. Paired "
              f"differences (`{CANDIDATE}` minus the other policy, trial by trial: the same person meets every policy): "
              f"mean ± standard error.\n\n"
              f"{people_table(rows, policies)}\n"
              f"The person's work beyond holding the object, from t_o on (J; the same trials):\n\n"
              f"{people_table(rows, policies, 'work', goal_error=False)}\n"
+             f"The person's peak force change, from t_o on (N; the same trials), against the {low:.0f}–{high:.0f} N "
+             f"partners exchange when one guides the other through a held contact (Sawers et al. 2017):\n\n"
+             f"{people_table(rows, policies, 'peak_force', goal_error=False)}\n"
              f"`{CANDIDATE}` below `{GOAL_ERROR_BASELINE}` in mean goal error: {len(rows) - len(misses)} of {len(rows)} "
-             f"person–goal pairs; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}; "
+             f"person–goal pairs, in mean forecast error: {len(rows) - len(forecast_misses)} of {len(rows)}; its mean peak "
+             f"force change within {low:.0f}–{high:.0f} N: {len(within)} of {len(peaks)}; RMS force change not above any baseline's: {len(rows) - len(heavier)} of {len(rows)}; "
              f"person's work below the passive robot's: {len(rows) - len(above_passive)} of {len(rows)}, not above any "
              f"baseline's: {len(rows) - len(more_work)} of {len(rows)}.\n\n"
              f"{_verdicts_by_person(rows, results)}\n"
@@ -149,7 +161,7 @@ def _verdicts_by_person(rows: list[dict], results: dict) -> str:
 
 
 def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
-    """Per person (columns): the continuous policy's and constant velocity's mean goal error per goal (top),
+    """Per person (columns): the candidate policy's and constant velocity's mean goal error per goal (top),
     every policy's RMS force change (middle) and the person's work beyond holding (bottom) per goal, bars at the
     mean, error bars one standard deviation."""
     people = list(dict.fromkeys(row["person"] for row in rows))

@@ -210,21 +210,27 @@ def test_sync_metrics_of_a_movement_that_ends_before_the_observation_time_are_na
 def test_people_rows_weigh_every_effort_of_the_candidate_against_each_baseline():
     from types import SimpleNamespace
 
-    from comanip.simulation.policy_comparison import people_rows, people_table
+    from comanip.simulation.policy_comparison import CANDIDATE, people_rows, people_table
 
-    def trials(goal_error, force, work):
-        return [SimpleNamespace(metrics={"goal_error_mean_m": goal_error + 0.001 * k, "rms_force_change_N": force + k,
-                                         "person_work_J": work + 0.1 * k}) for k in range(3)]
+    def trials(goal_error, forecast_error, force, work, peak):
+        return [SimpleNamespace(metrics={"goal_error_mean_m": goal_error + 0.001 * k, "forecast_error_mean_m": forecast_error,
+                                         "rms_force_change_N": force + k, "person_work_J": work + 0.1 * k,
+                                         "peak_force_change_N": peak}) for k in range(3)]
 
-    results = {"arm": {"near": {"passive": trials(float("nan"), 10.0, 2.0), "constant-velocity": trials(0.05, 12.0, 0.5),
-                                "continuous": trials(0.04, 11.0, 1.0)}}}
+    nan = float("nan")
+    results = {"arm": {"near": {"passive": trials(nan, nan, 10.0, 2.0, 30.0), "constant-velocity": trials(0.05, 0.02, 12.0, 0.5, 40.0),
+                                CANDIDATE: trials(0.04, 0.03, 11.0, 1.0, 35.0)}}}
     row, = people_rows(results)
-    assert row["goal_error_below"] is True
+    assert row["goal_error_below"] is True and row["forecast_error_below"] is False
     assert row["goal_error_difference_mm"][0] == pytest.approx(-10.0)
+    assert row["forecast_error_difference_mm"][0] == pytest.approx(10.0)
     assert row["force_change_above"] == ["passive"] and row["work_above"] == ["constant-velocity"]
+    assert row["peak_force_above"] == ["passive"]
     assert row["work_excess_constant-velocity_J"][0] == pytest.approx(0.5)
-    table = people_table([row], ["passive", "constant-velocity", "continuous"], "work", goal_error=False)
+    table = people_table([row], ["passive", "constant-velocity", CANDIDATE], "work", goal_error=False)
     assert "goal error" not in table and "**constant-velocity (+0.5 ± " in table
+    table = people_table([row], ["passive", "constant-velocity", CANDIDATE], "force_change")
+    assert "forecast error" in table and "yes, **no**" in table
 
 
 def test_the_continuous_policy_estimates_with_the_online_preset():
@@ -240,3 +246,61 @@ def test_the_continuous_policy_estimates_with_the_online_preset():
     policy = ContinuousPolicy(context)
     assert policy.estimator.model.name == "arm" and policy.estimator.width == context.online_model.width
     assert context.model.name != "arm"                                   # the other policies keep the scenario's model
+
+
+def test_forecast_error_is_the_mean_over_predictions_of_the_rms_distance_to_the_handle():
+    from comanip.simulation.rest_trajectory import RestTrajectory
+    from comanip.simulation.sync_scenario import forecast_error
+
+    t = np.arange(0.0, 1.0001, 0.001)
+    position = np.column_stack([0.3 + 0.2 * t, np.zeros_like(t), 0.5 - 0.3 * t])
+    record = _synthetic_record(t, position, np.zeros_like(position), np.zeros_like(position), position[-1])
+    exact = RestTrajectory(position, np.gradient(position, t, axis=0), 0.0, 0.001)
+    shifted = RestTrajectory(position + [0.0, 0.01, 0.0], np.gradient(position, t, axis=0), 0.0, 0.001)
+    assert forecast_error(record, [(0.2, exact)], until=0.8) == pytest.approx(0.0, abs=1e-12)
+    assert forecast_error(record, [(0.2, exact), (0.4, shifted)], until=0.8) == pytest.approx(0.005)
+    assert np.isnan(forecast_error(record, [(0.9, shifted)], until=0.8))       # made after MT: it forecasts nothing
+    assert np.isnan(forecast_error(record, [], until=0.8))
+
+
+def test_the_forecast_lead_descends_with_the_person_and_no_faster_than_the_goal_is_sure():
+    from comanip.simulation.policies.forecast import height_along
+
+    start, goal = np.array([0.3, 0.0, 0.5]), np.array([0.5, 0.0, 0.2])
+    path = start + np.outer(np.linspace(0.0, 1.2, 13), goal - start)       # along the chord, and past the goal
+    sure = np.zeros((3, 3))
+    progress, z = height_along(path, start, goal, sure, height=0.2)
+    np.testing.assert_allclose(progress, np.minimum(np.linspace(0.0, 1.2, 13), 1.0), atol=1e-12)
+    np.testing.assert_allclose(z, 0.5 - 0.3 * progress, atol=1e-12)
+    unsure, _ = height_along(path, start, goal, np.diag([0.01, 0.01, 1.0]), height=0.2)
+    assert np.all(unsure[1:] < progress[1:]) and unsure[-1] < 1.0            # the expected distance is longer
+    _, z_only = height_along(path + [0.0, 0.0, -0.1], start, goal, sure, height=0.2)
+    np.testing.assert_allclose(z_only, z, atol=1e-12)                         # the led axis does not move the lead
+
+
+def test_a_robot_that_gives_way_goes_its_share_of_the_way_from_the_handle_to_the_lead():
+    from types import SimpleNamespace
+
+    from comanip.simulation.policies import Prediction
+    from comanip.simulation.rest_trajectory import RestTrajectory
+    from comanip.simulation.sync_scenario import PolicyRobot
+
+    lead = RestTrajectory(np.tile([0.4, 0.1, 0.3], (10, 1)), np.tile([0.0, 0.0, -0.2], (10, 1)), 0.0, 0.001)
+
+    class Leading:
+        name, update_interval = "leading", None
+
+        def observe(self, t, position, velocity):
+            pass
+
+        def predict(self, t):
+            return Prediction(np.zeros(3), lead, lead_share=0.25)
+
+    controller = SimpleNamespace(translational_stiffness=None)
+    robot = PolicyRobot(controller, Leading(), SyncSettings(observation_time=0.001, known_height=False))
+    state = SimpleNamespace(position=np.array([0.3, 0.0, 0.5]), velocity=np.array([0.1, 0.0, 0.0]))
+    position, velocity = robot.command(0.002, state)
+    np.testing.assert_allclose(position, [0.3, 0.0, 0.5 + 0.25 * (0.3 - 0.5)])       # x–y follow the handle
+    np.testing.assert_allclose(velocity, [0.1, 0.0, 0.25 * -0.2])
+    with pytest.raises(ValueError, match="lead_share"):
+        Prediction(np.zeros(3), lead, lead_share=1.5)

@@ -29,7 +29,7 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial (default: %(default)s)")
     parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
     parser.add_argument("--policy", help="sync only: the robot policy, one of passive, prior-only, constant-velocity, "
-                                         "minimum-jerk, one-shot (default), continuous, or all of them")
+                                         "minimum-jerk, one-shot (default), continuous, forecast, or all of them")
     parser.add_argument("--trigger", help="handover only: what releases the robot, goal_distance (default: the handle "
                                           "within T of the known goal) or estimate (within T of the online goal estimate)")
     parser.add_argument("--person", help="sync only: who holds the handle, model (default: the reaching model's "

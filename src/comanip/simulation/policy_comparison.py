@@ -70,40 +70,47 @@ def compare_with_people(settings_by_goal: dict[str, SyncSettings], people: dict[
             for person, parameters in people.items()}
 
 
-#: The policy the people comparison's verdicts are about, and the one whose goal error it must beat.
-CANDIDATE, GOAL_ERROR_BASELINE = "continuous", "constant-velocity"
+#: The policy the people comparison's verdicts are about, and the one whose goal and forecast errors it must beat.
+CANDIDATE, GOAL_ERROR_BASELINE = "forecast", "constant-velocity"
+
+#: The robot's errors the people comparison sets against the baseline's: name -> key in the trial metrics (m).
+ERRORS = {"goal_error": "goal_error_mean_m", "forecast_error": "forecast_error_mean_m"}
 
 #: The person's efforts the people comparison reports: name -> (key in the trial metrics, heading, unit).
 EFFORTS = {
     "force_change": ("rms_force_change_N", "RMS force change", "N"),
     "work": ("person_work_J", "person's work beyond holding", "J"),
+    "peak_force": ("peak_force_change_N", "peak force change", "N"),
 }
 
 
 def people_rows(results: dict[str, dict[str, dict[str, list[SyncTrial]]]]) -> list[dict]:
     """One row per person and goal (results of :func:`compare_with_people`): the candidate's and the goal-error
-    baseline's mean goal error from t_o to MT (mm) and every policy's efforts (:data:`EFFORTS`: RMS force
-    change, N, and the person's work beyond holding, J), each as mean and standard deviation over the trials,
-    with the verdicts: ``goal_error_below`` (candidate's mean below the baseline's) and, per effort,
+    baseline's mean goal and forecast errors from t_o to MT (:data:`ERRORS`, mm) and every policy's efforts
+    (:data:`EFFORTS`: RMS force change, N, the person's work beyond holding, J, and the peak force change, N), each as
+    mean and standard deviation over the trials, with the verdicts: ``goal_error_below`` and
+    ``forecast_error_below`` (candidate's mean below the baseline's) and, per effort,
     ``<effort>_above`` (the policies whose mean effort is below the candidate's); and, over the trials paired
-    by seed (the same person for every policy), the candidate's goal error minus the baseline's
-    (``goal_error_difference_mm``) and its effort minus each lighter policy's (``<effort>_excess_<policy>_<unit>``),
+    by seed (the same person for every policy), the candidate's goal and forecast errors minus the baseline's
+    (``goal_error_difference_mm``, ``forecast_error_difference_mm``) and its effort minus each lighter policy's (``<effort>_excess_<policy>_<unit>``),
     as mean and standard error."""
     rows = []
     for person, by_goal in results.items():
         for goal, by_policy in by_goal.items():
             row = {"person": person, "goal": goal, "trials": len(next(iter(by_policy.values())))}
-            for name in (CANDIDATE, GOAL_ERROR_BASELINE):
-                if name in by_policy:
-                    row[f"goal_error_{name}_mm"] = _mean_std(by_policy[name], "goal_error_mean_m", 1e3)
+            for error, key in ERRORS.items():
+                for name in (CANDIDATE, GOAL_ERROR_BASELINE):
+                    if name in by_policy:
+                        row[f"{error}_{name}_mm"] = _mean_std(by_policy[name], key, 1e3)
             for effort, (key, _, unit) in EFFORTS.items():
                 for name, trials in by_policy.items():
                     row[f"{effort}_{name}_{unit}"] = _mean_std(trials, key, 1.0)
             if CANDIDATE in by_policy:
                 mine = by_policy[CANDIDATE]
                 if GOAL_ERROR_BASELINE in by_policy:
-                    row["goal_error_below"] = bool(row[f"goal_error_{CANDIDATE}_mm"][0] < row[f"goal_error_{GOAL_ERROR_BASELINE}_mm"][0])
-                    row["goal_error_difference_mm"] = _paired(mine, by_policy[GOAL_ERROR_BASELINE], "goal_error_mean_m", 1e3)
+                    for error, key in ERRORS.items():
+                        row[f"{error}_below"] = bool(row[f"{error}_{CANDIDATE}_mm"][0] < row[f"{error}_{GOAL_ERROR_BASELINE}_mm"][0])
+                        row[f"{error}_difference_mm"] = _paired(mine, by_policy[GOAL_ERROR_BASELINE], key, 1e3)
                 for effort, (key, _, unit) in EFFORTS.items():
                     row[f"{effort}_above"] = [name for name in by_policy if name != CANDIDATE
                                               and row[f"{effort}_{name}_{unit}"][0] < row[f"{effort}_{CANDIDATE}_{unit}"][0]]
@@ -121,21 +128,24 @@ def people_table(rows: list[dict], policies, effort: str = "force_change", goal_
     baselines = [name for name in policies if name != CANDIDATE]
     headings = ["person", "goal", "n"]
     if goal_error:
-        headings += [f"goal error t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)", "paired difference (mm)"]
+        for error in ERRORS:
+            what = error.replace("_", " ")
+            headings += [f"{what} t_o–MT, {CANDIDATE} (mm)", f"… {GOAL_ERROR_BASELINE} (mm)", "paired difference (mm)"]
     headings += [f"{heading}, {CANDIDATE} ({unit})"] + [f"… {name} ({unit})" for name in baselines]
     if goal_error:
-        headings.append(f"{CANDIDATE} below {GOAL_ERROR_BASELINE}?")
+        headings.append(f"{CANDIDATE} below {GOAL_ERROR_BASELINE}? (goal, forecast)")
     headings.append(f"baselines with less {heading} than {CANDIDATE}")
     lines = ["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)]
     for row in rows:
         cells = [row["person"], row["goal"], str(row["trials"])]
         if goal_error:
-            cells += [_pm(row.get(f"goal_error_{name}_mm")) for name in (CANDIDATE, GOAL_ERROR_BASELINE)]
-            cells.append(_pm(row.get("goal_error_difference_mm"), signed=True))
+            for error in ERRORS:
+                cells += [_pm(row.get(f"{error}_{name}_mm")) for name in (CANDIDATE, GOAL_ERROR_BASELINE)]
+                cells.append(_pm(row.get(f"{error}_difference_mm"), signed=True))
         cells += [_pm(row.get(f"{effort}_{name}_{unit}")) for name in [CANDIDATE] + baselines]
         if goal_error:
-            below = row.get("goal_error_below")
-            cells.append("–" if below is None else "yes" if below else "**no**")
+            below = [row.get(f"{error}_below") for error in ERRORS]
+            cells.append(", ".join("–" if b is None else "yes" if b else "**no**" for b in below))
         above = row.get(f"{effort}_above")
         cells.append("–" if above is None else "none" if not above else "**" + ", ".join(
             f"{name} ({_pm(row[f'{effort}_excess_{name}_{unit}'], signed=True)} {unit})" for name in above) + "**")
@@ -233,5 +243,5 @@ def _fmt(value: float) -> str:
     return f"{value:.3g}" if magnitude < 10 else f"{value:.0f}" if magnitude >= 100 else f"{value:.1f}"
 
 
-__all__ = ["CANDIDATE", "COMPARED", "EFFORTS", "GOAL_ERROR_BASELINE", "POLICIES", "compare_sync_policies", "compare_with_people",
+__all__ = ["CANDIDATE", "COMPARED", "EFFORTS", "ERRORS", "GOAL_ERROR_BASELINE", "POLICIES", "compare_sync_policies", "compare_with_people",
            "comparison_rows", "markdown_table", "people_rows", "people_table", "write_comparison"]

@@ -68,6 +68,11 @@ class RestTrajectory:
         velocity = np.where(((tau >= t[0]) & (tau <= t[-1]))[:, None], spline(inside, 1), 0.0)
         return cls(spline(inside), velocity, time_offset, dt)
 
+    def positions(self, times) -> np.ndarray:
+        """The rest positions (M, d), m, at real times (M,) s, held at the ends (as :meth:`__call__`)."""
+        k = np.rint((np.asarray(times, dtype=float) - self.time_offset) / self.dt).astype(int)
+        return self.position[np.clip(k, 0, len(self.position) - 1)]
+
     def __call__(self, t: float) -> RestTarget:
         """The rest position and velocity at real time t (s), held at the ends."""
         k = int(round((t - self.time_offset) / self.dt))

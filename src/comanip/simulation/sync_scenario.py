@@ -5,7 +5,9 @@ a robot policy (:mod:`comanip.simulation.policies`) predicts the goal and a rest
 motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. The default policy,
 ``one-shot``, is the paper's: it estimates the goal and the person's whole trajectory once, at t_o
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
-baselines (prior goal only, constant velocity, minimum-jerk fit) and the passive robot.
+baselines (prior goal only, constant velocity, minimum-jerk fit), the passive robot, and comanip's online
+estimate, leading along the model's reach to its goal (``continuous``) or along its forecast of the hand
+(``forecast``).
 
 The person is the model's own by default; ``SyncSettings.person`` (:class:`comanip.simulation.person.PersonParameters`) makes them
 move at another pace (``pace``) or along a recorded movement (``hand_path="recorded"``), so that a robot is not
@@ -76,8 +78,9 @@ class SyncSettings(ScenarioSettings):
 
 
 class PolicyRobot:
-    """Zero stiffness until t_o; then leads z along the rest motion of the policy's latest prediction (x and
-    y stay free: the rest follows the handle there), asking the policy again every update_interval."""
+    """Zero stiffness until t_o; then leads z along the rest motion of the policy's latest prediction, its
+    ``lead_share`` of the way from the handle (x and y stay free: the rest follows the handle there), asking the
+    policy again every update_interval."""
 
     def __init__(self, controller: CartesianImpedanceController, policy: RobotPolicy, settings: SyncSettings):
         self.controller, self.policy, self.settings = controller, policy, settings
@@ -85,6 +88,8 @@ class PolicyRobot:
         self.predictions = 0
         """Predictions made so far."""
         self.goal_estimate: np.ndarray | None = None
+        self.history: list[tuple[float, RestTrajectory]] = []
+        """(time s, rest motion) of every prediction made: the robot's forecasts of the handle."""
         self._next_update = settings.observation_time
         self.controller.translational_stiffness = np.zeros(3)
 
@@ -100,12 +105,15 @@ class PolicyRobot:
                     end_at_height(prediction.rest, self.settings.goal[2])
                 self.prediction, self.goal_estimate = prediction, prediction.goal
                 self.predictions += 1
+                self.history.append((t, prediction.rest))
                 self.controller.translational_stiffness = [0.0, 0.0, self.settings.robot_stiffness]
         if self.prediction is None:
             return RestTarget(position, velocity)            # no stiffness: the rest follows the handle
         rest_position, rest_velocity = self.prediction.rest(t)
+        share = self.prediction.lead_share
         position, velocity = position.copy(), velocity.copy()
-        position[2], velocity[2] = rest_position[2], rest_velocity[2]
+        position[2] += share * (rest_position[2] - position[2])
+        velocity[2] += share * (rest_velocity[2] - velocity[2])
         return RestTarget(position, velocity)
 
 
@@ -153,10 +161,25 @@ class SyncMetrics(NamedTuple):
     """Tracking error on the grid (P, 3), m."""
 
 
+def forecast_error(record: TrialRecord, history, until: float) -> float:
+    """The robot's forecast error (m): for every prediction made at a time t_i before ``until`` (s; the movement
+    time), the RMS distance between its rest motion and the handle over [t_i, until], averaged over the
+    predictions; NaN when there is none. history: (t_i s, :class:`RestTrajectory`) pairs, as
+    :attr:`PolicyRobot.history` records them."""
+    errors = []
+    for made_at, rest in history:
+        keep = (record.t >= made_at - 1e-9) & (record.t <= until + 1e-9)
+        if made_at < until and keep.any():
+            distance = np.linalg.norm(rest.positions(record.t[keep]) - record.position[keep], axis=1)
+            errors.append(np.sqrt(np.mean(distance**2)))
+    return float(np.mean(errors)) if errors else float("nan")
+
+
 def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimated_position: np.ndarray, width: float,
-                 observation_time: float) -> SyncMetrics:
+                 observation_time: float, history=()) -> SyncMetrics:
     """Measures of one trial (:func:`comanip.simulation.measures.trial_measures` and the paper's Fig. 7
-    errors), and the tracking error on the normalised-time grid (P,), (P, 3).
+    errors, and the forecast error of :func:`forecast_error` over the robot's ``history`` of predictions), and
+    the tracking error on the normalised-time grid (P,), (P, 3).
 
     goal_estimate: the robot's last goal estimate (3,), m, or None. The tracking errors are taken from t_o
     (when the first estimate exists) to MT and reported on a grid of t / MT (NaN when MT < t_o); force and
@@ -186,6 +209,7 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
         "reach_time_y_s": float(axis_times[1]),
         "reach_time_z_s": float(axis_times[2]),
         "peak_speed_m_per_s": float(speed.max()),
+        "forecast_error_mean_m": forecast_error(record, history, mt),
         "replans": record.replans,
         "iteration_capped_replans": record.iteration_capped_replans,
         **measures,
@@ -201,7 +225,8 @@ def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledS
                          dt=setup.world.timestep, duration=setup.trial_duration(settings.person), model=setup.model,
                          online_model=online_model, online_width=setup.width if settings.online_preset is None else online_model.width,
                          estimator=setup.estimator,
-                         prior_plan=setup.person_first_plan(start, prior), update_interval=settings.update_interval)
+                         prior_plan=setup.person_first_plan(start, prior), update_interval=settings.update_interval,
+                         goal_height=float(settings.goal[2]) if settings.known_height else None)
 
 
 def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progress: bool = True) -> list[SyncTrial]:
@@ -221,7 +246,8 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
         record = run_trial(setup.world, start, person, robot, context.duration)
         prediction = robot.prediction
         estimated = np.full((len(record.t), 3), np.nan) if prediction is None else np.array([prediction.rest(t)[0] for t in record.t])
-        metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time)
+        metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time,
+                                            robot.history)
         metrics["predictions"] = robot.predictions
         if prediction is not None and prediction.plan is not None and prediction.plan is not context.prior_plan:
             estimate = prediction.plan

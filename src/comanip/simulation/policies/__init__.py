@@ -6,13 +6,15 @@
 - ``constant-velocity`` (:mod:`constant_velocity`): the hand's current velocity extrapolated;
 - ``minimum-jerk`` (:mod:`minimum_jerk_fit`): a Flash–Hogan reach fitted to the observed prefix;
 - ``one-shot`` (:mod:`one_shot`): the paper's estimate at t_o, never revised (the scenario's default);
-- ``continuous`` (:mod:`continuous`): comanip's online estimate, revised with every observation.
+- ``continuous`` (:mod:`continuous`): comanip's online estimate, revised with every observation;
+- ``forecast`` (:mod:`forecast`): the same estimate's forecast of the hand as the lead, the robot giving way.
 
 >>> policy = POLICIES["minimum-jerk"](context)      # context: a PolicyContext
 """
 
 from comanip.simulation.policies.constant_velocity import ConstantVelocityPolicy
 from comanip.simulation.policies.continuous import ContinuousPolicy
+from comanip.simulation.policies.forecast import ForecastPolicy
 from comanip.simulation.policies.minimum_jerk_fit import MinimumJerkPolicy
 from comanip.simulation.policies.one_shot import OneShotPolicy
 from comanip.simulation.policies.passive import PassivePolicy
@@ -21,7 +23,7 @@ from comanip.simulation.policies.protocol import DEFAULT_UPDATE_INTERVAL, Policy
 
 #: policy name -> class (constructed with a PolicyContext)
 POLICIES = {cls.name: cls for cls in (PassivePolicy, PriorOnlyPolicy, ConstantVelocityPolicy, MinimumJerkPolicy,
-                                      OneShotPolicy, ContinuousPolicy)}
+                                      OneShotPolicy, ContinuousPolicy, ForecastPolicy)}
 
 
 def check_policy(name) -> str:
@@ -31,5 +33,5 @@ def check_policy(name) -> str:
     return name
 
 
-__all__ = ["ConstantVelocityPolicy", "ContinuousPolicy", "DEFAULT_UPDATE_INTERVAL", "MinimumJerkPolicy", "OneShotPolicy", "POLICIES",
+__all__ = ["ConstantVelocityPolicy", "ContinuousPolicy", "DEFAULT_UPDATE_INTERVAL", "ForecastPolicy", "MinimumJerkPolicy", "OneShotPolicy", "POLICIES",
            "PassivePolicy", "PolicyContext", "Prediction", "PriorOnlyPolicy", "RobotPolicy", "check_policy"]

@@ -54,6 +54,10 @@ class PolicyContext:
     """Time between predictions of the continuously updating policies (s)."""
     warm_start: Plan | None = None
     """A previous trial's one-shot estimate to start that solver from (None: the estimator's own search)."""
+    goal_height: float | None = None
+    """The placing height (m) when the scenario knows it (``SyncSettings.known_height``), else None. The robot
+    applies it to every prediction (:func:`comanip.simulation.sync_scenario.end_at_height`); a policy may lead to
+    it itself."""
 
     @cached_property
     def expected_movement_time(self) -> float:
@@ -88,6 +92,14 @@ class Prediction:
     """The rest motion the robot leads along (its z is used in the sync scenario), real time."""
     plan: Plan | None = None
     """The model's estimate behind the prediction, for the model-based policies."""
+    lead_share: float = 1.0
+    """How far the robot's rest goes from the handle towards the rest motion on the axes it leads, in [0, 1]:
+    rest = x + s (rest motion - x), and likewise its velocity, x the handle. 1: the rest motion itself; below 1
+    the robot gives way, its spring and damper pulling the handle towards the motion with s times their force."""
+
+    def __post_init__(self):
+        if not (isinstance(self.lead_share, (int, float)) and 0.0 <= self.lead_share <= 1.0):
+            raise ValueError(f"lead_share must be a number in [0, 1], got {self.lead_share!r}")
 
 
 class RobotPolicy(Protocol):
