@@ -64,3 +64,16 @@ def test_a_stream_refuses_time_going_back_and_skips_lost_samples():
 def test_bad_estimator_options_are_refused_when_the_stream_is_made():
     with pytest.raises(ValueError, match="width"):
         ReachStream(comanip.presets.arm(), width=-0.01)
+
+
+def test_a_stream_learns_the_person_from_every_reach_that_ends_at_rest():
+    t, x, v, goals = successive_reaches(4)
+    stream = ReachStream(comanip.presets.arm())
+    shared = set()
+    for k in range(len(t)):
+        stream.update(t[k], x[k], v[k])
+        if stream.estimator is not None:
+            shared.add(stream.estimator.person is stream.person)
+    assert stream.person.reaches == len(goals) and stream.estimator is None and shared == {True}
+    stream.forget_person()
+    assert stream.person.reaches == 0 and stream.person.spread == 1.0
