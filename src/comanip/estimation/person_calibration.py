@@ -129,14 +129,18 @@ class ScoredEstimates:
         return np.einsum("ki,ki->k", errors, np.linalg.solve(amplitude**2 * self.covariances, errors[:, :, None])[:, :, 0])
 
 
-def scored_estimates(reach: FinishedReach) -> ScoredEstimates | None:
-    """The estimates of ``reach`` its factors are read from (those from 25 % to 90 % of its movement time, with
-    a goal away from the hand), or None."""
+def scored_span(reach: FinishedReach) -> np.ndarray:
+    """Which of the reach's estimates (K,) lie from 25 % to 90 % of its movement time (:data:`SCORED_SPAN`)."""
     duration = reach.end_s - reach.onset_s
-    scored = (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
+    return (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
+
+
+def scored_estimates(reach: FinishedReach) -> ScoredEstimates | None:
+    """The estimates of ``reach`` its factors are read from (those of :func:`scored_span` with a goal away from the
+    hand), or None."""
     offsets = reach.goals - reach.hands
-    scored &= np.linalg.norm(offsets, axis=1) > 1e-6
-    if duration <= 0 or not scored.any():
+    scored = scored_span(reach) & (np.linalg.norm(offsets, axis=1) > 1e-6)
+    if reach.end_s <= reach.onset_s or not scored.any():
         return None
     times = reach.t[scored, None] + np.array(FORECAST_LEADS)
     truth = np.stack([np.interp(times, reach.hand_t, column) for column in reach.hand_position.T], axis=-1)
@@ -149,16 +153,16 @@ def scored_estimates(reach: FinishedReach) -> ScoredEstimates | None:
     return ScoredEstimates(offsets[scored], reach.covariances[scored], reach.end - reach.hands[scored], distances)
 
 
-def reach_factors(reach: FinishedReach) -> ReachFactors:
-    """The amplitude and pace factors (module docstring) one finished reach shows."""
-    scored = scored_estimates(reach)
+def reach_factors(reach: FinishedReach, scored: ScoredEstimates | None = None) -> ReachFactors:
+    """The amplitude and pace factors (module docstring) one finished reach shows (``scored``: its
+    :func:`scored_estimates`, when already at hand)."""
+    scored = scored or scored_estimates(reach)
     if scored is None:
         return ReachFactors(None, None)
     lengths = np.linalg.norm(scored.offsets, axis=1)
     along = np.einsum("ki,ki->k", scored.offsets, scored.ends)
     amplitude = float(np.clip(np.median(along / lengths**2), *FACTOR_RANGE))
-    duration = reach.end_s - reach.onset_s
-    within = (reach.t >= reach.onset_s + SCORED_SPAN[0] * duration) & (reach.t <= reach.onset_s + SCORED_SPAN[1] * duration)
+    within = scored_span(reach)
     left = reach.stops[within] - reach.t[within]
     timed = np.isfinite(left) & (left > 0.02)
     pace = None
@@ -210,13 +214,14 @@ class PersonCalibration:
     def learn(self, reach: FinishedReach) -> ReachFactors:
         """Learn from a finished reach; returns what it showed. The spread is read again from the person's last
         :data:`REMEMBERED` reaches at the amplitude learned now."""
-        shown = reach_factors(reach)
+        scored = scored_estimates(reach)
+        shown = reach_factors(reach, scored)
         if shown.amplitude is None or not self.settings.learns:
             return shown
         self._amplitudes.append(math.log(shown.amplitude))
         if shown.pace is not None:
             self._paces.append(math.log(shown.pace))
-        self._scored = [*self._scored, scored_estimates(reach)][-REMEMBERED:]
+        self._scored = [*self._scored, scored][-REMEMBERED:]
         try:
             self.spread = self._pooled([scored.spread(self.amplitude) for scored in self._scored],
                                        self.settings.new_person_spread, len(reach.end), self.spread)
