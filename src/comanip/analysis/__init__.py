@@ -39,7 +39,7 @@ from comanip.analysis.minimum_jerk_baseline import (
 from comanip.analysis.phase import PhaseCurve, phase_curves
 from comanip.analysis.profile_shape import ProfileShape, profile_shape
 from comanip.analysis.reach_grid import ReachOutcome, closed_loop_grid, home_start, open_loop_grid, unit_direction
-from comanip.analysis.speed_profile import SETTLING_FRACTION, SpeedMetrics, speed_metrics
+from comanip.analysis.speed_profile import SETTLING_FRACTION, ReachTiming, SpeedMetrics, movement_timing, speed_metrics
 from comanip.analysis.target_verdicts import HumanTargets, TargetVerdict, target_verdicts
 
 __all__ = [
@@ -55,6 +55,6 @@ __all__ = [
     "PhaseCurve", "phase_curves",
     "ProfileShape", "profile_shape",
     "ReachOutcome", "closed_loop_grid", "home_start", "open_loop_grid", "unit_direction",
-    "SETTLING_FRACTION", "SpeedMetrics", "speed_metrics",
+    "SETTLING_FRACTION", "ReachTiming", "SpeedMetrics", "movement_timing", "speed_metrics",
     "HumanTargets", "TargetVerdict", "target_verdicts",
 ]

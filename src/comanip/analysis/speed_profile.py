@@ -76,3 +76,44 @@ def speed_metrics(t, speed, settling_fraction: float = SETTLING_FRACTION) -> Spe
     j = k + 1 + int(below[0])
     movement_time = t[j - 1] + h * (speed[j - 1] - threshold) / (speed[j - 1] - speed[j])
     return SpeedMetrics(float(t_peak), float(peak), float(movement_time), float(t_peak / movement_time))
+
+
+
+@dataclass(frozen=True)
+class ReachTiming:
+    """Timing of one movement as recorded movements are timed (:func:`movement_timing`): times in s, speeds in m/s."""
+
+    onset: float
+    """Start of the movement (s from the start of the profile)."""
+    movement_time: float
+    """MT (s) from the onset to the end; NaN when the speed is above the end threshold at the last sample."""
+    peak_fraction: float
+    """(t_peak − onset) / MT: how early in the movement the speed peaks (NaN when MT is NaN)."""
+    peak_speed: float
+    """Peak speed (m/s)."""
+
+
+def movement_timing(t, speed, fraction: float = SETTLING_FRACTION) -> ReachTiming:
+    """Onset, MT and t_peak/MT of a speed profile by the rule recorded movements are cut by
+    (:func:`comanip.recordings.preprocessing.movement_bounds`), interpolated between samples so that they change
+    smoothly with the profile: the onset where the speed last rose through half of ``fraction``·v_peak before it first
+    exceeds ``fraction``·v_peak (t[0] when it starts above that); the end where it falls through ``fraction``·v_peak
+    after its last sample above it, so a corrective sub-movement is inside the movement; t_peak refined as in
+    :func:`speed_metrics`. t (T,) uniformly spaced times (s), speed (T,) ≥ 0 (m/s), T ≥ 3."""
+    metrics = speed_metrics(t, speed, fraction)
+    t = np.asarray(t, dtype=float)
+    speed = np.asarray(speed, dtype=float)
+    threshold = fraction * metrics.peak_speed
+    first = int(np.argmax(speed > threshold))
+    quiet = np.flatnonzero(speed[:first] <= 0.5 * threshold)
+    onset = t[0] if not quiet.size else _crossing(t, speed, int(quiet[-1]), 0.5 * threshold)
+    last = int(np.flatnonzero(speed > threshold)[-1])
+    if last == len(t) - 1:
+        return ReachTiming(float(onset), np.nan, np.nan, metrics.peak_speed)
+    duration = _crossing(t, speed, last, threshold) - onset
+    return ReachTiming(float(onset), float(duration), float((metrics.t_peak - onset) / duration), metrics.peak_speed)
+
+
+def _crossing(t: np.ndarray, speed: np.ndarray, k: int, level: float) -> float:
+    """The time between samples k and k + 1 where the speed passes ``level``, linearly interpolated."""
+    return float(t[k] + (t[k + 1] - t[k]) * (level - speed[k]) / (speed[k + 1] - speed[k]))

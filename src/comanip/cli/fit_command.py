@@ -1,5 +1,6 @@
-"""``comanip fit``: fit a model's parameters to recorded reaches (maximum likelihood) or to movement times
-per condition (least squares); write fit.json (values, standard errors, residuals, status), model.yaml
+"""``comanip fit``: fit a model's parameters to recorded reaches (maximum likelihood of their positions, or their
+timing matched by the model's closed-loop reaches: ``--match timing``) or to movement times per condition (least
+squares); write fit.json (values, standard errors, residuals, status), model.yaml
 (readable by ``comanip plan --preset``) and fit.png. The formats and the method: docs/fitting.md."""
 
 from __future__ import annotations
@@ -24,8 +25,15 @@ def add_parser(subparsers) -> None:
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
                         f"(default: {','.join(DEFAULT_PARAMETERS)} for recordings, {','.join(MT_DEFAULT_PARAMETERS)} for an MT table)")
+    parser.add_argument("--match", choices=("positions", "timing"), default="positions",
+                        help="recordings: 'positions' maximises the likelihood of the recorded positions under one open-loop "
+                        "plan per condition; 'timing' matches the mean MT and t_peak/MT of the model's closed-loop reaches "
+                        "to the recordings' (default: %(default)s)")
+    parser.add_argument("--executions", type=int, default=8, help="--match timing: closed-loop executions per condition "
+                        "(default: %(default)s)")
     parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
-    parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings, 100 for an MT table)")
+    parser.add_argument("--max-evaluations", type=int, help="optimiser evaluation budget (default: 200 for recordings' "
+                        "positions, 60 for their timing, 100 for an MT table)")
     parser.add_argument("--scheduler", type=scheduler_address, help="Dask scheduler address (e.g. tcp://host:8786) to plan the conditions on (default: here)")
     add_output_arguments(parser, "out/fit")
     parser.add_argument("--no-progress", action="store_true", help="no progress line")
@@ -40,6 +48,7 @@ def names(text: str) -> tuple[str, ...]:
 def run(args) -> int:
     from comanip.fitting.fit import fit_model
     from comanip.fitting.movement_times import MovementTimeTable, fit_movement_times
+    from comanip.fitting.timing_fit import fit_timing
     from comanip.recordings.trial_files import load_recordings
 
     model = load_model(args)
@@ -50,7 +59,12 @@ def run(args) -> int:
         options["parameters"] = args.parameters
     # the arguments, then the data, are checked before the output folder is made
     as_count("--max-evaluations", args.max_evaluations, optional=True)
-    ParameterSpace(model, options.get("parameters", DEFAULT_PARAMETERS if args.recordings else MT_DEFAULT_PARAMETERS), args.sigma_obs)
+    timing = args.match == "timing"
+    if timing and args.recordings is None:
+        raise ValueError("--match timing goes with --recordings; an MT table is fitted by its movement times")
+    as_count("--executions", args.executions)
+    defaults = DEFAULT_PARAMETERS if args.recordings and not timing else MT_DEFAULT_PARAMETERS
+    ParameterSpace(model, options.get("parameters", defaults), args.sigma_obs)
     if args.recordings is not None:
         data = load_recordings(args.recordings, args.trials, check_units=args.check_units, topic=args.topic, frame=args.frame)
     elif args.trials is not None or args.topic is not None or args.frame is not None:
@@ -58,7 +72,9 @@ def run(args) -> int:
     else:
         data = MovementTimeTable.read(args.mt_table)
     out = output_dir(args.out, "fit", args.force)
-    if args.recordings is not None:
+    if timing:
+        result = fit_timing(model, data, executions=args.executions, **options)
+    elif args.recordings is not None:
         result = fit_model(model, data, sigma_obs=args.sigma_obs, **options)
     else:
         result = fit_movement_times(model, data, **options)

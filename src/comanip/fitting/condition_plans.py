@@ -1,4 +1,5 @@
-"""Planning every condition of a fit for one model configuration, here or on a Dask cluster.
+"""Planning (or executing in closed loop) every condition of a fit for one model configuration, here or on a Dask
+cluster.
 
 Tasks carry the model as its config (plain data), never a Planner: planners are kept by their model's
 parameters in a cache that the ConditionPlanner owns (planning here) or that each Dask worker owns (a
@@ -18,11 +19,14 @@ import threading
 
 import numpy as np
 
+from comanip.analysis.speed_profile import ReachTiming
 from comanip.arguments import as_scheduler_address
+from comanip.fitting.closed_loop_timing import closed_loop_timings
 from comanip.model import ReachingModel
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
+from comanip.planning.solver_options import SolverOptions
 
 
 _PLANNERS = "comanip-condition-planners"
@@ -34,8 +38,9 @@ _CACHE_SIZE = 2
 
 def locked_planner(model: ReachingModel) -> tuple[Planner, threading.Lock]:
     """A Planner for ``model`` and the lock that serialises its solves (a Planner is not thread-safe, and a
-    Dask worker may run tasks in threads)."""
-    return Planner(model), threading.Lock()
+    Dask worker may run tasks in threads). A fit's planner serves one parameter set, so it is never compiled to C:
+    compiling takes seconds for every new model, more than the planner solves."""
+    return Planner(model, SolverOptions(compile=False)), threading.Lock()
 
 
 def plan_condition(planners: ModelCache, model_config: dict, start: np.ndarray, goal: np.ndarray,
@@ -47,11 +52,28 @@ def plan_condition(planners: ModelCache, model_config: dict, start: np.ndarray, 
         return planner.solve(start, goal, width)
 
 
+def time_condition(planners: ModelCache, model_config: dict, start: np.ndarray, goal: np.ndarray, width: float,
+                   executions: int, seed: int) -> list[ReachTiming]:
+    """The timing of one condition's closed-loop executions (:func:`~comanip.fitting.closed_loop_timing.closed_loop_timings`)
+    with the planner ``planners`` holds for the model given as its config."""
+    planner, lock = planners.get(model_config)
+    with lock:
+        return closed_loop_timings(planner, start, goal, width, executions, seed)
+
+
 def _plan_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, width: float) -> Plan:
     """:func:`plan_condition` on a Dask worker, with the worker's planners."""
     from comanip.caching.worker_cache import worker_cache
 
     return plan_condition(worker_cache(_PLANNERS), model_config, start, goal, width)
+
+
+def _time_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, width: float, executions: int,
+                    seed: int) -> list[ReachTiming]:
+    """:func:`time_condition` on a Dask worker, with the worker's planners."""
+    from comanip.caching.worker_cache import worker_cache
+
+    return time_condition(worker_cache(_PLANNERS), model_config, start, goal, width, executions, seed)
 
 
 class ConditionPlanner:
@@ -87,6 +109,14 @@ class ConditionPlanner:
         if self._client is None:
             return [plan_condition(self._planners, *task) for task in tasks]
         return self._client.gather(self._client.map(_plan_on_worker, *zip(*tasks), pure=False))
+
+    def timings(self, model: ReachingModel, executions: int, seed: int) -> list[list[ReachTiming]]:
+        """The timing of each reach's closed-loop executions for this model, in the order of ``reaches``."""
+        config = model.config()
+        tasks = [(config, start, goal, width, executions, seed) for start, goal, width in self.reaches]
+        if self._client is None:
+            return [time_condition(self._planners, *task) for task in tasks]
+        return self._client.gather(self._client.map(_time_on_worker, *zip(*tasks), pure=False))
 
 
 def _client(scheduler):

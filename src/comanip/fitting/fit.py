@@ -65,7 +65,7 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         A :class:`FitResult`. Input errors raise ValueError before any planning; a fit that fails later
         returns a result with status 'failed'; one whose data do not determine a parameter, 'unidentified'.
     """
-    data, conditions = _grouped(model, recordings, trials, start_tolerance, check_units)
+    data, conditions = grouped_trials(model, recordings, trials, start_tolerance, check_units)
     space = ParameterSpace(model, parameters, sigma_obs, bounds)
     max_evaluations = as_count("max_evaluations", max_evaluations)
     step = as_positive("step", step, "transformed units")
@@ -101,13 +101,13 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
 def recordings_nll(model: ReachingModel, recordings: str | Path | Sequence[Trial], *, trials: str | Path | None = None,
                    sigma_obs: float = 1e-3, start_tolerance: float = 0.005, scheduler=None, check_units: bool = True) -> float:
     """The negative log-likelihood (nats) :func:`fit_model` minimises, at the model as given."""
-    data, conditions = _grouped(model, recordings, trials, start_tolerance, check_units)
+    data, conditions = grouped_trials(model, recordings, trials, start_tolerance, check_units)
     space = ParameterSpace(model, ("sigma_obs",), sigma_obs)
     with ConditionPlanner([(c.start_state(model), c.goal, c.width) for c in conditions], scheduler) as planner:
         return RecordingsObjective(data, conditions, space, planner)(space.initial)
 
 
-def _grouped(model, recordings, trials_table, start_tolerance, check_units) -> tuple[list[Trial], list[Condition]]:
+def grouped_trials(model, recordings, trials_table, start_tolerance, check_units) -> tuple[list[Trial], list[Condition]]:
     """Checked trials and their conditions."""
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")

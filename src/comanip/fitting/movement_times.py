@@ -92,7 +92,7 @@ def fit_movement_times(model: ReachingModel, table: str | Path | MovementTimeTab
         except Exception as error:  # the fit never raises once planning started: report it as failed
             return failed_result(model, space, f"{type(error).__name__}: {error}", residuals.evaluations,
                                  time.perf_counter() - t_begin, SSE_KIND)
-    std = _least_squares_std(result.fun, result.jac)
+    std = least_squares_std(result.fun, result.jac)
     status = FitStatus.CONVERGED if result.status > 0 else FitStatus.MAX_EVALUATIONS
     values, std_errors = space.values(result.x), space.natural_std_errors(result.x, std)
     unidentified = identification(values, space.start_values, std_errors)
@@ -132,10 +132,13 @@ class _MovementTimeResiduals:
         return residual
 
 
-def _least_squares_std(residual: np.ndarray, jacobian: np.ndarray) -> np.ndarray:
-    """sqrt(diag(s² (JᵀJ)⁻¹)), s² = SSE / (m − p); NaN without spare conditions or with a singular JᵀJ."""
+def least_squares_std(residual: np.ndarray, jacobian: np.ndarray, whitened: bool = False) -> np.ndarray:
+    """sqrt(diag(s² (JᵀJ)⁻¹)) of residuals (m,) with their Jacobian (m, p): s² = SSE / (m − p) for residuals of unknown
+    variance, s² = 1 for ``whitened`` ones (divided by their known standard deviations); NaN without spare residuals
+    (unknown variance) or with a singular JᵀJ."""
     m, p = jacobian.shape
     information = jacobian.T @ jacobian
-    if m <= p or not np.all(np.isfinite(information)) or np.linalg.matrix_rank(information) < p:
+    if (m <= p and not whitened) or not np.all(np.isfinite(information)) or np.linalg.matrix_rank(information) < p:
         return np.full(p, np.nan)
-    return np.sqrt(np.diag(np.sum(residual**2) / (m - p) * np.linalg.inv(information)))
+    scale = 1.0 if whitened else np.sum(residual**2) / (m - p)
+    return np.sqrt(np.diag(scale * np.linalg.inv(information)))

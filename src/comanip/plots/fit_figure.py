@@ -17,9 +17,12 @@ MAX_CONDITIONS = 8
 
 
 def plot_fit(result: FitResult, path: str | Path) -> Path:
-    """Save the figure of a fit as a PNG: per-condition curves when the result has them, else movement times."""
+    """Save the figure of a fit as a PNG: per-condition curves when the result has them, the timing per condition for a
+    timing fit, else movement times."""
     if result.curves:
         return _plot_recordings_fit(result, path)
+    if result.conditions and "peak_fraction_predicted" in result.conditions[0]:
+        return _plot_timing_fit(result, path)
     return _plot_movement_time_fit(result, path)
 
 
@@ -62,6 +65,24 @@ def _plot_movement_time_fit(result: FitResult, path: str | Path) -> Path:
     ax.set_xlabel("index of difficulty log2(2D/w) (bits)")
     ax.set_ylabel("movement time (s)")
     ax.legend(fontsize=8)
+    return save_figure(fig, path, f"{result.model.name}: {_values(result)}")
+
+
+def _plot_timing_fit(result: FitResult, path: str | Path) -> Path:
+    """Recorded (mean and median over the trials) and predicted MT and t_peak/MT, per condition."""
+    rows = result.conditions
+    index = np.arange(len(rows))
+    fig, axes = plt.subplots(1, 2, figsize=(8.5, 3.8))
+    for ax, key, label in ((axes[0], "mt", "movement time (s)"), (axes[1], "peak_fraction", "t_peak / MT")):
+        suffix = "_s" if key == "mt" else ""
+        ax.plot(index, [r[f"{key}_recorded_mean{suffix}"] for r in rows], "o", color="C3", label="recorded, mean")
+        ax.plot(index, [r[f"{key}_recorded_median{suffix}"] for r in rows], "s", mfc="none", color="C3", label="recorded, median")
+        ax.plot(index, [np.nan if r[f"{key}_predicted{suffix}"] is None else r[f"{key}_predicted{suffix}"] for r in rows],
+                "x", color="k", ms=8, label="fitted model, closed loop")
+        ax.set_xticks(index, [f"{r['condition']}\n{r['trials']} trials" for r in rows], fontsize=7)
+        ax.set_xlabel("condition")
+        ax.set_ylabel(label)
+    axes[0].legend(fontsize=7)
     return save_figure(fig, path, f"{result.model.name}: {_values(result)}")
 
 
