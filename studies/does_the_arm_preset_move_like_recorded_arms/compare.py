@@ -4,8 +4,8 @@ People: every reach of a TAT-HUM 3-D data folder (default: the development split
 preprocessed by :meth:`comanip.recordings.TrackedSamples.recording` (4 ms grid, Savitzky–Golay velocities,
 onset and end at 5 % of the peak speed): movement time MT, t_peak / MT, peak speed, endpoint spread (SD of
 the endpoints of each target's reaches, per axis, pooled). Model: the preset's mean reach from rest over
-the people's median distance, with the width its YAML gives, timed the same way (docs/formulation.md §6),
-twice: its plan (open loop, what the online estimator's reach family holds) and its closed loop (the mean of
+the people's median distance, with the width its YAML gives, timed as the recordings are cut
+(:func:`comanip.analysis.movement_timing`), twice: its plan (open loop, what the online estimator's reach family holds) and its closed loop (the mean of
 ``--trials`` executions that replan every step from what the person sees, 100 ms late: the fast first
 sub-movement and the corrections after it); the endpoint SD from the plan's covariance at MT and over the
 closed-loop executions at their end; Fitts' law of the plans on the validation grid (D 0.15–0.45 m × w
@@ -25,7 +25,7 @@ import numpy as np
 
 import comanip
 from comanip.analysis.fitts import fit_fitts
-from comanip.analysis.speed_profile import speed_metrics
+from comanip.analysis.speed_profile import movement_timing, speed_metrics
 from comanip.execution import execute_receding_horizon
 from comanip.recordings import load_tathum
 
@@ -64,12 +64,10 @@ def people(folder: Path) -> dict:
 
 
 def timing(t: np.ndarray, speed: np.ndarray) -> dict:
-    """MT, t_peak / MT and the normalised profile of a mean speed profile, timed from its onset as people's."""
-    metrics = speed_metrics(t, speed)
-    onset = t[int(np.argmax(speed > 0.05 * metrics.peak_speed))]
-    duration = metrics.movement_time - onset
-    return {"movement_time": duration, "asymmetry": (metrics.t_peak - onset) / duration, "peak_speed": metrics.peak_speed,
-            "profile": np.interp(onset + PHASE * duration, t, speed) / metrics.peak_speed}
+    """MT, t_peak / MT and the normalised profile of a mean speed profile, timed as recorded movements are cut."""
+    metrics = movement_timing(t, speed)
+    return {"movement_time": metrics.movement_time, "asymmetry": metrics.peak_fraction, "peak_speed": metrics.peak_speed,
+            "profile": np.interp(metrics.onset + PHASE * metrics.movement_time, t, speed) / metrics.peak_speed}
 
 
 def model_reach(model, distance: float, trials: int) -> dict:

@@ -12,7 +12,7 @@ from comanip.analysis import movement_timing, speed_metrics
 from comanip.cli.main import main
 from comanip.execution import execute_receding_horizon
 from comanip.fitting import Trial
-from comanip.fitting.closed_loop_timing import recorded_timing
+from comanip.fitting.closed_loop_timing import mean_reach_timing, recorded_velocities
 from comanip.fitting.timing_fit import fit_timing
 
 TRUE_KAPPA = 2e-2
@@ -67,7 +67,9 @@ def test_a_recorded_trial_is_timed_as_its_speed():
     exact = movement_timing(t, minimum_jerk_speed(t, onset, duration, distance))
     cut = int(np.searchsorted(t, exact.onset + exact.movement_time)) + 1
     trial = Trial("cut", t[:cut], position[:cut], position[-1], 0.01)
-    timing = recorded_timing(trial)
+    velocity = recorded_velocities([trial], step)[0]
+    assert len(velocity) >= cut + 1 and np.all(velocity[cut:] == 0)    # at rest after its last sample
+    timing = mean_reach_timing(step, velocity)
     assert timing.movement_time == pytest.approx(exact.movement_time, abs=2 * step)
     assert timing.peak_fraction == pytest.approx(exact.peak_fraction, abs=0.01)
 
@@ -101,10 +103,10 @@ def test_timing_fit_recovers_kappa_from_the_models_closed_loop_reaches(kappa_tim
     assert kappa == pytest.approx(TRUE_KAPPA, rel=0.2)
     assert abs(kappa - TRUE_KAPPA) < 3 * se
     assert fit.objective_kind.startswith("chi²")
-    # the fitted model's executions take the recorded time in every condition, and peak as early
+    # the fitted model's mean reach takes the recorded one's time in every condition, and peaks as early
     for row in fit.conditions:
-        assert row["mt_predicted_s"] == pytest.approx(row["mt_recorded_mean_s"], rel=0.08)
-        assert row["peak_fraction_predicted"] == pytest.approx(row["peak_fraction_recorded_mean"], abs=0.05)
+        assert row["mt_predicted_s"] == pytest.approx(row["mt_recorded_s"], rel=0.08)
+        assert row["peak_fraction_predicted"] == pytest.approx(row["peak_fraction_recorded"], abs=0.05)
 
 
 @pytest.mark.slow
@@ -132,7 +134,7 @@ def test_timing_fit_refuses_bad_input_before_executing(synthetic_trials):
         fit_timing(model, synthetic_trials, ["kappa"], executions=0)
     with pytest.raises(ValueError, match="seed"):
         fit_timing(model, synthetic_trials, ["kappa"], seed=-1)
-    with pytest.raises(ValueError, match="2 trials more than conditions"):
-        fit_timing(model, synthetic_trials[:1], ["kappa"])
+    with pytest.raises(ValueError, match="at least 3 trials per condition"):
+        fit_timing(model, synthetic_trials[:2], ["kappa"])
     with pytest.raises(ValueError, match="hand moves in 3-D"):
         fit_timing(comanip.presets.cartesian(), synthetic_trials, ["kappa"])

@@ -29,6 +29,8 @@ def add_parser(subparsers) -> None:
                         help="recordings: 'positions' maximises the likelihood of the recorded positions under one open-loop "
                         "plan per condition; 'timing' matches the mean MT and t_peak/MT of the model's closed-loop reaches "
                         "to the recordings' (default: %(default)s)")
+    parser.add_argument("--width", type=float, help="goal width (m) of every recorded trial, instead of the recordings' "
+                        "(a motion-capture folder's is its endpoints' spread)")
     parser.add_argument("--executions", type=int, default=8, help="--match timing: closed-loop executions per condition "
                         "(default: %(default)s)")
     parser.add_argument("--sigma-obs", type=float, default=1e-3, help="measurement-noise std (m) of the recordings (default: %(default)s)")
@@ -67,15 +69,15 @@ def run(args) -> int:
     ParameterSpace(model, options.get("parameters", defaults), args.sigma_obs)
     if args.recordings is not None:
         data = load_recordings(args.recordings, args.trials, check_units=args.check_units, topic=args.topic, frame=args.frame)
-    elif args.trials is not None or args.topic is not None or args.frame is not None:
-        raise ValueError("--trials, --topic and --frame go with --recordings; an MT table holds its conditions itself")
+    elif args.trials is not None or args.topic is not None or args.frame is not None or args.width is not None:
+        raise ValueError("--trials, --width, --topic and --frame go with --recordings; an MT table holds its conditions itself")
     else:
         data = MovementTimeTable.read(args.mt_table)
     out = output_dir(args.out, "fit", args.force)
     if timing:
-        result = fit_timing(model, data, executions=args.executions, **options)
+        result = fit_timing(model, data, width=args.width, executions=args.executions, **options)
     elif args.recordings is not None:
-        result = fit_model(model, data, sigma_obs=args.sigma_obs, **options)
+        result = fit_model(model, data, sigma_obs=args.sigma_obs, width=args.width, **options)
     else:
         result = fit_movement_times(model, data, **options)
     written = [result.save_json(out / "fit.json"), result.save_yaml(out / "model.yaml")]

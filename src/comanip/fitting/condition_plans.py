@@ -21,7 +21,7 @@ import numpy as np
 
 from comanip.analysis.speed_profile import ReachTiming
 from comanip.arguments import as_scheduler_address
-from comanip.fitting.closed_loop_timing import closed_loop_timings
+from comanip.fitting.closed_loop_timing import closed_loop_timing
 from comanip.model import ReachingModel
 from comanip.caching.model_cache import ModelCache
 from comanip.planning.plan import Plan
@@ -53,12 +53,12 @@ def plan_condition(planners: ModelCache, model_config: dict, start: np.ndarray, 
 
 
 def time_condition(planners: ModelCache, model_config: dict, start: np.ndarray, goal: np.ndarray, width: float,
-                   executions: int, seed: int) -> list[ReachTiming]:
-    """The timing of one condition's closed-loop executions (:func:`~comanip.fitting.closed_loop_timing.closed_loop_timings`)
+                   executions: int, seed: int) -> ReachTiming:
+    """The timing of one condition's mean closed-loop reach (:func:`~comanip.fitting.closed_loop_timing.closed_loop_timing`)
     with the planner ``planners`` holds for the model given as its config."""
     planner, lock = planners.get(model_config)
     with lock:
-        return closed_loop_timings(planner, start, goal, width, executions, seed)
+        return closed_loop_timing(planner, start, goal, width, executions, seed)
 
 
 def _plan_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, width: float) -> Plan:
@@ -69,7 +69,7 @@ def _plan_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, wid
 
 
 def _time_on_worker(model_config: dict, start: np.ndarray, goal: np.ndarray, width: float, executions: int,
-                    seed: int) -> list[ReachTiming]:
+                    seed: int) -> ReachTiming:
     """:func:`time_condition` on a Dask worker, with the worker's planners."""
     from comanip.caching.worker_cache import worker_cache
 
@@ -110,8 +110,8 @@ class ConditionPlanner:
             return [plan_condition(self._planners, *task) for task in tasks]
         return self._client.gather(self._client.map(_plan_on_worker, *zip(*tasks), pure=False))
 
-    def timings(self, model: ReachingModel, executions: int, seed: int) -> list[list[ReachTiming]]:
-        """The timing of each reach's closed-loop executions for this model, in the order of ``reaches``."""
+    def timings(self, model: ReachingModel, executions: int, seed: int) -> list[ReachTiming]:
+        """The timing of each reach's mean closed-loop reach for this model, in the order of ``reaches``."""
         config = model.config()
         tasks = [(config, start, goal, width, executions, seed) for start, goal, width in self.reaches]
         if self._client is None:

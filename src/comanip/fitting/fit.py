@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -42,7 +43,7 @@ whose differences are inflated)."""
 
 def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], parameters: Sequence[str] = DEFAULT_PARAMETERS,
               *, trials: str | Path | None = None, sigma_obs: float = 1e-3, bounds: dict | None = None,
-              start_tolerance: float = 0.005, max_evaluations: int = 200, step: float = 0.05,
+              start_tolerance: float = 0.005, width: float | None = None, max_evaluations: int = 200, step: float = 0.05,
               scheduler=None, progress: bool = True, check_units: bool = True) -> FitResult:
     """Fit model fields to recorded reaches by maximum (pseudo-)likelihood.
 
@@ -55,6 +56,8 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         bounds: {name: (low, high)} natural-unit search bounds (default: a factor 1000 around the start;
             gamma's logit in [-12, 12]).
         start_tolerance: trials whose starts differ by at most this (m), with equal goal and width, share a plan.
+        width: every trial's goal width (m) instead of the recordings' (a motion-capture folder gives its endpoints'
+            spread, which is not the accuracy a model aims for).
         max_evaluations: Nelder-Mead's evaluation budget (the standard errors add 2p + 2p(p-1) more).
         step: finite-difference step for the standard errors, in transformed units (0.05: 5 % in a log parameter).
         scheduler: None plans locally; a Dask scheduler address or Client plans the conditions on that cluster.
@@ -65,7 +68,7 @@ def fit_model(model: ReachingModel, recordings: str | Path | Sequence[Trial], pa
         A :class:`FitResult`. Input errors raise ValueError before any planning; a fit that fails later
         returns a result with status 'failed'; one whose data do not determine a parameter, 'unidentified'.
     """
-    data, conditions = grouped_trials(model, recordings, trials, start_tolerance, check_units)
+    data, conditions = grouped_trials(model, recordings, trials, start_tolerance, check_units, width)
     space = ParameterSpace(model, parameters, sigma_obs, bounds)
     max_evaluations = as_count("max_evaluations", max_evaluations)
     step = as_positive("step", step, "transformed units")
@@ -107,8 +110,9 @@ def recordings_nll(model: ReachingModel, recordings: str | Path | Sequence[Trial
         return RecordingsObjective(data, conditions, space, planner)(space.initial)
 
 
-def grouped_trials(model, recordings, trials_table, start_tolerance, check_units) -> tuple[list[Trial], list[Condition]]:
-    """Checked trials and their conditions."""
+def grouped_trials(model, recordings, trials_table, start_tolerance, check_units,
+                   width: float | None = None) -> tuple[list[Trial], list[Condition]]:
+    """Checked trials and their conditions; ``width`` (m), when given, replaces every trial's goal width."""
     if not isinstance(model, ReachingModel):
         raise ValueError(f"model must be a comanip.ReachingModel (e.g. comanip.presets.planar()), got {type(model).__name__}")
     if isinstance(recordings, (str, Path)):
@@ -123,6 +127,9 @@ def grouped_trials(model, recordings, trials_table, start_tolerance, check_units
                          f"model's hand moves in {model.d}-D")
     if isinstance(start_tolerance, bool) or not isinstance(start_tolerance, (int, float)) or not start_tolerance >= 0:
         raise ValueError(f"start_tolerance must be a number ≥ 0 (m), got {start_tolerance!r}")
+    if width is not None:
+        width = as_positive("width", width, "m, the goal width of every trial")
+        trials = [replace(trial, width=width) for trial in trials]
     return trials, group_conditions(trials, float(start_tolerance))
 
 

@@ -3,15 +3,14 @@
 A recorded arm's path bows and its hand is seen by a tracker, so the likelihood of its positions under one
 open-loop plan (:func:`comanip.fitting.fit_model`) can prefer a model whose covariance is wide enough to hold the
 bow over one that moves in a person's time. This fit matches a person's timing: per condition (trials with one goal
-and width; their starts averaged), the mean over the model's closed-loop executions
-(:mod:`comanip.fitting.closed_loop_timing`) against the mean over the trials of two numbers, MT and t_peak/MT, each
-reach timed alike (:func:`comanip.analysis.speed_profile.movement_timing`). The residuals are whitened by the standard error of the trials' mean, from the covariance of
-the two numbers pooled over the conditions (each trial's deviation from its condition's mean), the model's own mean
-over its executions taken to scatter as much per execution (the simulated method of moments), so the objective is a
-chi² with 2·(conditions) − (parameters) degrees of freedom when the model can move as the people do. scipy's
-``least_squares`` (trust region, bounded, forward differences in the transformed parameters) minimises it; the
-standard errors are (JᵀJ)⁻¹ of the whitened residuals. A condition with an execution that does not settle counts as
-lasting its 2·H steps with its peak at half of them.
+and width; their starts averaged), the timing of the model's mean closed-loop reach against the timing of the
+trials' mean reach, both timed alike (:mod:`comanip.fitting.closed_loop_timing`): MT and t_peak/MT. The residuals are
+whitened by the covariance of their difference: the recorded mean reach's timing scatters as a bootstrap over its
+trials says, the model's mean over its executions as much per execution as the trials per trial (the simulated
+method of moments), so the objective is a chi² with 2·(conditions) − (parameters) degrees of freedom when the model
+can move as the people do. scipy's ``least_squares`` (trust region, bounded, forward differences in the transformed
+parameters) minimises it; the standard errors are (JᵀJ)⁻¹ of the whitened residuals. A mean reach that does not
+settle within 2·H steps counts as lasting them, its peak half-way.
 """
 
 from __future__ import annotations
@@ -24,7 +23,8 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from comanip.arguments import as_count, as_positive
-from comanip.fitting.closed_loop_timing import recorded_timing
+from comanip.analysis.speed_profile import ReachTiming
+from comanip.fitting.closed_loop_timing import mean_reach_timing, recorded_velocities
 from comanip.fitting.condition_plans import ConditionPlanner
 from comanip.fitting.conditions import Condition
 from comanip.fitting.evaluation_progress import ProgressBar
@@ -35,14 +35,21 @@ from comanip.fitting.parameters import MT_DEFAULT_PARAMETERS, ParameterSpace
 from comanip.model import ReachingModel
 from comanip.recordings.trial_files import Trial
 
-CHI2_KIND = "chi² of the mean MT and t_peak/MT against the recordings'"
+CHI2_KIND = "chi² of the mean reach's MT and t_peak/MT against the recordings'"
+
+MIN_TRIALS = 3
+"""Trials a condition needs (its mean reach's scatter is bootstrapped over them)."""
+BOOTSTRAP_RESAMPLES = 200
+"""Resamples of a condition's trials that give its mean reach's scatter."""
+BOOTSTRAP_SEED = 0
+"""Seeds the resampling, so a fit's whitening is the same at every run."""
 
 
 def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], parameters: Sequence[str] = MT_DEFAULT_PARAMETERS,
-               *, trials: str | Path | None = None, executions: int = 8, seed: int = 0, bounds: dict | None = None,
+               *, trials: str | Path | None = None, width: float | None = None, executions: int = 8, seed: int = 0, bounds: dict | None = None,
                max_evaluations: int = 60, diff_step: float = 0.02, scheduler=None, progress: bool = True,
                check_units: bool = True) -> FitResult:
-    """Fit model fields so that the model's closed-loop reaches take the recorded reaches' time and peak as early.
+    """Fit model fields so that the model's mean closed-loop reach takes the recorded reaches' time and peaks as early.
 
     Args:
         model: the model to start from (other fields fixed); it executes its reaches with its own ``observation``.
@@ -50,7 +57,9 @@ def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], p
             :class:`Trial`; each trial starts at rest at its first sample.
         parameters: free model fields (as in :func:`comanip.fitting.fit_model`; 'sigma_obs' has no meaning here).
         trials: a trials table with each trial's goal and width, when the recordings lack those columns.
-        executions: closed-loop executions per condition whose timing is averaged (≥ 1).
+        width: every trial's goal width (m) instead of the recordings' (a motion-capture folder gives its endpoints'
+            spread, which is not the accuracy a model aims for: its closed-loop endpoints scatter far less).
+        executions: closed-loop executions averaged into a condition's mean reach (≥ 1).
         seed: seeds their motor and sensory noise, the same at every evaluation.
         bounds: {name: (low, high)} natural-unit bounds (default: a factor 1000 around the start).
         max_evaluations: evaluation budget of ``least_squares`` (finite-difference evaluations not counted).
@@ -61,7 +70,7 @@ def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], p
 
     Returns:
         A :class:`FitResult` whose objective is the chi² (``objective_kind``) and whose conditions list each one's
-        trials, recorded and predicted MT and t_peak/MT; status 'failed' (never an exception) when the fit breaks down.
+        trials, recorded (with standard errors) and predicted MT and t_peak/MT; status 'failed' (never an exception) when the fit breaks down.
     """
     if "sigma_obs" in parameters:
         raise ValueError("sigma_obs is the recordings' measurement noise; a timing fit has no use for it")
@@ -70,7 +79,7 @@ def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], p
         raise ValueError(f"seed must be an integer ≥ 0, got {seed!r}")
     max_evaluations = as_count("max_evaluations", max_evaluations)
     diff_step = as_positive("diff_step", diff_step, "relative step")
-    data, conditions = grouped_trials(model, recordings, trials, np.inf, check_units)
+    data, conditions = grouped_trials(model, recordings, trials, np.inf, check_units, width)
     space = ParameterSpace(model, parameters, bounds=bounds)
     recorded = RecordedTiming(data, conditions, executions)
     reaches = [(c.start_state(model), c.goal, c.width) for c in conditions]
@@ -105,50 +114,57 @@ def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], p
 
 
 class RecordedTiming:
-    """The recorded trials' timing per condition: each trial's (MT, t_peak/MT), their mean per condition and the
-    whitening of a condition's difference from a model's mean over ``executions`` executions by the pooled covariance.
+    """The timing of each condition's recorded mean reach, and the whitening of a model's difference from it.
 
     Args:
         trials: the recorded trials; conditions: their conditions (indices into ``trials``); executions: the model's
-            executions per condition.
+            executions per mean reach.
     """
 
     def __init__(self, trials: list[Trial], conditions: list[Condition], executions: int):
         self.conditions = conditions
-        timings = [recorded_timing(trial) for trial in trials]
-        members = [[k for k in c.trials if np.isfinite(timings[k].movement_time)] for c in conditions]
-        self.trial_count = sum(len(m) for m in members)
-        if any(not m for m in members) or self.trial_count < len(conditions) + 2:
-            raise ValueError(f"a timing fit needs every condition to hold a recorded trial that comes to rest, and 2 "
-                             f"trials more than conditions in all; got {[len(m) for m in members]} settled trials in "
-                             f"{len(conditions)} conditions")
-        numbers = [np.array([[timings[k].movement_time, timings[k].peak_fraction] for k in m]) for m in members]
-        self.counts = np.array([len(m) for m in members])
-        self._standard_error = np.sqrt(1 / self.counts + 1 / executions)
-        """per condition, the standard error of the difference of the two means in units of one reach's spread"""
-        self.mean = np.array([x.mean(axis=0) for x in numbers])
-        """(conditions, 2): the trials' mean MT (s) and t_peak/MT per condition."""
-        self.median = np.array([np.median(x, axis=0) for x in numbers])
-        deviations = np.concatenate([x - x.mean(axis=0) for x in numbers])
-        covariance = deviations.T @ deviations / (self.trial_count - len(conditions))
-        if not np.all(np.linalg.eigvalsh(covariance) > 0):
-            raise ValueError("the recorded trials' MT and t_peak/MT do not vary independently (their pooled covariance "
-                             "is singular): a timing fit needs trials that differ")
-        self._whitening = np.linalg.inv(np.linalg.cholesky(covariance))
+        small = [len(c.trials) for c in conditions if len(c.trials) < MIN_TRIALS]
+        if small:
+            raise ValueError(f"a timing fit needs at least {MIN_TRIALS} trials per condition (goal and width), got "
+                             f"{[len(c.trials) for c in conditions]}")
+        self.trial_count = len(trials)
+        step = float(np.median(np.concatenate([np.diff(trial.t) for trial in trials])))
+        rng = np.random.default_rng(BOOTSTRAP_SEED)
+        self.timing, self.covariance, self._whitening = [], [], []
+        for c in conditions:
+            velocities = recorded_velocities([trials[k] for k in c.trials], step)
+            timing = _numbers(mean_reach_timing(step, velocities.mean(axis=0)))
+            if not np.all(np.isfinite(timing)):
+                raise ValueError(f"the mean reach of the trials aiming at {np.round(c.goal, 4).tolist()} m does not come "
+                                 f"to rest within them")
+            resampled = np.array([_numbers(mean_reach_timing(step, velocities[rng.integers(len(c.trials), size=len(c.trials))].mean(axis=0)))
+                                  for _ in range(BOOTSTRAP_RESAMPLES)])
+            covariance = np.cov(resampled[np.isfinite(resampled).all(axis=1)].T)
+            difference = covariance * (1 + len(c.trials) / executions)
+            if not np.all(np.linalg.eigvalsh(difference) > 0):
+                raise ValueError(f"the trials aiming at {np.round(c.goal, 4).tolist()} m do not vary in MT and t_peak/MT "
+                                 f"independently: a timing fit needs trials that differ")
+            self.timing.append(timing)
+            self.covariance.append(covariance)
+            self._whitening.append(np.linalg.inv(np.linalg.cholesky(difference)))
 
     def residuals(self, predicted: np.ndarray) -> np.ndarray:
-        """Predicted (conditions, 2) minus the trials' mean, over the standard error of the difference: (2·conditions,)."""
-        error = (predicted - self.mean) @ self._whitening.T
-        return (error / self._standard_error[:, None]).ravel()
+        """Predicted (conditions, 2) minus the recorded timing, whitened by their difference's covariance: (2·conditions,)."""
+        return np.concatenate([w @ (p - t) for w, p, t in zip(self._whitening, predicted, self.timing)])
 
     def rows(self, predicted: np.ndarray) -> list[dict]:
-        """One row per condition: its goal, width, trials, the recorded (mean, median) and the predicted (mean over the
-        executions; NaN for an unsettled one) MT and t_peak/MT; ``predicted`` (conditions, 2)."""
-        return [{"condition": c, "goal_m": cond.goal.tolist(), "width_m": float(cond.width), "trials": int(n),
-                 "mt_recorded_mean_s": float(mean[0]), "mt_recorded_median_s": float(median[0]), "mt_predicted_s": float(mine[0]),
-                 "peak_fraction_recorded_mean": float(mean[1]), "peak_fraction_recorded_median": float(median[1]),
-                 "peak_fraction_predicted": float(mine[1])}
-                for c, (cond, n, mean, median, mine) in enumerate(zip(self.conditions, self.counts, self.mean, self.median, predicted))]
+        """One row per condition: its goal, width, trials, the recorded mean reach's MT and t_peak/MT with their
+        bootstrap standard errors, and the predicted ones (NaN when unsettled); ``predicted`` (conditions, 2)."""
+        return [{"condition": k, "goal_m": c.goal.tolist(), "width_m": float(c.width), "trials": len(c.trials),
+                 "mt_recorded_s": float(t[0]), "mt_recorded_se_s": float(np.sqrt(cov[0, 0])), "mt_predicted_s": float(p[0]),
+                 "peak_fraction_recorded": float(t[1]), "peak_fraction_recorded_se": float(np.sqrt(cov[1, 1])),
+                 "peak_fraction_predicted": float(p[1])}
+                for k, (c, t, cov, p) in enumerate(zip(self.conditions, self.timing, self.covariance, predicted))]
+
+
+def _numbers(timing: ReachTiming) -> np.ndarray:
+    """(MT s, t_peak/MT) of a timing."""
+    return np.array([timing.movement_time, timing.peak_fraction])
 
 
 class _TimingResiduals:
@@ -163,13 +179,10 @@ class _TimingResiduals:
         self.evaluations = 0
 
     def timings(self, u: np.ndarray) -> np.ndarray:
-        """The conditions' predicted (MT, t_peak/MT) at u, the means over the executions (conditions, 2); NaN for a
-        condition with an unsettled execution (computed once per u)."""
+        """The conditions' predicted (MT, t_peak/MT) at u (conditions, 2), NaN where unsettled (computed once per u)."""
         key = np.asarray(u, dtype=float).tobytes()
         if key not in self._timings:
-            executed = self.planner.timings(self.space.model_for(u), self.executions, self.seed)
-            self._timings[key] = np.array([[np.mean([t.movement_time for t in runs]), np.mean([t.peak_fraction for t in runs])]
-                                           for runs in executed])
+            self._timings[key] = np.array([_numbers(t) for t in self.planner.timings(self.space.model_for(u), self.executions, self.seed)])
         return self._timings[key]
 
     def __call__(self, u: np.ndarray) -> np.ndarray:

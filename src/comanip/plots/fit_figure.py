@@ -69,16 +69,15 @@ def _plot_movement_time_fit(result: FitResult, path: str | Path) -> Path:
 
 
 def _plot_timing_fit(result: FitResult, path: str | Path) -> Path:
-    """Recorded (mean and median over the trials) and predicted MT and t_peak/MT, per condition."""
+    """Recorded (the trials' mean reach, ±2 standard errors) and predicted MT and t_peak/MT, per condition."""
     rows = result.conditions
     index = np.arange(len(rows))
     fig, axes = plt.subplots(1, 2, figsize=(8.5, 3.8))
-    for ax, key, label in ((axes[0], "mt", "movement time (s)"), (axes[1], "peak_fraction", "t_peak / MT")):
-        suffix = "_s" if key == "mt" else ""
-        ax.plot(index, [r[f"{key}_recorded_mean{suffix}"] for r in rows], "o", color="C3", label="recorded, mean")
-        ax.plot(index, [r[f"{key}_recorded_median{suffix}"] for r in rows], "s", mfc="none", color="C3", label="recorded, median")
-        ax.plot(index, [np.nan if r[f"{key}_predicted{suffix}"] is None else r[f"{key}_predicted{suffix}"] for r in rows],
-                "x", color="k", ms=8, label="fitted model, closed loop")
+    for ax, key, unit, label in ((axes[0], "mt", "_s", "movement time (s)"), (axes[1], "peak_fraction", "", "t_peak / MT")):
+        ax.errorbar(index, [r[f"{key}_recorded{unit}"] for r in rows], yerr=[2 * r[f"{key}_recorded_se{unit}"] for r in rows],
+                    fmt="o", color="C3", capsize=3, label="recorded mean reach ±2 SE")
+        ax.plot(index, [np.nan if r[f"{key}_predicted{unit}"] is None else r[f"{key}_predicted{unit}"] for r in rows],
+                "x", color="k", ms=8, label="fitted model's mean closed-loop reach")
         ax.set_xticks(index, [f"{r['condition']}\n{r['trials']} trials" for r in rows], fontsize=7)
         ax.set_xlabel("condition")
         ax.set_ylabel(label)
