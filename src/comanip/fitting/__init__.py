@@ -1,16 +1,17 @@
-"""Fitting a reaching model's parameters to data: recorded hand trajectories (maximum likelihood,
-:func:`fit_model`) or published movement times per condition (least squares, :func:`fit_movement_times`).
+"""Fitting a reaching model's parameters to data: recorded hand trajectories (maximum likelihood of their positions,
+:func:`fit_model`, or their timing matched by the model's closed-loop reaches, :func:`fit_timing`) or published
+movement times per condition (least squares, :func:`fit_movement_times`).
 The recording format and the method are described in docs/fitting.md."""
 
 from importlib import import_module
 
 _EXPORTS = {"fit_model": "comanip.fitting.fit", "recordings_nll": "comanip.fitting.fit",
-            "fit_movement_times": "comanip.fitting.movement_times", "MovementTimeTable": "comanip.fitting.movement_times",
+            "fit_movement_times": "comanip.fitting.movement_times", "fit_timing": "comanip.fitting.timing_fit", "MovementTimeTable": "comanip.fitting.movement_times",
             "Trial": "comanip.recordings.trial_files", "load_recordings": "comanip.recordings.trial_files",
             "FitResult": "comanip.fitting.fit_result", "FitStatus": "comanip.fitting.fit_result"}
 """the public names and their modules, imported on first use (the CLI reads DEFAULT_PARAMETERS without scipy)"""
 
-__all__ = ["fit_model", "recordings_nll", "fit_movement_times", "MovementTimeTable", "Trial", "load_recordings", "FitResult", "FitStatus"]
+__all__ = ["fit_model", "recordings_nll", "fit_movement_times", "fit_timing", "MovementTimeTable", "Trial", "load_recordings", "FitResult", "FitStatus"]
 
 
 def __getattr__(name: str):
