@@ -26,7 +26,8 @@ from comanip.recordings.trial_files import tracked_trials
 from studies.does_the_arm_preset_move_like_recorded_arms.compare import ARMS, model_reach, people
 
 #: (free parameters, goal width of every trial in m or None for the recordings' endpoint spread)
-ARM_FITS = ((("kappa", "gamma"), None), (("kappa", "activation.0"), None), (("kappa", "gamma"), 0.008), (("kappa",), 0.008))
+ARM_FITS = ((("kappa", "gamma"), None), (("kappa", "activation.0"), None), (("kappa", "gamma"), 0.008), (("kappa",), 0.008),
+            (("kappa", "activation.0"), 0.006))
 
 
 def synthetic_row() -> str:
