@@ -5,7 +5,7 @@ reaches; from kappa 0.008), to show it recovers what made the data. Then ``coman
 folder (default: the arm development split beside the repository) from the `arm` preset, with the free parameters
 and goal widths of each row. Each fitted model (and the preset as it is) is then measured as
 ``studies/does_the_arm_preset_move_like_recorded_arms`` measures the preset: its mean closed-loop reach over the people's
-median distance (32 executions) against the people's median MT and t_peak/MT IQR, and Fitts' law of its plans on the
+median distance (``EXECUTIONS`` of them) against the people's median MT and t_peak/MT IQR, and Fitts' law of its plans on the
 validation grid. Prints a markdown table.
 
     PYTHONPATH=src python -m studies.can_a_timing_fit_give_the_arm_preset.fit_arm_timing [--arms FOLDER]
@@ -24,6 +24,9 @@ from comanip.fitting import Trial, fit_timing
 from comanip.recordings import load_tathum
 from comanip.recordings.trial_files import tracked_trials
 from studies.does_the_arm_preset_move_like_recorded_arms.compare import ARMS, model_reach, people
+
+EXECUTIONS = 96
+"""Closed-loop executions in a measured model's mean reach: its t_peak/MT scatters by a few hundredths over 8."""
 
 #: (free parameters, goal width of every trial in m or None for the recordings' endpoint spread)
 ARM_FITS = ((("kappa", "gamma"), None), (("kappa", "activation.0"), None), (("kappa", "gamma"), 0.008), (("kappa",), 0.008),
@@ -51,7 +54,7 @@ def _values(fit) -> str:
 def measured(model, recorded: dict) -> tuple[str, bool]:
     """The row's measured columns for a model, and whether it meets every target."""
     D = float(np.median(recorded["distance"]))
-    mine = model_reach(model, D, 32)
+    mine = model_reach(model, D, EXECUTIONS)
     closed, fitts = mine["closed"], mine["fitts"]
     mt = float(np.median(recorded["movement_time"]))
     low, high = np.percentile(recorded["asymmetry"], [25, 75])
@@ -72,7 +75,7 @@ def main(argv=None):
     print(f"The timing fit (`comanip fit --match timing`, 8 executions per mean reach) on the model's own reaches and on "
           f"the recorded arm reaches ({recorded['count']}; 2 targets), from the `arm` preset (kappa {preset.kappa:g}, "
           f"gamma {preset.gamma:g}, activation {preset.activation[0]:g} s, width {preset.width:g} m); each model's mean "
-          f"closed-loop reach over {float(np.median(recorded['distance'])):.3f} m (32 executions) at its width, against "
+          f"closed-loop reach over {float(np.median(recorded['distance'])):.3f} m ({EXECUTIONS} executions) at its width, against "
           f"the people's median MT {mt:.3f} s (within 10 %) and t_peak/MT IQR {low:.3f}–{high:.3f}, and Fitts' law of its "
           f"plans on the validation grid (80–160 ms/bit, R² ≥ 0.95)\n")
     print("| fit | goal widths | fitted ± SE | chi² / dof | evaluations, time | mean reach MT (s) | t_peak / MT | Fitts' law | "
