@@ -124,7 +124,7 @@ def test_a_jittering_tracker_gets_the_configured_estimation_rate(reach, transiti
         recording = replay.run(times, states, None)
         status = replay.node.status()[1]
     stamps = np.array([stamp for stamp, *_ in recording.goals])
-    assert len(stamps) > 30
+    assert len(stamps) > 20                    # until the hand rests near its goal (about 1.4 s): then the reach is over
     assert (len(stamps) - 1) / (stamps[-1] - stamps[0]) == pytest.approx(20.0, abs=0.3)
     assert np.all(np.abs(np.diff(stamps) - 0.05) < 0.02)  # each the pose nearest its due time: within 8 ms of it
     assert status["achieved_rate_hz"] == pytest.approx(20.0, abs=0.3) and status["configured_rate_hz"] == 20.0
@@ -156,7 +156,7 @@ def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, t
         assert replay.node.status()[1]["last_event"] == f"prior goal {GOAL.tolist()} m, for the next reach"
         for k in range(6):
             send(k)
-        assert np.array_equal(replay.node._reach.prior_goal, GOAL)
+        assert np.array_equal(replay.node.loop.reach.prior_goal, GOAL)
         send(6, position=nan)                          # a NaN position (its twist is fine)
         send(6, frame="camera")                        # another frame: pose and twist
         send(4)                                        # stamps before the last accepted pose and twist
