@@ -256,3 +256,16 @@ def test_the_loop_fed_as_the_ros_node_feeds_it_estimates_what_reach_stream_estim
             np.testing.assert_array_equal(estimate.goal, expected.estimate.goal)
             compared += 1
     assert compared > 60
+
+
+def test_a_first_reach_begun_at_the_first_sample_whose_hand_leaves_only_past_the_horizon_starts_the_next_there():
+    """The first sample starts a reach; the hand rests longer than the horizon, then reaches: that reach is
+    estimated (a reach of its own, from its lead), not left past the first one's horizon."""
+    t = np.arange(0.0, 2.0, 0.01)
+    x, v = hand(t - 0.5)                                          # leaves its rest at 1.0 s
+    estimator = RecordingEstimator()
+    loop = EstimationLoop(estimator, LoopSettings(horizon=0.5, first_sample_starts_reach=True))
+    events = run(loop, t, x, v)
+    assert [k for k, e in enumerate(events) if e is LoopEvent.STARTED][0] == 0
+    assert LoopEvent.PAST_HORIZON in events and loop.reach.number == 2 and 0.8 < loop.reach.clock < 1.0
+    assert len(estimator.reaches()[1]) > 30 and LoopEvent.FINISHED in events

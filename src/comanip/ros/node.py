@@ -31,7 +31,8 @@ Stale: the status says ``stale: true`` (level WARN) while there is no estimate y
 or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep
 being published. The status also reports the estimation rate achieved (estimates per second of input time over
 the last ``RATE_WINDOW`` s, every estimate counted, published or not) and the latency (from a pose's arrival to
-its estimate's publication: the last one and the median over the same window), and counts the poses by what
+the publication of its goal and predicted path, which go out before the schedule is built on them: the last one
+and the median over the same window), and counts the poses by what
 they were for: estimated, skipped (between due times, or replaced by a newer one), ignored (past the horizon),
 resting (between reaches), rejected. Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
 """
@@ -287,20 +288,24 @@ class GoalNode(Node):
             self.get_logger().warning(f"estimate at t = {job.t:.3f} s failed ({estimate.status}: {estimate.message}); "
                                       "keeping the last good one, marked stale")
             return float("nan")
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
-            schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
         frame, clock = s.frame_id, job.reach.clock
-        messages = (goal_message(estimate.goal, estimate.goal_covariance, job.sample.stamp, frame),
-                    path_message(estimate, clock, frame), schedule_message(schedule, clock))
-        good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, messages)
+        goal, path = goal_message(estimate.goal, estimate.goal_covariance, job.sample.stamp, frame), path_message(estimate, clock, frame)
         with self._lock:
             if self.loop.reach is not job.reach:
                 return float("nan")  # a reset or a new reach came while solving
-            self._good = good
             self._counts["estimates"] += 1
-        self._publish_estimate(good)
+        self._goal_pub.publish(goal)              # goal and forecast first: the schedule on them takes milliseconds more
+        self._path_pub.publish(path)
         latency = self._last["latency_s"] = time.perf_counter() - job.sample.received
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
+            schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
+        good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, (goal, path, schedule_message(schedule, clock)))
+        with self._lock:
+            if self.loop.reach is not job.reach:
+                return latency
+            self._good = good
+        self._schedule_pub.publish(good.messages[2])
         return latency
 
     # ---- publishing
