@@ -187,8 +187,9 @@ def live_latency(run: dict, sent: int) -> dict:
     """From a live run (:func:`ros_node_rate.two_processes`): the latencies (ms) from publishing a pose to receiving
     the goal (``goal``) and the predicted path (``forecast``) made from it, the first estimate (a cold start) apart,
     each also over the first and the last ``QUEUE_SPAN`` s of the run (a queue that grows makes the last ones
-    longer); the poses sent, those the node never received (``dropped``), and those it did not estimate
-    (``skipped``: between due times, or replaced by a newer one while an estimate ran)."""
+    longer); the estimate's own time (``solve``, ms, as the node's status reports it after each estimate); the poses
+    sent, those the node never received (``dropped``), and those it did not estimate (``skipped``: between due
+    times, or replaced by a newer one while an estimate ran)."""
     stamps = sorted(run["goals"])[1:]
     paths = {round(stamp, 5): received for stamp, received in run["paths"].items()}
     goal = 1e3 * np.array([run["goals"][s][0] - s for s in stamps])
@@ -196,7 +197,11 @@ def live_latency(run: dict, sent: int) -> dict:
     since = np.array(stamps) - run["begin"]
     first, last = since <= since[0] + QUEUE_SPAN, since >= since[-1] - QUEUE_SPAN
     status = run["statuses"][-1]
-    return {"goal": goal, "forecast": forecast[np.isfinite(forecast)], "goal_first": goal[first], "goal_last": goal[last],
+    solve = {}
+    for values in run["statuses"]:
+        if values["estimate_stamp_s"] not in ("", "nan", None):
+            solve.setdefault(values["estimate_stamp_s"], 1e3 * float(values["last_solve_time_s"]))
+    return {"goal": goal, "solve": np.array(list(solve.values())), "forecast": forecast[np.isfinite(forecast)], "goal_first": goal[first], "goal_last": goal[last],
             "estimates": len(stamps) + 1, "sent": sent, "dropped": sent - int(status["inputs"]), "skipped": int(status["skipped"])}
 
 
@@ -208,7 +213,8 @@ def live_summary(latency: dict, tracker_rate: float, estimation_rate: float) -> 
     return (f"Live, the node in its own process fed in real time by a {tracker_rate:g} Hz tracker, estimating at "
             f"{estimation_rate:g} Hz: latency from publishing a pose to receiving its goal {spread(latency['goal'])}, its "
             f"forecast (the predicted path) {spread(latency['forecast'])} ({latency['estimates']} estimates of "
-            f"{latency['sent']} poses; {latency['skipped']} skipped, {latency['dropped']} dropped). The queue: goal latency "
+            f"{latency['sent']} poses; {latency['skipped']} skipped, {latency['dropped']} dropped); the estimate itself, as "
+            f"the node's status reports it, {spread(latency['solve'])}. The queue: goal latency "
             f"over the first {QUEUE_SPAN:g} s {spread(latency['goal_first'])}, over the last {QUEUE_SPAN:g} s "
             f"{spread(latency['goal_last'])}.")
 

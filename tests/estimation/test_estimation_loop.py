@@ -218,27 +218,30 @@ def test_a_gap_in_the_input_starts_the_next_reach_at_the_pose_after_it():
 
 
 def three_reaches():
-    """Three minimum-jerk reaches of 0.3 m, each after 0.6 s at rest, from one 100 Hz tracker with 0.5 mm noise and
-    up to 1 ms of stamp jitter: times (K,) s, positions (K, 3) m, velocities (K, 3) m/s."""
+    """Three minimum-jerk reaches of 0.3 m, each after 0.6 s at rest, from one 100 Hz tracker with 0.5 mm noise:
+    times (K,) s, positions (K, 3) m, velocities (K, 3) m/s (a 30 ms backward difference), and the goals."""
     rng = np.random.default_rng(1)
-    position, t, x = np.zeros(3), [], []
+    goals, position, t, x = [], np.zeros(3), [], []
     for direction in ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, -1.0, 0.0]):
         goal = position + 0.3 * np.array(direction) / np.linalg.norm(direction)
         for k in range(120):
             s = max(k - 60, 0) / 60
             t.append(len(t) * 0.01), x.append(position + (goal - position) * (10 * s**3 - 15 * s**4 + 6 * s**5))
         position = goal
+        goals.append(goal)
     for k in range(60):
         t.append(len(t) * 0.01), x.append(position.copy())
     x = np.array(x) + rng.normal(0, 5e-4, (len(t), 3))
-    return np.array(t) + rng.uniform(0, 1e-3, len(t)), x, np.r_[np.zeros((3, 3)), (x[3:] - x[:-3]) / 0.03]
+    return np.array(t), x, np.r_[np.zeros((3, 3)), (x[3:] - x[:-3]) / 0.03], goals
 
 
 def test_the_loop_fed_as_the_ros_node_feeds_it_estimates_what_reach_stream_estimates():
     """Poses and velocities arriving apart, the first pose starting a reach, every pose due: from the second
     reach on (the first begins at the first pose here, where the hand leaves its rest in ReachStream) the goals
-    are ReachStream's, sample for sample."""
-    t, x, v = three_reaches()
+    are ReachStream's, sample for sample. The times jitter, as a tracker's do: with samples exactly a rest window
+    apart, rounding would decide whether the hand rests."""
+    t, x, v, _ = three_reaches()
+    t = t + np.random.default_rng(2).uniform(0, 1e-3, len(t))
     no_learning = dict(person=PersonCalibration(CalibrationSettings(learns=False)))
     stream = ReachStream(comanip.presets.arm(), **no_learning)
     model = comanip.presets.arm()
