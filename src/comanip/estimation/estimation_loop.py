@@ -83,7 +83,8 @@ class LoopSettings:
     horizon: float = math.inf
     """Samples this long (s) or longer after their reach's clock are not used (the model's horizon H·h)."""
     restart_after: float | None = None
-    """A gap between two positions longer than this (s) starts over, as :meth:`EstimationLoop.restart`; None: never."""
+    """A gap between two positions longer than this (s) ends the reach under way and starts the segmentation over
+    (with ``first_sample_starts_reach``, the sample after the gap starts the next reach); None: never."""
     first_sample_starts_reach: bool = False
     """True: the first sample starts a reach (module docstring, step 2); False: only the hand leaving its rest."""
 
@@ -99,7 +100,7 @@ class LoopSettings:
             as_positive("restart_after", self.restart_after, "s")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class HandSample:
     """The hand at one stamp."""
 
@@ -113,9 +114,9 @@ class HandSample:
     """When the position arrived (``time.perf_counter()``, s), for a front end's latency; NaN: not told."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Reach:
-    """A reach the loop has started."""
+    """A reach the loop has started (one object per reach: the loop tells reaches apart by identity)."""
 
     number: int
     """Reaches started since the loop (re)started, this one included (1 for the first)."""
@@ -129,7 +130,7 @@ class Reach:
     """Its samples from its clock up to the one that started it, which its estimator gets first."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Update:
     """An estimator update the loop has made due (module docstring, step 5)."""
 

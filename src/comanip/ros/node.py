@@ -207,13 +207,17 @@ class GoalNode(Node):
                 self._counts["ignored"] += 1
                 self._last["event"] = (f"pose at t = {step.stamp - self.loop.reach.clock:.3f} s is past the model's horizon "
                                        f"{self._horizon:g} s; waiting for the hand to rest and start the next reach")
-            elif step.event in (LoopEvent.STARTED, LoopEvent.FINISHED):
-                self._recent = [] if step.event is LoopEvent.STARTED else self._recent
-                verb = "started" if step.event is LoopEvent.STARTED else "finished: the hand rests,"
-                self._last["event"] = f"reach {self.loop.reach.number} {verb} at stamp {step.stamp:.6f} s"
-                self.get_logger().info(self._last["event"])
+            elif step.event is LoopEvent.STARTED:
+                self._recent = []
+                self._log_event(f"reach {self.loop.reach.number} started at stamp {self.loop.reach.clock:.6f} s")
+            elif step.event is LoopEvent.FINISHED:
+                self._log_event(f"reach {self.loop.reach.number} finished: the hand rests at stamp {step.stamp:.6f} s")
         if self.loop.due is not None:
             self._lock.notify()
+
+    def _log_event(self, event: str) -> None:
+        self._last["event"] = event
+        self.get_logger().info(event)
 
     def _on_prior(self, message: PointStamped) -> None:
         with self._lock:
@@ -223,15 +227,13 @@ class GoalNode(Node):
                 self._reject(error)
                 return
             self.loop.prior_goal = sample.vector
-            self._last["event"] = f"prior goal {sample.vector.tolist()} m, for the next reach"
-            self.get_logger().info(self._last["event"])
+            self._log_event(f"prior goal {sample.vector.tolist()} m, for the next reach")
 
     def _on_reset(self, _message: Empty) -> None:
         with self._lock:
             self.loop.restart()
             self._good = None
-            self._last["event"] = "reset: the next hand pose starts a reach"
-            self.get_logger().info(self._last["event"])
+            self._log_event("reset: the next hand pose starts a reach")
 
     def _reject(self, error: RejectedMessage) -> None:
         """Count and log a rejected input, and say so in a status at once (called holding the lock)."""
