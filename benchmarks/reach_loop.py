@@ -180,17 +180,22 @@ def live(preset: str, rate: float, seconds: float, t, position, velocity):
     stamps = sorted(run["goals"])
     starts, goals, numbers = published(run["statuses"], stamps, [run["goals"][s][1] for s in stamps], t, run["begin"])
     goals[t > seconds] = np.nan
-    return starts, goals, numbers, live_latency(run, int(keep.sum()))
+    return starts, goals, numbers, live_latency(run, int(keep.sum()), [run["begin"] + s for s in starts])
 
 
-def live_latency(run: dict, sent: int) -> dict:
+def live_latency(run: dict, sent: int, starts: list[float]) -> dict:
     """From a live run (:func:`ros_node_rate.two_processes`): the latencies (ms) from publishing a pose to receiving
     the goal (``goal``) and the predicted path (``forecast``) made from it, the first estimate (a cold start) apart,
     each also over the first and the last ``QUEUE_SPAN`` s of the run (a queue that grows makes the last ones
-    longer); the estimate's own time (``solve``, ms, as the node's status reports it after each estimate); the poses
-    sent, those the node never received (``dropped``), and those it did not estimate (``skipped``: between due
-    times, or replaced by a newer one while an estimate ran)."""
-    stamps = sorted(run["goals"])[1:]
+    longer), and apart for the first estimate of each reach (``goal_first_of_reach``: the reach's lead replayed
+    first; ``starts``, the reaches' clocks, s) and for the others (``goal_within_reach``); the estimate's own time
+    (``solve``, ms, as the node's status reports it after each estimate); the poses sent, those the node never
+    received (``dropped``), and those it did not estimate (``skipped``: between due times, or replaced by a newer
+    one while an estimate ran); the machine's load average as the run began (``load``)."""
+    every = sorted(run["goals"])
+    reach_of = np.searchsorted(starts, every, side="right")
+    opening = np.r_[True, reach_of[1:] != reach_of[:-1]][1:]
+    stamps = every[1:]
     paths = {round(stamp, 5): received for stamp, received in run["paths"].items()}
     goal = 1e3 * np.array([run["goals"][s][0] - s for s in stamps])
     forecast = 1e3 * np.array([paths.get(round(s, 5), np.nan) - s for s in stamps])
@@ -201,8 +206,10 @@ def live_latency(run: dict, sent: int) -> dict:
     for values in run["statuses"]:
         if values["estimate_stamp_s"] not in ("", "nan", None):
             solve.setdefault(values["estimate_stamp_s"], 1e3 * float(values["last_solve_time_s"]))
-    return {"goal": goal, "solve": np.array(list(solve.values())), "forecast": forecast[np.isfinite(forecast)], "goal_first": goal[first], "goal_last": goal[last],
-            "estimates": len(stamps) + 1, "sent": sent, "dropped": sent - int(status["inputs"]), "skipped": int(status["skipped"])}
+    return {"goal": goal, "forecast": forecast[np.isfinite(forecast)], "goal_first": goal[first], "goal_last": goal[last],
+            "goal_first_of_reach": goal[opening], "goal_within_reach": goal[~opening], "solve": np.array(list(solve.values())),
+            "estimates": len(every), "sent": sent, "dropped": sent - int(status["inputs"]), "skipped": int(status["skipped"]),
+            "load": run["load"]}
 
 
 def live_summary(latency: dict, tracker_rate: float, estimation_rate: float) -> str:
@@ -214,7 +221,9 @@ def live_summary(latency: dict, tracker_rate: float, estimation_rate: float) -> 
             f"{estimation_rate:g} Hz: latency from publishing a pose to receiving its goal {spread(latency['goal'])}, its "
             f"forecast (the predicted path) {spread(latency['forecast'])} ({latency['estimates']} estimates of "
             f"{latency['sent']} poses; {latency['skipped']} skipped, {latency['dropped']} dropped); the estimate itself, as "
-            f"the node's status reports it, {spread(latency['solve'])}. The queue: goal latency "
+            f"the node's status reports it, {spread(latency['solve'])}; the first goal of each reach, whose lead the "
+            f"estimator gets first, {spread(latency['goal_first_of_reach'])}, the others {spread(latency['goal_within_reach'])}"
+            f" (load average {latency['load']:.2f} as the run began). The queue: goal latency "
             f"over the first {QUEUE_SPAN:g} s {spread(latency['goal_first'])}, over the last {QUEUE_SPAN:g} s "
             f"{spread(latency['goal_last'])}.")
 
