@@ -83,8 +83,8 @@ RATE_WINDOW = 1.0
 
 def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded",
                     calibration: PersonCalibration | None = None) -> OnlineGoalEstimator:
-    """The goal estimator of one reach from ``start`` (2n,), at rest, for the ``person`` of
-    :attr:`NodeSettings.person`, with what is known of them (``calibration``, shared by the node's reaches): the
+    """The node's goal estimator, from ``start`` (2n,) at rest (its loop resets it for every reach), for the ``person``
+    of :attr:`NodeSettings.person`, with what is known of them (``calibration``, shared by the node's reaches): the
     one place that names the estimator."""
     options = CORRECTING_PERSON if person == "correcting" else OnlineOptions()
     return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=options,
@@ -118,13 +118,12 @@ class GoalNode(Node):
         model = s.model()
         self._d = model.d
         self._horizon = model.H * model.h
-        self._planner = estimation_planner(model)
-        self._families = FamilyCache(size=1)
         self._transition = transition_model if transition_model is not None else TransitionModel()
         person = PersonCalibration(CalibrationSettings(learns=s.learn_person))   # shared by the node's reaches
         prior = None if s.prior_goal is None else np.array(s.prior_goal)
         self.loop = EstimationLoop(
-            reach_estimator(self._planner, self._families, np.zeros(model.state_size), prior, s.width, s.person, person),
+            reach_estimator(estimation_planner(model), FamilyCache(size=1), np.zeros(model.state_size), prior, s.width, s.person,
+                            person),
             LoopSettings(SegmentationSettings(radius=s.rest_radius, window=s.rest_window), rate=s.estimation_rate,
                          pairing_tolerance=s.twist_tolerance, horizon=self._horizon, restart_after=s.input_timeout,
                          first_sample_starts_reach=True))
