@@ -29,7 +29,7 @@ class RecordingEstimator:
     def reset(self, start, *, prior_goal=None):
         self.calls.append(("reset", np.array(start), prior_goal))
 
-    def update(self, t, position, velocity):
+    def update(self, t, position, velocity, forecast=True):
         self.calls.append(("update", t, np.array(position), np.array(velocity)))
         self.latest = t
         return t
