@@ -39,6 +39,8 @@ ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" /
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 MATCH_BEFORE = 0.3
 """A reach start found up to this long (s) before a recorded onset belongs to that reach."""
+QUEUE_SPAN = 10.0
+"""The live latencies are also given over the first and the last this many seconds (s) of the live run."""
 
 
 @dataclass(frozen=True)
@@ -166,9 +168,9 @@ def through_node(preset: str, rate: float, t, position, velocity):
 
 def live(preset: str, rate: float, seconds: float, t, position, velocity):
     """The first ``seconds`` of the stream published in real time to the goal node running in its own process
-    (``python -m comanip ros``, estimating at ``rate`` Hz), as a robot's tracker would: its reach starts (s),
-    per sample the latest goal received (3,) and the reach it belongs to, and the latencies (ms) from publishing
-    a pose to receiving the goal made from it."""
+    (``python -m comanip ros``, estimating at ``rate`` Hz), as a robot's tracker would: its reach starts (s), per
+    sample the latest goal received (3,) and the reach it belongs to, and what :func:`live_latency` reads from the
+    run."""
     sys.path.insert(0, str(Path(__file__).parent))
     from ros_node_rate import two_processes
 
@@ -178,8 +180,52 @@ def live(preset: str, rate: float, seconds: float, t, position, velocity):
     stamps = sorted(run["goals"])
     starts, goals, numbers = published(run["statuses"], stamps, [run["goals"][s][1] for s in stamps], t, run["begin"])
     goals[t > seconds] = np.nan
-    latency = 1e3 * np.array([run["goals"][s][0] - s for s in stamps])
-    return starts, goals, numbers, latency
+    return starts, goals, numbers, live_latency(run, int(keep.sum()), [run["begin"] + s for s in starts])
+
+
+def live_latency(run: dict, sent: int, starts: list[float]) -> dict:
+    """From a live run (:func:`ros_node_rate.two_processes`): the latencies (ms) from publishing a pose to receiving
+    the goal (``goal``) and the predicted path (``forecast``) made from it, the first estimate (a cold start) apart,
+    each also over the first and the last ``QUEUE_SPAN`` s of the run (a queue that grows makes the last ones
+    longer), and apart for the first estimate of each reach (``goal_first_of_reach``: the reach's lead replayed
+    first; ``starts``, the reaches' clocks, s) and for the others (``goal_within_reach``); the estimate's own time
+    (``solve``, ms, as the node's status reports it after each estimate); the poses sent, those the node never
+    received (``dropped``), and those it did not estimate (``skipped``: between due times, or replaced by a newer
+    one while an estimate ran); the machine's load average as the run began (``load``)."""
+    every = sorted(run["goals"])
+    reach_of = np.searchsorted(starts, every, side="right")
+    opening = np.r_[True, reach_of[1:] != reach_of[:-1]][1:]
+    stamps = every[1:]
+    paths = {round(stamp, 5): received for stamp, received in run["paths"].items()}
+    goal = 1e3 * np.array([run["goals"][s][0] - s for s in stamps])
+    forecast = 1e3 * np.array([paths.get(round(s, 5), np.nan) - s for s in stamps])
+    since = np.array(stamps) - run["begin"]
+    first, last = since <= since[0] + QUEUE_SPAN, since >= since[-1] - QUEUE_SPAN
+    status = run["statuses"][-1]
+    solve = {}
+    for values in run["statuses"]:
+        if values["estimate_stamp_s"] not in ("", "nan", None):
+            solve.setdefault(values["estimate_stamp_s"], 1e3 * float(values["last_solve_time_s"]))
+    return {"goal": goal, "forecast": forecast[np.isfinite(forecast)], "goal_first": goal[first], "goal_last": goal[last],
+            "goal_first_of_reach": goal[opening], "goal_within_reach": goal[~opening], "solve": np.array(list(solve.values())),
+            "estimates": len(every), "sent": sent, "dropped": sent - int(status["inputs"]), "skipped": int(status["skipped"]),
+            "load": run["load"]}
+
+
+def live_summary(latency: dict, tracker_rate: float, estimation_rate: float) -> str:
+    """The live run's latencies and queue (:func:`live_latency`) as a paragraph."""
+    def spread(values):
+        return f"median {np.median(values):.1f} ms, p95 {np.percentile(values, 95):.1f} ms"
+
+    return (f"Live, the node in its own process fed in real time by a {tracker_rate:g} Hz tracker, estimating at "
+            f"{estimation_rate:g} Hz: latency from publishing a pose to receiving its goal {spread(latency['goal'])}, its "
+            f"forecast (the predicted path) {spread(latency['forecast'])} ({latency['estimates']} estimates of "
+            f"{latency['sent']} poses; {latency['skipped']} skipped, {latency['dropped']} dropped); the estimate itself, as "
+            f"the node's status reports it, {spread(latency['solve'])}; the first goal of each reach, whose lead the "
+            f"estimator gets first, {spread(latency['goal_first_of_reach'])}, the others {spread(latency['goal_within_reach'])}"
+            f" (load average {latency['load']:.2f} as the run began). The queue: goal latency "
+            f"over the first {QUEUE_SPAN:g} s {spread(latency['goal_first'])}, over the last {QUEUE_SPAN:g} s "
+            f"{spread(latency['goal_last'])}.")
 
 
 def error_table(label: str, rows) -> str:
@@ -219,6 +265,8 @@ def main(argv=None):
     parser.add_argument("--live", type=float, default=0.0, help="also publish the first LIVE s of the stream in real time "
                         "to the goal node in its own process (0: not)")
     parser.add_argument("--live-rate", type=float, default=50.0, help="the live node's estimation_rate (Hz)")
+    parser.add_argument("--live-tracker-rate", type=float, default=None, help="tracker samples per second of the live "
+                        "stream (Hz; default: --rate)")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "reach_loop")
     args = parser.parse_args(argv)
     if not args.arms.is_dir():
@@ -243,15 +291,17 @@ def main(argv=None):
         for row, node_row in zip(rows, node_rows):
             row.update({f"node_{k}": v for k, v in node_row.items() if k.startswith(("found", "error"))})
     if args.live > 0:
-        live_starts, live_goals, live_numbers, latency = live(args.preset, args.live_rate, args.live, t, position, velocity)
+        tracker_rate = args.live_tracker_rate or args.rate
+        live_t, live_position, live_velocity = (t, position, velocity) if tracker_rate == args.rate else \
+            tracked.stream(rate_hz=tracker_rate)
+        live_starts, live_goals, live_numbers, latency = live(args.preset, args.live_rate, args.live, live_t, live_position,
+                                                              live_velocity)
         within = [k for k, r in enumerate(reaches) if r.end_time <= args.live]
-        live_rows = scored([reaches[k] for k in within], matched_starts(live_starts, [reaches[k] for k in within]), t,
+        live_rows = scored([reaches[k] for k in within], matched_starts(live_starts, [reaches[k] for k in within]), live_t,
                            live_goals, live_numbers)
-        lines.append(error_table(f"goal node, live: its own process, real time, {args.live_rate:g} Hz, first {args.live:g} s",
-                                 live_rows))
-        node_line += (f"\n\nLive, the node in its own process fed in real time: latency from publishing a pose to receiving "
-                      f"its goal median {np.median(latency[1:]):.1f} ms, p95 {np.percentile(latency[1:], 95):.1f} ms "
-                      f"({len(latency)} goals).")
+        lines.append(error_table(f"goal node, live: its own process, real time, {tracker_rate:g} Hz tracker, "
+                                 f"{args.live_rate:g} Hz estimation_rate, first {args.live:g} s", live_rows))
+        node_line += "\n\n" + live_summary(latency, tracker_rate, args.live_rate)
     summary = (f"{len(reaches)} recorded arm reaches ({args.arms.name}, development split) back to back with "
                f"{args.rest:g} s of rest, one {t[-1]:.0f} s stream at {args.rate:g} Hz, `{args.preset}` preset, no reset: "
                f"reaches found, and error / D, median [IQR] over the found reaches\n\n{header}\n" + "\n".join(lines)

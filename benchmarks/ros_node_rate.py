@@ -70,10 +70,13 @@ def two_processes(rate: float, times, states, src: Path | None = None, goal=GOAL
     """Real time with the node in its own process (``python -m comanip ros``) at ``estimation_rate`` rate; ``src``:
     the checkout's source folder the node imports (None: this environment's); ``parameters``: further node
     parameters (name: value). Also returns ``begin`` (the wall time, s, of time 0 of ``times``), ``goals``
-    (pose stamp s -> (wall time received s, goal (3,) m)) and ``statuses`` (every status's values)."""
+    (pose stamp s -> (wall time received s, goal (3,) m)), ``paths`` (pose stamp s -> wall time its predicted path
+    was received, s), ``statuses`` (every status's values) and ``load`` (the machine's load average over the
+    last minute as the poses began)."""
     import rclpy
     from diagnostic_msgs.msg import DiagnosticArray
     from geometry_msgs.msg import PoseStamped, PoseWithCovarianceStamped, TwistStamped
+    from nav_msgs.msg import Path as PathMessage
     from rclpy.node import Node
 
     from comanip.ros.messages import seconds, stamp_of, status_values
@@ -88,9 +91,11 @@ def two_processes(rate: float, times, states, src: Path | None = None, goal=GOAL
     node = subprocess.Popen([sys.executable, "-m", "comanip", "ros", "--params", str(params)], stderr=subprocess.DEVNULL, env=env)
     rclpy.init(domain_id=domain)
     player = Node("comanip_rate_benchmark")
-    goals, statuses = {}, []
+    goals, paths, statuses = {}, {}, []
     player.create_subscription(PoseWithCovarianceStamped, "goal/estimate", lambda m: goals.setdefault(
         seconds(m.header.stamp), (time.time(), np.array([m.pose.pose.position.x, m.pose.pose.position.y, m.pose.pose.position.z]))), 50)
+    player.create_subscription(PathMessage, "hand/predicted_path", lambda m: m.poses and paths.setdefault(
+        seconds(m.poses[0].header.stamp), time.time()), 50)        # a forecast begins at the pose it was made from
     player.create_subscription(DiagnosticArray, "status", lambda m: statuses.append(status_values(m)), 50)
     pose_pub = player.create_publisher(PoseStamped, "hand/pose", 50)
     twist_pub = player.create_publisher(TwistStamped, "hand/twist", 50)
@@ -98,6 +103,7 @@ def two_processes(rate: float, times, states, src: Path | None = None, goal=GOAL
         while not statuses and time.time() - t0 < 120:
             rclpy.spin_once(player, timeout_sec=0.05)
         build = time.time() - t0
+        load = os.getloadavg()[0]
         begin = time.time()
         for t, state in zip(times, states):
             while (wait := begin + t - time.time()) > 0:
@@ -127,7 +133,7 @@ def two_processes(rate: float, times, states, src: Path | None = None, goal=GOAL
             "p95_ms": 1e3 * np.percentile(latencies[1:], 95), "goal_error_mm": 1e3 * np.linalg.norm(goals[stamps[-1]][1] - goal),
             "status_rate_hz": float(last.get("achieved_rate_hz", "nan")),
             "status_latency_ms": 1e3 * float(last.get("latency_median_s", "nan")), "begin": begin, "goals": goals,
-            "statuses": statuses}
+            "paths": paths, "statuses": statuses, "load": load}
 
 
 def lock_step(times, states, repeats: int, tracker_rate: float) -> str:
@@ -168,7 +174,7 @@ def main(argv=None) -> None:
             for label, src in codes.items():
                 runs[label].append(two_processes(rate, times, states, src))
         for label, results in runs.items():
-            m = {key: float(np.median([r[key] for r in results])) for key in results[0] if key not in ("begin", "goals", "statuses")}
+            m = {key: float(np.median([r[key] for r in results])) for key in results[0] if key not in ("begin", "goals", "paths", "statuses", "load")}
             print(f"| real time, two processes | {label} | {rate:g} | {m['estimates']:.0f} | {m['rate_hz']:.2f} | {m['ratio']:.3f} "
                   f"| {m['skipped']:.0f} | {m['median_ms']:.1f} | {m['p95_ms']:.1f} | {m['cold_ms']:.0f} "
                   f"| {_optional(m['status_rate_hz'], 2)} | {_optional(m['status_latency_ms'], 1)} "

@@ -453,3 +453,26 @@ def test_a_batch_of_recordings_gets_the_estimates_of_streaming_them(online, cart
             expected = by_hand.update(recording.t[k] - 1.0, recording.position[k], recording.velocity[k])
             np.testing.assert_allclose(estimate.goal, expected.goal, rtol=0, atol=1e-12)
         assert len(estimates) == len(recording.t)
+
+
+def test_updates_without_the_forecast_leave_the_later_estimates_and_what_is_learned_the_same():
+    """A reach's lead given without forecasts (as the loop gives it): the prior's estimates lack theirs, the rest
+    is as with them, the estimates after it and what the person is taught from the reach."""
+    model = comanip.presets.arm()
+    t = np.arange(0.0, 1.0, 0.004)
+    s = np.clip((t - 0.15) / 0.5, 0, 1)
+    x = np.outer(0.25 * (10 * s**3 - 15 * s**4 + 6 * s**5), [0.6, 0.8, 0.0])
+    v = np.outer(0.25 * (30 * s**2 - 60 * s**3 + 30 * s**4) / 0.5, [0.6, 0.8, 0.0])
+    lead, full = (comanip.OnlineGoalEstimator(model, np.zeros(model.state_size)) for _ in range(2))
+    statuses = set()
+    for k in range(len(t)):
+        mine = lead.update(t[k], x[k], v[k], forecast=k >= 60)
+        theirs = full.update(t[k], x[k], v[k])
+        statuses.add(mine.status)
+        assert (mine.forecast is None) == (k < 60 and mine.status == "uninformative")
+        if mine.forecast is not None:
+            np.testing.assert_array_equal(mine.ee_mean, theirs.ee_mean)
+        np.testing.assert_array_equal(mine.goal, theirs.goal)
+        np.testing.assert_array_equal(mine.goal_covariance, theirs.goal_covariance)
+    assert "uninformative" in statuses and len(statuses) > 1
+    assert lead.finish_reach() == full.finish_reach() and lead.person.reaches == full.person.reaches == 1

@@ -18,6 +18,7 @@ from comanip.multicomponent.transition_model import TransitionModel  # noqa: E40
 from comanip.ros.node import reach_estimator  # noqa: E402
 from comanip.ros.replay import BASE_STAMP, Replay, replay_csv  # noqa: E402
 from comanip.ros.node_settings import NodeSettings  # noqa: E402
+from tests.estimation.test_estimation_loop import three_reaches  # noqa: E402
 
 GOAL = np.array([0.4, 0.25, -0.1])
 
@@ -124,7 +125,7 @@ def test_a_jittering_tracker_gets_the_configured_estimation_rate(reach, transiti
         recording = replay.run(times, states, None)
         status = replay.node.status()[1]
     stamps = np.array([stamp for stamp, *_ in recording.goals])
-    assert len(stamps) > 30
+    assert len(stamps) > 20                    # until the hand rests near its goal (about 1.4 s): then the reach is over
     assert (len(stamps) - 1) / (stamps[-1] - stamps[0]) == pytest.approx(20.0, abs=0.3)
     assert np.all(np.abs(np.diff(stamps) - 0.05) < 0.02)  # each the pose nearest its due time: within 8 ms of it
     assert status["achieved_rate_hz"] == pytest.approx(20.0, abs=0.3) and status["configured_rate_hz"] == 20.0
@@ -156,7 +157,7 @@ def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, t
         assert replay.node.status()[1]["last_event"] == f"prior goal {GOAL.tolist()} m, for the next reach"
         for k in range(6):
             send(k)
-        assert np.array_equal(replay.node._reach.prior_goal, GOAL)
+        assert np.array_equal(replay.node.loop.reach.prior_goal, GOAL)
         send(6, position=nan)                          # a NaN position (its twist is fine)
         send(6, frame="camera")                        # another frame: pose and twist
         send(4)                                        # stamps before the last accepted pose and twist
@@ -201,26 +202,6 @@ def test_stale_when_estimates_overrun_the_budget_and_still_published(reach, tran
             values = replay.wait_handled(k + 1)
         assert values["stale"] == "true" and values["stale_reason"].startswith("last estimate took")
         assert int(values["late"]) == int(values["estimates"]) == len(replay.recording.goals) > 0
-
-
-def three_reaches():
-    """Three minimum-jerk reaches of 0.3 m, each after 0.6 s at rest, from one 100 Hz tracker with 0.5 mm noise:
-    times (K,) s, positions (K, 3) m, velocities (K, 3) m/s (a 30 ms backward difference), and the goals."""
-    rng = np.random.default_rng(1)
-    goals, position, t, x = [], np.zeros(3), [], []
-    for direction in ([1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [-1.0, -1.0, 0.0]):
-        goal = position + 0.3 * np.array(direction) / np.linalg.norm(direction)
-        for k in range(60):
-            t.append(len(t) * 0.01), x.append(position.copy())
-        for k in range(60):
-            s = k / 60
-            t.append(len(t) * 0.01), x.append(position + (goal - position) * (10 * s**3 - 15 * s**4 + 6 * s**5))
-        position = goal
-        goals.append(goal)
-    for k in range(60):
-        t.append(len(t) * 0.01), x.append(position.copy())
-    x = np.array(x) + rng.normal(0, 5e-4, (len(t), 3))
-    return np.array(t), x, np.r_[np.zeros((3, 3)), (x[3:] - x[:-3]) / 0.03], goals
 
 
 def test_an_uninterrupted_stream_of_reaches_gets_a_reach_number_and_a_goal_each_without_a_reset(transition):

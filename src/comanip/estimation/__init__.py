@@ -8,8 +8,11 @@ from comanip.estimation.goal_smoothing import GoalSmoothing
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.person_calibration import CalibrationSettings, PersonCalibration
 from comanip.estimation.recorded_trials import estimate_recordings
-from comanip.estimation.reach_stream import ReachSegmenter, ReachStart, ReachStream, SegmentationSettings, StreamEstimate
+from comanip.estimation.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep
+from comanip.estimation.reach_segmentation import ReachSegmenter, ReachStart, SegmentationSettings
+from comanip.estimation.reach_stream import ReachStream, StreamEstimate
 
-__all__ = ["CalibrationSettings", "EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator", "GoalPosterior",
-           "GoalSmoothing", "estimate_goal", "estimate_recordings", "goal_posterior", "OnlineGoalEstimator", "OnlineOptions",
-           "PersonCalibration", "ReachSegmenter", "ReachStart", "ReachStream", "SegmentationSettings", "StreamEstimate"]
+__all__ = ["CalibrationSettings", "EstimationLoop", "EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator",
+           "GoalPosterior", "GoalSmoothing", "LoopEvent", "LoopSettings", "LoopStep", "estimate_goal", "estimate_recordings",
+           "goal_posterior", "OnlineGoalEstimator", "OnlineOptions", "PersonCalibration", "ReachSegmenter", "ReachStart",
+           "ReachStream", "SegmentationSettings", "StreamEstimate"]

@@ -205,7 +205,7 @@ class OnlineGoalEstimator:
         """Observations received so far."""
         return self._hand.count
 
-    def update(self, time_s, position, velocity) -> GoalEstimate:
+    def update(self, time_s, position, velocity, *, forecast: bool = True) -> GoalEstimate:
         """Add an observation and re-estimate the goal.
 
         Args:
@@ -213,6 +213,10 @@ class OnlineGoalEstimator:
                 only on the planning grid (after the horizon H·h it is read at the last step).
             position: observed hand position (d,), m.
             velocity: observed hand velocity (d,), m/s.
+            forecast: False leaves the forecast of the hand out of an estimate that is the prior (status
+                ``uninformative``; its plan is then the model's reach to the prior goal), which is most of its
+                cost; for observations whose estimate is not read (a reach's lead, given before its newest
+                sample). The estimates of the later updates are the same.
 
         A sample the tracker lost (position or velocity all NaN) is skipped: the previous estimate is returned
         unchanged (before any tracked sample, the prior with status ``uninformative``) and the next good
@@ -251,7 +255,7 @@ class OnlineGoalEstimator:
         self._last_time = time_s
         self._hand.append(time_s, position, velocity)
         with self._blas:                                    # threads only slow products of this size down
-            self.latest = self._estimate(t_begin)
+            self.latest = self._estimate(t_begin, forecast)
         return self.latest
 
     def _check_plausible(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
@@ -274,16 +278,16 @@ class OnlineGoalEstimator:
             self._warned = True
             warnings.warn(problem, stacklevel=3)
 
-    def _estimate(self, t_begin: float) -> GoalEstimate:
+    def _estimate(self, t_begin: float, forecast: bool) -> GoalEstimate:
         """The first explanation that explains the hand gives the estimate; none: the prior."""
         reasons = []
         for explanation in self.explanations:
             explained = explanation.explain(self._hand, self.latest)
             if explained.explains:
-                return self._result(explained, t_begin, reasons)
+                return self._result(explained, t_begin, reasons, forecast)
             reasons.append(explained.message)
         return self._result(Explained.explaining(self.prior_mean, self.prior_cov, EstimateStatus.UNINFORMATIVE,
-                                                 "the estimate is the prior"), t_begin, reasons)
+                                                 "the estimate is the prior"), t_begin, reasons, forecast)
 
     def _person_acceleration(self) -> np.ndarray:
         """The hand's acceleration (d,) m/s² from its last velocities, NaN on the axes a robot leads
@@ -292,9 +296,11 @@ class OnlineGoalEstimator:
         acceleration[list(self.options.led_axes)] = np.nan
         return acceleration
 
-    def _result(self, explained: Explained, t_begin: float, reasons: Sequence[str] = ()) -> GoalEstimate:
-        """The estimate of ``explained``, with the model's predicted reach to its goal; its message follows
-        why the explanations asked before it did not explain the hand."""
+    def _result(self, explained: Explained, t_begin: float, reasons: Sequence[str] = (),
+                with_forecast: bool = True) -> GoalEstimate:
+        """The estimate of ``explained``, with the model's predicted reach to its goal and the forecast of the hand
+        (``with_forecast``: :meth:`update`'s ``forecast``); its message follows why the explanations asked before it did not explain
+        the hand."""
         model, n = self.model, self.model.n
         status, observed = explained.status, self._hand.last_observation
         stop = None if explained.timing is None else explained.timing.onset_s + explained.timing.movement_time_s
@@ -315,7 +321,7 @@ class OnlineGoalEstimator:
         predicted = (1 - fraction) * timed.mean[before, :2 * n] + fraction * timed.mean[min(before + 1, model.H), :2 * n]
         forecast = None
         t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
-        if self._hand.count:
+        if self._hand.count and (with_forecast or status != EstimateStatus.UNINFORMATIVE):
             forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
                                        observed[n:], goal, covariance, stop,
                                        self._person_acceleration())

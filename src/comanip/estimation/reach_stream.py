@@ -1,153 +1,26 @@
 """Goal estimates over an uninterrupted stream of a hand: rest, reach, rest, the next reach, with no reset.
 
-A robot beside a person sees one stream of hand samples (times s, positions m, velocities m/s) in which the
-person makes one reach after another and rests in between. :class:`ReachSegmenter` segments it from the motion
-itself (:mod:`comanip.estimation.hand_rest`: rest is judged from positions, which a tracker's noise does not
-make move):
-
-1. **At rest.** The last ``lead + window`` seconds of samples are kept. The rest position is where the hand
-   rests (the mean of its positions over the window while they stay within ``radius`` of it and drift slower
-   than ``creep``), or its first sample until it has rested for a window.
-2. **A reach starts** when a sample lies farther than ``radius`` from the rest position and the hand moves
-   faster than ``start_speed`` (a drift or the return after an overshoot is not a reach): it starts from the
-   rest position at rest, its clock at the first kept sample of the last ``lead`` seconds, and those samples
-   are its first observations.
-3. **The reach ends** when the hand rests again (as in 1, over a window that lies after the sample that
-   started the reach), and the stream is at rest again (1).
-
-:class:`ReachStream` starts its :class:`~comanip.estimation.online_estimator.OnlineGoalEstimator` anew at each
-reach (``reset``) and feeds it the reach's samples; its estimates are the stream's, numbered by the reach. The
+:class:`ReachStream` runs an :class:`~comanip.estimation.estimation_loop.EstimationLoop` over samples that come
+paired (time s, position m, velocity m/s) and estimates every sample of a reach at once: the reaches are found
+in the motion itself (:mod:`comanip.estimation.reach_segmentation`), each starts the stream's
+:class:`~comanip.estimation.online_estimator.OnlineGoalEstimator` anew (``reset``) and feeds it the reach's
+samples, from the rest just before the hand left it; its estimates are the stream's, numbered by the reach. The
 estimator holds only the reach's own samples, so the cost of an update is bounded by the longest reach, not by
 the length of the stream. What it learns of the person (:attr:`ReachStream.person`,
 :mod:`comanip.estimation.person_calibration`) carries over: each reach is learned from when the hand rests
-again, and :meth:`ReachStream.forget_person` starts over with a new person. The ROS node shares the segmenter and
-estimates at its own rate.
+again, and :meth:`ReachStream.forget_person` starts over with a new person.
 """
 
 from __future__ import annotations
 
-from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
 
-from comanip.arguments import as_positive
-from comanip.estimation.endpoint_baselines import MOVING_SPEED
+from comanip.estimation.estimation_loop import EstimationLoop, LoopEvent, LoopSettings
 from comanip.estimation.goal_estimate import GoalEstimate
-from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S, fitted_velocity, has_left, lost_sample, resting_position
 from comanip.estimation.online_estimator import OnlineGoalEstimator
-
-START_SPAN = 0.05
-"""Span (s) of the positions whose fitted velocity tells a reach leaving its rest from a drift."""
-LEAD_S = 0.15
-"""Default time (s) before a reach leaves the rest radius whose samples it begins with (the hand at rest, then
-its onset)."""
-
-
-@dataclass(frozen=True)
-class SegmentationSettings:
-    """How a stream is split into rests and reaches (module docstring)."""
-
-    radius: float = REST_RADIUS_M
-    """A sample farther than this (m) from the rest position starts a reach; a hand whose positions stay
-    within it of their mean for ``window`` seconds rests (:mod:`comanip.estimation.hand_rest`)."""
-    window: float = REST_WINDOW_S
-    """How long (s) the hand must stay still to rest."""
-    lead: float = LEAD_S
-    """How much of the rest before a reach (s) the reach begins with."""
-    start_speed: float = 0.1
-    """A reach leaves its rest faster than this (m/s, the velocity of a line fitted to the last ``START_SPAN``
-    seconds of positions, at least three): a slower departure (a drift, the return after an overshoot) is not
-    a new reach."""
-    creep: float = MOVING_SPEED
-    """A hand moving slower than this (m/s, the slope of a line fitted to its positions over the window) is at
-    rest even while it drifts: the rest position follows it, and no drift, however long, starts a reach."""
-
-    def __post_init__(self):
-        as_positive("radius", self.radius, "m")
-        as_positive("creep", self.creep, "m/s")
-        as_positive("start_speed", self.start_speed, "m/s")
-        as_positive("window", self.window, "s")
-        as_positive("lead", self.lead, "s")
-
-
-@dataclass(frozen=True)
-class ReachStart:
-    """A reach the segmenter has just found."""
-
-    number: int
-    """Reaches started so far, this one included (1 for the first)."""
-    start: np.ndarray
-    """The rest position it starts from (d,), m."""
-    clock: float
-    """Stream time (s) of the reach's time 0: its first sample."""
-    samples: list
-    """Its samples so far, (stream time s, position (d,) m, velocity (d,) m/s), from its time 0 to the one
-    that started it."""
-
-
-class ReachSegmenter:
-    """Rest and reaches in a stream of samples (module docstring, steps 1-3); cheap enough for every sample.
-
-    Args:
-        settings: :class:`SegmentationSettings`.
-    """
-
-    def __init__(self, settings: SegmentationSettings | None = None):
-        self.settings = settings or SegmentationSettings()
-        if not isinstance(self.settings, SegmentationSettings):
-            raise ValueError(f"settings must be a SegmentationSettings, got {type(self.settings).__name__}")
-        self.reset()
-
-    def reset(self) -> None:
-        """Start over: at rest, no reach, nothing kept."""
-        self._kept: deque = deque()              # (t, position, velocity): the rest so far, or the reach's last window
-        self._rest: np.ndarray | None = None
-        self._departure = np.inf                 # stream time (s) of the sample that started the reach under way
-        self.reaches = 0
-        """Reaches started so far."""
-        self.moving = False
-        """True while a reach is under way."""
-
-    def update(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> ReachStart | None:
-        """Add a sample (stream time s, position (d,) m, velocity (d,) m/s); the reach it starts, else None.
-        Afterwards :attr:`moving` says whether a reach is under way (False once the sample ended one)."""
-        s = self.settings
-        self._kept.append((time_s, position, velocity))
-        span = s.window if self.moving else s.lead + s.window
-        while len(self._kept) > 1 and self._kept[1][0] <= time_s - span:   # keep one sample at or before the span
-            self._kept.popleft()
-        if self.moving:
-            kept = [k for k in self._kept if k[0] >= self._departure]
-            resting = None if len(kept) < len(self._kept) else self._resting(kept)
-            if resting is not None:
-                self.moving, self._rest = False, resting
-            return None
-        resting = self._resting(self._kept)
-        if resting is not None or self._rest is None:
-            self._rest = np.array(position, dtype=float) if resting is None else resting
-            return None
-        if not has_left(np.asarray(position)[None], self._rest, s.radius) or self._departing_speed() < s.start_speed:
-            return None
-        lead = [k for k in self._kept if k[0] >= time_s - s.lead - 1e-9]
-        self.reaches, self.moving, self._departure = self.reaches + 1, True, time_s
-        return ReachStart(self.reaches, self._rest.copy(), lead[0][0], lead)
-
-    def _departing_speed(self) -> float:
-        """Speed (m/s) of a line fitted to the kept positions of the last START_SPAN s (at least the last three)."""
-        kept = list(self._kept)
-        if len(kept) < 3:
-            return np.inf
-        recent = [k for k in kept if k[0] >= kept[-1][0] - START_SPAN]
-        recent = kept[-3:] if len(recent) < 3 else recent
-        slope, _ = fitted_velocity(np.array([k[0] for k in recent]), np.array([k[1] for k in recent]))
-        return float(np.linalg.norm(slope))
-
-    def _resting(self, samples) -> np.ndarray | None:
-        """Where the hand rests over the last window of ``samples`` ((t, position, velocity) ...), or None."""
-        s = self.settings
-        return resting_position(np.array([k[0] for k in samples]), np.array([k[1] for k in samples]), s.window, s.radius,
-                                creep=s.creep)
+from comanip.estimation.reach_segmentation import SegmentationSettings
 
 
 @dataclass(frozen=True)
@@ -169,7 +42,7 @@ class ReachStream:
 
     Args:
         model: a ReachingModel or Planner of a point mass, as :class:`OnlineGoalEstimator` takes.
-        settings: :class:`SegmentationSettings`.
+        settings: :class:`~comanip.estimation.reach_segmentation.SegmentationSettings`.
         estimator_options: keyword arguments for the stream's :class:`OnlineGoalEstimator` (``prior_std``,
             ``width``, ``options``, ``cache``, ``person``; each reach's start comes from the stream).
 
@@ -179,18 +52,17 @@ class ReachStream:
 
     def __init__(self, model, settings: SegmentationSettings | None = None, **estimator_options):
         self.model = model
-        self.segmenter = ReachSegmenter(settings)
         body_model = getattr(model, "model", model)
-        self._estimator = OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
-        self.person = self._estimator.person
+        estimator = OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
+        self.loop = EstimationLoop(estimator, LoopSettings(segmentation=settings or SegmentationSettings()))
+        """The stream's loop: its reaches, segmenter and estimator."""
+        self.person = estimator.person
         """What the stream's reaches have taught of the person."""
         self.reset()
 
     def reset(self) -> None:
         """Start over: at rest, no reach (never needed: a rest ends every reach)."""
-        self.segmenter.reset()
-        self._reach: OnlineGoalEstimator | None = None
-        self._last_time = -np.inf
+        self.loop.restart()
         self.latest = StreamEstimate(0, False, None, None)
 
     def forget_person(self) -> None:
@@ -200,33 +72,17 @@ class ReachStream:
     @property
     def estimator(self) -> OnlineGoalEstimator | None:
         """The estimator of the reach under way; None at rest."""
-        return self._reach
+        return self.loop.estimator if self.loop.under_way else None
 
     def update(self, time_s: float, position, velocity) -> StreamEstimate:
         """Add a sample (stream time s, increasing; position (d,) m; velocity (d,) m/s) and return what is known.
 
         A sample the tracker lost (all NaN) is skipped, as :meth:`OnlineGoalEstimator.update` skips it."""
-        time_s = float(time_s)
-        if not time_s > self._last_time:
-            raise ValueError(f"time_s must increase from sample to sample: got {time_s:g} s after {self._last_time:g} s")
-        if lost_sample(position) or lost_sample(velocity):
+        if self.loop.add_sample(time_s, position, velocity).event is LoopEvent.LOST:
             return self.latest
-        position, velocity = np.asarray(position, dtype=float), np.asarray(velocity, dtype=float)
-        self._last_time = time_s
-        latest = self.latest
-        started = self.segmenter.update(time_s, position, velocity)
-        if started is not None:
-            model = getattr(self.model, "model", self.model)
-            self._estimator.reset(np.r_[started.start, np.zeros(model.state_size - len(started.start))])
-            self._reach = self._estimator
-            for t, p, v in started.samples:
-                estimate = self._reach.update(t - started.clock, p, v)
-            latest = StreamEstimate(started.number, True, estimate, started.clock)
-        elif self._reach is not None:
-            latest = StreamEstimate(latest.reach, True, self._reach.update(time_s - latest.reach_start, position, velocity),
-                                    latest.reach_start)
-        if not self.segmenter.moving and self._reach is not None:
-            self._reach.finish_reach()                   # the hand rests: the reach is over
-            self._reach = None
-        self.latest = StreamEstimate(latest.reach, self.segmenter.moving, latest.estimate, latest.reach_start)
+        update = self.loop.take_due()
+        estimate = self.latest.estimate if update is None else self.loop.estimate(update)
+        reach = self.loop.reach
+        self.latest = (StreamEstimate(0, False, None, None) if reach is None
+                       else StreamEstimate(reach.number, self.loop.moving, estimate, reach.clock))
         return self.latest

@@ -1,27 +1,26 @@
 """The ROS 2 goal node: online goal estimation, prediction and the handover's impedance schedule, in a robot's loop.
 
 Inputs (topic names are parameters, :class:`~comanip.ros.node_settings.NodeSettings`): the hand's pose and twist,
-a prior goal, a reset. A reach starts at the first hand pose (after startup, a reset, or a gap in the input
-longer than ``input_timeout``): that pose and the twist paired with it are the start s_0 = [x; xdot], and its
-stamp is t = 0. The stream needs no reset between reaches: every paired pose also goes to a
-:class:`~comanip.estimation.reach_stream.ReachSegmenter`, and when the hand has rested (within ``rest_radius``
-for ``rest_window``) and leaves its rest again, the next reach starts, from where it rested, its t = 0 the
-segmenter's (the rest just before it left); the status says which reach is under way and whether the hand
-moves. Every later pose, paired with the twist of (nearly) the same stamp, is an observation at
-t = stamp - start stamp. ``estimation_rate`` of them per second of input time go to the estimator: the due times
-lie on a grid of 1 / estimation_rate from the reach's start, and the pose nearest each due time (the first within
-half the input's spacing of it) is estimated, so a tracker whose stamps jitter still gets the configured rate
-(a rule of 'one period since the last estimated pose' loses up to a pose spacing every period). After a gap longer
-than a period the grid restarts at the next pose.
+a prior goal, a reset. The node converts each checked message into a sample of an
+:class:`~comanip.estimation.estimation_loop.EstimationLoop`, which does the rest as it does for
+:class:`~comanip.estimation.ReachStream`: it pairs each pose with the twist of (nearly) the same stamp
+(``twist_tolerance``); a reach starts at the first hand pose (after startup, a reset, or a gap in the input
+longer than ``input_timeout``), at rest at that pose's position, its stamp t = 0; every paired pose goes to the
+reach segmenter, and when the hand has rested (within ``rest_radius`` for ``rest_window``) the reach is over (the
+estimator learns the person from it) and the next one starts when the hand leaves its rest again, from where it
+rested, its t = 0 the segmenter's (the rest just before it left); the status says which reach is under way and
+whether the hand moves. ``estimation_rate`` poses per second of input time are due for an estimate, on a grid of
+1 / estimation_rate from the reach's start (the pose nearest each due time), so a tracker whose stamps jitter
+still gets the configured rate; poses past the model's horizon, and those at rest between reaches, are not
+estimated.
 
 The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
-far, any time; the reach starts at rest at the first pose's position) and run in a worker thread, so the
-executor's callbacks only check and queue messages and never wait for a solve; when the worker falls behind,
-the newest observation replaces one still queued (counted as skipped). An estimate is a few Gauss–Newton steps
-on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes longer than
-``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in time.
-Each successful estimate is published at once: g_hat with covariance,
-the predicted hand path, and the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover`
+far, any time) and run in a worker thread, so the executor's callbacks only check messages and feed the loop,
+and never wait for a solve; when the worker falls behind, the newest due pose replaces one not yet estimated
+(counted as skipped): an estimate is always of the newest pose, never of a stale one. An estimate is a few
+Gauss–Newton steps on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes
+longer than ``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in
+time. Each successful estimate is published at once: g_hat with covariance, the predicted hand path, and the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover`
 on the predicted reach (the robot's impedance rest position follows the predicted hand, and its stiffness
 ramps to 0 where the transition model predicts the person takes over). Timers republish the last good
 estimate and the status (``status_rate``), and sample the schedule at the node's clock into the equilibrium
@@ -32,8 +31,10 @@ Stale: the status says ``stale: true`` (level WARN) while there is no estimate y
 or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep
 being published. The status also reports the estimation rate achieved (estimates per second of input time over
 the last ``RATE_WINDOW`` s, every estimate counted, published or not) and the latency (from a pose's arrival to
-its estimate's publication: the last one and the median over the same window).
-Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
+the publication of its goal and predicted path, which go out before the schedule is built on them: the last one
+and the median over the same window), and counts the poses by what
+they were for: estimated, skipped (between due times, or replaced by a newer one), ignored (past the horizon),
+resting (between reaches), rejected. Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
 """
 
 from __future__ import annotations
@@ -60,7 +61,8 @@ except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.reach_stream import ReachSegmenter, SegmentationSettings
+from comanip.estimation.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep, Reach, Update
+from comanip.estimation.reach_segmentation import SegmentationSettings
 from comanip.estimation.model_families import FamilyCache
 from comanip.estimation.online_options import CORRECTING_PERSON
 from comanip.estimation.person_calibration import CalibrationSettings, PersonCalibration
@@ -69,8 +71,8 @@ from comanip.estimation.estimate_status import EstimateStatus
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.planner import Planner
-from comanip.ros.messages import (RejectedMessage, Sample, goal_message, path_message, pose_of, read_vector, schedule_message,
-                                  stamp_of, status_message)
+from comanip.ros.messages import (RejectedMessage, goal_message, path_message, pose_of, read_vector, schedule_message, stamp_of,
+                                  status_message)
 from comanip.ros.node_settings import NodeSettings
 
 QUEUE_DEPTH = 50
@@ -81,39 +83,12 @@ RATE_WINDOW = 1.0
 
 def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded",
                     calibration: PersonCalibration | None = None) -> OnlineGoalEstimator:
-    """The goal estimator of one reach from ``start`` (2n,), at rest, for the ``person`` of
-    :attr:`NodeSettings.person`, with what is known of them (``calibration``, shared by the node's reaches): the
+    """The node's goal estimator, from ``start`` (2n,) at rest (its loop resets it for every reach), for the ``person``
+    of :attr:`NodeSettings.person`, with what is known of them (``calibration``, shared by the node's reaches): the
     one place that names the estimator."""
     options = CORRECTING_PERSON if person == "correcting" else OnlineOptions()
     return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=options,
                                person=calibration)
-
-
-@dataclass
-class Reach:
-    """The reach in progress: its number, start stamp (s), start state s_0 (2n,) (at rest at the first pose's
-    position: the estimator's plans start from rest), prior goal (d,) or None, and the samples (stamp s,
-    position (d,) m, velocity (d,) m/s) from its start up to the pose that started it, which its estimator
-    sees first."""
-
-    number: int
-    start_stamp: float
-    start: np.ndarray
-    prior_goal: np.ndarray | None
-    lead: list
-
-
-@dataclass
-class Observation:
-    """A queued observation of ``reach`` at ``t`` s after its start: position (d,) m, velocity (d,) m/s."""
-
-    reach: Reach
-    t: float
-    stamp: float
-    position: np.ndarray
-    velocity: np.ndarray
-    received: float
-    """time.perf_counter() when the pose arrived (s), for the latency."""
 
 
 @dataclass
@@ -143,29 +118,25 @@ class GoalNode(Node):
         model = s.model()
         self._d = model.d
         self._horizon = model.H * model.h
-        self._planner = estimation_planner(model)
-        self._families = FamilyCache(size=1)
-        reach_estimator(self._planner, self._families, np.zeros(model.state_size), None, s.width, s.person)  # builds the reach family once
         self._transition = transition_model if transition_model is not None else TransitionModel()
-        self._reach: Reach | None = None
-        self._reach_estimator = None
-        self._person = PersonCalibration(CalibrationSettings(learns=s.learn_person))   # shared by the node's reaches
-        self._segmenter = ReachSegmenter(SegmentationSettings(radius=s.rest_radius, window=s.rest_window))
-        self._prior = None if s.prior_goal is None else np.array(s.prior_goal)
+        person = PersonCalibration(CalibrationSettings(learns=s.learn_person))   # shared by the node's reaches
+        prior = None if s.prior_goal is None else np.array(s.prior_goal)
+        self.loop = EstimationLoop(
+            reach_estimator(estimation_planner(model), FamilyCache(size=1), np.zeros(model.state_size), prior, s.width, s.person,
+                            person),
+            LoopSettings(SegmentationSettings(radius=s.rest_radius, window=s.rest_window), rate=s.estimation_rate,
+                         pairing_tolerance=s.twist_tolerance, horizon=self._horizon, restart_after=s.input_timeout,
+                         first_sample_starts_reach=True))
+        """The node's loop (:mod:`comanip.estimation.estimation_loop`): its callbacks feed it under the node's lock,
+        its worker runs the updates it makes due."""
         self._last_pose: float | None = None
         self._last_twist: float | None = None
-        self._twists: list[Sample] = []
-        self._unpaired: list[tuple[Sample, float | None, float]] = []
-        """Checked hand poses waiting for their twists: (sample, the previous pose's stamp, when it arrived)."""
         self._last_input_clock: float | None = None
-        self._next_due: float | None = None
-        """Input stamp (s) of the next estimate's due time (the estimation_rate's grid)."""
         self._recent: list[tuple[float, float]] = []
         """(input stamp s, latency s or NaN) of the estimates of the last RATE_WINDOW s of input time."""
-        self._pending: Observation | None = None
         self._busy = False
         self._good: GoodEstimate | None = None
-        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, estimates=0, failed=0, late=0)
+        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, resting=0, estimates=0, failed=0, late=0)
         self._last = dict(solve_ok=True, solve_status="none", solve_time_s=float("nan"), latency_s=float("nan"), rejection="", event="started")
 
         self._goal_pub = self.create_publisher(PoseWithCovarianceStamped, s.goal_topic, QUEUE_DEPTH)
@@ -203,8 +174,7 @@ class GoalNode(Node):
                 self._reject(error)
                 return
             self._last_twist = sample.stamp
-            self._twists = self._twists[-(QUEUE_DEPTH - 1):] + [sample]
-            self._pair()
+            self._handle(self.loop.add_velocity(sample.stamp, sample.vector))
 
     def _on_pose(self, message: PoseStamped) -> None:
         received = time.perf_counter()
@@ -215,69 +185,38 @@ class GoalNode(Node):
                 self._counts["inputs"] += 1
                 self._reject(error)
                 return
-            self._unpaired.append((sample, self._last_pose, received))
             self._last_pose = sample.stamp
             self._last_input_clock = self.now()
-            self._pair()
+            self._handle(self.loop.add_position(sample.stamp, sample.vector, received))
 
-    def _pair(self) -> None:
-        """Pair each pose waiting for its twist with the twist stamped nearest it (within twist_tolerance) and
-        observe it, in stamp order; a pose older than the newest twist by more than the tolerance never will
-        be paired (twists arrive in stamp order) and is rejected."""
-        tolerance = self.settings.twist_tolerance + 1e-9
-        waiting = []
-        for sample, previous, received in self._unpaired:
-            nearest = min(self._twists, key=lambda twist: abs(twist.stamp - sample.stamp)) if self._twists else None
-            if nearest is not None and abs(nearest.stamp - sample.stamp) <= tolerance:
-                self._counts["inputs"] += 1
-                self._observe(sample, nearest.vector, previous, received)
-            elif self._last_twist is not None and sample.stamp < self._last_twist - tolerance or len(self._unpaired) > QUEUE_DEPTH:
-                self._counts["inputs"] += 1
+    def _handle(self, steps: list[LoopStep]) -> None:
+        """Count, log and act on what the loop made of each pose (holding the lock); wake the worker for an update."""
+        for step in steps:
+            if step.event is LoopEvent.WAITING:
+                continue
+            self._counts["inputs"] += 1
+            if step.event is LoopEvent.UNPAIRED:
                 self._reject(RejectedMessage(f"hand pose rejected: no hand twist within {self.settings.twist_tolerance:g} s "
-                                             f"of its stamp {sample.stamp:.6f} s"))
-            else:
-                waiting.append((sample, previous, received))
-        self._unpaired = waiting
+                                             f"of its stamp {step.stamp:.6f} s"))
+            elif step.event is LoopEvent.NOT_DUE:
+                self._counts["skipped"] += 1
+            elif step.event is LoopEvent.AT_REST:
+                self._counts["resting"] += 1
+            elif step.event is LoopEvent.PAST_HORIZON:
+                self._counts["ignored"] += 1
+                self._last["event"] = (f"pose at t = {step.stamp - self.loop.reach.clock:.3f} s is past the model's horizon "
+                                       f"{self._horizon:g} s; waiting for the hand to rest and start the next reach")
+            elif step.event is LoopEvent.STARTED:
+                self._recent = []
+                self._log_event(f"reach {self.loop.reach.number} started at stamp {self.loop.reach.clock:.6f} s")
+            elif step.event is LoopEvent.FINISHED:
+                self._log_event(f"reach {self.loop.reach.number} finished: the hand rests at stamp {step.stamp:.6f} s")
+        if self.loop.due is not None:
+            self._lock.notify()
 
-    def _observe(self, sample: Sample, velocity: np.ndarray, previous: float | None, received: float) -> None:
-        """Start a reach (after none, a reset or a gap since the ``previous`` pose stamp), or queue the
-        observation, or count it skipped or ignored."""
-        s = self.settings
-        reach = self._reach
-        if reach is None or (previous is not None and sample.stamp - previous > s.input_timeout):
-            self._segmenter.reset()
-            self._segmenter.update(sample.stamp, sample.vector, velocity)
-            self._start_reach(1 if reach is None else reach.number + 1, sample.stamp, sample.vector)
-            return
-        started = self._segmenter.update(sample.stamp, sample.vector, velocity)
-        if started is not None and started.number > 1:       # the first is the reach begun at the first pose
-            self._start_reach(reach.number + 1, started.clock, started.start, started.samples[:-1])
-            reach = self._reach
-        t = sample.stamp - reach.start_stamp
-        if t >= self._horizon:
-            self._counts["ignored"] += 1
-            self._last["event"] = (f"pose at t = {t:.3f} s is past the model's horizon {self._horizon:g} s; waiting for "
-                                   "the hand to rest and start the next reach")
-            return
-        period, due = 1.0 / s.estimation_rate, self._next_due
-        half_spacing = 0.5 * (sample.stamp - previous) if previous is not None else 0.0
-        if sample.stamp < due - half_spacing - 1e-9:  # the next pose is nearer the due time
-            self._counts["skipped"] += 1
-            return
-        if self._pending is not None:
-            self._counts["skipped"] += 1
-        self._pending = Observation(reach, t, sample.stamp, sample.vector, velocity, received)
-        self._next_due = due + period if sample.stamp < due + period else sample.stamp + period
-        self._lock.notify()
-
-    def _start_reach(self, number: int, stamp: float, position: np.ndarray, lead=()) -> None:
-        """Start reach ``number`` at ``stamp`` (s, its t = 0) from rest at ``position`` (d,) m, its ``lead`` samples
-        before the pose that started it (:class:`Reach`) (holding the lock)."""
-        self._reach = Reach(number, stamp, np.r_[position, np.zeros_like(position)], self._prior, list(lead))
-        self._next_due = stamp + 1.0 / self.settings.estimation_rate
-        self._recent = []
-        self._last["event"] = f"reach {number} started at stamp {stamp:.6f} s"
-        self.get_logger().info(self._last["event"])
+    def _log_event(self, event: str) -> None:
+        self._last["event"] = event
+        self.get_logger().info(event)
 
     def _on_prior(self, message: PointStamped) -> None:
         with self._lock:
@@ -286,16 +225,14 @@ class GoalNode(Node):
             except RejectedMessage as error:
                 self._reject(error)
                 return
-            self._prior = sample.vector
-            self._last["event"] = f"prior goal {sample.vector.tolist()} m, for the next reach"
-            self.get_logger().info(self._last["event"])
+            self.loop.prior_goal = sample.vector
+            self._log_event(f"prior goal {sample.vector.tolist()} m, for the next reach")
 
     def _on_reset(self, _message: Empty) -> None:
         with self._lock:
-            self._reach, self._pending, self._good, self._next_due, self._unpaired = None, None, None, None, []
-            self._segmenter.reset()
-            self._last["event"] = "reset: the next hand pose starts a reach"
-            self.get_logger().info(self._last["event"])
+            self.loop.restart()
+            self._good = None
+            self._log_event("reset: the next hand pose starts a reach")
 
     def _reject(self, error: RejectedMessage) -> None:
         """Count and log a rejected input, and say so in a status at once (called holding the lock)."""
@@ -308,11 +245,11 @@ class GoalNode(Node):
     def _work(self) -> None:
         while True:
             with self._lock:
-                while self._pending is None and not self._stopping:
+                while self.loop.due is None and not self._stopping:
                     self._lock.wait()
                 if self._stopping:
                     return
-                job, self._pending, self._busy = self._pending, None, True
+                job, self._busy = self.loop.take_due(), True
             latency = float("nan")
             try:
                 latency = self._estimate(job)
@@ -322,32 +259,23 @@ class GoalNode(Node):
                 self.get_logger().error(f"estimate at t = {job.t:.3f} s raised {type(error).__name__}: {error}")
             with self._lock:
                 self._busy = False
-                if self._reach is job.reach:
-                    self._recent = [(stamp, seconds) for stamp, seconds in self._recent if stamp > job.stamp - RATE_WINDOW]
-                    self._recent.append((job.stamp, latency))
+                if self.loop.reach is job.reach and job.sample is not None:
+                    stamp = job.sample.stamp
+                    self._recent = [(before, seconds) for before, seconds in self._recent if before > stamp - RATE_WINDOW]
+                    self._recent.append((stamp, latency))
             self._publish_status()
 
-    def _estimate(self, job: Observation) -> float:
-        """Estimate from the observation and publish the estimate; returns the latency (s) from the pose's arrival to
-        the publication, NaN when nothing was published."""
+    def _estimate(self, job: Update) -> float:
+        """Run the update and publish its estimate; returns the latency (s) from the pose's arrival to the
+        publication, NaN when nothing was published."""
         s = self.settings
-        if self._reach_estimator is None or self._reach_estimator[0] is not job.reach:
-            if self._reach_estimator is None:
-                estimator = reach_estimator(self._planner, self._families, job.reach.start, job.reach.prior_goal, s.width,
-                                            s.person, self._person)
-            else:                                        # learns from the reach before (what it knows of the person)
-                estimator = self._reach_estimator[1]
-                estimator.reset(job.reach.start, prior_goal=job.reach.prior_goal)
-            for stamp, position, velocity in job.reach.lead:
-                if stamp - job.reach.start_stamp < job.t:
-                    estimator.update(stamp - job.reach.start_stamp, position, velocity)
-            self._reach_estimator = (job.reach, estimator)
-        estimator = self._reach_estimator[1]
         try:
-            estimate = estimator.update(job.t, job.position, job.velocity)
+            estimate = self.loop.estimate(job)
         except ValueError as error:
             self._last["solve_status"] = f"refused: {error}"
             self.get_logger().info(f"observation at t = {job.t:.3f} s not used: {error}")
+            return float("nan")
+        if job.sample is None:                           # the update only finished its reach
             return float("nan")
         if estimate.status == EstimateStatus.UNINFORMATIVE:  # the hand has not moved yet: nothing to estimate, nothing failed
             self._last.update(solve_status=estimate.status, event=f"waiting for movement at t = {job.t:.3f} s")
@@ -361,20 +289,24 @@ class GoalNode(Node):
             self.get_logger().warning(f"estimate at t = {job.t:.3f} s failed ({estimate.status}: {estimate.message}); "
                                       "keeping the last good one, marked stale")
             return float("nan")
+        frame, clock = s.frame_id, job.reach.clock
+        goal, path = goal_message(estimate.goal, estimate.goal_covariance, job.sample.stamp, frame), path_message(estimate, clock, frame)
+        with self._lock:
+            if self.loop.reach is not job.reach:
+                return float("nan")  # a reset or a new reach came while solving
+            self._counts["estimates"] += 1
+        self._goal_pub.publish(goal)              # goal and forecast first: the schedule on them takes milliseconds more
+        self._path_pub.publish(path)
+        latency = self._last["latency_s"] = time.perf_counter() - job.sample.received
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
             schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
-        frame = s.frame_id
-        messages = (goal_message(estimate.goal, estimate.goal_covariance, job.stamp, frame),
-                    path_message(estimate, job.reach.start_stamp, frame), schedule_message(schedule, job.reach.start_stamp))
-        good = GoodEstimate(estimate, schedule, job.reach, job.stamp, messages)
+        good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, (goal, path, schedule_message(schedule, clock)))
         with self._lock:
-            if self._reach is not job.reach:
-                return float("nan")  # a reset or a new reach came while solving
+            if self.loop.reach is not job.reach:
+                return latency
             self._good = good
-            self._counts["estimates"] += 1
-        self._publish_estimate(good)
-        latency = self._last["latency_s"] = time.perf_counter() - job.received
+        self._schedule_pub.publish(good.messages[2])
         return latency
 
     # ---- publishing
@@ -389,7 +321,7 @@ class GoalNode(Node):
         if good is None:
             return
         now = self.now()
-        schedule, t = good.schedule, now - good.reach.start_stamp
+        schedule, t = good.schedule, now - good.reach.clock
         rest = [np.interp(t, schedule.t, schedule.rest_position[:, k]) for k in range(schedule.rest_position.shape[1])]
         stiffness = float(np.interp(t, schedule.t, schedule.stiffness))
         pose = PoseStamped()
@@ -421,11 +353,12 @@ class GoalNode(Node):
         """(why the estimate is stale, '' when fresh; the status values: counts, last solve, last rejection, ...)."""
         with self._lock:
             reason = self.stale_reason()
-            good, reach = self._good, self._reach
-            return reason, dict(stale=bool(reason), stale_reason=reason, **self._counts,
-                                pending=bool(self._pending is not None or self._busy or self._unpaired),
-                                reach=0 if reach is None else reach.number, moving=self._segmenter.moving,
-                                reach_start_stamp_s=float("nan") if reach is None else reach.start_stamp,
+            good, reach = self._good, self.loop.reach
+            counts = dict(self._counts, skipped=self._counts["skipped"] + self.loop.replaced)
+            return reason, dict(stale=bool(reason), stale_reason=reason, **counts,
+                                pending=bool(self.loop.due is not None or self._busy or self.loop.waiting),
+                                reach=0 if reach is None else reach.number, moving=self.loop.moving,
+                                reach_start_stamp_s=float("nan") if reach is None else reach.clock,
                                 estimate_stamp_s=float("nan") if good is None else good.stamp,
                                 goal_m=[] if good is None else good.estimate.goal.tolist(),
                                 transition_time_s=float("nan") if good is None else good.schedule.transition_time,

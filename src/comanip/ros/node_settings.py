@@ -62,7 +62,8 @@ class NodeSettings:
     """Wall-time budget of one estimate (s): one that takes longer is still published but marks the status stale
     (the estimate runs in a worker thread, so the node's callbacks are never held up by it)."""
     estimation_rate: float = 20.0
-    """Most estimates per second of input time (Hz); hand poses in between are skipped."""
+    """Most estimates per second of input time (Hz); hand poses in between are skipped, and so is a due pose that
+    a newer one replaces while an estimate runs."""
     command_rate: float = 100.0
     """Rate of the equilibrium pose and stiffness (Hz)."""
     status_rate: float = 10.0
@@ -71,7 +72,7 @@ class NodeSettings:
     """Input older than this (s) makes the estimate stale; a pose after a longer gap starts a new reach."""
     rest_radius: float = REST_RADIUS_M
     """A hand pose farther than this (m) from where the hand rests starts the next reach; a hand whose poses stay
-    within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.reach_stream`)."""
+    within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.reach_segmentation`)."""
     rest_window: float = REST_WINDOW_S
     """How long (s) the hand must stay still to rest between reaches."""
     person: str = "recorded"
