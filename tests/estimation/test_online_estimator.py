@@ -69,6 +69,15 @@ def test_family_refuses_a_model_that_is_not_rotation_invariant():
         OnlineGoalEstimator(comanip.Planner(model), np.zeros(4))
 
 
+def test_family_takes_an_invariant_model_whose_forces_are_large():
+    """A narrow goal for one muscle stage: its activation states reach several N, where the planner's convergence noise
+    in N is larger than in m, and the model is still rotation-invariant."""
+    model = comanip.presets.arm().replace(kappa=8e-3, activation=(0.04,), width=0.006)
+    family = OnlineGoalEstimator(comanip.Planner(model), np.zeros(6)).family
+    assert family.invariance_error <= 1e-5
+    assert np.abs(family.plans[-1].mean[:, 6:]).max() > 1.0     # forces beyond 1 N: the relative check is what holds
+
+
 def test_whitening_matches_the_joint_covariance(cartesian_planner):
     model = cartesian_planner.model
     plan = cartesian_planner.solve(np.zeros(6), [0.3, 0.1, 0.0])

@@ -32,8 +32,9 @@ from comanip.planning.planner import Planner
 from comanip.planning.starts.reach_library import reflection_onto
 
 INVARIANCE_TOLERANCE = 1e-5
-"""Largest difference (m, m/s, ...) between an oblique plan and the turned member for the model to count as
-rotation-invariant: well above the planner's convergence noise, far below any model asymmetry."""
+"""Largest difference between an oblique plan and the turned member, in each state entry relative to its largest
+magnitude along the plan (at least 1 of its unit: m, m/s, N), for the model to count as rotation-invariant: well above
+the planner's convergence noise, far below any model asymmetry."""
 
 
 @dataclass
@@ -116,7 +117,8 @@ class ReachFamily:
         of the intervals between members: the accuracy of every prediction within the range (at most the
         tolerance; the range ends where that cannot be reached)."""
         self.invariance_error = self._invariance_error(planner)
-        """Largest |mean| difference between an oblique plan and the turned member (state units)."""
+        """Largest |mean| difference between an oblique plan and the turned member, in each state entry relative to its
+        largest magnitude along the plan (at least 1 of its unit)."""
         if self.invariance_error > INVARIANCE_TOLERANCE:
             raise ValueError(f"the model {model.name!r} is not rotation-invariant (an oblique plan differs from the turned "
                              f"axis plan by {self.invariance_error:.3g}): a reach family needs M = m I, D = c I, isotropic "
@@ -196,7 +198,8 @@ class ReachFamily:
         u = np.ones(self.model.d) / np.sqrt(self.model.d)
         plan = planner.solve(np.zeros(self.nx), self.distances[k] * u, self.width)
         turned = self.prediction(np.zeros(self.model.d), self.distances[k] * u, order=0, covariance=False)
-        return float(np.abs(plan.mean - turned.mean).max())
+        scale = np.maximum(1.0, np.abs(plan.mean).max(axis=0))
+        return float((np.abs(plan.mean - turned.mean) / scale).max())
 
     def along(self, distances: np.ndarray) -> np.ndarray:
         """The mean along the axis per state block, a_b,i(D) (M, H+1, blocks), at distances (M,) m within the range."""
