@@ -31,10 +31,11 @@ from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 from comanip.planning.starts.reach_library import reflection_onto
 
-INVARIANCE_TOLERANCE = 1e-5
+INVARIANCE_TOLERANCE = 1e-4
 """Largest difference between an oblique plan and the turned member, in each state entry relative to its largest
-magnitude along the plan (at least 1 of its unit: m, m/s, N), for the model to count as rotation-invariant: well above
-the planner's convergence noise, far below any model asymmetry."""
+magnitude along the plan (at least 1 of its unit: m, m/s, N), for the model to count as rotation-invariant: above
+the planner's convergence noise (largest for narrow goals and large muscle forces), far below any model asymmetry
+(per-channel noise differs by several hundredths)."""
 
 
 @dataclass
