@@ -44,7 +44,7 @@ def recorded_velocities(trials: list[Trial], step: float) -> np.ndarray:
     for k, trial in enumerate(trials):
         t = trial.t - trial.t[0]
         inside = grid <= t[-1] + 1e-12
-        position = np.column_stack([np.interp(grid[inside], t, axis) for axis in trial.position.T])
-        if inside.sum() >= 2:
+        if inside.sum() >= 2:   # a trial shorter than one step stays at rest
+            position = np.column_stack([np.interp(grid[inside], t, axis) for axis in trial.position.T])
             velocities[k, inside] = np.gradient(position, step, axis=0)
     return velocities
