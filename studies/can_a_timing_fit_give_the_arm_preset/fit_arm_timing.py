@@ -2,8 +2,9 @@
 
 First the fit on reaches the model itself executed (the planar preset at kappa 0.02, closed loop, 3 goals × 12
 reaches; from kappa 0.008), to show it recovers what made the data. Then ``comanip.fit_timing`` on a TAT-HUM 3-D data
-folder (default: the arm development split beside the repository) from the `arm` preset, with the free parameters
-and goal widths of each row. Each fitted model (and the preset as it is) is then measured as
+folder (default: the arm development split beside the repository) from ``START``, the `arm` preset's body with two
+muscle stages, kappa 0.012 and an 8 mm goal, with the free parameters and goal widths of each row; the last row is
+the fit that gives the `arm` preset. Each fitted model (and the preset as it is) is then measured as
 ``studies/does_the_arm_preset_move_like_recorded_arms`` measures the preset: its mean closed-loop reach over the people's
 median distance (``EXECUTIONS`` of them) against the people's median MT and t_peak/MT IQR, and Fitts' law of its plans on the
 validation grid. Prints a markdown table.
@@ -28,7 +29,10 @@ from studies.does_the_arm_preset_move_like_recorded_arms.compare import ARMS, mo
 EXECUTIONS = 96
 """Closed-loop executions in a measured model's mean reach: its t_peak/MT scatters by a few hundredths over 8."""
 
-#: (free parameters, goal width of every trial in m or None for the recordings' endpoint spread, changes to the preset
+START_CHANGES = {"kappa": 0.012, "activation": (0.04, 0.04), "width": 0.008}
+"""What the model the fits start from changes in the `arm` preset: two muscle stages (activation and force), kappa, width (m)."""
+
+#: (free parameters, goal width of every trial in m or None for the recordings' endpoint spread, changes to ``START``
 #: the fit starts from)
 ARM_FITS = ((("kappa", "gamma"), None, {}), (("kappa", "activation.0"), None, {}), (("kappa", "gamma"), 0.008, {}),
             (("kappa",), 0.008, {}), (("kappa", "activation.0"), 0.006, {}), (("kappa",), 0.006, {"activation": (0.04,)}))
@@ -71,21 +75,24 @@ def main(argv=None):
     args = parser.parse_args(argv)
     recorded, trials = people(args.arms), tracked_trials(load_tathum(args.arms))
     preset = comanip.presets.arm()
+    start_model = preset.replace(**START_CHANGES)
     mt = float(np.median(recorded["movement_time"]))
     low, high = np.percentile(recorded["asymmetry"], [25, 75])
     print(f"The timing fit (`comanip fit --match timing`, 8 executions per mean reach) on the model's own reaches and on "
-          f"the recorded arm reaches ({recorded['count']}; 2 targets), from the `arm` preset (kappa {preset.kappa:g}, "
-          f"gamma {preset.gamma:g}, activation {preset.activation[0]:g} s, width {preset.width:g} m); each model's mean "
+          f"the recorded arm reaches ({recorded['count']}; 2 targets), from the `arm` body with two muscle stages (kappa "
+          f"{start_model.kappa:g}, gamma {start_model.gamma:g}, activation {', '.join(f'{a:g}' for a in start_model.activation)} s, "
+          f"width {start_model.width:g} m); each model's mean "
           f"closed-loop reach over {float(np.median(recorded['distance'])):.3f} m ({EXECUTIONS} executions) at its width, against "
           f"the people's median MT {mt:.3f} s (within 10 %) and t_peak/MT IQR {low:.3f}–{high:.3f}, and Fitts' law of its "
           f"plans on the validation grid (80–160 ms/bit, R² ≥ 0.95)\n")
     print("| fit | goal widths | fitted ± SE | chi² / dof | evaluations, time | mean reach MT (s) | t_peak / MT | Fitts' law | "
           "MT / t_peak / Fitts met |\n|---|---|---|---|---|---|---|---|---|")
     print(synthetic_row(), flush=True)
-    row, _ = measured(preset, recorded)
-    print(f"| the `arm` preset as it is (no fit) | {preset.width:g} m | | | | {row} |", flush=True)
+    for name, model in (("the start, two muscle stages (no fit)", start_model), ("the `arm` preset (no fit)", preset)):
+        row, _ = measured(model, recorded)
+        print(f"| {name} | {model.width:g} m | | | | {row} |", flush=True)
     for parameters, width, changes in ARM_FITS:
-        fit = fit_timing(preset.replace(**changes), trials, parameters, width=width, progress=False)
+        fit = fit_timing(start_model.replace(**changes), trials, parameters, width=width, progress=False)
         used = fit.model.replace(width=float(np.mean([c["width_m"] for c in fit.conditions])))
         row, _ = measured(used, recorded)
         widths = "recorded endpoint spread" if width is None else f"{width:g} m"
