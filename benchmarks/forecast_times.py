@@ -51,6 +51,8 @@ STAGE_NAMES = {"HandAtRest": "the hand at rest", "Vetoed": "the model at its own
                "ModelAtOwnPace": "the model at its own pace", "ModelAtPersonPace": "the model at the person's pace",
                "RecordedPeople": "recorded people (the people model)"}
 """Readable names of the default chain's explanations (others keep their class name)."""
+REST = "the rest (estimate, smoothing, forecast)"
+"""The stage of an update outside its explanations."""
 
 
 def timed_stage(explanation, stage_times: list):
@@ -87,11 +89,11 @@ def timed_updates(model, reaches, repeats: int, stages: dict | None = None):
                 wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
                 longest = ""
                 if stages is not None:
-                    name, seconds = max(asked + [("the rest", wall - sum(s for _, s in asked))], key=lambda pair: pair[1])
-                    longest = f"{name} {1e3 * seconds:.1f} ms"
-                    for name, seconds in asked:
+                    parts = asked + [(REST, wall - sum(seconds for _, seconds in asked))]
+                    for name, seconds in parts:
                         stages.setdefault(name, []).append(seconds)
-                    stages.setdefault("the rest (estimate, smoothing, forecast)", []).append(wall - sum(s for _, s in asked))
+                    name, seconds = max(parts, key=lambda pair: pair[1])
+                    longest = f"{name} {1e3 * seconds:.1f} ms"
                 forecast = estimate.forecast
                 begin = time.perf_counter()
                 continued_reach(estimator.family, estimator.transition, estimator.start_position, estimate.t_obs,
