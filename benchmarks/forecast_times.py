@@ -47,6 +47,16 @@ def recorded_reaches(limit: int):
     return [(r.t, r.position, r.velocity) for r in (trial.streamed_recording() for trial in load_tathum(ARMS)[:limit])]
 
 
+def recorded_mouse_movements(limit: int):
+    """The first ``limit`` movements of the ``cursory`` development split (the ``data`` extra), or [] without it."""
+    try:
+        from comanip.recordings import load_cursory
+        recordings = load_cursory("development")[:limit]
+    except ImportError:
+        return []
+    return [(r.t, r.position, r.velocity) for r in recordings]
+
+
 STAGE_NAMES = {"HandAtRest": "the hand at rest", "Vetoed": "the model at its own pace, with its vetoes",
                "ModelAtOwnPace": "the model at its own pace", "ModelAtPersonPace": "the model at the person's pace",
                "RecordedPeople": "recorded people (the people model)"}
@@ -120,6 +130,8 @@ def main(argv=None):
         sources = [("sampled", sampled_reaches(model, args.reaches, rng))]
         if name == "arm" and ARMS.is_dir():
             sources.append(("recorded arms", recorded_reaches(args.reaches)))
+        if model.d == 2 and (mouse := recorded_mouse_movements(args.reaches)):
+            sources.append(("recorded mouse", mouse))
         for source, reaches in sources:
             stages = {} if args.stages else None
             updates = timed_updates(model, reaches, args.repeats, stages)

@@ -1,6 +1,8 @@
 """The online estimator composed of explanations: the first that explains the hand gives the estimate, a
 user's own explanation plugs in, and the model-timing estimator is the own-pace explanation alone."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -40,6 +42,9 @@ def planner(cartesian_planner):
 
 def test_the_default_explanations_in_order(planner):
     chain = OnlineGoalEstimator(planner, np.zeros(6)).explanations
+    assert [type(e) for e in chain] == [HandAtRest, Vetoed, RecordedPeople]
+    assert type(chain[1].explanation) is ModelAtOwnPace and [type(v) for v in chain[1].vetoes] == [MisfitAbove]
+    chain = OnlineGoalEstimator(planner, np.zeros(6), options=OnlineOptions(timing="paced")).explanations
     assert [type(e) for e in chain] == [HandAtRest, Vetoed, ModelAtPersonPace, RecordedPeople]
     assert type(chain[1].explanation) is ModelAtOwnPace
     assert [type(v) for v in chain[1].vetoes] == [PaceContradiction, MisfitAbove] and chain[1].vetoes[0].paced is chain[2]
@@ -138,3 +143,36 @@ def test_an_account_gives_a_status_exactly_when_it_explains_the_hand():
         Explained(np.zeros(3), np.eye(3), Verdict.MISFITS, "no", Status.SOLVED)
     with pytest.raises(ValueError, match="status"):
         Explained(np.zeros(3), np.eye(3), Verdict.EXPLAINS, "yes")
+
+
+EXAMPLE_ARMS = Path(__file__).resolve().parents[2] / "examples" / "data" / "arm_reaches" / "tathum" / "data_3d"
+
+
+def test_leaving_out_the_person_pace_changes_no_estimate_it_would_not_have_given():
+    """On recorded arm reaches (the examples' copy) the model at the person's pace neither explains the hand nor vetoes
+    the model at its own pace in any update, so the default chain, which does not ask it, gives every estimate the
+    chain with it (timing="paced") gives, to the bit; a reach at another pace of the model's own, where it does
+    explain, tells them apart."""
+    import comanip
+    from comanip.recordings import load_tathum
+    model = comanip.presets.load("arm")
+    reaches = [trial.streamed_recording() for trial in load_tathum(EXAMPLE_ARMS)[:4]]
+    assert reaches
+    for reach in reaches:
+        chains = {timing: OnlineGoalEstimator(model, np.r_[reach.position[0], np.zeros(model.state_size - model.n)],
+                                              options=OnlineOptions(timing=timing)) for timing in ("estimated", "paced")}
+        for k in range(len(reach.t)):
+            default, paced = (chains[timing].update(reach.t[k], reach.position[k], reach.velocity[k]) for timing in chains)
+            assert "person's pace" not in paced.message.split("; ")[-1]
+            np.testing.assert_array_equal(default.goal, paced.goal)
+            np.testing.assert_array_equal(default.goal_covariance, paced.goal_covariance)
+            np.testing.assert_array_equal(default.forecast.mean, paced.forecast.mean)
+        assert chains["paced"].explanations[1].ruled_out == chains["estimated"].explanations[1].ruled_out
+    planar = comanip.presets.planar()
+    plan = comanip.Planner(planar).solve(np.zeros(4), [0.3, 0.1], 0.02)
+    t = np.arange(0.0, plan.t[-1] * 1.4, 0.01)
+    position = np.column_stack([np.interp(t, plan.t * 1.4, plan.ee_mean[:, i]) for i in range(2)])
+    velocity = np.column_stack([np.interp(t, plan.t * 1.4, plan.ee_velocity[:, i]) for i in range(2)]) / 1.4
+    chains = [OnlineGoalEstimator(planar, np.zeros(4), options=OnlineOptions(timing=timing)) for timing in ("estimated", "paced")]
+    differ = [not np.array_equal(*(chain.update(t[k], position[k], velocity[k]).goal for chain in chains)) for k in range(len(t))]
+    assert any(differ)

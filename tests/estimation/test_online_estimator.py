@@ -360,7 +360,7 @@ def test_estimate_goal_reports_a_covariance_and_takes_prior_std(cartesian_planne
 
 def test_model_timing_keeps_the_model_at_its_own_pace():
     """timing="model" never changes the explanation: on a reach 40 % slower than the model's it keeps the
-    model-pace estimate (solved or not), where the default moves to an explanation at the person's pace."""
+    model-pace estimate (solved or not), where timing="paced" moves to an explanation at the person's pace."""
     model = comanip.presets.planar()
     planner = comanip.Planner(model)
     plan = planner.solve(np.zeros(4), [0.3, 0.1], 0.02)
@@ -368,7 +368,7 @@ def test_model_timing_keeps_the_model_at_its_own_pace():
     position = np.column_stack([np.interp(t, plan.t * 1.4, plan.ee_mean[:, i]) for i in range(2)])
     velocity = np.column_stack([np.interp(t, plan.t * 1.4, plan.ee_velocity[:, i]) for i in range(2)]) / 1.4
     fixed = OnlineGoalEstimator(planner, np.zeros(4), options=OnlineOptions(timing="model"))
-    free = OnlineGoalEstimator(planner, np.zeros(4))
+    free = OnlineGoalEstimator(planner, np.zeros(4), options=OnlineOptions(timing="paced"))
     messages = set()
     for k in range(len(t)):
         fixed_estimate = fixed.update(t[k], position[k], velocity[k])

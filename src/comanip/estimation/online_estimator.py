@@ -11,13 +11,16 @@ estimate** (none: the prior, status ``uninformative``). With ``OnlineOptions(tim
 2. the reaching model at its own pace, the reach starting at t = 0: the MAP goal under the model's belief
    (:class:`~comanip.estimation.explanations.ModelAtOwnPace`), vetoed for the rest of the reach
    (:class:`~comanip.estimation.explanations.Vetoed`) once its misfit exceeds ``OnlineOptions.mismatch_threshold``
-   (:class:`~comanip.estimation.explanations.MisfitAbove`) or the model's reach at the person's pace contradicts
-   its timing (:class:`~comanip.estimation.explanations.PaceContradiction`);
-3. the model's reach at the person's own pace and onset, where that fits and pins the goal's distance
-   (:class:`~comanip.estimation.explanations.ModelAtPersonPace`);
-4. the model fitted to recorded people (:class:`~comanip.estimation.explanations.RecordedPeople`, status
+   (:class:`~comanip.estimation.explanations.MisfitAbove`);
+3. the model fitted to recorded people (:class:`~comanip.estimation.explanations.RecordedPeople`, status
    ``people_model``).
 
+``timing="paced"`` adds the model's reach at the person's own pace and onset between the second and the third,
+where that fits and pins the goal's distance (:class:`~comanip.estimation.explanations.ModelAtPersonPace`), and
+lets it veto the second where it contradicts the model's timing
+(:class:`~comanip.estimation.explanations.PaceContradiction`): for hands that move as the model does but at
+another pace (a simulated person at ×0.7, say). On recorded people's hands it does not explain the hand, and
+it costs more than the rest of an update together, so the default leaves it out.
 ``timing="model"`` asks only the second, which then always explains the hand (exact for the model's own
 reaches). Pass ``explanations=`` to compose your own (each an object with ``reset(reach)`` and
 ``explain(hand, latest)`` returning an :class:`~comanip.estimation.explanations.Explained` with its
@@ -135,11 +138,13 @@ class OnlineGoalEstimator:
         """The explanations ``options.timing`` names (module docstring)."""
         if self.options.timing == "model":
             return [ModelAtOwnPace(self.model, self.options)]
-        person_pace = ModelAtPersonPace(PacedModel(self.family), self.options)
         people = self.options.people_model or shipped_people_model("arm" if d == 3 else "mouse")
         if d == 3 and people.kind == "mouse":
             raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: fit one "
                              "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
+        if self.options.timing == "estimated":
+            return [HandAtRest(), vetoed_own_pace(self.model, self.options), RecordedPeople(people)]
+        person_pace = ModelAtPersonPace(PacedModel(self.family), self.options)
         return [HandAtRest(), vetoed_own_pace(self.model, self.options, person_pace), person_pace, RecordedPeople(people)]
 
     def reset(self, start=None, *, prior_goal=_SAME) -> None:

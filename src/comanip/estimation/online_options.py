@@ -14,7 +14,7 @@ from comanip.estimation.observation import OBSERVATION_STD, observation_covarian
 from comanip.estimation.people_model import PeopleModel
 
 
-TIMINGS = ("estimated", "model")
+TIMINGS = ("estimated", "paced", "model")
 """The values of :attr:`OnlineOptions.timing`."""
 
 
@@ -68,21 +68,22 @@ class OnlineOptions:
     timing: str = "estimated"
     """"model": the reach starts at t = 0 and moves at the model's pace (the estimate above, exact for the
     model's own reaches). "estimated": that estimate while the model at its own pace explains the observations
-    (whitened misfit at most ``mismatch_threshold``, and the model's timing not rejected by a fit of its reach
-    at a free pace and onset); from the first update on which it does not, the model's reach at the person's
-    own pace and onset (:mod:`comanip.estimation.paced_model`) where that explains the hand (misfit at most
-    ``paced_threshold``), else the model fitted to recorded people (:mod:`comanip.estimation.people_model`),
-    status ``people_model``. Goals from either are combined with the prior."""
+    (whitened misfit at most ``mismatch_threshold``); from the first update on which it does not, the model
+    fitted to recorded people (:mod:`comanip.estimation.people_model`), status ``people_model``. "paced": as
+    "estimated", the model's timing also rejected by a fit of its reach at a free pace and onset, and that reach
+    at the person's own pace and onset (:mod:`comanip.estimation.paced_model`) asked before the people model,
+    where it explains the hand (misfit at most ``paced_threshold``): for hands that move as the model does at
+    another pace. Goals from either are combined with the prior."""
     mismatch_threshold: float = 9.0
-    """With ``timing="estimated"``: the largest mean squared whitened residual (per observed number) at which
+    """With ``timing="estimated"`` or ``"paced"``: the largest mean squared whitened residual (per observed number) at which
     the model at its own pace still explains the observations (about 1 for the model's own reaches)."""
     people_model: PeopleModel | None = None
-    """With ``timing="estimated"``: the model of people's movements (:class:`comanip.estimation.people_model.PeopleModel`,
+    """With ``timing="estimated"`` or ``"paced"``: the model of people's movements (:class:`comanip.estimation.people_model.PeopleModel`,
     e.g. fitted to your own recordings); None: the one that ships with comanip for the kind of movement the
     reaching model makes (``arm``, fitted to arm reaches, for a 3-D model; ``mouse`` for a 2-D one). A model
     fitted to mouse movements is refused for a 3-D reach."""
     paced_threshold: float = 0.05
-    """With ``timing="estimated"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
+    """With ``timing="paced"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
     goal_smoothing: GoalSmoothing | None = GoalSmoothing()
     """How the estimate's ``goal`` is smoothed over updates for a robot to follow

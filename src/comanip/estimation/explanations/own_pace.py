@@ -142,7 +142,7 @@ class ModelAtOwnPace:
             covariance = options.covariance_scale * problem.distance_spread(goal, covariance, whitening)
             if not (np.all(np.isfinite(goal)) and np.all(np.isfinite(covariance))):
                 raise np.linalg.LinAlgError("non-finite estimate")
-            misfit = problem.misfit(whitening, goal) if options.timing == "estimated" else None
+            misfit = problem.misfit(whitening, goal) if options.timing != "model" else None
         except np.linalg.LinAlgError as error:
             self._whitening = None
             goal, covariance = (reach.prior_mean, reach.prior_cov) if previous is None else (previous.goal, previous.covariance)
@@ -198,9 +198,9 @@ class ModelAtOwnPace:
         return noise
 
 
-def vetoed_own_pace(model: ReachingModel, options: OnlineOptions, person_pace: ModelAtPersonPace) -> Vetoed:
-    """The model at its own pace as the estimator's default chain asks it: ruled out for the rest of the reach
-    where ``person_pace`` contradicts its timing (:class:`PaceContradiction`) or its misfit exceeds
-    ``options.mismatch_threshold`` (:class:`MisfitAbove`)."""
-    return Vetoed(ModelAtOwnPace(model, options),
-                  (PaceContradiction(person_pace), MisfitAbove(options.mismatch_threshold, "the model at its own pace")))
+def vetoed_own_pace(model: ReachingModel, options: OnlineOptions, person_pace: ModelAtPersonPace | None = None) -> Vetoed:
+    """The model at its own pace as the estimator's default chains ask it: ruled out for the rest of the reach
+    where its misfit exceeds ``options.mismatch_threshold`` (:class:`MisfitAbove`) or, given ``person_pace``, where
+    that contradicts its timing (:class:`PaceContradiction`)."""
+    misfit = MisfitAbove(options.mismatch_threshold, "the model at its own pace")
+    return Vetoed(ModelAtOwnPace(model, options), (misfit,) if person_pace is None else (PaceContradiction(person_pace), misfit))
