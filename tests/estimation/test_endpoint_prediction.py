@@ -11,6 +11,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 import comanip
+from comanip.estimation import OnlineOptions
 from comanip.estimation.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
 from comanip.estimation.template_matching import TemplateLibrary, TemplateMatching
 from comanip.recordings import recording_from_samples
@@ -118,7 +119,8 @@ def played(plan, pace, rest=0.3, step=0.01):
 def test_the_models_own_reach_at_another_pace_gives_its_goal(preset, mid_reach):
     """Played at ×0.6–×1.6 of its duration: the final estimate within 0.02 D, and from half of the movement
     on within ``mid_reach`` D (0.10 D for plain point masses; the presets with muscle activation stages
-    change their shape with the distance more, docs/results/real_people.md); at the model's own pace exact."""
+    change their shape with the distance more, docs/results/real_people.md); at the model's own pace exact. The
+    chain that asks the model at the person's pace (``timing="paced"``)."""
     model = comanip.presets.load(preset)
     planner = comanip.Planner(model)
     goal = np.array([0.3, 0.1, 0.05][:model.n])
@@ -126,7 +128,8 @@ def test_the_models_own_reach_at_another_pace_gives_its_goal(preset, mid_reach):
     D = np.linalg.norm(goal)
     onset, end = movement_bounds(plan.t, plan.ee_velocity)
     for pace in (0.6, 1.0, 1.3, 1.6):
-        estimator = comanip.OnlineGoalEstimator(planner, np.zeros(model.state_size), width=0.02)
+        estimator = comanip.OnlineGoalEstimator(planner, np.zeros(model.state_size), width=0.02,
+                                                options=OnlineOptions(timing="paced"))
         t, position, velocity = played(plan, pace)
         worst = 0.0
         for k in range(len(t)):
@@ -174,11 +177,16 @@ def test_a_recorded_hand_that_stalls_after_a_failed_update_keeps_the_whitening_i
 
 
 def test_the_people_models_tree_walk_equals_scikit_learns_predict(people):
-    from comanip.estimation.people_model import TreeEnsemble, _along_regressor, _samples
+    from comanip.estimation.people_model import StackedTrees, TreeEnsemble, _along_regressor, _samples
     X, along, _, _, _ = _samples(people[:20])
     regressor = _along_regressor(X, along, seed=0)
     walked = np.array([TreeEnsemble.of(regressor)(x) for x in X])
     np.testing.assert_allclose(walked, regressor.predict(X), rtol=0, atol=1e-9)
+    # ensembles of other depths and sizes walked together give each one's own prediction
+    other = _along_regressor(X[::3], along[::3] ** 2, seed=1)
+    stacked = StackedTrees([TreeEnsemble.of(regressor), TreeEnsemble.of(other)])
+    np.testing.assert_allclose(np.array([stacked(x) for x in X]), np.column_stack([regressor.predict(X), other.predict(X)]),
+                               rtol=0, atol=1e-9)
 
 
 def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(people, tmp_path):

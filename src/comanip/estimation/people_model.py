@@ -137,6 +137,7 @@ class PeopleModel:
     existed, ``over path`` (a itself)."""
 
     def __post_init__(self):
+        object.__setattr__(self, "_trees", StackedTrees([e for e in (self.along, self.spread, self.remaining) if e is not None]))
         if self.kind not in KINDS:
             raise ValueError(f"kind must be one of {sorted(KINDS)}, got {self.kind!r}")
         if self.along_target not in ALONG_TARGETS:
@@ -208,13 +209,14 @@ class PeopleModel:
         if t[-1] - t[np.flatnonzero(speed > REST_FRACTION * features[3])[-1]] >= REST_TIME:
             return EndpointPrediction(position[-1].copy(), stopped, float(t[-1]))
         x = features[self.columns]
-        along, log_squared = float(ALONG_TARGETS[self.along_target](self.along(x))), self.spread(x)
+        predicted = self._trees(x)
+        along, log_squared = float(ALONG_TARGETS[self.along_target](predicted[0])), float(predicted[1])
         goal = position[-1] + path * max(along, 0.0) * u
         variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
         if path < STOPPING_TIME * speed[-1]:
             variance = max(variance, (STOPPING_TIME * speed[-1]) ** 2)
         end_time = None if self.remaining is None else \
-            float(t[-1]) + features[0] * max(math.exp(self.remaining(x)) - REMAINING_FLOOR, 0.0)
+            float(t[-1]) + features[0] * max(math.exp(predicted[2]) - REMAINING_FLOOR, 0.0)
         return EndpointPrediction(goal, variance * np.eye(len(u)), end_time)
 
     def save(self, path: str | Path) -> Path:
@@ -245,8 +247,8 @@ class PeopleModel:
 
 class TreeEnsemble:
     """A fitted gradient-boosted regressor as arrays of its trees' nodes, evaluated on one row by walking all
-    its trees at once: the same number as scikit-learn's ``predict`` of the regressor it came from (to
-    rounding, a test checks), in tens of microseconds, and saved as plain arrays."""
+    its trees at once (:class:`StackedTrees`): the same number as scikit-learn's ``predict`` of the regressor it
+    came from (to rounding, a test checks), in tens of microseconds, and saved as plain arrays."""
 
     FIELDS = ("feature", "threshold", "left", "right", "leaf", "value", "baseline")
 
@@ -255,8 +257,8 @@ class TreeEnsemble:
         self.threshold, self.value = np.asarray(threshold, dtype=float), np.asarray(value, dtype=float)
         self.leaf = np.asarray(leaf, dtype=bool)
         self.baseline = float(baseline)
-        self._rows = np.arange(self.feature.shape[0])
         self.depth = self._depth()
+        self._walk = StackedTrees((self,))
 
     @classmethod
     def of(cls, regressor) -> "TreeEnsemble":
@@ -286,12 +288,42 @@ class TreeEnsemble:
 
     def __call__(self, x: np.ndarray) -> float:
         """The regressor's prediction for one row of finite features x (F,)."""
-        rows, node = self._rows, np.zeros(len(self._rows), dtype=np.intp)
-        for _ in range(self.depth):
-            left = x[self.feature[rows, node]] <= self.threshold[rows, node]
-            step = np.where(left, self.left[rows, node], self.right[rows, node])
-            node = np.where(self.leaf[rows, node], node, step)
-        return self.baseline + float(self.value[rows, node].sum())
+        return float(self._walk(x)[0])
+
+
+class StackedTrees:
+    """Several :class:`TreeEnsemble` s evaluated on one row together: their nodes in flat arrays, each child a flat
+    index and each leaf its own child, so that one comparison of the row against every node's threshold and one
+    step per level of the deepest tree walk every tree of every ensemble at once."""
+
+    def __init__(self, ensembles):
+        offsets, features, thresholds, lefts, rights, values, owners = [], [], [], [], [], [], []
+        base = 0
+        for k, ensemble in enumerate(ensembles):
+            trees, width = ensemble.feature.shape
+            index = base + width * np.arange(trees)[:, None] + np.arange(width)          # (trees, width) flat
+            offset = base + width * np.arange(trees)[:, None]
+            features.append(np.where(ensemble.leaf, 0, ensemble.feature).ravel())
+            thresholds.append(ensemble.threshold.ravel())
+            lefts.append(np.where(ensemble.leaf, index, offset + ensemble.left).ravel())
+            rights.append(np.where(ensemble.leaf, index, offset + ensemble.right).ravel())
+            values.append(ensemble.value.ravel())
+            offsets.append(index[:, 0])
+            owners.append(np.full(trees, k))
+            base += trees * width
+        self._feature, self._threshold = np.concatenate(features), np.concatenate(thresholds)
+        self._left, self._right, self._value = np.concatenate(lefts), np.concatenate(rights), np.concatenate(values)
+        self._roots, self._owner = np.concatenate(offsets), np.concatenate(owners)
+        self._baseline = np.array([ensemble.baseline for ensemble in ensembles])
+        self._depth = max(ensemble.depth for ensemble in ensembles)
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        """Each ensemble's prediction (E,) for one row of finite features x (F,)."""
+        goes_left = x[self._feature] <= self._threshold
+        node = self._roots
+        for _ in range(self._depth):
+            node = np.where(goes_left[node], self._left[node], self._right[node])
+        return self._baseline + np.bincount(self._owner, weights=self._value[node], minlength=len(self._baseline))
 
 
 def share_to_go(beyond: np.ndarray) -> np.ndarray:
