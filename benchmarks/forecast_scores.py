@@ -47,7 +47,7 @@ def forecast_rows(trace, recording, name: str, estimator) -> list[dict]:
                  "constant acceleration": kinematic.constant_acceleration(x, v, a, lead),
                  "minimum jerk to the estimate's goal and stop": kinematic.minimum_jerk_to(x, v, a, estimate.goal, stop_in, lead),
                  name: predicted.position,
-                 GIVEN_THE_END[0]: continued_reach(estimator.family, estimator.transition, estimator.start_position, t_now,
+                 GIVEN_THE_END[0]: continued_reach(estimator.family, estimator.start_position, t_now,
                                                    x, v, recording.end, np.zeros((len(x), len(x))), recording.end_time,
                                                    a).at(t_now + lead).position,
                  GIVEN_THE_END[1]: kinematic.minimum_jerk_to(x, v, a, recording.end, recording.end_time - t_now, lead)}

@@ -106,7 +106,7 @@ def timed_updates(model, reaches, repeats: int, stages: dict | None = None):
                     longest = f"{name} {1e3 * seconds:.1f} ms"
                 forecast = estimate.forecast
                 begin = time.perf_counter()
-                continued_reach(estimator.family, estimator.transition, estimator.start_position, estimate.t_obs,
+                continued_reach(estimator.family, estimator.start_position, estimate.t_obs,
                                 position[k], velocity[k], estimate.goal, estimate.goal_covariance, forecast.stop_time)
                 out.append((wall, cpu, time.perf_counter() - begin, k, longest))
     return out

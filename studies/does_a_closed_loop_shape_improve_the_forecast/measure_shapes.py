@@ -90,7 +90,7 @@ def main(argv=None):
             t_now, x, v = reach.t[k], reach.position[k], reach.velocity[k]
             a = path_baselines.recent_acceleration(reach.t[:k + 1], reach.velocity[:k + 1])
             truth = np.array([reach.position_at(t_now + s) for s in lead])
-            paths = {name: continued_reach(family, estimator.transition, reach.position[0], t_now, x, v, reach.end,
+            paths = {name: continued_reach(family, reach.position[0], t_now, x, v, reach.end,
                                            np.zeros((len(x), len(x))), reach.end_time, a).at(t_now + lead).position
                      for name, family in shapes.items()}
             paths["minimum jerk"] = path_baselines.minimum_jerk_to(x, v, a, reach.end, reach.end_time - t_now, lead)

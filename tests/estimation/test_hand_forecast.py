@@ -32,7 +32,7 @@ def _own_forecast(arm, k, goal_covariance=None):
     """The forecast from step k of the model's own reach, at its own stop."""
     model, family, transition, goal, plan = arm
     stop = model.h * movement_span(plan.ee_speed).last
-    return continued_reach(family, transition, np.zeros(3), plan.t[k], plan.ee_mean[k], plan.ee_velocity[k], goal,
+    return continued_reach(family, np.zeros(3), plan.t[k], plan.ee_mean[k], plan.ee_velocity[k], goal,
                            np.zeros((3, 3)) if goal_covariance is None else goal_covariance, stop)
 
 
@@ -58,7 +58,7 @@ def test_on_the_models_own_reach_the_forecast_is_close_to_replanning_from_the_ha
 def test_it_starts_at_the_hands_state_and_ends_at_rest_on_the_goal(arm):
     _, family, transition, goal, _ = arm
     x, v, a = np.array([0.05, 0.02, 0.01]), np.array([0.6, 0.5, -0.2]), np.array([-3.0, 1.0, 2.0])
-    forecast = continued_reach(family, transition, np.zeros(3), 0.2, x, v, goal, np.zeros((3, 3)), 0.5, a)
+    forecast = continued_reach(family, np.zeros(3), 0.2, x, v, goal, np.zeros((3, 3)), 0.5, a)
     start = forecast.at(0.2)
     np.testing.assert_allclose(start.position[0], x, atol=1e-12)
     np.testing.assert_allclose(start.velocity[0], v, atol=1e-9)
@@ -143,7 +143,7 @@ def test_any_hand_state_gives_a_bounded_forecast_that_ends_on_the_goal(arm, posi
     velocity and acceleration can carry it in the time left, and stops on the goal."""
     _, family, transition, goal, _ = arm
     x, v, a = np.array(position), np.array(velocity), np.array(acceleration)
-    forecast = continued_reach(family, transition, np.zeros(3), t_now, x, v, goal, 1e-4 * np.eye(3), t_now + stop_in, a)
+    forecast = continued_reach(family, np.zeros(3), t_now, x, v, goal, 1e-4 * np.eye(3), t_now + stop_in, a)
     R = max(forecast.stop_time - t_now, 0.02)
     path = forecast.at(t_now + np.linspace(0.0, R + 0.1, 40))
     assert np.all(np.isfinite(path.position)) and np.all(np.isfinite(path.covariance))
@@ -151,3 +151,10 @@ def test_any_hand_state_gives_a_bounded_forecast_that_ends_on_the_goal(arm, posi
     assert np.linalg.norm(path.position - x, axis=1).max() <= 2 * reach + 1e-9
     np.testing.assert_allclose(path.position[-1], goal, atol=1e-9)
     assert np.all(np.linalg.eigvalsh(path.covariance) >= -1e-12)
+
+
+def test_the_familys_transition_powers_are_the_models_step_map_repeated(arm):
+    _, family, transition, _, _ = arm
+    np.testing.assert_allclose(family.transition_powers[1], transition, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(family.transition_powers[3], transition @ transition @ transition, rtol=1e-12, atol=1e-15)
+    np.testing.assert_array_equal(family.transition_powers[0], np.eye(family.nx))

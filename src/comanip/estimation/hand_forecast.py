@@ -41,7 +41,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from comanip.estimation.reach_family import ReachFamily
+from comanip.estimation.reach_family import FamilyMember, ReachFamily
 from comanip.estimation.reach_timing import movement_span
 
 LAST_SHARE = 0.05
@@ -159,22 +159,26 @@ def _rest_terms(sigma: np.ndarray, remaining: float, dv: np.ndarray, da: np.ndar
     return position, velocity
 
 
-def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np.ndarray, t_now: float,
+def continued_reach(family: ReachFamily, reach_start: np.ndarray, t_now: float,
                     position: np.ndarray, velocity: np.ndarray, goal: np.ndarray, goal_covariance: np.ndarray,
-                    stop_time: float | None, acceleration: np.ndarray | None = None) -> HandForecast:
+                    stop_time: float | None, acceleration: np.ndarray | None = None,
+                    member: FamilyMember | None = None) -> HandForecast:
     """The forecast (module docstring) of the hand at ``position`` (d,) m and ``velocity`` (d,) m/s at ``t_now``
     (s), heading for ``goal`` (d,) m with covariance ``goal_covariance`` (d, d) m², in a reach that started at
     rest at ``reach_start`` (d,) m and stops at ``stop_time`` (s; None: where the model's own reach from t = 0
     does), accelerating at ``acceleration`` (d,) m/s² now (None, or an entry NaN: as the model's reach does at
-    its phase).
-    ``transition`` is the model's one-step state map A (nx, nx)."""
+    its phase). ``member``: the family's member at the goal's distance where the caller has read it already
+    (:attr:`~comanip.estimation.reach_family.ReachPrediction.member`), else it is read here."""
     model = family.model
     n, nx, H, h = family.n, family.nx, family.H, model.h
     blocks = nx // n
     to_goal = goal - position
     r = float(np.linalg.norm(to_goal))
     D = float(np.linalg.norm(goal - reach_start))
-    along = family.along(np.array([max(D, r, 1e-9)]))[0]              # (H+1, blocks) in the member's frame
+    distance = family.in_range(max(D, r, 1e-9))
+    if member is None or member.distance != distance:
+        member = family.member(distance)
+    along = member.along                                              # (H+1, blocks) in the member's frame
     a, speed = along[:, 0], along[:, 1]
     first, last = movement_span(np.abs(speed)) if np.abs(speed).max() > 0 else (0, H)
     tau = h * np.arange(H + 1)
@@ -225,19 +229,12 @@ def continued_reach(family: ReachFamily, transition: np.ndarray, reach_start: np
 
     # 4. the covariance: the motor noise still to come, and the goal's uncertainty along the way
     k0 = int(min(round(phase / h), H))
-    member_cov = family.member_covariance(max(D, r, 1e-9))
     frame = family.frame(u)
-    cov = np.zeros((len(t), nx, nx))
-    propagated = member_cov[k0]
     grid_steps = np.round(model_times / h).astype(int)
     grid_steps[0] = k0
     grid_steps = np.concatenate((grid_steps, [grid_steps[-1]] * (len(t) - len(grid_steps)))).astype(int)
-    previous = k0
-    for i, j in enumerate(grid_steps):
-        for _ in range(j - previous):
-            propagated = transition @ propagated @ transition.T
-        previous = j
-        cov[i] = member_cov[j] - propagated
+    powers = family.transition_powers[grid_steps - k0]                # A^(j - k0) (K+1, nx, nx)
+    cov = member.covariance[grid_steps] - powers @ member.covariance[k0] @ powers.transpose(0, 2, 1)
     cov = 0.5 * (cov + cov.transpose(0, 2, 1))
     scales = np.repeat(block_scale, n)
     cov = frame @ (cov * np.outer(scales, scales)) @ frame.T

@@ -51,7 +51,6 @@ from comanip.estimation.estimation_planner import checked_model
 from comanip.estimation.explanations import (Explained, Explanation, HandAtRest, HandTrace, ModelAtOwnPace, ModelAtPersonPace,
                                              Reach, RecordedPeople, vetoed_own_pace)
 from comanip.estimation.explanations.base import grid_position
-from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.hand_forecast import continued_reach
 from comanip.estimation.path_baselines import recent_acceleration
@@ -127,9 +126,6 @@ class OnlineGoalEstimator:
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self.explanations = list(explanations) if explanations is not None else self._explanations(d)
-        self.transition = np.asarray(linearised_step_function(model.body, model.h)(
-            np.zeros(model.state_size), np.zeros(model.n))[1])
-        """A (nx, nx): the model's one-step state map (linear dynamics), for the forecast's belief."""
         self._blas = SingleThreadBlas()
         self._hand = HandTrace(d)
         self.reset(start)
@@ -327,9 +323,8 @@ class OnlineGoalEstimator:
         forecast = None
         t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
         if self._hand.count and (with_forecast or status != EstimateStatus.UNINFORMATIVE):
-            forecast = continued_reach(self.family, self.transition, self.start_position, self._last_time, observed[:n],
-                                       observed[n:], goal, covariance, stop,
-                                       self._person_acceleration())
+            forecast = continued_reach(self.family, self.start_position, self._last_time, observed[:n], observed[n:], goal,
+                                       covariance, stop, self._person_acceleration(), member=prediction.member)
             if status != EstimateStatus.UNINFORMATIVE:
                 ahead = forecast.at(self._last_time + np.array(FORECAST_LEADS))
                 self._forecasts.append((ahead.position, ahead.covariance))

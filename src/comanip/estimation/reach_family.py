@@ -23,10 +23,12 @@ import bisect
 import math
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 
+from comanip.belief.propagation import linearised_step_function
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 from comanip.planning.starts.reach_library import reflection_onto
@@ -36,6 +38,19 @@ INVARIANCE_TOLERANCE = 1e-4
 magnitude along the plan (at least 1 of its unit: m, m/s, N), for the model to count as rotation-invariant: above
 the planner's convergence noise (largest for narrow goals and large muscle forces), far below any model asymmetry
 (per-channel noise differs by several hundredths)."""
+
+
+@dataclass(frozen=True)
+class FamilyMember:
+    """The family's plan to one distance along e_1, before it is turned onto a goal's direction. Shapes: H steps,
+    nx state entries."""
+
+    distance: float
+    """D (m), within the family's range."""
+    along: np.ndarray
+    """The mean along the axis per state block, a_b,i(D) (H+1, blocks)."""
+    covariance: np.ndarray
+    """Sigma_i(D) (H+1, nx, nx), in the member's frame."""
 
 
 @dataclass
@@ -59,6 +74,8 @@ class ReachPrediction:
     (order 2; :meth:`hessian_contraction`)."""
     mixed: np.ndarray | None = None
     """a'/D - a/D² (H+1, blocks) (per m)."""
+    member: "FamilyMember | None" = None
+    """The member it was turned from, when its covariance was asked for (the forecast reads it again)."""
 
     def hessian_contraction(self, z: np.ndarray) -> np.ndarray:
         """sum_ik z_ik d² mu_ik / d g² (d, d) for weights z (H+1, nx): with P = I - u u^T the second derivative
@@ -211,6 +228,25 @@ class ReachFamily:
         c = self._path.c[:, k, :size]
         return (((c[0] * dx + c[1]) * dx + c[2]) * dx + c[3]).reshape(len(distances), self.H + 1, self.blocks)
 
+    @cached_property
+    def transition_powers(self) -> np.ndarray:
+        """A^m (H+1, nx, nx), m = 0..H: the powers of the model's one-step state map (linear dynamics)."""
+        A = np.asarray(linearised_step_function(self.model.body, self.model.h)(np.zeros(self.nx), np.zeros(self.n))[1])
+        powers = np.empty((self.H + 1, self.nx, self.nx))
+        powers[0] = np.eye(self.nx)
+        for m in range(1, self.H + 1):
+            powers[m] = A @ powers[m - 1]
+        return powers
+
+    def in_range(self, distance: float) -> float:
+        """``distance`` (m) clipped to the family's range: where the family reads it."""
+        return min(max(distance, self._low), self._high)
+
+    def member(self, distance: float) -> FamilyMember:
+        """The member at ``distance`` (m, read at the nearest end of the range outside it)."""
+        D = self.in_range(distance)
+        return FamilyMember(D, self.along(np.array([D]))[0], self.member_covariance(D))
+
     def member_covariance(self, distance: float) -> np.ndarray:
         """Sigma_i (H+1, nx, nx) of the plan to ``distance`` (m, within the range) along e_1, in that frame."""
         x = math.log(min(max(distance, self._low), self._high))
@@ -246,10 +282,11 @@ class ReachFamily:
         along = values[:size].reshape(H + 1, nb)
         mean = (along[:, :, None] * u).reshape(H + 1, nb * n)
         mean[:, :n] += start_position
-        cov = None
+        cov = member = None
         if covariance:
             T = self.frame(u)
-            cov = T @ self.member_covariance(D) @ T.T
+            member = FamilyMember(D, along, self.member_covariance(D))
+            cov = T @ member.covariance @ T.T
         jacobian = curvature = mixed = None
         if order >= 1:
             radial = u[:, None] * u
@@ -263,4 +300,4 @@ class ReachFamily:
                 curvature = (second - first) / D**2 if inside else np.zeros_like(first)      # d²a/dD²
                 mixed = slope / D_safe - along / D_safe**2
         return ReachPrediction(mean=mean, cov=cov, torque=values[size:size + H, None] * u, objective=float(values[-1]),
-                               mean_jacobian=jacobian, direction=u, curvature=curvature, mixed=mixed)
+                               mean_jacobian=jacobian, direction=u, curvature=curvature, mixed=mixed, member=member)
