@@ -176,3 +176,28 @@ def test_leaving_out_the_person_pace_changes_no_estimate_it_would_not_have_given
     chains = [OnlineGoalEstimator(planar, np.zeros(4), options=OnlineOptions(timing=timing)) for timing in ("estimated", "paced")]
     differ = [not np.array_equal(*(chain.update(t[k], position[k], velocity[k]).goal for chain in chains)) for k in range(len(t))]
     assert any(differ)
+
+
+def test_the_model_at_its_own_pace_gives_up_only_where_its_solve_would_be_vetoed(planner):
+    """The model's reach played in 0.3 of its time: at the goal its solve starts from, the misfit exceeds the give-up level,
+    so it misfits without iterating and the veto rules it out, as it rules out the solved account on the same
+    observations; on the model's own reach it never gives up."""
+    from comanip.estimation.explanations.own_pace import GIVE_UP_FACTOR
+    plan = planner.solve(np.zeros(6), [0.3, 0.1, 0.0])
+    options = OnlineOptions()
+    level = GIVE_UP_FACTOR * options.mismatch_threshold
+    for pace, gives_up in ((0.3, True), (1.0, False)):
+        t = np.arange(0.01, plan.t[-1] * pace, 0.01)
+        position = np.column_stack([np.interp(t, plan.t * pace, plan.ee_mean[:, i]) for i in range(3)])
+        velocity = np.column_stack([np.interp(t, plan.t * pace, plan.ee_velocity[:, i]) for i in range(3)]) / pace
+        quick, solved = (OnlineGoalEstimator(planner, np.zeros(6), explanations=[
+            Vetoed(ModelAtOwnPace(planner.model, options, give_up_above=above), [MisfitAbove(options.mismatch_threshold, "own")])])
+            for above in (level, None))
+        answers = []
+        for k in range(len(t)):
+            quick.update(t[k], position[k], velocity[k])
+            solved.update(t[k], position[k], velocity[k])
+            answers.append(quick.explanations[0].explanation._last)
+        assert (quick.explanations[0].ruled_out is not None) == (solved.explanations[0].ruled_out is not None) == gives_up
+        gave_up = [a for a in answers if a is not None and a.verdict is Verdict.MISFITS]
+        assert bool(gave_up) == gives_up and all(a.misfit > level and a.iterations == 0 for a in gave_up)

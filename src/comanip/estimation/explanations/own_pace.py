@@ -32,7 +32,7 @@ import numpy as np
 
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
-from comanip.estimation.explanations.base import Explained, HandTrace, Reach, grid_position
+from comanip.estimation.explanations.base import Explained, HandTrace, Reach, Verdict, grid_position
 from comanip.estimation.explanations.person_pace import ModelAtPersonPace, PaceContradiction
 from comanip.estimation.explanations.vetoed import MisfitAbove, Vetoed
 from comanip.estimation.goal_estimate import GoalEstimate
@@ -47,6 +47,10 @@ from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
 
 COVARIANCE_ROUNDS = 3
 """Whitenings rebuilt per update at most (each at the goal the previous round ended at)."""
+GIVE_UP_FACTOR = 2.0
+"""The default chain's model at its own pace misfits without a solve where its misfit at the goal the solve would
+start from exceeds this many times the veto's threshold: a solve lowers the misfit from its starting goal by far
+less (docs/results/real_people.md, the update stages), so the veto would rule it out after the solve all the same."""
 
 
 class ModelAtOwnPace:
@@ -55,10 +59,13 @@ class ModelAtOwnPace:
     Args:
         model: the point-mass model of the reach family.
         options: the estimator's options.
+        give_up_above: a misfit above which, at the goal its solve would start from, it does not solve and says it
+            misfits (verdict MISFITS), where the hand stays within the reach family's distances and a person's
+            hand speeds; None: it always solves and explains.
     """
 
-    def __init__(self, model: ReachingModel, options: OnlineOptions):
-        self.model, self.options = model, options
+    def __init__(self, model: ReachingModel, options: OnlineOptions, give_up_above: float | None = None):
+        self.model, self.options, self.give_up_above = model, options, give_up_above
         n = model.n
         _, A, _ = linearised_step_function(model.body, model.h)(np.zeros(model.state_size), np.zeros(n))
         self._A = np.asarray(A)
@@ -87,8 +94,9 @@ class ModelAtOwnPace:
 
     def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
         self._add(hand)
-        self._last = estimate = self._estimate(hand)
-        return estimate if self._humanlike(hand) else replace(estimate, contestable=False)
+        humanlike = self._humanlike(hand)
+        self._last = estimate = self._estimate(hand, self.give_up_above if humanlike else None)
+        return estimate if humanlike else replace(estimate, contestable=False)
 
     def _add(self, hand: HandTrace) -> None:
         """Average the observations not yet added into their grid steps."""
@@ -112,9 +120,10 @@ class ModelAtOwnPace:
         return bool(np.sqrt((offset * offset).sum(axis=1)).max() <= self.reach.family.distances[-1]
                     and np.sqrt((velocity * velocity).sum(axis=1)).max() <= MAX_HUMAN_HAND_SPEED_M_S)
 
-    def _estimate(self, hand: HandTrace) -> Explained:
+    def _estimate(self, hand: HandTrace, give_up_above: float | None) -> Explained:
         """The MAP estimate (module docstring) with its misfit (mean squared whitened residual per observed
-        number; None when nothing was fitted or the timing is the model's)."""
+        number; None when nothing was fitted or the timing is the model's); where the misfit at the starting goal
+        exceeds ``give_up_above``, that goal unsolved, verdict MISFITS."""
         reach, options = self.reach, self.options
         steps = np.flatnonzero(self._counts)
         counts = self._counts[steps]
@@ -131,8 +140,12 @@ class ModelAtOwnPace:
             else:
                 goal = previous.goal
             iterations = 0
-            for _ in range(COVARIANCE_ROUNDS):
+            for round_ in range(COVARIANCE_ROUNDS):
                 whitening = self._whitening_at(goal, hand.count)
+                if round_ == 0 and give_up_above is not None and (start := problem.misfit(whitening, goal)) > give_up_above:
+                    return Explained.not_explaining(reach, Verdict.MISFITS, f"the model at its own pace misfits the hand "
+                                                    f"(misfit {start:.3g} per observed number before its solve)",
+                                                    goal=goal, misfit=start)
                 solved = MapNewton(problem, whitening, options.tolerance, options.step_fraction,
                                    reach.family.width).solve(goal, options.max_iterations)
                 goal, covariance = solved.x, solved.local_model.covariance()
@@ -203,4 +216,5 @@ def vetoed_own_pace(model: ReachingModel, options: OnlineOptions, person_pace: M
     where its misfit exceeds ``options.mismatch_threshold`` (:class:`MisfitAbove`) or, given ``person_pace``, where
     that contradicts its timing (:class:`PaceContradiction`)."""
     misfit = MisfitAbove(options.mismatch_threshold, "the model at its own pace")
-    return Vetoed(ModelAtOwnPace(model, options), (misfit,) if person_pace is None else (PaceContradiction(person_pace), misfit))
+    own_pace = ModelAtOwnPace(model, options, give_up_above=GIVE_UP_FACTOR * options.mismatch_threshold)
+    return Vetoed(own_pace, (misfit,) if person_pace is None else (PaceContradiction(person_pace), misfit))

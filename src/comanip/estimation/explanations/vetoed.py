@@ -3,7 +3,8 @@
 :class:`Vetoed` asks its explanation, then, where that explains the hand, its vetoes in order; the first veto
 with a reason rules the explanation out, and it stays out until the next reach (a reach whose first part one
 account failed to explain is not that account's reach later on). Vetoes are asked only of an account that may
-be contested (``Explained.contestable``) once the hand has set off (:meth:`HandTrace.onset`).
+be contested (``Explained.contestable``) that explains the hand or says it misfits it, once the hand has set off
+(:meth:`HandTrace.onset`).
 
 The default chain (:mod:`comanip.estimation.online_estimator`) vetoes the model at its own pace by its misfit
 (:class:`MisfitAbove`) and by its reach at the person's pace where that contradicts its timing
@@ -28,7 +29,7 @@ class Veto(Protocol):
         """Start a new reach."""
 
     def veto(self, hand: HandTrace, explained: Explained) -> str | None:
-        """Why ``explained``, an account that explains the hand, is ruled out, or None."""
+        """Why ``explained``, an account that explains or misfits the hand, is ruled out, or None."""
 
 
 class MisfitAbove:
@@ -66,7 +67,8 @@ class Vetoed:
         if self.ruled_out is not None:
             return Explained.not_explaining(self.reach, Verdict.RULED_OUT, self.ruled_out)
         explained = self.explanation.explain(hand, latest)
-        if not (explained.explains and explained.contestable and hand.onset() is not None):
+        judged = explained.explains or explained.verdict is Verdict.MISFITS
+        if not (judged and explained.contestable and hand.onset() is not None):
             return explained
         why = next((reason for veto in self.vetoes if (reason := veto.veto(hand, explained)) is not None), None)
         if why is None:
