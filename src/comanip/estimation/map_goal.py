@@ -200,7 +200,7 @@ class MapProblem:
             noise: the averaged observations' noise covariances (S, 2n, 2n).
         """
         family = self.family
-        n, H = family.model.n, family.model.H
+        n = family.model.n
         sigma_q, sigma_v = observation_std
         directions = []
         if np.linalg.norm(latest[n:]) > MOVEMENT_SIGMAS * sigma_v:
@@ -215,16 +215,24 @@ class MapProblem:
             directions.append(prior_offset / np.linalg.norm(prior_offset))
         m = self.m
         best, best_score = None, math.inf
+        member_cov = family.member_cov[:, self.steps, :m, :m]
+        # the members' means at the observations in their own frame: a_b (K, S) on the first axis of each block b
+        along = self.weights @ family.member_along[:, :, :m // n]                        # (K, S, blocks)
+        member_means = np.zeros(along.shape[:2] + (m,))
+        member_means[:, :, ::n] = along
+        observed = self.observed.copy()
+        observed[:, :n] -= self.start_position
+        factored = None                 # (noise in the member's frame, its members' inverses, log-determinants)
         for u in directions:
             goals = self.start_position + family.distances[:, None] * u
-            K = len(goals)
-            means = (family.member_along[:, :, :, None] * u).reshape(K, H + 1, -1)[:, :, :m]
-            means[:, :, :n] += self.start_position
-            r = self.observed - np.einsum("sj,kjm->ksm", self.weights, means)
             T = family.frame(u)[:m, :m]
-            S = T @ family.member_cov[:, self.steps, :m, :m] @ T.T + noise
-            solved = np.linalg.solve(S, r[..., None])[..., 0]
-            _, log_det = np.linalg.slogdet(S)
+            r = observed @ T - member_means                                               # (K, S, m), member frame
+            turned = T.T @ noise @ T            # the same for every direction where the noise is isotropic per block
+            if factored is None or not np.allclose(turned, factored[0], rtol=0.0, atol=1e-12 * float(np.abs(noise).max())):
+                S = member_cov + turned
+                factored = turned, np.linalg.inv(S), np.linalg.slogdet(S)[1]
+            solved = (factored[1] @ r[..., None])[..., 0]
+            log_det = factored[2]
             offsets = goals - self.prior_mean
             scores = 0.5 * (np.sum(r * solved, axis=(1, 2)) + log_det.sum(axis=1)
                             + np.einsum("ki,ij,kj->k", offsets, self.prior_precision, offsets))

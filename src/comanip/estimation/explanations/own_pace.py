@@ -60,8 +60,9 @@ class ModelAtOwnPace:
         model: the point-mass model of the reach family.
         options: the estimator's options.
         give_up_above: a misfit above which, at the goal its solve would start from, it does not solve and says it
-            misfits (verdict MISFITS), where the hand stays within the reach family's distances and a person's
-            hand speeds; None: it always solves and explains.
+            misfits (verdict MISFITS), as it does where that goal lies at the family's shortest distance behind the
+            hand, while the hand stays within the reach family's distances and a person's hand speeds; None: it
+            always solves and explains.
     """
 
     def __init__(self, model: ReachingModel, options: OnlineOptions, give_up_above: float | None = None):
@@ -122,8 +123,9 @@ class ModelAtOwnPace:
 
     def _estimate(self, hand: HandTrace, give_up_above: float | None) -> Explained:
         """The MAP estimate (module docstring) with its misfit (mean squared whitened residual per observed
-        number; None when nothing was fitted or the timing is the model's); where the misfit at the starting goal
-        exceeds ``give_up_above``, that goal unsolved, verdict MISFITS."""
+        number; None when nothing was fitted or the timing is the model's); given ``give_up_above``, the starting
+        goal unsolved with verdict MISFITS where the misfit there exceeds it or the goal lies behind the hand
+        (:meth:`_behind_the_hand`)."""
         reach, options = self.reach, self.options
         steps = np.flatnonzero(self._counts)
         counts = self._counts[steps]
@@ -139,6 +141,10 @@ class ModelAtOwnPace:
                                                 "no observation shows movement: the estimate is the prior")
             else:
                 goal = previous.goal
+            if give_up_above is not None and self._behind_the_hand(goal, hand):
+                return Explained.not_explaining(reach, Verdict.MISFITS, "the model at its own pace misfits the hand (its "
+                                                "best reach is shorter than the family's shortest, the hand beyond it)",
+                                                goal=goal, misfit=math.inf)
             iterations = 0
             for round_ in range(COVARIANCE_ROUNDS):
                 whitening = self._whitening_at(goal, hand.count)
@@ -163,6 +169,14 @@ class ModelAtOwnPace:
                                         "the previous estimate is kept", misfit=math.inf)
         return Explained.explaining(goal, 0.5 * (covariance + covariance.T), solved.status, solved.message,
                                     iterations=iterations, misfit=misfit)
+
+    def _behind_the_hand(self, goal: np.ndarray, hand: HandTrace) -> bool:
+        """Whether ``goal`` sits at the reach family's smallest distance with the hand farther from the start than it:
+        the observations' best reach at the model's pace is shorter than any the family plans, yet the hand has gone
+        past it (a hand that set off later than the model's reach from t = 0 would)."""
+        start, shortest = self.reach.start_position, self.reach.family.distances[0]
+        offset = hand.position[-1] - start
+        return bool(np.linalg.norm(goal - start) <= shortest * (1 + 1e-6) and math.sqrt(float(offset @ offset)) > shortest)
 
     def _stale(self, goal: np.ndarray, observations: int) -> bool:
         """True when the whitening was made for a goal farther from ``goal`` than the covariance tolerance, or
