@@ -201,3 +201,28 @@ def test_the_model_at_its_own_pace_gives_up_only_where_its_solve_would_be_vetoed
         assert (quick.explanations[0].ruled_out is not None) == (solved.explanations[0].ruled_out is not None) == gives_up
         gave_up = [a for a in answers if a is not None and a.verdict is Verdict.MISFITS]
         assert bool(gave_up) == gives_up and all(a.misfit > level and a.iterations == 0 for a in gave_up)
+
+
+def test_the_model_at_its_own_pace_misfits_a_hand_beyond_its_best_reach():
+    """Recorded arm reaches (the examples' copy), streamed from before their onset: where the model at its own pace is
+    first asked, its best reach from t = 0 is the family's shortest while the hand has gone farther, so it says it
+    misfits without solving and is ruled out; solved instead, its goal stays at that shortest distance, behind the
+    hand."""
+    import comanip
+    from comanip.recordings import load_tathum
+    model = comanip.presets.load("arm")
+    for reach in [trial.streamed_recording() for trial in load_tathum(EXAMPLE_ARMS)[:3]]:
+        start = np.r_[reach.position[0], np.zeros(model.state_size - model.n)]
+        options = OnlineOptions()
+        quick = OnlineGoalEstimator(model, start)
+        solved = OnlineGoalEstimator(model, start, explanations=[HandAtRest(), ModelAtOwnPace(model, options)])
+        for k in range(len(reach.t)):
+            quick.update(reach.t[k], reach.position[k], reach.velocity[k])
+            answer = solved.update(reach.t[k], reach.position[k], reach.velocity[k])
+            first = quick.explanations[1].explanation._last
+            if first is not None:
+                break
+        shortest = quick.family.distances[0]
+        assert first.verdict is Verdict.MISFITS and first.misfit == np.inf and quick.explanations[1].ruled_out is not None
+        assert np.linalg.norm(answer.unsmoothed_goal - reach.position[0]) <= 1.01 * shortest
+        assert np.linalg.norm(reach.position[k] - reach.position[0]) > shortest
