@@ -174,6 +174,7 @@ class OnlineGoalEstimator:
         self._history: list[tuple] = []    # (t, hand, goal, covariance, stop) of each estimate, before calibration
         self._forecasts: list[tuple] = []  # (positions (L, d), covariances (L, d, d)) of its forecast at the leads
         self._last_time = -math.inf
+        self._planned = None      # (goal and timing, prediction, timed plan) of the last estimate's reach
         self._warned = False
         self.latest: GoalEstimate | None = None
         """The last estimate, None before the first update."""
@@ -297,6 +298,19 @@ class OnlineGoalEstimator:
         acceleration[list(self.options.led_axes)] = np.nan
         return acceleration
 
+    def _planned_reach(self, goal: np.ndarray, timing) -> tuple:
+        """The model's reach to ``goal`` (:meth:`Reach.prediction`) and that reach played at ``timing``: the last
+        update's where its goal and timing were the same (the prior's, while the hand rests), its arrays read-only
+        since successive estimates then share them."""
+        key = (goal.tobytes(), timing)
+        if self._planned is None or self._planned[0] != key:
+            prediction = self.reach.prediction(goal, order=0)
+            timed = timed_plan(prediction.mean, prediction.cov, prediction.torque, self.model.h, self.model.n, timing)
+            for array in (*timed, prediction.mean, prediction.cov, prediction.torque):
+                array.flags.writeable = False
+            self._planned = (key, prediction, timed)
+        return self._planned[1], self._planned[2]
+
     def _result(self, explained: Explained, t_begin: float, reasons: Sequence[str] = (),
                 with_forecast: bool = True) -> GoalEstimate:
         """The estimate of ``explained``, with the model's predicted reach to its goal and the forecast of the hand
@@ -316,8 +330,7 @@ class OnlineGoalEstimator:
                 self._smoother.reset()
             else:
                 goal, covariance = self._smoother.smooth(self._last_time, goal, covariance, observed[:n])
-        prediction = self.reach.prediction(goal, order=0)
-        timed = timed_plan(prediction.mean, prediction.cov, prediction.torque, model.h, n, explained.timing)
+        prediction, timed = self._planned_reach(goal, explained.timing)
         before, fraction = grid_position(max(self._last_time - timed.t[0], 0.0), timed.t[1] - timed.t[0], model.H)
         predicted = (1 - fraction) * timed.mean[before, :2 * n] + fraction * timed.mean[min(before + 1, model.H), :2 * n]
         forecast = None

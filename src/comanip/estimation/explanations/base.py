@@ -34,6 +34,7 @@ class HandTrace:
         """Observations so far."""
         self.d = d
         self._onset: tuple[int, float | None] = (0, None)    # (count, onset) of the last onset found
+        self._left: tuple[bytes, int, bool] = (b"", 0, False)  # (start, count checked, whether it left) of has_left
 
     def append(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
         if self.count == len(self._rows):
@@ -72,8 +73,16 @@ class HandTrace:
         return self._onset[1]
 
     def has_left(self, start_position: np.ndarray) -> bool:
-        """Whether the hand has left its start (:func:`comanip.estimation.hand_rest.has_left`)."""
-        return has_left(self.position, start_position)
+        """Whether the hand has left its start (:func:`comanip.estimation.hand_rest.has_left`), looking only at the
+        observations since the last call for the same start."""
+        key = np.asarray(start_position, dtype=float).tobytes()
+        if self._left[0] != key:
+            self._left = (key, 0, False)
+        _, checked, left = self._left
+        if not left and checked < self.count:
+            left = has_left(self.position[checked:], start_position)
+        self._left = (key, self.count, left)
+        return left
 
 
 class Reach:
