@@ -89,6 +89,13 @@ class Recording:
         """Hand position (d,), m, at ``time_s`` (s on ``t``), linearly interpolated."""
         return np.array([np.interp(time_s, self.t, column) for column in self.position.T])
 
+    def states_from_onset(self, d: int | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """The movement's samples as an observations CSV holds them: times (K,) s from the onset (the first is
+        the onset, t = 0) and states (K, 2d) [position m; velocity m/s] of the first ``d`` axes (None: all)."""
+        d = self.position.shape[1] if d is None else d
+        keep = self.t >= self.onset - 1e-9
+        return self.t[keep] - self.onset, np.hstack([self.position[keep, :d], self.velocity[keep, :d]])
+
     def seen_until(self, fraction: float) -> int:
         """Number of samples observed when ``fraction`` of the movement time has passed since the onset."""
         return int(np.searchsorted(self.t, self.onset + fraction * self.movement_time, side="right"))

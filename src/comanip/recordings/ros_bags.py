@@ -111,9 +111,7 @@ def bag_observations(path: str | Path, d: int, topic: str | None = None, *, fram
     """Observed hand states of the movement in a bag, as an observations CSV holds them: times (K,) s from the
     movement's onset (the first row is the onset, t = 0) and states (K, 2d) [position m; velocity m/s] of the
     first d of x, y, z, from :func:`read_bag`."""
-    recording = read_bag(path, topic, frame=frame, axes="xyz"[:d], check_units=check_units)
-    keep = recording.t >= recording.onset - 1e-9
-    return recording.t[keep] - recording.onset, np.hstack([recording.position, recording.velocity])[keep]
+    return read_bag(path, topic, frame=frame, axes="xyz"[:d], check_units=check_units).states_from_onset()
 
 
 def _hand_connection(connections, topic: str | None, path: Path):

@@ -1,5 +1,6 @@
 """Recorded reaches read as trials (times, positions, goal and width): a CSV file, a folder of them, a motion-capture
-folder or a ROS 2 bag. The fit (:mod:`comanip.fitting`) takes its trials from here.
+folder (TAT-HUM's layout, or Vicon Nexus trajectories exports) or a ROS 2 bag. The fit (:mod:`comanip.fitting`) takes
+its trials from here.
 
 A recordings file has the columns ``t, x, y`` (and ``z`` for 3-D reaches): t in s from the movement's
 start, positions in m. A ``trial`` column names the trial of each row (rows of one trial in time order);
@@ -22,6 +23,7 @@ import numpy as np
 from comanip.arguments import as_positive
 from comanip.recordings.csv_table import read_table
 from comanip.recordings.motion_capture import load_tathum
+from comanip.recordings.nexus_trajectories import is_nexus_export, load_nexus_trajectories, nexus_exports
 from comanip.recordings.ros_bags import bag_name, bag_samples, is_bag
 from comanip.units import check_positions_m, check_times_s
 
@@ -51,18 +53,23 @@ class Trial:
 
 
 def load_recordings(path: str | Path, trials: str | Path | None = None, *, check_units: bool = True,
-                    topic: str | None = None, frame: str | None = None) -> list[Trial]:
-    """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name), or from a ROS 2 bag.
+                    topic: str | None = None, frame: str | None = None, marker: str | None = None,
+                    max_gap: float | None = None) -> list[Trial]:
+    """Trials from a recordings CSV or a folder of them (every ``*.csv`` in it, by name), from a ROS 2 bag, or from
+    motion capture.
 
     Args:
         path: a recordings file, a folder of recordings files, a bag (its trial's goal and width from
-            ``trials``), or a motion-capture folder in the TAT-HUM layout (:func:`tracked_trials`: goals and
-            widths from the endpoints of each target's trials).
+            ``trials``), a motion-capture folder in the TAT-HUM layout, or a Vicon Nexus trajectories export or a
+            folder of them (:mod:`comanip.recordings.nexus_trajectories`); for motion capture, :func:`tracked_trials`
+            gives the goals and widths from the endpoints of each target's trials.
         trials: a trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal and
             width columns; a file of that name inside the folder is not read as recordings.
         check_units: refuse a trial whose times look like ms or whose positions and goal look like mm
             (:mod:`comanip.units`); False reads them as s and m whatever they look like.
         topic, frame: a bag's hand topic and frame (:func:`comanip.recordings.ros_bags.bag_samples`).
+        marker, max_gap: a Nexus export's marker and longest bridged gap
+            (:func:`comanip.recordings.nexus_trajectories.read_nexus_trajectories`; None: its defaults).
 
     Returns:
         The trials, in file order and then in order of first appearance.
@@ -80,6 +87,10 @@ def load_recordings(path: str | Path, trials: str | Path | None = None, *, check
         raise ValueError(f"a topic and a frame choose the samples of a ROS 2 bag; {str(path)!r} is not a bag")
     if is_tathum_folder(path):
         return tracked_trials(load_tathum(path))
+    if is_nexus_export(path) or nexus_exports(path):
+        return tracked_trials(load_nexus_trajectories(path, marker, max_gap=max_gap, check_units=check_units))
+    if marker is not None or max_gap is not None:
+        raise ValueError(f"a marker and a longest gap choose the samples of a Nexus export; {str(path)!r} is not one")
     if path.is_dir():
         skip = None if trials is None else Path(trials).resolve()
         files = [f for f in sorted(path.glob("*.csv")) if f.resolve() != skip]
