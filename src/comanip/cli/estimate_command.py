@@ -3,7 +3,8 @@ goals, the posterior over them); write the estimate and its predicted trajectory
 
 The observation comes from arguments (``--observed`` and ``--t-obs``) or from a CSV of timestamped states
 with a header ``t_s, q0.., qdot0..`` (the columns of a plan CSV, so ``comanip plan`` output can be read back)
-or from a ROS 2 bag of the hand's position (its velocity smoothed from the positions, times from the onset):
+or from a ROS 2 bag or a Vicon Nexus trajectories export of the hand's position (its velocity smoothed from the
+positions, times from the onset):
 its last row at or before ``--t-obs`` is the observation, a row at t = 0 is the start, and every row up
 to the horizon feeds the posterior.
 """
@@ -17,8 +18,8 @@ import numpy as np
 
 from comanip.arguments import as_optional_positive, as_vector
 from comanip.cli.command_help import command_help
-from comanip.cli.options import (add_bag_arguments, add_model_arguments, add_reach_arguments, add_unit_check_argument,
-                                 input_file_or_bag, load_model, vector)
+from comanip.cli.options import (add_bag_arguments, add_marker_arguments, add_model_arguments, add_reach_arguments,
+                                 add_unit_check_argument, input_file_or_bag, load_model, vector)
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimator import METHODS, check_method
@@ -35,8 +36,10 @@ def add_parser(subparsers) -> None:
     add_reach_arguments(parser, "the CSV's t = 0 row, else at rest at the body's home position", "out/estimate", "figures")
     parser.add_argument("--observed", type=vector, help="observed state [q; qdot], comma-separated")
     parser.add_argument("--observations", type=input_file_or_bag, help="CSV of timestamped states (header t_s, q0.., qdot0..), "
-                        "or a ROS 2 bag of the hand's position (MCAP or sqlite3; times from the movement's onset)")
+                        "a ROS 2 bag of the hand's position (MCAP or sqlite3) or a Vicon Nexus trajectories export (a bag's or "
+                        "an export's times from the movement's onset)")
     add_bag_arguments(parser, "--observations")
+    add_marker_arguments(parser, "--observations")
     add_unit_check_argument(parser, "--observations")
     parser.add_argument("--t-obs", type=float, default=0.2, help="time of the observation after the start, s (default: %(default)s, "
                         "the paper's); before the model's step h it says nothing about the goal and needs --prior")
@@ -88,7 +91,8 @@ def run(args) -> int:
     times = states = None
     if args.observations is not None:
         times, states = read_hand_states(args.observations, n, check_units=args.check_units, joint_angles=not body.is_linear,
-                                         name="--observations", topic=args.topic, frame=args.frame)
+                                         name="--observations", topic=args.topic, frame=args.frame, marker=args.marker,
+                                         max_gap=args.max_gap)
         before = np.flatnonzero((times > 0) & (times <= args.t_obs))
         if before.size == 0:
             raise ValueError(f"--observations has no row with 0 < t_s ≤ --t-obs = {args.t_obs:g} s")

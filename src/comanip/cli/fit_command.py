@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from comanip.arguments import as_count
 from comanip.cli.command_help import command_help
-from comanip.cli.options import (add_bag_arguments, add_model_arguments, add_unit_check_argument, input_file,
-                                 input_file_or_folder, load_model, scheduler_address)
+from comanip.cli.options import (add_bag_arguments, add_marker_arguments, add_model_arguments, add_unit_check_argument,
+                                 input_file, input_file_or_folder, load_model, scheduler_address)
 from comanip.cli.outputs import add_output_arguments, output_dir, report, write_manifest
 from comanip.fitting.parameters import DEFAULT_PARAMETERS, MT_DEFAULT_PARAMETERS, ParameterSpace
 
@@ -17,10 +17,12 @@ def add_parser(subparsers) -> None:
     parser = subparsers.add_parser("fit", help=command_help("fit"), description=__doc__)
     data = parser.add_mutually_exclusive_group(required=True)
     data.add_argument("--recordings", type=input_file_or_folder, help="recordings CSV (trial, t, x, y[, z], goal and width columns), "
-                      "a folder of them, or a ROS 2 bag of one trial (its goal and width from --trials)")
+                      "a folder of them, a ROS 2 bag of one trial (its goal and width from --trials), a motion-capture folder (TAT-HUM), "
+                      "or a Vicon Nexus trajectories export or a folder of them")
     data.add_argument("--mt-table", type=input_file, help="movement-time CSV (distance_m, width_m, mt_s per condition)")
     parser.add_argument("--trials", type=input_file, help="trials table (trial, goal_x, goal_y[, goal_z], width) for recordings without goal columns")
     add_bag_arguments(parser, "--recordings")
+    add_marker_arguments(parser, "--recordings")
     add_unit_check_argument(parser, "the recordings")
     add_model_arguments(parser)
     parser.add_argument("--parameters", type=names, help=f"free parameters, comma-separated model fields or sigma_obs "
@@ -68,9 +70,11 @@ def run(args) -> int:
     defaults = DEFAULT_PARAMETERS if args.recordings and not timing else MT_DEFAULT_PARAMETERS
     ParameterSpace(model, options.get("parameters", defaults), args.sigma_obs)
     if args.recordings is not None:
-        data = load_recordings(args.recordings, args.trials, check_units=args.check_units, topic=args.topic, frame=args.frame)
-    elif args.trials is not None or args.topic is not None or args.frame is not None or args.width is not None:
-        raise ValueError("--trials, --width, --topic and --frame go with --recordings; an MT table holds its conditions itself")
+        data = load_recordings(args.recordings, args.trials, check_units=args.check_units, topic=args.topic, frame=args.frame,
+                               marker=args.marker, max_gap=args.max_gap)
+    elif any(value is not None for value in (args.trials, args.topic, args.frame, args.width, args.marker, args.max_gap)):
+        raise ValueError("--trials, --width, --topic, --frame, --marker and --max-gap go with --recordings; an MT table "
+                         "holds its conditions itself")
     else:
         data = MovementTimeTable.read(args.mt_table)
     out = output_dir(args.out, "fit", args.force)

@@ -49,6 +49,18 @@ def add_bag_arguments(parser: argparse.ArgumentParser, what: str) -> None:
                                         "child frame (transforms) (default: the topic's only frame)")
 
 
+def add_marker_arguments(parser: argparse.ArgumentParser, what: str) -> None:
+    """--marker and --max-gap: which marker of a Vicon Nexus export given as ``what`` is the hand's, and the longest
+    gap in it that is bridged."""
+    parser.add_argument("--marker", help=f"the hand's marker when {what} is a Vicon Nexus trajectories export (or a folder "
+                                         "of them), with or without its subject; {arm} is the arm of the file's name "
+                                         "(default: {arm}FTP, the fingertip of the arm that reached)")
+    from comanip.recordings.nexus_trajectories import MAX_GAP_S
+
+    parser.add_argument("--max-gap", type=float, help=f"when {what} is a Nexus export: the longest gap (s) of the marker "
+                                                      f"that is bridged by interpolation (default: {MAX_GAP_S:g})")
+
+
 def load_model(args: argparse.Namespace) -> ReachingModel:
     """The model named by --preset; a ValueError names the argument."""
     try:
