@@ -112,9 +112,9 @@ def read_nexus_trajectories(path: str | Path, marker: str | None = None, *, max_
         ``file``, the ``marker`` read (its full name) and the ``rate_hz``.
 
     Raises:
-        ValueError (one line): a header that is not a Nexus trajectories export's (which line, what it should be),
-        a marker the file does not have (listing those it has), units other than mm, cm or m, a value that is
-        not a number, frames that do not increase, a marker never tracked, or a gap longer than ``max_gap``.
+        ValueError: (one line) for a header that is not a Nexus trajectories export's (which line, what it should
+            be), a marker the file does not have (listing those it has), units other than mm, cm or m, a value that
+            is not a number, frames that do not increase, a marker never tracked, or a gap longer than ``max_gap``.
     """
     path = Path(path)
     marker = FINGERTIP if marker is None else marker
@@ -181,8 +181,10 @@ def load_nexus_trajectories(path: str | Path, marker: str | None = None, *, peop
 
     Args:
         path: an export, or a folder holding exports (in it or in one sub-folder per person).
-        marker, max_gap, check_units: as for :func:`read_nexus_trajectories`.
+        marker: as for :func:`read_nexus_trajectories`.
         people: the participants to read (e.g. ``["ADL001", "ADL002"]``); None: every one.
+        max_gap: as for :func:`read_nexus_trajectories`.
+        check_units: as for :func:`read_nexus_trajectories`.
 
     Returns:
         The trials by path, named ``"<participant>/<file stem>"`` (``"ADL001/ADL001FR1"``), each ``label`` with the
