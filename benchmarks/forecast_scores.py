@@ -23,6 +23,20 @@ GIVEN_THE_END = ("the forecast given the recorded endpoint and stop", "minimum j
 """What a perfect goal and stop would give each shape: not predictors, the ceiling of each."""
 
 
+def truth(recording, k: int) -> np.ndarray:
+    """Where the recorded hand is at +LEADS s from its sample k (held at its endpoint after the end): (len(LEADS), d) m."""
+    return np.array([recording.position_at(recording.t[k] + s) for s in LEADS])
+
+
+def kinematic_paths(recording, k: int) -> dict[str, np.ndarray]:
+    """The hand staying, constant velocity and constant acceleration from the recording's sample k, at +LEADS s:
+    {forecaster: (len(LEADS), d) m}; the acceleration from the velocities up to k."""
+    x, v = recording.position[k], recording.velocity[k]
+    a = kinematic.recent_acceleration(recording.t[:k + 1], recording.velocity[:k + 1])
+    return {"hand stays": kinematic.hand_stays(x, LEADS), "constant velocity": kinematic.constant_velocity(x, v, LEADS),
+            "constant acceleration": kinematic.constant_acceleration(x, v, a, LEADS)}
+
+
 def forecast_rows(trace, recording, name: str, estimator) -> list[dict]:
     """One row per (start fraction, lead, forecaster) for one movement; ``trace`` is [(t, estimate)] of every
     update of the online estimator ``name`` (an :class:`~comanip.OnlineGoalEstimator`, ``estimator``)."""
@@ -39,12 +53,10 @@ def forecast_rows(trace, recording, name: str, estimator) -> list[dict]:
         x, v = recording.position[k], recording.velocity[k]
         a = kinematic.recent_acceleration(recording.t[:k + 1], recording.velocity[:k + 1])
         lead = np.array(LEADS)
-        truth = np.array([recording.position_at(t_now + s) for s in lead])
+        recorded = truth(recording, k)
         predicted = forecast.at(t_now + lead)
         stop_in = forecast.stop_time - t_now
-        paths = {"hand stays": kinematic.hand_stays(x, lead),
-                 "constant velocity": kinematic.constant_velocity(x, v, lead),
-                 "constant acceleration": kinematic.constant_acceleration(x, v, a, lead),
+        paths = kinematic_paths(recording, k) | {
                  "minimum jerk to the estimate's goal and stop": kinematic.minimum_jerk_to(x, v, a, estimate.goal, stop_in, lead),
                  name: predicted.position,
                  GIVEN_THE_END[0]: continued_reach(estimator.family, estimator.start_position, t_now,
@@ -53,7 +65,7 @@ def forecast_rows(trace, recording, name: str, estimator) -> list[dict]:
                  GIVEN_THE_END[1]: kinematic.minimum_jerk_to(x, v, a, recording.end, recording.end_time - t_now, lead)}
         for forecaster, path in paths.items():
             for i, s in enumerate(lead):
-                error = path[i] - truth[i]
+                error = path[i] - recorded[i]
                 covered = None
                 if forecaster == name:
                     try:
