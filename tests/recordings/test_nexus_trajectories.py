@@ -179,3 +179,5 @@ def test_the_ue_adl_people_read_as_fingertip_reaches_from_rest_to_rest():
         at_rest += (resting_position(t[before], samples.position[before]) is not None
                     and resting_position(t[after], samples.position[after]) is not None)
     assert at_rest >= 195                       # three of ADL007's trials begin as the hand moves
+    streamed = [t.streamed_recording() for t, r in zip(trials, recordings) if r.onset >= 0.15]
+    assert len(streamed) >= 195 and min(r.t[0] for r in streamed) >= 0.0       # times since the stream's start

@@ -113,7 +113,7 @@ class TrackedSamples:
         ok = self.tracked[chosen] & (earlier >= 0)
         j = seen[earlier[ok]]
         velocity[ok] = (position[chosen[ok]] - position[j]) / (t[chosen[ok]] - t[j])[:, None]
-        return t[chosen] - begin, position[chosen].copy(), velocity
+        return np.maximum(t[chosen] - begin, 0.0), position[chosen].copy(), velocity   # a chosen time may lie 1e-9 s early
 
     def streamed_recording(self, *, lead: float = STREAM_LEAD_S, rate_hz: float = STREAM_RATE_HZ,
                            velocity_window: float = VELOCITY_WINDOW_S) -> Recording:
