@@ -251,11 +251,12 @@ def main(argv=None):
     print(f"{len(people)} people, {sum(counts.values())} reaches read in {time.perf_counter() - begin:.0f} s", file=log, flush=True)
     from comanip.estimation.people_model import PeopleModel
 
+    def fit(recordings):
+        return (LearnedForecaster(max_iter=args.max_iter, every=args.every).fit(recordings),
+                PeopleModel.fit(recordings, kind="arm") if args.comanip else None)
+
     rows = []
-    fit = lambda recordings: LearnedForecaster(max_iter=args.max_iter, every=args.every).fit(recordings)
-    for i, (person, learned) in enumerate(leave_one_person_out(people, fit)):
-        others = [r for other, recordings in people.items() if other != person for r in recordings]
-        people_model = PeopleModel.fit(others, kind="arm") if args.comanip else None
+    for i, (person, (learned, people_model)) in enumerate(leave_one_person_out(people, fit)):
         rows += score_person(person, people[person], learned, people_model)
         print(f"  {i + 1}/{len(people)} {person} left out: trained on {len(learned.trained_on)} reaches, "
               f"{time.perf_counter() - begin:.0f} s", file=log, flush=True)
