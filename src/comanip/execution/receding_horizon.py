@@ -79,7 +79,7 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
         rng: random generator for the motor (and sensory) noise (default: a fresh unseeded one).
         noise: False executes the commands exactly (a deterministic closed loop).
         max_wall_time: wall budget per replan (s), every cost of the cycle included; the cycle returns its best plan
-            so far. None: no wall budget.
+            so far, after one Newton iteration at least. None: no wall budget.
         observation: an Observation replans from the Kalman estimate made from measurements of [q; qdot] with
             its noise and delay (the start is known exactly; cycles of h only); None uses the model's ``observation``,
             and replans from the actual state when the model has none. ``Observation(0, 0)`` forces the exact state

@@ -4,9 +4,12 @@ A control loop replans every cycle from the state it measures. A :class:`Replann
 
 1. the previous plan's torques are moved to the current time (:func:`shifted_torques`: a cycle of any length,
    not only whole model steps);
-2. from them and the measured state, a fixed number of Newton iterations (``iterations``) or as many as fit a wall
-   budget (``max_wall_time``, every cost of the cycle included: the shift, the checks, the evaluation at the shifted
-   plan and the iterations; an iteration starts only when a recent iteration's time, its 90th percentile, still fits);
+2. from them and the measured state, one Newton iteration every cycle (the real-time iteration), then more up to a
+   fixed number (``iterations``) or while they fit a wall budget (``max_wall_time``, every cost of the cycle
+   included: the shift, the checks, the evaluation at the shifted plan and the iterations; a further iteration
+   starts only when a recent iteration's time, its 90th percentile, still fits). The first iteration runs even where
+   it does not fit the budget, and the cycle then overruns it (its ``wall_time`` says by how much): a cycle that
+   stopped before it would send the shifted plan, and a loop of such cycles never converges along the loop;
 3. the best plan comes back as a :class:`Replan` whose ``status`` says how the iterations stand
    (:class:`~comanip.optim.Progress`: 'converged', 'converging', 'not_contracting').
 
@@ -30,6 +33,7 @@ import numpy as np
 
 from comanip.arguments import as_count, as_nonnegative, as_optional_positive
 from comanip.optim import Evaluation, Progress, contraction, progress_of
+from comanip.optim.newton_loop import never
 from comanip.planning.newton_reach_solver import NewtonReachSolver
 from comanip.planning.plan import Plan, PlanStatus, with_reach_check
 from comanip.planning.planner import Planner
@@ -61,8 +65,8 @@ class Replan:
 
     status: Progress
     """'converged' (the plan is optimal for the cycle's state), 'converging' (the budget ran out with the first-order
-    optimality lower than at the shifted plan), 'not_contracting' (neither: the budget allowed no iteration, the
-    iterations did not lower the optimality, the solve failed, or the goal is out of reach)."""
+    optimality lower than at the shifted plan), 'not_contracting' (neither: the iterations did not lower the
+    optimality, the solve failed, or the goal is out of reach)."""
     torque: np.ndarray
     """The plan's commands tau_i (H, n), N·m (N for point masses); tau_0 is the one to send now."""
     params: ReachParameters
@@ -132,7 +136,7 @@ class Replanner:
         iterations: Newton iterations per cycle (≥ 1); None: as many as the wall budget allows, or, without one, until
             the solve converges (the planner's iteration limit).
         max_wall_time: wall budget of a cycle (s), every cost included; None: no budget. With both, a cycle stops at
-            whichever comes first.
+            whichever comes first, after its first iteration.
 
     >>> replanner = Replanner(comanip.Planner(comanip.presets.load("franka_rest")), iterations=1)
     >>> replan = replanner.first_plan(start, goal, 0.02)
@@ -182,9 +186,15 @@ class Replanner:
             guess = planner.starts.moved_onto_goal(guess, planned, params, goal_q)
         solver = planner.solver
         with solver.blas:
-            solve = solver.newton_solve(guess, params, self._deadline(began), solver.curvature)
+            # the real-time iteration: one iteration every cycle, whatever the budget, so that the iterations converge
+            # along the loop; more while a recent iteration's time still fits
+            solve = solver.newton_solve(guess, params, np.inf, solver.curvature)
             set_up = time.perf_counter()
-            result = solver.finite(solve.advance(self._iteration_limit), guess, params)
+            result = solve.advance(1)
+            if self._iteration_limit > 1 and not solve.finished:
+                solve.expired = self._expired(began, first_iteration=time.perf_counter() - set_up)
+                result = solve.advance(self._iteration_limit)
+            result = solver.finite(result, guess, params)
         ended = time.perf_counter()
         if self.max_wall_time is not None:  # a cycle without iterations counts too, so that old times age out
             self._iteration_times = [*self._iteration_times[1 - RECENT_CYCLES:], (ended - set_up) / result.nit if result.nit else 0.0]
@@ -200,13 +210,16 @@ class Replanner:
         return Replan(progress_of(result), torque, params, result.status, result.message, result.nit, ended - began,
                       result.optimality, result.start_optimality, goal_q, build_plan)
 
-    def _deadline(self, began: float) -> float:
-        """The time (perf_counter, s) after which no Newton iteration starts: the budget's end less the RESERVE_QUANTILE
-        of the recent times per iteration, so that the cycle ends within its budget (inf without a budget)."""
+    def _expired(self, began: float, first_iteration: float) -> Callable[[], bool]:
+        """Whether the cycle that began at ``began`` (perf_counter, s) and whose first iteration took
+        ``first_iteration`` seconds may start no more Newton iterations: past the budget's end less the
+        RESERVE_QUANTILE of the recent times per iteration, this one's included, so that the cycle ends within its
+        budget where an iteration fits in it (never, without a budget)."""
         if self.max_wall_time is None:
-            return np.inf
-        reserve = float(np.quantile(self._iteration_times, RESERVE_QUANTILE)) if self._iteration_times else 0.0
-        return began + self.max_wall_time - reserve
+            return never
+        reserve = float(np.quantile([*self._iteration_times, first_iteration], RESERVE_QUANTILE))
+        deadline = began + self.max_wall_time - reserve
+        return lambda: time.perf_counter() > deadline
 
     def _unreachable(self, guess: np.ndarray, params: ReachParameters, goal_q: np.ndarray, began: float) -> Replan:
         """The cycle of a goal out of the arm's reach: the shifted plan, status 'not_contracting'."""
