@@ -175,7 +175,7 @@ def test_bad_messages_are_rejected_with_a_log_line_and_the_node_goes_on(reach, t
     np.testing.assert_allclose(goal, GOAL, atol=1e-4)  # and it went on estimating
 
 
-def test_stale_when_input_stops_with_the_last_estimate_still_published(reach, transition):
+def test_stale_when_input_stops_the_status_says_so_and_no_old_estimate_is_sent_again(reach, transition):
     settings, _, plan = reach
     with Replay(settings, transition) as replay:
         for k in range(12):
@@ -183,14 +183,16 @@ def test_stale_when_input_stops_with_the_last_estimate_still_published(reach, tr
             replay.publish(plan.t[k], plan.mean[k, :3], plan.mean[k, 3:])
             values = replay.wait_handled(k + 1)
         assert values["stale"] == "false" and int(values["estimates"]) > 0
-        republished = replay.recording.republished
+        goals, statuses = len(replay.recording.goals), len(replay.recording.statuses)
         for t in np.arange(plan.t[11], plan.t[11] + 1.0, 0.02):  # the clock runs on, the hand is not seen
             replay.set_clock(float(t))
             replay.drain(0.005)
         replay.drain(0.1)
         level, values = replay.recording.statuses[-1][1], replay.recording.statuses[-1][3]
         assert values["stale"] == "true" and values["stale_reason"].startswith("no input for more than") and level == 1
-        assert replay.recording.republished > republished
+        # the status goes on at status_rate with the last estimate's goal; the goal topic carries new estimates only
+        assert len(replay.recording.statuses) >= statuses + 5 and len(replay.recording.goals) == goals
+        np.testing.assert_allclose(np.array(values["goal_m"].strip("[]").split(","), dtype=float), replay.recording.goals[-1][1])
 
 
 def test_stale_when_estimates_overrun_the_budget_and_still_published(reach, transition):
@@ -243,3 +245,27 @@ def test_a_reach_found_in_the_stream_is_estimated_as_reach_stream_estimates_it(t
             np.testing.assert_allclose(goal, expected, atol=1e-9)
             compared += 1
     assert compared > 60
+
+
+def test_a_tracker_without_twists_is_estimated_from_its_poses_and_each_goal_carries_its_poses_stamp(reach, transition):
+    """Poses alone, stamped where a float second cannot hold the nanoseconds (2026's epoch seconds): no pose is
+    rejected, the velocity comes from the poses' backward difference, the estimates find the goal, and every goal
+    message carries the stamp of a pose sent, to the nanosecond."""
+    from builtin_interfaces.msg import Time
+
+    _, _, plan = reach
+    times = np.arange(0.0, 1.6, 0.004)
+    positions = np.column_stack([np.interp(times, plan.t, plan.mean[:, k]) for k in range(3)])
+    sent = [Time(sec=1_765_000_000 + int(t), nanosec=int(round((t % 1) * 1e9)) + 123) for t in times]
+    with Replay(NodeSettings(estimation_rate=250.0), transition) as replay:
+        for k, (t, position) in enumerate(zip(times, positions)):
+            replay.set_clock(t)
+            replay.publish(t, position, np.zeros(3), twist=False, stamp=sent[k])
+            values = replay.wait_handled(k + 1)
+        replay.drain(0.05)
+        recording = replay.recording
+    assert int(values["rejected"]) == 0 and values["velocity_from"] == "poses"
+    assert len(recording.goals) > 100
+    assert set(recording.goal_stamps) <= {(stamp.sec, stamp.nanosec) for stamp in sent}
+    assert len(set(recording.goal_stamps)) == len(recording.goal_stamps)       # each estimate sent once
+    np.testing.assert_allclose(recording.goals[-1][1], GOAL, atol=0.01)

@@ -20,6 +20,8 @@ from comanip.ros.node_settings import NodeSettings
     ({"equilibrium_orientation": [1, 1, 0, 0]}, "equilibrium_orientation must be a unit quaternion"),
     ({"estimation_rat": 3}, "unknown parameter(s) ['estimation_rat']"),
     ({"person": "mouse"}, "person must be one of ('recorded', 'correcting'), got 'mouse'"),
+    ({"velocity_source": "imu"}, "velocity_source must be one of ('auto', 'twist', 'poses'), got 'imu'"),
+    ({"velocity_window": -0.02}, "velocity_window must be a finite number > 0 (s)"),
 ])
 def test_a_bad_setting_is_a_value_error_naming_it(values, message):
     with pytest.raises(ValueError) as error:
@@ -42,6 +44,15 @@ def test_the_command_reports_a_bad_parameter_file_in_one_line(tmp_path, capsys):
     params.write_text("status_rate: 0\n")
     assert main(["ros", "--params", str(params)]) == 2
     assert capsys.readouterr().err.strip() == "comanip ros: error: status_rate must be a finite number > 0 (Hz), got 0"
+
+
+def test_the_preset_and_rate_on_the_command_line_override_the_parameter_file(tmp_path, capsys):
+    params = tmp_path / "params.yaml"
+    params.write_text("preset: cartesian\nestimation_rate: 20\n")
+    assert main(["ros", "--params", str(params), "--preset", "franka"]) == 2
+    assert "needs a point-mass model" in capsys.readouterr().err
+    assert main(["ros", "--preset", "arm", "--estimation-rate", "-250"]) == 2
+    assert capsys.readouterr().err.strip() == "comanip ros: error: estimation_rate must be a finite number > 0 (Hz), got -250.0"
 
 
 def test_the_ros_guides_franka_parameters_are_valid(tmp_path):

@@ -37,10 +37,12 @@ class RejectedMessage(ValueError):
 
 @dataclass(frozen=True)
 class Sample:
-    """One checked input: ``stamp`` (s, ROS time) and ``vector`` (d,) (m or m/s)."""
+    """One checked input: ``stamp`` (s, ROS time), ``vector`` (d,) (m or m/s) and the message's own stamp
+    (``header_stamp``, exact: an answer to it carries it back unchanged)."""
 
     stamp: float
     vector: np.ndarray
+    header_stamp: Time
 
 
 def seconds(stamp: Time) -> float:
@@ -65,7 +67,7 @@ def read_vector(kind: str, header, xyz, d: int, frame_id: str, previous_stamp: f
         raise RejectedMessage(f"{kind} rejected: non-finite values {values.tolist()} at stamp {stamp:.6f} s")
     if previous_stamp is not None and not stamp > previous_stamp:
         raise RejectedMessage(f"{kind} rejected: stamp {stamp:.6f} s is not after the previous one, {previous_stamp:.6f} s")
-    return Sample(stamp, values[:d])
+    return Sample(stamp, values[:d], header.stamp)
 
 
 def pose_of(position, orientation=(0.0, 0.0, 0.0, 1.0)) -> Pose:
@@ -78,11 +80,12 @@ def pose_of(position, orientation=(0.0, 0.0, 0.0, 1.0)) -> Pose:
     return pose
 
 
-def goal_message(goal, covariance, stamp: float, frame_id: str) -> PoseWithCovarianceStamped:
-    """g_hat (d,) m with its covariance (d, d) m² in the position block of the 6×6 pose covariance; the
-    orientation is unknown (variance -1 on its diagonal, the ROS convention for 'not estimated')."""
+def goal_message(goal, covariance, stamp: Time, frame_id: str) -> PoseWithCovarianceStamped:
+    """g_hat (d,) m with its covariance (d, d) m² in the position block of the 6×6 pose covariance, stamped ``stamp``
+    (the pose it answers); the orientation is unknown (variance -1 on its diagonal, the ROS convention for 'not
+    estimated')."""
     message = PoseWithCovarianceStamped()
-    message.header.stamp, message.header.frame_id = stamp_of(stamp), frame_id
+    message.header.stamp, message.header.frame_id = stamp, frame_id
     message.pose.pose = pose_of(goal)
     full = np.zeros((6, 6))
     d = len(goal)

@@ -1,40 +1,47 @@
 """The ROS 2 goal node: online goal estimation, prediction and the handover's impedance schedule, in a robot's loop.
 
-Inputs (topic names are parameters, :class:`~comanip.ros.node_settings.NodeSettings`): the hand's pose and twist,
-a prior goal, a reset. The node converts each checked message into a sample of an
+Inputs (topic names are parameters, :class:`~comanip.ros.node_settings.NodeSettings`): the hand's pose and, if the
+tracker sends one, its twist, a prior goal, a reset. The node converts each checked message into a sample of an
 :class:`~comanip.estimation.estimation_loop.EstimationLoop`, which does the rest as it does for
-:class:`~comanip.estimation.ReachStream`: it pairs each pose with the twist of (nearly) the same stamp
-(``twist_tolerance``); a reach starts at the first hand pose (after startup, a reset, or a gap in the input
-longer than ``input_timeout``), at rest at that pose's position, its stamp t = 0; every paired pose goes to the
-reach segmenter, and when the hand has rested (within ``rest_radius`` for ``rest_window``) the reach is over (the
-estimator learns the person from it) and the next one starts when the hand leaves its rest again, from where it
-rested, its t = 0 the segmenter's (the rest just before it left); the status says which reach is under way and
-whether the hand moves. ``estimation_rate`` poses per second of input time are due for an estimate, on a grid of
-1 / estimation_rate from the reach's start (the pose nearest each due time), so a tracker whose stamps jitter
-still gets the configured rate; poses past the model's horizon, and those at rest between reaches, are not
-estimated.
+:class:`~comanip.estimation.ReachStream`. The hand's velocity (``velocity_source``) is the twist of (nearly) the
+same stamp as the pose (``twist_tolerance``), or a backward difference of the poses over ``velocity_window``
+(:class:`~comanip.estimation.derived_velocity.DerivedVelocity`, the rule the recorded people the model is fitted on
+were streamed with); by default the poses' until the first twist arrives. A reach starts at the first hand pose
+(after startup, a reset, or a gap in the input longer than ``input_timeout``), at rest at that pose's position,
+its stamp t = 0; every pose goes to the reach segmenter, and when the hand has rested (within ``rest_radius`` for
+``rest_window``) the reach is over (the estimator learns the person from it) and the next one starts when the
+hand leaves its rest again, from where it rested, its t = 0 the segmenter's (the rest just before it left); the
+status says which reach is under way and whether the hand moves. ``estimation_rate`` poses per second of input
+time are due for an estimate, on a grid of 1 / estimation_rate from the reach's start (the pose nearest each due
+time), so a tracker whose stamps jitter still gets the configured rate (the tracker's own rate, e.g. 250 Hz,
+estimates every pose); poses past the model's horizon, and those at rest between reaches, are not estimated.
 
 The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
 far, any time) and run in a worker thread, so the executor's callbacks only check messages and feed the loop,
-and never wait for a solve; when the worker falls behind, the newest due pose replaces one not yet estimated
-(counted as skipped): an estimate is always of the newest pose, never of a stale one. An estimate is a few
+and never wait for a solve. The node never queues: when an estimate takes longer than the poses' spacing, the
+newest due pose replaces one not yet estimated (counted as skipped), so an estimate is always of the newest
+pose, never of a stale one, and the answers thin out instead of falling behind. An estimate is a few
 Gauss–Newton steps on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes
 longer than ``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in
-time. Each successful estimate is published at once: g_hat with covariance, the predicted hand path, and the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover`
-on the predicted reach (the robot's impedance rest position follows the predicted hand, and its stiffness
-ramps to 0 where the transition model predicts the person takes over). Timers republish the last good
-estimate and the status (``status_rate``), and sample the schedule at the node's clock into the equilibrium
-pose and stiffness (``command_rate``). The status is also published after every estimate and every
-rejected input.
+time. Each successful estimate is published once, at once: g_hat with covariance, stamped exactly with the pose it
+answers (the pose message's own stamp), the predicted hand path, and the handover schedule of
+:func:`~comanip.multicomponent.handover.plan_handover` on the predicted reach (the robot's impedance rest position
+follows the predicted hand, and its stiffness ramps to 0 where the transition model predicts the person takes
+over); so every message on the goal topic is a new estimate. Timers publish the status (``status_rate``; it
+carries the last good estimate's goal and stamp) and sample the schedule at the node's clock into the equilibrium
+pose and stiffness (``command_rate``). The status is also published after every estimate and every rejected
+input.
 
 Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed
-or overran ``max_wall_time``, or no input came for ``input_timeout``; the last good estimate and schedule keep
-being published. The status also reports the estimation rate achieved (estimates per second of input time over
-the last ``RATE_WINDOW`` s, every estimate counted, published or not) and the latency (from a pose's arrival to
-the publication of its goal and predicted path, which go out before the schedule is built on them: the last one
-and the median over the same window), and counts the poses by what
-they were for: estimated, skipped (between due times, or replaced by a newer one), ignored (past the horizon),
-resting (between reaches), rejected. Malformed inputs (NaN, another frame, a stamp not after the previous) are logged and counted, never raised.
+or overran ``max_wall_time``, or no input came for ``input_timeout``; the equilibrium pose and stiffness keep
+following the last good schedule. The status also reports, over the last ``RATE_WINDOW`` s of input time, the
+poses' rate, the estimation rate achieved (every estimate counted, published or not), the share of the poses
+estimated, and the latency (from a pose's arrival to the publication of its goal and predicted path, which go out
+before the schedule is built on them: the last one, the median and the 95th percentile); it counts the estimates
+whose latency exceeded the poses' spacing (``over_period``: the next pose came before the answer), and the poses by
+what they were for: estimated, skipped (between due times, or replaced by a newer one), ignored (past the
+horizon), resting (between reaches), rejected. Malformed inputs (NaN, another frame, a stamp not after the
+previous) are logged and counted, never raised.
 """
 
 from __future__ import annotations
@@ -42,6 +49,7 @@ from __future__ import annotations
 import threading
 import time
 import warnings
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,6 +69,7 @@ except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator, OnlineOptions
+from comanip.estimation.derived_velocity import DerivedVelocity
 from comanip.estimation.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep, Reach, Update
 from comanip.estimation.reach_segmentation import SegmentationSettings
 from comanip.estimation.model_families import FamilyCache
@@ -93,14 +102,12 @@ def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, 
 
 @dataclass
 class GoodEstimate:
-    """The last successful estimate, the schedule built on it, when (stamps in s), and its three messages
-    (built once, republished as they are)."""
+    """The last successful estimate, the schedule built on it, and the stamp (s) of the pose it answers."""
 
     estimate: GoalEstimate
     schedule: HandoverSchedule
     reach: Reach
     stamp: float
-    messages: tuple
 
 
 class GoalNode(Node):
@@ -131,12 +138,20 @@ class GoalNode(Node):
         its worker runs the updates it makes due."""
         self._last_pose: float | None = None
         self._last_twist: float | None = None
+        self._derived = DerivedVelocity(s.velocity_window, restart_after=s.input_timeout)
+        """The velocity from the poses (``velocity_source`` 'poses', or 'auto' before the first twist)."""
+        self._header_stamps: deque = deque(maxlen=QUEUE_DEPTH * 4)
+        """(stamp s, the pose message's own stamp) of the recent poses, so that an answer carries its pose's stamp
+        exactly."""
+        self._poses: deque = deque()
+        """Stamps (s) of the poses of the last RATE_WINDOW s of input time."""
         self._last_input_clock: float | None = None
         self._recent: list[tuple[float, float]] = []
         """(input stamp s, latency s or NaN) of the estimates of the last RATE_WINDOW s of input time."""
         self._busy = False
         self._good: GoodEstimate | None = None
-        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, resting=0, estimates=0, failed=0, late=0)
+        self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, resting=0, estimates=0, failed=0, late=0,
+                            over_period=0)
         self._last = dict(solve_ok=True, solve_status="none", solve_time_s=float("nan"), latency_s=float("nan"), rejection="", event="started")
 
         self._goal_pub = self.create_publisher(PoseWithCovarianceStamped, s.goal_topic, QUEUE_DEPTH)
@@ -150,7 +165,7 @@ class GoalNode(Node):
         self.create_subscription(PointStamped, s.prior_goal_topic, self._on_prior, QUEUE_DEPTH)
         self.create_subscription(Empty, s.reset_topic, self._on_reset, QUEUE_DEPTH)
         self.create_timer(1.0 / s.command_rate, self._publish_command)
-        self.create_timer(1.0 / s.status_rate, self._republish)
+        self.create_timer(1.0 / s.status_rate, self._publish_status)
         self._worker = threading.Thread(target=self._work, name="comanip-goal-estimates", daemon=True)
         self._worker.start()
 
@@ -166,7 +181,14 @@ class GoalNode(Node):
         """The node's clock (s): ROS time, or the replay's /clock under use_sim_time."""
         return self.get_clock().now().nanoseconds * 1e-9
 
+    def derives_velocity(self) -> bool:
+        """True while the velocity comes from the poses (``velocity_source``)."""
+        source = self.settings.velocity_source
+        return source == "poses" or (source == "auto" and self._last_twist is None)
+
     def _on_twist(self, message: TwistStamped) -> None:
+        if self.settings.velocity_source == "poses":
+            return
         with self._lock:
             try:
                 sample = read_vector("hand twist", message.header, message.twist.linear, self._d, self.settings.frame_id, self._last_twist)
@@ -187,7 +209,15 @@ class GoalNode(Node):
                 return
             self._last_pose = sample.stamp
             self._last_input_clock = self.now()
-            self._handle(self.loop.add_position(sample.stamp, sample.vector, received))
+            self._header_stamps.append((sample.stamp, sample.header_stamp))
+            self._poses.append(sample.stamp)
+            while self._poses[0] < sample.stamp - RATE_WINDOW:
+                self._poses.popleft()
+            if self.derives_velocity():
+                velocity = self._derived.add(sample.stamp, sample.vector)
+                self._handle([self.loop.add_sample(sample.stamp, sample.vector, velocity, received)])
+            else:
+                self._handle(self.loop.add_position(sample.stamp, sample.vector, received))
 
     def _handle(self, steps: list[LoopStep]) -> None:
         """Count, log and act on what the loop made of each pose (holding the lock); wake the worker for an update."""
@@ -231,6 +261,7 @@ class GoalNode(Node):
     def _on_reset(self, _message: Empty) -> None:
         with self._lock:
             self.loop.restart()
+            self._derived.restart()
             self._good = None
             self._log_event("reset: the next hand pose starts a reach")
 
@@ -263,6 +294,8 @@ class GoalNode(Node):
                     stamp = job.sample.stamp
                     self._recent = [(before, seconds) for before, seconds in self._recent if before > stamp - RATE_WINDOW]
                     self._recent.append((stamp, latency))
+                    if latency > self._input_period():
+                        self._counts["over_period"] += 1
             self._publish_status()
 
     def _estimate(self, job: Update) -> float:
@@ -290,32 +323,33 @@ class GoalNode(Node):
                                       "keeping the last good one, marked stale")
             return float("nan")
         frame, clock = s.frame_id, job.reach.clock
-        goal, path = goal_message(estimate.goal, estimate.goal_covariance, job.sample.stamp, frame), path_message(estimate, clock, frame)
         with self._lock:
             if self.loop.reach is not job.reach:
                 return float("nan")  # a reset or a new reach came while solving
             self._counts["estimates"] += 1
-        self._goal_pub.publish(goal)              # goal and forecast first: the schedule on them takes milliseconds more
-        self._path_pub.publish(path)
+            stamp = self._header_stamp(job.sample.stamp)
+        self._goal_pub.publish(goal_message(estimate.goal, estimate.goal_covariance, stamp, frame))
+        self._path_pub.publish(path_message(estimate, clock, frame))   # goal and forecast first: the schedule takes longer
         latency = self._last["latency_s"] = time.perf_counter() - job.sample.received
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
             schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
-        good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, (goal, path, schedule_message(schedule, clock)))
         with self._lock:
             if self.loop.reach is not job.reach:
                 return latency
-            self._good = good
-        self._schedule_pub.publish(good.messages[2])
+            self._good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp)
+        self._schedule_pub.publish(schedule_message(schedule, clock))
         return latency
 
-    # ---- publishing
-    def _publish_estimate(self, good: GoodEstimate) -> None:
-        goal, path, schedule = good.messages
-        self._goal_pub.publish(goal)
-        self._path_pub.publish(path)
-        self._schedule_pub.publish(schedule)
+    def _header_stamp(self, stamp: float):
+        """The pose message's own stamp for the pose stamped ``stamp`` (s), and the older ones forgotten (holding the
+        lock); a stamp rounded to the nanosecond for a pose no longer kept."""
+        kept = self._header_stamps
+        while kept and kept[0][0] < stamp:
+            kept.popleft()
+        return kept[0][1] if kept and kept[0][0] == stamp else stamp_of(stamp)
 
+    # ---- publishing
     def _publish_command(self) -> None:
         good = self._good
         if good is None:
@@ -330,12 +364,6 @@ class GoalNode(Node):
         self._equilibrium_pub.publish(pose)
         rotational = self.settings.rotational_stiffness
         self._stiffness_pub.publish(Float64MultiArray(data=[stiffness] * 3 + [rotational] * 3))
-
-    def _republish(self) -> None:
-        good = self._good
-        if good is not None:
-            self._publish_estimate(good)
-        self._publish_status()
 
     def stale_reason(self) -> str:
         """Why the published estimate is stale ('' when it is fresh)."""
@@ -366,15 +394,27 @@ class GoalNode(Node):
                                 last_latency_s=self._last["latency_s"], **self._achieved(), last_rejection=self._last["rejection"],
                                 last_event=self._last["event"])
 
+    def _input_period(self) -> float:
+        """The poses' median spacing (s) over the last RATE_WINDOW s of input time (inf until there are two; called
+        holding the lock)."""
+        return float(np.median(np.diff(self._poses))) if len(self._poses) > 1 else float("inf")
+
     def _achieved(self) -> dict:
-        """The status's achieved rate (estimates per second of input time) and median latency (s) over the estimates
-        of the last RATE_WINDOW s of input time (called holding the lock); NaN until there are two."""
+        """Over the last RATE_WINDOW s of input time (called holding the lock; NaN until there are two): the poses'
+        rate, the estimates' rate (per second of input time), the share of the poses estimated, and the estimates'
+        median and 95th-percentile latency (s)."""
         stamps = [stamp for stamp, _ in self._recent]
         latencies = [seconds for _, seconds in self._recent if not np.isnan(seconds)]
         span = stamps[-1] - stamps[0] if len(stamps) > 1 else 0.0
+        poses = self._poses
+        input_span = poses[-1] - poses[0] if len(poses) > 1 else 0.0
         return dict(achieved_rate_hz=(len(stamps) - 1) / span if span > 0 else float("nan"),
                     configured_rate_hz=self.settings.estimation_rate,
-                    latency_median_s=float(np.median(latencies)) if latencies else float("nan"))
+                    input_rate_hz=(len(poses) - 1) / input_span if input_span > 0 else float("nan"),
+                    estimated_share=len([t for t in stamps if t >= poses[0]]) / len(poses) if poses else float("nan"),
+                    latency_median_s=float(np.median(latencies)) if latencies else float("nan"),
+                    latency_p95_s=float(np.percentile(latencies, 95)) if latencies else float("nan"),
+                    velocity_from="poses" if self.derives_velocity() else "twist")
 
     def _publish_status(self) -> None:
         reason, values = self.status()

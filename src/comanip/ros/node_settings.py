@@ -14,6 +14,7 @@ import yaml
 
 from comanip import presets
 from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S
+from comanip.recordings.motion_capture import VELOCITY_WINDOW_S
 from comanip.arguments import as_goal_width, as_nonnegative, as_positive, as_vector
 from comanip.bodies.point_mass import PointMass
 from comanip.model import ReachingModel
@@ -22,6 +23,8 @@ from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS
 
 PERSONS = ("recorded", "correcting")
 """The values of :attr:`NodeSettings.person`."""
+VELOCITY_SOURCES = ("auto", "twist", "poses")
+"""The values of :attr:`NodeSettings.velocity_source`."""
 
 
 @dataclass(frozen=True)
@@ -63,11 +66,12 @@ class NodeSettings:
     (the estimate runs in a worker thread, so the node's callbacks are never held up by it)."""
     estimation_rate: float = 20.0
     """Most estimates per second of input time (Hz); hand poses in between are skipped, and so is a due pose that
-    a newer one replaces while an estimate runs."""
+    a newer one replaces while an estimate runs. The tracker's own rate (e.g. 250) estimates every pose."""
     command_rate: float = 100.0
     """Rate of the equilibrium pose and stiffness (Hz)."""
     status_rate: float = 10.0
-    """Rate at which the last good estimate and the status are republished (Hz)."""
+    """Rate at which the status is republished (Hz); it carries the last good estimate's goal and stamp (the goal and
+    path topics carry each estimate once, when it is new)."""
     input_timeout: float = 0.25
     """Input older than this (s) makes the estimate stale; a pose after a longer gap starts a new reach."""
     rest_radius: float = REST_RADIUS_M
@@ -85,6 +89,13 @@ class NodeSettings:
     (:mod:`comanip.estimation.person_calibration`); false: every reach is a person not seen yet."""
     twist_tolerance: float = 0.005
     """Largest stamp difference (s) between a pose and the twist paired with it."""
+    velocity_source: str = "auto"
+    """Where the hand's velocity comes from (:data:`VELOCITY_SOURCES`): "twist", the twist stamped nearest each pose
+    (within ``twist_tolerance``; a pose without one is rejected); "poses", a backward difference of the poses over
+    ``velocity_window`` (:mod:`comanip.estimation.derived_velocity`; twists are ignored); "auto", from the poses until
+    the first twist arrives, then from the twists."""
+    velocity_window: float = VELOCITY_WINDOW_S
+    """Span (s) of the backward difference that derives the velocity from the poses."""
     ramp_time: float = DEFAULT_RAMP_TIME
     """Stiffness ramp to 0 at the handover (s), :func:`comanip.multicomponent.handover.plan_handover`."""
     leading_stiffness: float = LEADING_STIFFNESS
@@ -108,9 +119,11 @@ class NodeSettings:
         if self.prior_goal is not None:
             object.__setattr__(self, "prior_goal", tuple(as_vector("prior_goal", self.prior_goal, model.d, "m").tolist()))
         for name in ("max_wall_time", "estimation_rate", "command_rate", "status_rate", "input_timeout", "rotational_stiffness",
-                     "rest_radius", "rest_window"):
+                     "rest_radius", "rest_window", "velocity_window"):
             object.__setattr__(self, name, as_positive(name, getattr(self, name), UNITS[name]))
         object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
+        if self.velocity_source not in VELOCITY_SOURCES:
+            raise ValueError(f"velocity_source must be one of {VELOCITY_SOURCES}, got {self.velocity_source!r}")
         if self.person not in PERSONS:
             raise ValueError(f"person must be one of {PERSONS}, got {self.person!r}")
         if not isinstance(self.learn_person, bool):
@@ -163,4 +176,4 @@ TOPICS = ("hand_pose_topic", "hand_twist_topic", "prior_goal_topic", "reset_topi
           "equilibrium_topic", "stiffness_topic", "schedule_topic", "status_topic")
 
 UNITS = {"max_wall_time": "s", "estimation_rate": "Hz", "command_rate": "Hz", "status_rate": "Hz", "input_timeout": "s",
-         "rotational_stiffness": "N·m/rad", "rest_radius": "m", "rest_window": "s"}
+         "rotational_stiffness": "N·m/rad", "rest_radius": "m", "rest_window": "s", "velocity_window": "s"}

@@ -55,7 +55,9 @@ class Recording:
     """What the node published during a replay (times: ``stamp`` ROS time in s, ``t`` = stamp - BASE_STAMP)."""
 
     goals: list = field(default_factory=list)
-    """(stamp, goal (d,) m, covariance (d, d) m², latency s): the first message of each estimate."""
+    """(stamp, goal (d,) m, covariance (d, d) m², latency s) of each goal message (one per estimate)."""
+    goal_stamps: list = field(default_factory=list)
+    """(sec, nanosec) of each goal message's header stamp, as received."""
     paths: dict = field(default_factory=dict)
     """estimate stamp -> predicted path (K, 4): stamp, x, y, z."""
     schedules: list = field(default_factory=list)
@@ -66,8 +68,6 @@ class Recording:
     """(stamp, level, message, values dict) of every status."""
     lost: int = 0
     """Hand poses sent that the node never received (dropped by the middleware's queues when it fell behind)."""
-    republished: int = 0
-    """How many goal messages repeated an estimate already received (the node's status_rate republishing)."""
     sent: dict = field(default_factory=dict)
     """pose stamp -> time.perf_counter() when it was published."""
     wall_time: float = 0.0
@@ -153,9 +153,7 @@ class Replay:
     # ---- recording
     def _on_goal(self, message: PoseWithCovarianceStamped) -> None:
         stamp = seconds(message.header.stamp)
-        if any(stamp == g[0] for g in self.recording.goals[-3:]):
-            self.recording.republished += 1
-            return
+        self.recording.goal_stamps.append((message.header.stamp.sec, message.header.stamp.nanosec))
         d = self.node._d
         p = message.pose.pose.position
         covariance = np.asarray(message.pose.covariance).reshape(6, 6)[:d, :d]
@@ -198,10 +196,11 @@ class Replay:
         while time.perf_counter() < end:
             self.executor.spin_once(timeout_sec=0.001)
 
-    def publish(self, t: float, position, velocity, *, frame_id: str | None = None, twist: bool = True) -> None:
-        """Publish the twist and the pose of the hand at t (s after BASE_STAMP): position (3,) m, velocity (3,) m/s."""
+    def publish(self, t: float, position, velocity, *, frame_id: str | None = None, twist: bool = True, stamp=None) -> None:
+        """Publish the twist (unless ``twist`` is False) and the pose of the hand at t (s after BASE_STAMP): position
+        (3,) m, velocity (3,) m/s; ``stamp``: the messages' header stamp (a builtin_interfaces/Time) instead."""
         frame = self.settings.frame_id if frame_id is None else frame_id
-        stamp = stamp_of(BASE_STAMP + t)
+        stamp = stamp_of(BASE_STAMP + t) if stamp is None else stamp
         position, velocity = np.zeros(3) + np.r_[position, np.zeros(3 - len(position))], np.r_[velocity, np.zeros(3 - len(velocity))]
         if twist:
             message = TwistStamped()
@@ -212,7 +211,7 @@ class Replay:
         message.header.stamp, message.header.frame_id = stamp, frame
         message.pose.position.x, message.pose.position.y, message.pose.position.z = (float(v) for v in position)
         message.pose.orientation.w = 1.0
-        self.recording.sent[BASE_STAMP + t] = time.perf_counter()
+        self.recording.sent[seconds(stamp)] = time.perf_counter()
         self._pose.publish(message)
 
     def wait_handled(self, poses: int, timeout: float = 30.0) -> dict:
