@@ -24,13 +24,13 @@ pose, never of a stale one, and the answers thin out instead of falling behind. 
 Gauss–Newton steps on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes
 longer than ``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in
 time. Each successful estimate is published once, at once: g_hat with covariance, stamped exactly with the pose it
-answers (the pose message's own stamp), the predicted hand path, and the handover schedule of
-:func:`~comanip.multicomponent.handover.plan_handover` on the predicted reach (the robot's impedance rest position
-follows the predicted hand, and its stiffness ramps to 0 where the transition model predicts the person takes
-over); so every message on the goal topic is a new estimate. Timers publish the status (``status_rate``; it
-carries the last good estimate's goal and stamp) and sample the schedule at the node's clock into the equilibrium
-pose and stiffness (``command_rate``). The status is also published after every estimate and every rejected
-input.
+answers (the pose message's own stamp), and the predicted hand path; then, at most ``schedule_rate`` times a
+second, the handover schedule of :func:`~comanip.multicomponent.handover.plan_handover` on the predicted reach (the
+robot's impedance rest position follows the predicted hand, and its stiffness ramps to 0 where the transition
+model predicts the person takes over). Every message on the goal topic is a new estimate. Timers publish the
+status (``status_rate``; it carries the last good estimate's goal and stamp, and goes out at once after a
+rejected input too) and sample the schedule at the node's clock into the equilibrium pose and stiffness
+(``command_rate``).
 
 Stale: the status says ``stale: true`` (level WARN) while there is no estimate yet, the last solve failed
 or overran ``max_wall_time``, or no input came for ``input_timeout``; the equilibrium pose and stiffness keep
@@ -62,6 +62,7 @@ try:  # the 'ros' extra; without it, one line naming the extra
     from nav_msgs.msg import Path
     import rclpy
     from rcl_interfaces.msg import ParameterDescriptor
+    from rclpy.event_handler import PublisherEventCallbacks, SubscriptionEventCallbacks
     from rclpy.node import Node
     from rclpy.parameter import Parameter
     from std_msgs.msg import Empty, Float64MultiArray
@@ -85,9 +86,15 @@ from comanip.ros.messages import (RejectedMessage, goal_message, path_message, p
 from comanip.ros.node_settings import NodeSettings
 
 QUEUE_DEPTH = 50
-"""Depth of every subscription and publisher queue (messages)."""
+"""Depth of the publishers' queues and of the subscriptions but the hand's (messages)."""
+INPUT_DEPTH = 1
+"""Unread hand poses (and twists) the node keeps: a newer one replaces one not yet read, so that no queue of poses
+builds up behind a slow estimate."""
 RATE_WINDOW = 1.0
 """Input time (s) over which the status's achieved rate and median latency are taken."""
+QUIET_PUBLISHER, QUIET_SUBSCRIPTION = (PublisherEventCallbacks(use_default_callbacks=False),
+                                      SubscriptionEventCallbacks(use_default_callbacks=False))
+"""No QoS-event handlers on the node's topics (each would be visited on every wake of the executor)."""
 
 
 def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded",
@@ -102,12 +109,14 @@ def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, 
 
 @dataclass
 class GoodEstimate:
-    """The last successful estimate, the schedule built on it, and the stamp (s) of the pose it answers."""
+    """The last successful estimate, the last schedule built (on it or an estimate before it, ``schedule_rate``), the
+    stamps (s) of the pose the estimate answers and of the one whose estimate the schedule was built on."""
 
     estimate: GoalEstimate
     schedule: HandoverSchedule
     reach: Reach
     stamp: float
+    scheduled: float
 
 
 class GoalNode(Node):
@@ -116,10 +125,13 @@ class GoalNode(Node):
 
     def __init__(self, settings: NodeSettings, *, transition_model: TransitionModel | None = None, node_name: str = "comanip_goal",
                  use_sim_time: bool = False, **node_kwargs):
-        super().__init__(node_name, parameter_overrides=[Parameter("use_sim_time", value=use_sim_time)], **node_kwargs)
-        self._lock = threading.Condition()
-        self._stopping = False
-        self._worker: threading.Thread | None = None
+        # every entity of a node is visited on every wake of the executor, in Python: the node has only its own topics
+        # and timers (no parameter or type-description services, no QoS-event callbacks)
+        super().__init__(node_name, parameter_overrides=[Parameter("use_sim_time", value=use_sim_time),
+                                                         Parameter("start_type_description_service", value=False)],
+                         start_parameter_services=False, **node_kwargs)
+        self._lock = threading.RLock()
+        """Held by every callback: the node's state may be read (``status``) from another thread."""
         self.settings = self._declared(settings)
         s = self.settings
         model = s.model()
@@ -148,26 +160,34 @@ class GoalNode(Node):
         self._last_input_clock: float | None = None
         self._recent: list[tuple[float, float]] = []
         """(input stamp s, latency s or NaN) of the estimates of the last RATE_WINDOW s of input time."""
-        self._busy = False
         self._good: GoodEstimate | None = None
         self._counts = dict(inputs=0, rejected=0, skipped=0, ignored=0, resting=0, estimates=0, failed=0, late=0,
                             over_period=0)
         self._last = dict(solve_ok=True, solve_status="none", solve_time_s=float("nan"), latency_s=float("nan"), rejection="", event="started")
 
-        self._goal_pub = self.create_publisher(PoseWithCovarianceStamped, s.goal_topic, QUEUE_DEPTH)
-        self._path_pub = self.create_publisher(Path, s.path_topic, QUEUE_DEPTH)
-        self._schedule_pub = self.create_publisher(Float64MultiArray, s.schedule_topic, QUEUE_DEPTH)
-        self._equilibrium_pub = self.create_publisher(PoseStamped, s.equilibrium_topic, QUEUE_DEPTH)
-        self._stiffness_pub = self.create_publisher(Float64MultiArray, s.stiffness_topic, QUEUE_DEPTH)
-        self._status_pub = self.create_publisher(DiagnosticArray, s.status_topic, QUEUE_DEPTH)
-        self.create_subscription(PoseStamped, s.hand_pose_topic, self._on_pose, QUEUE_DEPTH)
-        self.create_subscription(TwistStamped, s.hand_twist_topic, self._on_twist, QUEUE_DEPTH)
-        self.create_subscription(PointStamped, s.prior_goal_topic, self._on_prior, QUEUE_DEPTH)
-        self.create_subscription(Empty, s.reset_topic, self._on_reset, QUEUE_DEPTH)
+        self._goal_pub = self._publisher(PoseWithCovarianceStamped, s.goal_topic)
+        self._path_pub = self._publisher(Path, s.path_topic)
+        self._schedule_pub = self._publisher(Float64MultiArray, s.schedule_topic)
+        self._equilibrium_pub = self._publisher(PoseStamped, s.equilibrium_topic)
+        self._stiffness_pub = self._publisher(Float64MultiArray, s.stiffness_topic)
+        self._status_pub = self._publisher(DiagnosticArray, s.status_topic)
+        self._subscription(PoseStamped, s.hand_pose_topic, self._on_pose, INPUT_DEPTH)
+        self._subscription(TwistStamped, s.hand_twist_topic, self._on_twist, INPUT_DEPTH)
+        self._subscription(PointStamped, s.prior_goal_topic, self._on_prior)
+        self._subscription(Empty, s.reset_topic, self._on_reset)
         self.create_timer(1.0 / s.command_rate, self._publish_command)
         self.create_timer(1.0 / s.status_rate, self._publish_status)
-        self._worker = threading.Thread(target=self._work, name="comanip-goal-estimates", daemon=True)
-        self._worker.start()
+        self._estimates = self.create_guard_condition(self._run_due)
+        """Triggered when an update falls due: its callback runs after every input that has arrived is read."""
+
+    def _publisher(self, message_type, topic: str):
+        """A publisher on ``topic`` without QoS-event handlers (:data:`QUIET_PUBLISHER`)."""
+        return self.create_publisher(message_type, topic, QUEUE_DEPTH, event_callbacks=QUIET_PUBLISHER)
+
+    def _subscription(self, message_type, topic: str, callback, depth: int = QUEUE_DEPTH) -> None:
+        """A subscription to ``topic`` keeping ``depth`` unread messages, without QoS-event handlers
+        (:data:`QUIET_SUBSCRIPTION`)."""
+        self.create_subscription(message_type, topic, callback, depth, event_callbacks=QUIET_SUBSCRIPTION)
 
     def _declared(self, settings: NodeSettings) -> NodeSettings:
         """Declare every setting as a ROS parameter and return the settings with the overrides given to the
@@ -176,7 +196,7 @@ class GoalNode(Node):
         values = {name: self.declare_parameter(name, value, descriptor).value for name, value in settings.to_mapping().items()}
         return NodeSettings.from_mapping(values)
 
-    # ---- the executor's callbacks: check, queue, never solve
+    # ---- the inputs: checked, fed to the loop
     def now(self) -> float:
         """The node's clock (s): ROS time, or the replay's /clock under use_sim_time."""
         return self.get_clock().now().nanoseconds * 1e-9
@@ -220,7 +240,7 @@ class GoalNode(Node):
                 self._handle(self.loop.add_position(sample.stamp, sample.vector, received))
 
     def _handle(self, steps: list[LoopStep]) -> None:
-        """Count, log and act on what the loop made of each pose (holding the lock); wake the worker for an update."""
+        """Count, log and act on what the loop made of each pose (holding the lock); an update due triggers its run."""
         for step in steps:
             if step.event is LoopEvent.WAITING:
                 continue
@@ -242,7 +262,7 @@ class GoalNode(Node):
             elif step.event is LoopEvent.FINISHED:
                 self._log_event(f"reach {self.loop.reach.number} finished: the hand rests at stamp {step.stamp:.6f} s")
         if self.loop.due is not None:
-            self._lock.notify()
+            self._estimates.trigger()
 
     def _log_event(self, event: str) -> None:
         self._last["event"] = event
@@ -272,15 +292,13 @@ class GoalNode(Node):
         self.get_logger().warning(str(error))
         self._publish_status()
 
-    # ---- the worker: one estimate at a time, the newest observation first
-    def _work(self) -> None:
-        while True:
-            with self._lock:
-                while self.loop.due is None and not self._stopping:
-                    self._lock.wait()
-                if self._stopping:
-                    return
-                job, self._busy = self.loop.take_due(), True
+    # ---- the estimates: one at a time, on the newest due pose
+    def _run_due(self) -> None:
+        """The update due, if one still is (a later trigger may find it taken), estimated and published."""
+        with self._lock:
+            job = self.loop.take_due()
+            if job is None:
+                return
             latency = float("nan")
             try:
                 latency = self._estimate(job)
@@ -288,15 +306,12 @@ class GoalNode(Node):
                 self._last.update(solve_ok=False, solve_status=f"error: {type(error).__name__}: {error}")
                 self._counts["failed"] += 1
                 self.get_logger().error(f"estimate at t = {job.t:.3f} s raised {type(error).__name__}: {error}")
-            with self._lock:
-                self._busy = False
-                if self.loop.reach is job.reach and job.sample is not None:
-                    stamp = job.sample.stamp
-                    self._recent = [(before, seconds) for before, seconds in self._recent if before > stamp - RATE_WINDOW]
-                    self._recent.append((stamp, latency))
-                    if latency > self._input_period():
-                        self._counts["over_period"] += 1
-            self._publish_status()
+            if self.loop.reach is job.reach and job.sample is not None:
+                stamp = job.sample.stamp
+                self._recent = [(before, seconds) for before, seconds in self._recent if before > stamp - RATE_WINDOW]
+                self._recent.append((stamp, latency))
+                if latency > self._input_period():
+                    self._counts["over_period"] += 1
 
     def _estimate(self, job: Update) -> float:
         """Run the update and publish its estimate; returns the latency (s) from the pose's arrival to the
@@ -331,13 +346,19 @@ class GoalNode(Node):
         self._goal_pub.publish(goal_message(estimate.goal, estimate.goal_covariance, stamp, frame))
         self._path_pub.publish(path_message(estimate, clock, frame))   # goal and forecast first: the schedule takes longer
         latency = self._last["latency_s"] = time.perf_counter() - job.sample.received
+        good = self._good
+        if good is not None and good.reach is job.reach and job.sample.stamp - good.scheduled < 1.0 / s.schedule_rate:
+            with self._lock:        # the schedule stays the last one's (schedule_rate)
+                if self.loop.reach is job.reach:
+                    self._good = GoodEstimate(estimate, good.schedule, job.reach, job.sample.stamp, good.scheduled)
+            return latency
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
             schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
         with self._lock:
             if self.loop.reach is not job.reach:
                 return latency
-            self._good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp)
+            self._good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, job.sample.stamp)
         self._schedule_pub.publish(schedule_message(schedule, clock))
         return latency
 
@@ -384,7 +405,7 @@ class GoalNode(Node):
             good, reach = self._good, self.loop.reach
             counts = dict(self._counts, skipped=self._counts["skipped"] + self.loop.replaced)
             return reason, dict(stale=bool(reason), stale_reason=reason, **counts,
-                                pending=bool(self.loop.due is not None or self._busy or self.loop.waiting),
+                                pending=bool(self.loop.due is not None or self.loop.waiting),
                                 reach=0 if reach is None else reach.number, moving=self.loop.moving,
                                 reach_start_stamp_s=float("nan") if reach is None else reach.clock,
                                 estimate_stamp_s=float("nan") if good is None else good.stamp,
@@ -420,14 +441,6 @@ class GoalNode(Node):
         reason, values = self.status()
         level = DiagnosticStatus.WARN if reason else DiagnosticStatus.OK
         self._status_pub.publish(status_message(level, reason or "estimating", values, self.now()))
-
-    def destroy_node(self):
-        with self._lock:
-            self._stopping = True
-            self._lock.notify()
-        if self._worker is not None:
-            self._worker.join(timeout=5.0)
-        return super().destroy_node()
 
 
 def spin(settings: NodeSettings, ros_args: list[str]) -> int:

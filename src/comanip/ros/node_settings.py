@@ -69,6 +69,10 @@ class NodeSettings:
     a newer one replaces while an estimate runs. The tracker's own rate (e.g. 250) estimates every pose."""
     command_rate: float = 100.0
     """Rate of the equilibrium pose and stiffness (Hz)."""
+    schedule_rate: float = 50.0
+    """Most handover schedules built per second of input time (Hz): an estimate whose pose comes less than
+    1 / schedule_rate after the last schedule's keeps that schedule (building one takes about as long as an
+    estimate); the first estimate of a reach always builds one."""
     status_rate: float = 10.0
     """Rate at which the status is republished (Hz); it carries the last good estimate's goal and stamp (the goal and
     path topics carry each estimate once, when it is new)."""
@@ -118,7 +122,7 @@ class NodeSettings:
             object.__setattr__(self, "width", as_goal_width("width", self.width))
         if self.prior_goal is not None:
             object.__setattr__(self, "prior_goal", tuple(as_vector("prior_goal", self.prior_goal, model.d, "m").tolist()))
-        for name in ("max_wall_time", "estimation_rate", "command_rate", "status_rate", "input_timeout", "rotational_stiffness",
+        for name in ("max_wall_time", "estimation_rate", "command_rate", "schedule_rate", "status_rate", "input_timeout", "rotational_stiffness",
                      "rest_radius", "rest_window", "velocity_window"):
             object.__setattr__(self, name, as_positive(name, getattr(self, name), UNITS[name]))
         object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
@@ -175,5 +179,5 @@ class NodeSettings:
 TOPICS = ("hand_pose_topic", "hand_twist_topic", "prior_goal_topic", "reset_topic", "goal_topic", "path_topic",
           "equilibrium_topic", "stiffness_topic", "schedule_topic", "status_topic")
 
-UNITS = {"max_wall_time": "s", "estimation_rate": "Hz", "command_rate": "Hz", "status_rate": "Hz", "input_timeout": "s",
+UNITS = {"max_wall_time": "s", "estimation_rate": "Hz", "command_rate": "Hz", "schedule_rate": "Hz", "status_rate": "Hz", "input_timeout": "s",
          "rotational_stiffness": "N·m/rad", "rest_radius": "m", "rest_window": "s", "velocity_window": "s"}
