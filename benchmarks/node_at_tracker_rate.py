@@ -30,6 +30,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from reach_loop import ARMS, joined_stream  # noqa: E402  (the joined stream beside this script)
+from solve_times import reference_source  # noqa: E402
 
 from comanip.recordings import load_tathum  # noqa: E402
 
@@ -187,7 +188,8 @@ def main(argv=None) -> None:
     parser.add_argument("--rate", type=float, default=250.0, help="the tracker's poses per second and the node's "
                         "estimation_rate (Hz)")
     parser.add_argument("--twists", action="store_true", help="also publish a twist with each pose")
-    parser.add_argument("--compare", type=Path, help="a checkout whose node takes turns with this one (both get twists)")
+    parser.add_argument("--compare", help="another checkout (its folder) or a git revision whose node takes turns with "
+                        "this one (both get twists)")
     parser.add_argument("--turn", type=float, default=2.0, help="minutes per turn with --compare")
     parser.add_argument("--markdown", action="store_true")
     parser.add_argument("--out", type=Path, default=Path(__file__).parent / "results" / "node_at_tracker_rate")
@@ -204,10 +206,14 @@ def main(argv=None) -> None:
         lines += table("this node" + (", poses and twists" if args.twists else ", poses only"), results["this node"])
     else:
         t, position, reaches = tracker_stream(args.turn, args.rate)
-        runs = {"this node": [], f"{args.compare.name}": []}
-        for turn in range(max(1, int(round(args.minutes / args.turn)))):
-            for label, src in (("this node", None), (args.compare.name, args.compare.resolve() / "src")):
-                runs[label].append(live_run(t, position, args.rate, True, src, f"{label}, turn {turn + 1}"))
+        reference, clean_up = reference_source(args.compare)
+        runs = {"this node": [], f"previous ({args.compare})": []}
+        try:
+            for turn in range(max(1, int(round(args.minutes / args.turn)))):
+                for label, src in zip(runs, (None, reference)):
+                    runs[label].append(live_run(t, position, args.rate, True, src, f"{label}, turn {turn + 1}"))
+        finally:
+            clean_up()
         for label, turns in runs.items():
             rows = [minute_rows(t, run, reaches, args.rate)[-1] for run in turns]
             for k, row in enumerate(rows):

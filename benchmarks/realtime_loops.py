@@ -1,12 +1,12 @@
 """Closed loops at a robot's rate, replanned on a per-cycle budget, against the same loops replanned to convergence.
 
-    .venv/bin/python benchmarks/realtime_loops.py [--presets franka_rest,planar] [--problems 20] [--rate 100] [--markdown]
+    .venv/bin/python benchmarks/realtime_loops.py [--presets franka_rest,planar] [--problems 20] [--rate 100|step] [--markdown]
 
 Problems: ``--problems`` spread evenly over each preset's workspace set (``benchmarks/workspace/<preset>.json``: the
 Panda from its ready pose to goals 0.1–0.3 m away, point masses from the origin to goals 0.05–0.8 m away, widths
 5–50 mm, starts at rest and moving); each problem's goal jumps once, at 30 % of the horizon H·h, by 5 cm (even
 problems) or 20 cm (odd) in a seeded random direction (for an arm, to a goal it reaches). Every loop runs
-1.5·H·h seconds at ``--rate`` Hz, its first plan a full (cold) solve from the start, every later cycle warm from the
+1.5·H·h seconds at ``--rate`` Hz (``step``: a cycle of the preset's own step h), its first plan a full (cold) solve from the start, every later cycle warm from the
 previous plan shifted by the cycle; once with motor noise (the same noise seed for every loop of a problem) and once
 without, where the loops differ by their replanning alone (with noise, one run's cost moves by percents with the
 noise it meets, so the noisy rows compare sums over many problems).
@@ -124,7 +124,7 @@ def jumped_goal(planner: comanip.Planner, problem, size: float, rng: np.random.G
     raise RuntimeError(f"no reachable goal {size} m from {problem.goal}")
 
 
-def run_preset(preset: str, count: int, rate: float, budget: float | None, progress) -> tuple[str, dict[tuple[str, bool], LoopRuns]]:
+def run_preset(preset: str, count: int, rate: float | None, budget: float | None, progress) -> tuple[str, dict[tuple[str, bool], LoopRuns]]:
     """The preset's kind of body ('arm' or 'point mass') and every loop's runs on its problems, with and without
     motor noise, keyed by (loop, noise)."""
     model = comanip.presets.load(preset)
@@ -133,7 +133,7 @@ def run_preset(preset: str, count: int, rate: float, budget: float | None, progr
     budget = BUDGETS[kind] if budget is None else budget
     problems = workspace.load(preset)
     chosen = np.unique(np.linspace(0, len(problems) - 1, count).round().astype(int))
-    period = 1.0 / rate
+    period = model.h if rate is None else 1.0 / rate
     steps = round(RUN_LENGTH * model.H * model.h / period)
     loops = {"converged": Replanner(planner, iterations=None), "1 iteration": Replanner(planner, iterations=1),
              "budget": Replanner(planner, iterations=None, max_wall_time=budget),
@@ -193,8 +193,9 @@ def loop_label(key: tuple[str, bool], row: dict) -> str:
 
 
 def markdown(results: dict[str, dict], kinds: dict[str, str], args) -> str:
+    cycle = "loops at each preset's own step h" if args.rate == "step" else f"{float(args.rate):g} Hz loops"
     lines = [f"Measured by `benchmarks/realtime_loops.py --markdown --presets {args.presets} --problems {args.problems} "
-             f"--rate {args.rate:g}` ({args.rate:g} Hz loops of 1.5 H·h, each problem's goal jumping by 5 or 20 cm at "
+             f"--rate {args.rate}` ({cycle} of 1.5 H·h, each problem's goal jumping by 5 or 20 cm at "
              f"0.3 H·h; executed cost minus the converged loop's with the same noise, over |J_best|, the mean over the "
              f"problems and the largest; cycle times after the first plan; 1-minute load average "
              f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores at the end):", "",
@@ -231,13 +232,14 @@ def main(argv=None) -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--presets", default="franka_rest,planar,cartesian,human,human_cartesian")
     parser.add_argument("--problems", type=int, default=20, help="problems per preset, spread over its workspace set")
-    parser.add_argument("--rate", type=float, default=100.0, help="control rate (Hz)")
+    parser.add_argument("--rate", default="100", help="control rate (Hz), or 'step': each preset's own step h")
     parser.add_argument("--budget", type=float, default=None, help="wall budget per cycle (s); default 5 ms arms, 1 ms point masses")
     parser.add_argument("--markdown", action="store_true", help="print the speed page's block")
     args = parser.parse_args(argv)
+    rate = None if args.rate == "step" else float(args.rate)
     results, kinds = {}, {}
     for preset in args.presets.split(","):
-        kinds[preset], runs = run_preset(preset, args.problems, args.rate, args.budget,
+        kinds[preset], runs = run_preset(preset, args.problems, rate, args.budget,
                                          lambda text: print(text, file=sys.stderr, flush=True))
         results[preset] = summary(runs)
         for key, row in results[preset].items():  # with --markdown on stderr, as progress

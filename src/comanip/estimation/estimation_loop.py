@@ -33,8 +33,8 @@ says so in a :class:`LoopStep` (its :class:`LoopEvent`):
    estimator learn from it (``finish_reach``).
 
 What each front end adds is its own: :class:`~comanip.estimation.reach_stream.ReachStream` estimates every due
-update at once; the ROS 2 node (:mod:`comanip.ros.node`) converts messages into samples, estimates in a worker
-thread and publishes.
+update at once; the ROS 2 node (:mod:`comanip.ros.node`) converts messages into samples, estimates once the
+messages that have arrived are read, and publishes.
 """
 
 from __future__ import annotations

@@ -17,10 +17,12 @@ time), so a tracker whose stamps jitter still gets the configured rate (the trac
 estimates every pose); poses past the model's horizon, and those at rest between reaches, are not estimated.
 
 The estimates come from :class:`~comanip.estimation.OnlineGoalEstimator` (every observation of the reach so
-far, any time) and run in a worker thread, so the executor's callbacks only check messages and feed the loop,
-and never wait for a solve. The node never queues: when an estimate takes longer than the poses' spacing, the
-newest due pose replaces one not yet estimated (counted as skipped), so an estimate is always of the newest
-pose, never of a stale one, and the answers thin out instead of falling behind. An estimate is a few
+far, any time) and run in the executor's thread, one at a time: a pose that makes an update due triggers a guard
+condition whose callback runs after every input that has arrived is read, so the update runs on the newest due
+pose (one interpreter thread: a second would share the interpreter with the first and slow both). The node never
+queues: it keeps one unread pose (``INPUT_DEPTH``; a newer one replaces it), and when an estimate takes longer
+than the poses' spacing the newest due pose replaces one not yet estimated (counted as skipped), so an estimate
+is always of the newest pose, never of a stale one, and the answers thin out instead of falling behind. An estimate is a few
 Gauss–Newton steps on a precomputed reach family, not a plan solve, and takes no budget argument: one that takes
 longer than ``max_wall_time`` is still published, counted as late, and marks the status stale until one comes in
 time. Each successful estimate is published once, at once: g_hat with covariance, stamped exactly with the pose it
@@ -147,7 +149,7 @@ class GoalNode(Node):
                          pairing_tolerance=s.twist_tolerance, horizon=self._horizon, restart_after=s.input_timeout,
                          first_sample_starts_reach=True))
         """The node's loop (:mod:`comanip.estimation.estimation_loop`): its callbacks feed it under the node's lock,
-        its worker runs the updates it makes due."""
+        the guard condition's callback runs the updates it makes due."""
         self._last_pose: float | None = None
         self._last_twist: float | None = None
         self._derived = DerivedVelocity(s.velocity_window, restart_after=s.input_timeout)

@@ -62,8 +62,7 @@ class NodeSettings:
     status_topic: str = "status"
     """diagnostic_msgs/DiagnosticArray: stale flag, solve status, counts, last rejection."""
     max_wall_time: float = 0.25
-    """Wall-time budget of one estimate (s): one that takes longer is still published but marks the status stale
-    (the estimate runs in a worker thread, so the node's callbacks are never held up by it)."""
+    """Wall-time budget of one estimate (s): one that takes longer is still published but marks the status stale."""
     estimation_rate: float = 20.0
     """Most estimates per second of input time (Hz); hand poses in between are skipped, and so is a due pose that
     a newer one replaces while an estimate runs. The tracker's own rate (e.g. 250) estimates every pose."""
