@@ -1,6 +1,7 @@
 """Closed loops at a robot's rate, replanned on a per-cycle budget, against the same loops replanned to convergence.
 
-    .venv/bin/python benchmarks/realtime_loops.py [--presets franka_rest,planar] [--problems 20] [--rate 100|step] [--markdown]
+    .venv/bin/python benchmarks/realtime_loops.py [--presets franka_rest,planar] [--problems 20] [--rate 100|step]
+                                                  [--compare REF] [--markdown]
 
 Problems: ``--problems`` spread evenly over each preset's workspace set (``benchmarks/workspace/<preset>.json``: the
 Panda from its ready pose to goals 0.1–0.3 m away, point masses from the origin to goals 0.05–0.8 m away, widths
@@ -34,6 +35,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import subprocess
 import sys
 import time
 from dataclasses import dataclass, field
@@ -50,6 +52,7 @@ from comanip.planning.solver_options import SolverOptions
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import workspace  # noqa: E402  (the sampled problem sets beside this script)
+from solve_times import reference_source  # noqa: E402
 
 JUMPS = (0.05, 0.2)
 """Goal jumps (m), alternating over the problems."""
@@ -235,8 +238,16 @@ def main(argv=None) -> None:
     parser.add_argument("--rate", default="100", help="control rate (Hz), or 'step': each preset's own step h")
     parser.add_argument("--budget", type=float, default=None, help="wall budget per cycle (s); default 5 ms arms, 1 ms point masses")
     parser.add_argument("--markdown", action="store_true", help="print the speed page's block")
+    parser.add_argument("--compare", default=None, help="another checkout (its folder) or a git revision: the same loops "
+                        "with its code, in a process of its own beside this one, its table after this one's")
     args = parser.parse_args(argv)
     rate = None if args.rate == "step" else float(args.rate)
+    previous = None
+    if args.compare is not None:
+        reference, clean_up = reference_source(args.compare)
+        command = [sys.executable, __file__, "--presets", args.presets, "--problems", str(args.problems), "--rate", args.rate,
+                   *(["--budget", str(args.budget)] if args.budget is not None else []), "--markdown"]
+        previous = subprocess.Popen(command, stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(reference)})
     results, kinds = {}, {}
     for preset in args.presets.split(","):
         kinds[preset], runs = run_preset(preset, args.problems, rate, args.budget,
@@ -249,6 +260,10 @@ def main(argv=None) -> None:
                   f"{100 * row['flagged']:.1f} %", file=sys.stderr if args.markdown else sys.stdout, flush=True)
     if args.markdown:
         print(markdown(results, kinds, args))
+    if previous is not None:
+        table = previous.communicate()[0]
+        clean_up()
+        print(f"\nThe same loops with the code of {args.compare}, run beside these in a process of its own:\n\n{table}")
 
 
 if __name__ == "__main__":
