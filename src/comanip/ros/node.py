@@ -308,7 +308,7 @@ class GoalNode(Node):
                 self._last.update(solve_ok=False, solve_status=f"error: {type(error).__name__}: {error}")
                 self._counts["failed"] += 1
                 self.get_logger().error(f"estimate at t = {job.t:.3f} s raised {type(error).__name__}: {error}")
-            if self.loop.reach is job.reach and job.sample is not None:
+            if job.sample is not None:
                 stamp = job.sample.stamp
                 self._recent = [(before, seconds) for before, seconds in self._recent if before > stamp - RATE_WINDOW]
                 self._recent.append((stamp, latency))
@@ -339,28 +339,19 @@ class GoalNode(Node):
             self.get_logger().warning(f"estimate at t = {job.t:.3f} s failed ({estimate.status}: {estimate.message}); "
                                       "keeping the last good one, marked stale")
             return float("nan")
-        frame, clock = s.frame_id, job.reach.clock
-        with self._lock:
-            if self.loop.reach is not job.reach:
-                return float("nan")  # a reset or a new reach came while solving
-            self._counts["estimates"] += 1
-            stamp = self._header_stamp(job.sample.stamp)
-        self._goal_pub.publish(goal_message(estimate.goal, estimate.goal_covariance, stamp, frame))
+        frame, clock = s.frame_id, job.reach.clock   # no callback runs during an update: its reach is the loop's
+        self._counts["estimates"] += 1
+        self._goal_pub.publish(goal_message(estimate.goal, estimate.goal_covariance, self._header_stamp(job.sample.stamp), frame))
         self._path_pub.publish(path_message(estimate, clock, frame))   # goal and forecast first: the schedule takes longer
         latency = self._last["latency_s"] = time.perf_counter() - job.sample.received
         good = self._good
         if good is not None and good.reach is job.reach and job.sample.stamp - good.scheduled < 1.0 / s.schedule_rate:
-            with self._lock:        # the schedule stays the last one's (schedule_rate)
-                if self.loop.reach is job.reach:
-                    self._good = GoodEstimate(estimate, good.schedule, job.reach, job.sample.stamp, good.scheduled)
+            self._good = GoodEstimate(estimate, good.schedule, job.reach, job.sample.stamp, good.scheduled)  # schedule_rate
             return latency
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # the transition model's extrapolation warning; its status says so
             schedule = plan_handover(estimate, self._transition, ramp_time=s.ramp_time, leading_stiffness=s.leading_stiffness)
-        with self._lock:
-            if self.loop.reach is not job.reach:
-                return latency
-            self._good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, job.sample.stamp)
+        self._good = GoodEstimate(estimate, schedule, job.reach, job.sample.stamp, job.sample.stamp)
         self._schedule_pub.publish(schedule_message(schedule, clock))
         return latency
 
