@@ -270,3 +270,18 @@ def test_a_tracker_without_twists_is_estimated_from_its_poses_and_each_goal_carr
     assert set(recording.goal_stamps) <= {(stamp.sec, stamp.nanosec) for stamp in sent}
     assert len(set(recording.goal_stamps)) == len(recording.goal_stamps)       # each estimate sent once
     np.testing.assert_allclose(recording.goals[-1][1], GOAL, atol=0.01)
+
+
+def test_the_handover_schedule_is_rebuilt_at_most_schedule_rate_times_a_second(reach, transition):
+    """Every pose of a 200 Hz tracker estimated, the schedule rebuilt on at most 25 of them a second: the schedules
+    sent are one per 40 ms of input time (the first estimate's included), and the goals keep coming at the tracker's
+    rate."""
+    _, _, plan = reach
+    times = np.arange(0.0, 1.0, 0.005)
+    states = np.column_stack([np.interp(times, plan.t, plan.mean[:, k]) for k in range(6)])
+    with Replay(NodeSettings(estimation_rate=400.0, schedule_rate=25.0), transition) as replay:
+        recording = replay.run(times, states, None)
+    goals = np.array([stamp for stamp, *_ in recording.goals]) - BASE_STAMP
+    assert len(goals) > 150
+    span = goals[-1] - goals[0]
+    assert len(recording.schedules) <= int(span * 25.0) + 2 and len(recording.schedules) >= int(span * 25.0) - 2
