@@ -29,10 +29,14 @@ class RecordingEstimator:
     def reset(self, start, *, prior_goal=None):
         self.calls.append(("reset", np.array(start), prior_goal))
 
-    def update(self, t, position, velocity, forecast=True):
+    def update(self, t, position, velocity):
         self.calls.append(("update", t, np.array(position), np.array(velocity)))
         self.latest = t
         return t
+
+    def observe(self, times, positions, velocities):      # observations whose estimates are not read: updates here
+        for t, position, velocity in zip(times, positions, velocities):
+            self.update(t, position, velocity)
 
     def finish_reach(self):
         self.calls.append(("finish",))

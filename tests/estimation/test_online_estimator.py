@@ -465,24 +465,50 @@ def test_a_batch_of_recordings_gets_the_estimates_of_streaming_them(online, cart
         assert len(estimates) == len(recording.t)
 
 
-def test_updates_without_the_forecast_leave_the_later_estimates_and_what_is_learned_the_same():
-    """A reach's lead given without forecasts (as the loop gives it): the prior's estimates lack theirs, the rest
-    is as with them, the estimates after it and what the person is taught from the reach."""
+@pytest.mark.parametrize("timing", ["estimated", "paced"])
+def test_observations_whose_estimates_are_not_read_leave_the_later_estimates_and_what_is_learned_the_same(timing):
+    """A reach's lead observed in batches (as the loop gives it) rather than updated: its last estimate (read after
+    it), the estimates after it and what the person is taught from the reach are those of one update per sample;
+    the lead holds samples at rest (estimated lazily), moving ones (estimated at once) and a lost one."""
     model = comanip.presets.arm()
     t = np.arange(0.0, 1.0, 0.004)
     s = np.clip((t - 0.15) / 0.5, 0, 1)
     x = np.outer(0.25 * (10 * s**3 - 15 * s**4 + 6 * s**5), [0.6, 0.8, 0.0])
     v = np.outer(0.25 * (30 * s**2 - 60 * s**3 + 30 * s**4) / 0.5, [0.6, 0.8, 0.0])
-    lead, full = (comanip.OnlineGoalEstimator(model, np.zeros(model.state_size)) for _ in range(2))
-    statuses = set()
-    for k in range(len(t)):
-        mine = lead.update(t[k], x[k], v[k], forecast=k >= 60)
-        theirs = full.update(t[k], x[k], v[k])
-        statuses.add(mine.status)
-        assert (mine.forecast is None) == (k < 60 and mine.status == "uninformative")
-        if mine.forecast is not None:
-            np.testing.assert_array_equal(mine.ee_mean, theirs.ee_mean)
+    x[40] = v[40] = np.nan                                        # a sample the tracker lost
+    options = OnlineOptions(timing=timing)
+    lead, full = (comanip.OnlineGoalEstimator(model, np.zeros(model.state_size), options=options) for _ in range(2))
+    statuses = [full.update(t[k], x[k], v[k]).status for k in range(60)]
+    for batch in (slice(0, 30), slice(30, 50), slice(50, 60)):
+        lead.observe(t[batch], x[batch], v[batch])
+    read, theirs = lead.latest, full.latest
+    np.testing.assert_array_equal(read.goal, theirs.goal)
+    np.testing.assert_array_equal(read.goal_covariance, theirs.goal_covariance)
+    assert read.t_obs == theirs.t_obs and read.status == theirs.status
+    for k in range(60, len(t)):
+        mine, theirs = lead.update(t[k], x[k], v[k]), full.update(t[k], x[k], v[k])
+        np.testing.assert_array_equal(mine.ee_mean, theirs.ee_mean)
         np.testing.assert_array_equal(mine.goal, theirs.goal)
         np.testing.assert_array_equal(mine.goal_covariance, theirs.goal_covariance)
-    assert "uninformative" in statuses and len(statuses) > 1
+    assert "uninformative" in statuses[:30] and set(statuses[50:]) != {"uninformative"}   # the lead rests, then moves
     assert lead.finish_reach() == full.finish_reach() and lead.person.reaches == full.person.reaches == 1
+
+
+def test_observations_are_checked_as_updates_are():
+    """Batches of observations of the wrong shape, going back in time or repeating a time are refused before any
+    is added, as an update refuses them."""
+    estimator = OnlineGoalEstimator(comanip.presets.arm(), np.zeros(6))
+    with pytest.raises(ValueError, match=r"observe takes times \(K,\) s, positions and velocities \(K, 3\)"):
+        estimator.observe([0.0, 0.01], np.zeros((2, 2)), np.zeros((2, 2)))
+    assert estimator.observation_count == 0
+    with pytest.raises(ValueError, match="must not go backwards"):
+        estimator.observe([0.02, 0.01], np.zeros((2, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="repeats the previous observation's time"):
+        estimator.observe([0.03, 0.03], np.zeros((2, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="position must be finite"):
+        estimator.observe([0.04, 0.05], [[0.0, 0.0, 0.0], [0.0, np.nan, 0.0]], np.zeros((2, 3)))
+    assert estimator.observation_count == 0
+    estimator.observe([0.04, 0.05], np.zeros((2, 3)), np.zeros((2, 3)))
+    with pytest.raises(ValueError, match="must not go backwards"):
+        estimator.update(0.045, np.zeros(3), np.zeros(3))
+    assert estimator.observation_count == 2 and estimator.latest.status == "uninformative"

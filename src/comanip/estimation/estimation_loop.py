@@ -29,7 +29,7 @@ says so in a :class:`LoopStep` (its :class:`LoopEvent`):
 5. **Estimation** (:meth:`EstimationLoop.estimate`, which may run on another thread than steps 1-4, one update
    at a time). The first update of a reach restarts the estimator (``reset`` from the reach's rest, with the
    prior goal the reach started with; the reach before is learned from) and gives it the reach's lead samples
-   (their estimates unread, so without the forecast while they are the prior); then the sample, at t = stamp - the reach's clock; an update that finishes its reach then has the
+   (their estimates unread: :meth:`~comanip.estimation.online_estimator.OnlineGoalEstimator.observe`); then the sample, at t = stamp - the reach's clock; an update that finishes its reach then has the
    estimator learn from it (``finish_reach``).
 
 What each front end adds is its own: :class:`~comanip.estimation.reach_stream.ReachStream` estimates every due
@@ -313,8 +313,9 @@ class EstimationLoop:
             model = self.estimator.model
             self.estimator.reset(np.r_[reach.start, np.zeros(model.state_size - len(reach.start))], prior_goal=reach.prior_goal)
             self._estimated = reach
-            for sample in reach.lead:                # their estimates are not read: the prior's without its forecast
-                self.estimator.update(sample.stamp - reach.clock, sample.position, sample.velocity, forecast=False)
+            if reach.lead:                           # their estimates are not read
+                self.estimator.observe([sample.stamp - reach.clock for sample in reach.lead],
+                                       [sample.position for sample in reach.lead], [sample.velocity for sample in reach.lead])
         if update.sample is not None:
             self.estimator.update(update.t, update.sample.position, update.sample.velocity)
         if update.finishes:

@@ -57,7 +57,7 @@ from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.goal_smoothing import GoalSmoother
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.hand_rest import lost_sample, resting_position
+from comanip.estimation.hand_rest import REST_RADIUS_M, has_left, lost_sample, resting_position
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
@@ -126,6 +126,7 @@ class OnlineGoalEstimator:
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
         self.explanations = list(explanations) if explanations is not None else self._explanations(d)
+        self._at_rest_first = bool(self.explanations) and isinstance(self.explanations[0], HandAtRest)
         self._blas = SingleThreadBlas()
         self._hand = HandTrace(d)
         self.reset(start)
@@ -176,8 +177,8 @@ class OnlineGoalEstimator:
         self._last_time = -math.inf
         self._planned = None      # (goal and timing, prediction, timed plan) of the last estimate's reach
         self._warned = False
-        self.latest: GoalEstimate | None = None
-        """The last estimate, None before the first update."""
+        self._latest: GoalEstimate | None = None
+        self._rest_pending = False     # an at-rest observation's estimate not made yet (observe)
 
     def finish_reach(self) -> ReachFactors | None:
         """Learn from the reach so far as a finished one (:meth:`PersonCalibration.learn`) where its hand came to
@@ -207,7 +208,7 @@ class OnlineGoalEstimator:
         """Observations received so far."""
         return self._hand.count
 
-    def update(self, time_s, position, velocity, *, forecast: bool = True) -> GoalEstimate:
+    def update(self, time_s, position, velocity) -> GoalEstimate:
         """Add an observation and re-estimate the goal.
 
         Args:
@@ -215,10 +216,6 @@ class OnlineGoalEstimator:
                 only on the planning grid (after the horizon H·h it is read at the last step).
             position: observed hand position (d,), m.
             velocity: observed hand velocity (d,), m/s.
-            forecast: False leaves the forecast of the hand out of an estimate that is the prior (status
-                ``uninformative``; its plan is then the model's reach to the prior goal), which is most of its
-                cost; for observations whose estimate is not read (a reach's lead, given before its newest
-                sample). The estimates of the later updates are the same.
 
         A sample the tracker lost (position or velocity all NaN) is skipped: the previous estimate is returned
         unchanged (before any tracked sample, the prior with status ``uninformative``) and the next good
@@ -233,6 +230,102 @@ class OnlineGoalEstimator:
             says why and the goal and covariance are the previous estimate's (or the prior's).
         """
         t_begin = time.perf_counter()
+        checked = self._checked(time_s, position, velocity)
+        if checked is None:
+            if self.latest is None:
+                return self._result(Explained.explaining(self.prior_mean, self.prior_cov, EstimateStatus.UNINFORMATIVE,
+                                                         "no tracked sample yet: the estimate is the prior"), t_begin)
+            return self.latest
+        return self._added_and_estimated(t_begin, *checked, forecast=True)
+
+    def observe(self, times_s, positions, velocities) -> None:
+        """Add observations whose estimates are not read (a reach's lead, given before its newest sample): each
+        checked as :meth:`update` checks it, and estimated only where a later estimate could depend on it. While
+        the hand has not left its start and :class:`~comanip.estimation.explanations.HandAtRest` is the first
+        explanation, the estimate is the prior, which no explanation is asked for: it is made, without the
+        forecast of the hand, when :attr:`latest` is next read. From the first observation that has left the start
+        on, each is estimated as it is added, without the forecast where the estimate is the prior. The estimates
+        of the later updates are those after one :meth:`update` per observation.
+
+        Args:
+            times_s: (K,) s since the reach's start, increasing, after the previous observation's.
+            positions: (K, d) m.
+            velocities: (K, d) m/s.
+        """
+        times, positions, velocities = (np.asarray(value, dtype=float) for value in (times_s, positions, velocities))
+        if not (times.ndim == 1 and positions.shape == velocities.shape == (len(times), self.model.d)):
+            raise ValueError(f"observe takes times (K,) s, positions and velocities (K, {self.model.d}) m and m/s, got "
+                             f"shapes {times.shape}, {positions.shape} and {velocities.shape}")
+        if len(times) and not self._checked_at_once(times, positions, velocities):
+            times, positions, velocities = self._checked_in_turn(times, positions, velocities)
+        resting = 0                                         # the leading rows at rest, added at once
+        if len(times) and self._at_rest_first and not self._hand.has_left(self.start_position):
+            offset = positions - self.start_position
+            left = (offset * offset).sum(axis=1) > REST_RADIUS_M ** 2
+            resting = int(np.argmax(left)) if left.any() else len(times)
+            if resting:
+                self._hand.extend(times[:resting], positions[:resting], velocities[:resting])
+                self._last_time, self._rest_pending = float(times[resting - 1]), True
+        for time_s, position, velocity in zip(times[resting:], positions[resting:], velocities[resting:]):
+            self._added_and_estimated(time.perf_counter(), float(time_s), position, velocity, forecast=False)
+
+    def _checked_in_turn(self, times: np.ndarray, positions: np.ndarray, velocities: np.ndarray) -> tuple:
+        """The rows of (K,) s, (K, d) m, (K, d) m/s checked one by one (:meth:`_checked`, each after the one
+        before), none added: those the tracker did not lose, as (K',) s, (K', d) m, (K', d) m/s."""
+        before, kept = self._last_time, []
+        try:
+            for row in zip(times, positions, velocities):
+                checked = self._checked(*row)
+                if checked is not None:
+                    kept.append(checked)
+                    self._last_time = checked[0]
+        finally:
+            after, self._last_time = self._last_time, before
+        if not kept:
+            self._last_time = after                         # a lost sample's time, before any tracked one
+            return times[:0], positions[:0], velocities[:0]
+        return tuple(np.array(column) for column in zip(*kept))
+
+    def _checked_at_once(self, times: np.ndarray, positions: np.ndarray, velocities: np.ndarray) -> bool:
+        """Whether every row of (K,) s, (K, d) m, (K, d) m/s passes :meth:`_checked` without a word: all finite, the
+        times increasing from after the previous observation's, and none that :meth:`_check_plausible` warns of."""
+        if not (np.all(np.isfinite(times)) and np.all(np.isfinite(positions)) and np.all(np.isfinite(velocities))
+                and times[0] >= 0 and times[0] > self._last_time and np.all(np.diff(times) > 0)):
+            return False
+        if self._warned:
+            return True
+        offset = positions - self.start_position
+        return bool(times[-1] <= MAX_REACH_DURATION_S
+                    and (offset * offset).sum(axis=1).max() <= MAX_HUMAN_REACH_M ** 2
+                    and (velocities * velocities).sum(axis=1).max() <= (10 * MAX_HUMAN_HAND_SPEED_M_S) ** 2)
+
+    @property
+    def latest(self) -> GoalEstimate | None:
+        """The last estimate, None before the first update."""
+        if self._rest_pending:
+            self._rest_pending = False
+            self._latest = self._result(self.explanations[0].explain(self._hand, self._latest), time.perf_counter(),
+                                        with_forecast=False)
+        return self._latest
+
+    def _added_and_estimated(self, t_begin: float, time_s: float, position: np.ndarray, velocity: np.ndarray,
+                             forecast: bool) -> GoalEstimate:
+        """A checked observation added and estimated (the at-rest estimate before it made first, since the
+        explanations read it): the estimate."""
+        if self._rest_pending:
+            self.latest                                     # noqa: B018 (made from the trace before this observation)
+        self._add(time_s, position, velocity)
+        with self._blas:                                    # threads only slow products of this size down
+            self._latest = self._estimate(t_begin, forecast)
+        return self._latest
+
+    def _add(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
+        self._last_time = time_s
+        self._hand.append(time_s, position, velocity)
+
+    def _checked(self, time_s, position, velocity) -> tuple[float, np.ndarray, np.ndarray] | None:
+        """The observation checked by :meth:`update`'s rules: (time_s s, position (d,) m, velocity (d,) m/s); None
+        for a sample the tracker lost."""
         model = self.model
         if isinstance(time_s, bool) or not isinstance(time_s, (int, float, np.integer, np.floating)) or not math.isfinite(time_s):
             raise ValueError(f"time_s must be a finite time in s since the start, got {time_s!r}")
@@ -245,20 +338,14 @@ class OnlineGoalEstimator:
             # a sample the tracker lost: skipped, the estimate stands until the next good one
             if self.latest is None:
                 self._last_time = time_s
-                return self._result(Explained.explaining(self.prior_mean, self.prior_cov, EstimateStatus.UNINFORMATIVE,
-                                                         "no tracked sample yet: the estimate is the prior"), t_begin)
-            return self.latest
+            return None
         position = as_vector("position", position, model.d, "hand position, m")
         velocity = as_vector("velocity", velocity, model.d, "hand velocity, m/s")
         if time_s == self._last_time:
             raise ValueError(f"time_s {time_s:g} s repeats the previous observation's time; each observation needs its "
                              "own time (a sample sent twice: send it once)")
         self._check_plausible(time_s, position, velocity)
-        self._last_time = time_s
-        self._hand.append(time_s, position, velocity)
-        with self._blas:                                    # threads only slow products of this size down
-            self.latest = self._estimate(t_begin, forecast)
-        return self.latest
+        return time_s, position, velocity
 
     def _check_plausible(self, time_s: float, position: np.ndarray, velocity: np.ndarray) -> None:
         """A warning, once per reach, for an observation no person's reach makes: a time over a minute since

@@ -43,6 +43,15 @@ class HandTrace:
         row[0], row[1:1 + self.d], row[1 + self.d:] = time_s, position, velocity
         self.count += 1
 
+    def extend(self, times_s: np.ndarray, positions: np.ndarray, velocities: np.ndarray) -> None:
+        """Observations (K,) s, (K, d) m, (K, d) m/s appended in order."""
+        count = len(times_s)
+        while self.count + count > len(self._rows):
+            self._rows = np.concatenate([self._rows, np.zeros_like(self._rows)])
+        rows = self._rows[self.count:self.count + count]
+        rows[:, 0], rows[:, 1:1 + self.d], rows[:, 1 + self.d:] = times_s, positions, velocities
+        self.count += count
+
     @property
     def t(self) -> np.ndarray:
         return self._rows[:self.count, 0]
