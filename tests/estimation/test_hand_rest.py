@@ -3,7 +3,7 @@
 import numpy as np
 
 import comanip
-from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S, has_left, resting_position
+from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S, has_left, resting_position, too_far_apart_to_rest
 
 
 def noisy_reach(seed=0, step=0.01, noise=1e-3):
@@ -26,6 +26,28 @@ def test_rest_is_read_from_positions_within_the_radius_over_the_window():
     assert resting_position(t[:5], still[:5]) is None            # seen for less than the window
     creeping = np.outer(t, [0.03, 0, 0])                         # 3 cm/s: 3 mm in the window, inside the radius
     assert resting_position(t, creeping) is not None and resting_position(t, creeping, creep=0.02) is None
+
+
+def test_a_window_whose_ends_are_too_far_apart_to_rest_has_no_rest():
+    rng = np.random.default_rng(3)
+    t = np.arange(0.0, 1.5 * REST_WINDOW_S, 0.004)
+    first = int(np.searchsorted(t, t[-1] - REST_WINDOW_S))
+    refused = 0
+    for spread, drift in rng.uniform([0.2, 0.0], [3.0, 3.0], (400, 2)):
+        position = (rng.normal(0, spread * REST_RADIUS_M / 2, (len(t), 3))
+                    + np.outer(t / REST_WINDOW_S, rng.normal(0, drift * REST_RADIUS_M, 3)))
+        if too_far_apart_to_rest(position[first], position[-1]):
+            refused += 1
+            assert resting_position(t, position) is None
+    assert 50 < refused < 350                                    # both kinds of window were drawn
+
+
+def test_a_hand_resting_between_two_points_more_than_a_radius_apart_still_rests():
+    t = np.arange(0.0, 0.3, 0.01)
+    position = np.zeros((len(t), 3))
+    position[:, 0] = np.where(np.arange(len(t)) % 2, 0.9, -0.9) * REST_RADIUS_M   # samples 1.8 radii apart
+    assert not too_far_apart_to_rest(position[0], position[1])
+    assert resting_position(t, position) is not None
 
 
 def test_a_noisy_tracked_hand_keeps_one_status_before_its_reach_and_its_goal_once_it_rests():

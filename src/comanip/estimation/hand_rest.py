@@ -59,6 +59,16 @@ def fitted_velocity(t: np.ndarray, position: np.ndarray) -> FittedVelocity:
     return FittedVelocity(slope, float(np.sqrt(float((residual * residual).sum()) / max(len(times) - 2, 1) / spread)))
 
 
+def too_far_apart_to_rest(first, last, radius: float = REST_RADIUS_M) -> bool:
+    """True when two positions (d,) m of one window lie more than twice ``radius`` (m) apart, so that no mean lies
+    within ``radius`` of both and the hand does not rest over that window (:func:`resting_position` says None);
+    a test without arrays, for a stream's every sample."""
+    gap = 0.0
+    for a, b in zip(first, last):
+        gap += (a - b) * (a - b)
+    return gap > 4.0 * radius * radius * (1.0 + 1e-9)
+
+
 def resting_position(t: np.ndarray, position: np.ndarray, window: float = REST_WINDOW_S, radius: float = REST_RADIUS_M,
                      creep: float = np.inf) -> np.ndarray | None:
     """The mean position (d,) m of the last ``window`` s when the hand rests there (module docstring), else None.

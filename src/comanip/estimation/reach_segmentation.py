@@ -27,7 +27,8 @@ import numpy as np
 
 from comanip.arguments import as_positive
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S, fitted_velocity, has_left, resting_position
+from comanip.estimation.hand_rest import (REST_RADIUS_M, REST_WINDOW_S, fitted_velocity, has_left, resting_position,
+                                          too_far_apart_to_rest)
 
 START_SPAN = 0.05
 """Span (s) of the positions whose fitted velocity tells a reach leaving its rest from a drift."""
@@ -138,5 +139,9 @@ class ReachSegmenter:
     def _resting(self, samples) -> np.ndarray | None:
         """Where the hand rests over the last window of ``samples`` ((t, position, velocity) ...), or None."""
         s = self.settings
+        newest = samples[-1]
+        oldest = next(k for k in samples if k[0] >= newest[0] - s.window)   # the window's first sample
+        if too_far_apart_to_rest(oldest[1], newest[1], s.radius):          # a moving hand's every sample: no arrays
+            return None
         return resting_position(np.array([k[0] for k in samples]), np.array([k[1] for k in samples]), s.window, s.radius,
                                 creep=s.creep)
