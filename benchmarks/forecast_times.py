@@ -32,6 +32,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from solve_times import reference_source, worker_reply  # noqa: E402  (beside this script)
+
 ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
 SLOWEST = 3
 """Slowest updates listed per preset and source."""
@@ -173,16 +176,7 @@ def serve(presets: list[str], count: int, seed: int, with_stages: bool) -> None:
         model, _, reaches = built[which]
         print(json.dumps(timed_reach(model, reaches[k], stages[which])), flush=True)
         if k == len(reaches) - 1:
-            print(json.dumps(stages[which]), flush=True)
-
-
-def _reply(worker: subprocess.Popen):
-    while True:
-        line = worker.stdout.readline()
-        if not line:
-            raise RuntimeError(f"benchmark worker {worker.args} ended early (exit code {worker.wait()})")
-        if line.startswith(("{", "[")):
-            return json.loads(line)
+            print(json.dumps(stages[which] or {}), flush=True)   # one JSON object, stages timed or not
 
 
 def measure(srcs: list[Path], presets: list[str], count: int, repeats: int, seed: int, with_stages: bool) -> list[list[dict]]:
@@ -191,7 +185,7 @@ def measure(srcs: list[Path], presets: list[str], count: int, repeats: int, seed
     args = [sys.executable, __file__, "--serve", "--presets", ",".join(presets), "--reaches", str(count), "--seed", str(seed)]
     workers = [subprocess.Popen(args + (["--stages"] if with_stages else []), stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                 text=True, env={**os.environ, "PYTHONPATH": str(src)}) for src in srcs]
-    heads = [_reply(worker) for worker in workers]
+    heads = [worker_reply(worker) for worker in workers]
     out = [[] for _ in workers]
     for which, (label, size) in enumerate(heads[0]):
         per_reach, stages = [[] for _ in workers], [None for _ in workers]
@@ -200,9 +194,9 @@ def measure(srcs: list[Path], presets: list[str], count: int, repeats: int, seed
                 for w, worker in enumerate(workers):
                     worker.stdin.write(f"{which} {k}\n")
                     worker.stdin.flush()
-                    per_reach[w].append(_reply(worker))
+                    per_reach[w].append(worker_reply(worker))
                     if k == size - 1:
-                        stages[w] = _reply(worker)
+                        stages[w] = worker_reply(worker)
         for w in range(len(workers)):
             out[w].append(summary(label, per_reach[w], stages[w] if with_stages else None))
         print(f"  {label}: done", file=sys.stderr, flush=True)
@@ -261,8 +255,6 @@ def main(argv=None):
     if args.compare is None:
         print(markdown(measure([here], presets, args.reaches, args.repeats, args.seed, args.stages), ["this code"], command))
         return
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from solve_times import reference_source
     source, clean_up = reference_source(args.compare)
     try:
         results = measure([here, source], presets, args.reaches, args.repeats, args.seed, args.stages)

@@ -39,6 +39,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import workspace  # noqa: E402  (the sampled problem sets beside this script)
+from solve_times import worker_reply  # noqa: E402
 
 CASES = ("warm", "cold", "cold_moving")
 SOLVERS = ("newton", "ipopt")
@@ -84,22 +85,13 @@ def serve(preset: str) -> None:
         print(json.dumps({"runs": [problems.solve(solver, case, k) for k in range(int(first), int(last))]}), flush=True)
 
 
-def _reply(worker: subprocess.Popen):
-    while True:
-        line = worker.stdout.readline()
-        if not line:
-            raise RuntimeError(f"benchmark process {worker.args} ended early (exit code {worker.wait()})")
-        if line.startswith("{"):
-            return json.loads(line)
-
-
 def rows(preset: str, sources: dict[str, Path], repeats: int, block: int, blas_threads: int) -> list[str]:
     threads = {name: str(blas_threads) for name in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS")}
     workers = {label: subprocess.Popen([sys.executable, __file__, "--serve", preset], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
                                        text=True, env={**os.environ, **threads, "PYTHONPATH": str(src)})
                for label, src in sources.items()}
     for worker in workers.values():
-        _reply(worker)
+        worker_reply(worker)
     lines = []
     for case in CASES:
         runs = {(label, solver): [] for label in workers for solver in SOLVERS}
@@ -109,7 +101,7 @@ def rows(preset: str, sources: dict[str, Path], repeats: int, block: int, blas_t
                 for solver in (SOLVERS if b % 2 == 0 else SOLVERS[::-1]):
                     worker.stdin.write(f"{solver} {case} {first} {last}\n")
                     worker.stdin.flush()
-                    runs[label, solver] += _reply(worker)["runs"]
+                    runs[label, solver] += worker_reply(worker)["runs"]
         for label in workers:
             newton, ipopt = (np.array(runs[label, solver], dtype=float) for solver in SOLVERS)
             gap = np.abs(newton[:, 1] - ipopt[:, 1]) / np.abs(ipopt[:, 1])

@@ -29,6 +29,9 @@ import numpy as np
 
 import comanip
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from solve_times import reference_source, worker_reply  # noqa: E402  (beside this script)
+
 
 def stream_of_reaches(seconds: float, rate: float, noise: float, seed: int = 0):
     """Times (K,) s, positions (K, 3) m, velocities (K, 3) m/s of the stream (module docstring), and its reach count."""
@@ -74,16 +77,6 @@ def serve(seconds: float, rate: float, noise: float, preset: str) -> None:
         print(json.dumps(out), flush=True)
 
 
-def _reply(worker: subprocess.Popen) -> dict:
-    """The next JSON line a ``--serve`` process writes (other output on its stdout is skipped)."""
-    while True:
-        line = worker.stdout.readline()
-        if not line:
-            raise RuntimeError(f"benchmark worker {worker.args} ended early (exit code {worker.wait()})")
-        if line.startswith("{"):
-            return json.loads(line)
-
-
 def measure(srcs: list[Path], args) -> tuple[dict, list[dict]]:
     """The stream's size and, per checkout (``srcs``), every sample's update time, reach flag and reach count; each
     checkout in its own process, the processes taking turns second by second of the stream."""
@@ -91,14 +84,14 @@ def measure(srcs: list[Path], args) -> tuple[dict, list[dict]]:
                "--noise", str(args.noise), "--preset", args.preset]
     workers = [subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE, text=True,
                                 env={**os.environ, "PYTHONPATH": str(src)}) for src in srcs]
-    head = [_reply(worker) for worker in workers][0]
+    head = [worker_reply(worker) for worker in workers][0]
     runs = [{"ms": [], "moving": [], "reach": []} for _ in workers]
     chunk = max(1, int(args.rate))
     for a in range(0, head["samples"], chunk):
         for worker, run in zip(workers, runs):
             worker.stdin.write(f"{a} {min(a + chunk, head['samples'])}\n")
             worker.stdin.flush()
-            for key, values in _reply(worker).items():
+            for key, values in worker_reply(worker).items():
                 run[key] += values
         print(f"  {a / args.rate:.0f} s", file=sys.stderr, end="\r", flush=True)
     for worker in workers:
@@ -108,6 +101,8 @@ def measure(srcs: list[Path], args) -> tuple[dict, list[dict]]:
 
 
 def _stats(values: np.ndarray, largest: bool = True) -> str:
+    if not len(values):
+        return "–"
     parts = [np.median(values), np.percentile(values, 95)] + ([values.max()] if largest else [])
     return " / ".join(f"{v:.2f}" for v in parts)
 
@@ -128,7 +123,7 @@ def table(head: dict, runs: list[dict], names: list[str], args) -> str:
             first = part & (np.diff(run["reach"], prepend=0) > 0)
             lines.append(f"| {label} | {name} | {part.sum()} | {_stats(run['ms'][part])} | "
                          f"{_stats(run['ms'][part & run['moving']], largest=False)} | "
-                         + (_stats(run["ms"][first]) if first.any() else "–") + " |")
+                         + _stats(run["ms"][first]) + " |")
     lines += ["", f"Measured by `benchmarks/reach_stream_times.py {' '.join(sys.argv[1:])}` (1-minute load average at "
               f"the end {os.getloadavg()[0]:.2f})."]
     return "\n".join(lines)
@@ -150,8 +145,6 @@ def main(argv=None):
     if args.compare is None:
         print(table(*measure([here], args), ["this code"], args))
         return
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from solve_times import reference_source
     source, clean_up = reference_source(args.compare)
     try:
         head, runs = measure([here, source], args)

@@ -450,20 +450,20 @@ def measure_side_by_side(sources: list[Path], key: str, repeats: int) -> list[di
     workers = [subprocess.Popen([sys.executable, __file__, "--only", key, "--serve"], stdin=subprocess.PIPE,
                                 stdout=subprocess.PIPE, text=True, env={**os.environ, "PYTHONPATH": str(src)})
                for src in sources]
-    heads = [_reply(worker) for worker in workers]  # each has built its case
+    heads = [worker_reply(worker) for worker in workers]  # each has built its case
     runs = [[] for _ in workers]
     for k in range(repeats if heads[0]["size"] is None else min(repeats, heads[0]["size"])):
         for worker, run in zip(workers, runs):
             worker.stdin.write(f"{k}\n")
             worker.stdin.flush()
-            run.append(Timed(*_reply(worker)))
+            run.append(Timed(*worker_reply(worker)))
     for worker in workers:
         worker.stdin.close()
         worker.wait()
     return [summary(head["name"], head["build_s"], head["paper_s"], run) for head, run in zip(heads, runs)]
 
 
-def _reply(worker: subprocess.Popen):
+def worker_reply(worker: subprocess.Popen):
     """The next JSON line a ``--serve`` process writes (other output on its stdout is skipped)."""
     while True:
         line = worker.stdout.readline()
