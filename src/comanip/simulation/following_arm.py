@@ -62,7 +62,7 @@ class FollowedAxes:
 
     def start(self, intended_position) -> None:
         """Begin a reach with the intention at rest at intended_position (3,) m: the next :meth:`apply` takes the
-        hand as the held position and the arm's force around this intention as F_hold."""
+        hand as the held position and the arm's force around this intention, the hand at rest there, as F_hold."""
         self._rest = np.array(intended_position, dtype=float)
         self._held = None
 
@@ -75,7 +75,7 @@ class FollowedAxes:
             return
         if self._held is None:
             self._held, self._time, self._offset = position[a].copy(), t, self._rest[a] - position[a]
-            self._holding = self._holding_impedance(self._rest, np.zeros(3), position, velocity)[a]
+            self._holding = self._holding_impedance(self._rest, np.zeros(3), position, np.zeros(3))[a]
         else:
             self._held += (1.0 - np.exp(-(t - self._time) / arm.time_constant)) * (position[a] - self._held)
             self._time = t
