@@ -130,6 +130,14 @@ def arrival_measures(record: TrialRecord, person_axes, robot_axes, mt: float) ->
                                    (peaks[1] - peaks[0]) / mt, height_error]))
 
 
+def speed_profiles(record: TrialRecord, grid: np.ndarray, person_axes=(0, 1), robot_axes=(2,)) -> np.ndarray:
+    """The handle's speed on the person's axes, ||xdot_{L_p}||, and on the robot's, ||xdot_{L_r}|| (m/s), at the
+    normalised times grid (P,) = t / MT (the paper's Fig. 7): (P, 2), NaN beyond the trial's end."""
+    mt = movement_time(record)
+    speeds = [np.linalg.norm(record.velocity[:, list(axes)], axis=1) for axes in (person_axes, robot_axes)]
+    return np.column_stack([np.interp(grid * mt, record.t, speed, right=np.nan) for speed in speeds])
+
+
 def goal_error_measures(record: TrialRecord, mt: float) -> dict:
     """Goal-estimate error (m) at the first estimate, at ERROR_FRACTIONS of mt (s), its mean from the first
     estimate to mt, and at the end; all NaN when the record holds no estimate."""
