@@ -26,7 +26,7 @@ def plot_speed_profiles(results: dict, path: str | Path, policies=None, title: s
         for row, name in enumerate(policies):
             ax = axes[row, column]
             profiles = np.stack([speed_profiles(trial.record, GRID) for trial in results[goal][name]])   # (N, P, 2)
-            for k, (label, color) in enumerate([("person: x–y speed", "tab:blue"), ("robot: z speed", "tab:orange")]):
+            for k, (label, color) in enumerate([("x–y speed (the person's axes)", "tab:blue"), ("z speed (the robot's axis)", "tab:orange")]):
                 mean, std = np.nanmean(profiles[:, :, k], axis=0), np.nanstd(profiles[:, :, k], axis=0)
                 ax.plot(GRID, mean, color=color, lw=1.5, label=label)
                 ax.fill_between(GRID, mean - std, mean + std, color=color, alpha=0.2, lw=0)
