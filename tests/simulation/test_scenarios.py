@@ -155,3 +155,5 @@ def test_cli_rejects_bad_input_before_building_anything(capsys):
     assert "release_trigger must be one of goal_distance, estimate, got 'time'" in capsys.readouterr().err
     assert main(["simulate", "sync", "--trigger", "estimate"]) == 2
     assert "--trigger applies to the handover scenario only" in capsys.readouterr().err
+    assert main(["simulate", "handover", "--person-leads-height"]) == 2
+    assert "--person-leads-height applies to the sync scenario only" in capsys.readouterr().err
