@@ -177,10 +177,11 @@ people move a heavy handle more slowly than a fingertip, and at the recorded pac
 would take 6 times the force. The handle's movement takes {sync['movement_time_s']:.2f} s, at up to
 {sync['peak_speed_m_per_s']:.2f} m/s. This is the paper's synchronisation task: the person leads x–y and leaves the height to
 the robot, their arm following it; from t_o = {sync['observation_time_s']:.1f} s the robot leads the height along its online
-estimate of the person's goal (`{sync['policy']}` policy), to arrive in step with them. It does so to within
-{sync['arrival_lag_mt']:+.3f} MT (the height's arrival minus the person's horizontal arrival, over the movement time), its
-speed peak {sync['peak_lag_mt']:+.3f} MT from theirs, the height {1e3 * sync['height_error_at_arrival_m']:.1f} mm from the table
-when the person arrives. The figure shows what this section names:
+estimate of the person's goal (`{sync['policy']}` policy), to arrive in step with them. The height arrives
+{sync['arrival_lag_mt']:+.3f} MT after the person's horizontal arrival (over the movement time; negative: before), its speed
+peaks {sync['peak_lag_mt']:+.3f} MT after theirs, and when the person arrives the height is
+{1e3 * sync['height_error_at_arrival_m']:.1f} mm from the table (in step would be within 0.05 MT and 5 mm). The figure shows
+what this section names:
 
 - **{QUANTITIES['goal']}** (top left): at the end of the trial the goal estimate is {1e3 * sync['goal_error_final_m']:.1f} mm
   from the person's goal, at half the movement {100 * sync['goal_error_50pct_m']:.1f} cm; the handle ends
