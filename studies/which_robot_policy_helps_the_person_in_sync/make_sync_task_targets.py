@@ -29,7 +29,7 @@ from comanip.plots.sync_speed_profiles import plot_speed_profiles  # noqa: E402
 from comanip.simulation import PersonParameters, ScenarioSetup, SyncSettings  # noqa: E402
 from comanip.simulation.policies import POLICIES  # noqa: E402
 from comanip.simulation.policy_comparison import compare_with_people, people_rows, people_table  # noqa: E402
-from comanip.simulation.sync_targets import pairs_table, target_rows, targets_table  # noqa: E402
+from comanip.simulation.sync_targets import pairs_table, robots_table, target_rows, targets_table  # noqa: E402
 from studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison import ARM_REACHES, ONLINE_PRESETS  # noqa: E402
 from studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison import (  # noqa: E402
     GOALS, add_run_arguments, load_runs, save_run)
@@ -116,6 +116,9 @@ def block(results: dict, trials: int, seed: int, wall: float, variant: bool) -> 
             f"Per person and goal (bold: the target missed; the guiding force, {low:.0f}–{high:.0f} N, is asked of "
             f"{', '.join(p for p in GUIDING_PEOPLE if p in results)}):\n\n"
             f"{pairs_table(rows)}\n"
+            f"Every robot held to the same targets (pairs meeting each; \"below every other robot's\" against all the "
+            f"others):\n\n"
+            f"{robots_table(results, GUIDING_FORCE_N, GUIDING_PEOPLE)}\n"
             f"Every robot's RMS force change (mean ± std over the trials; paired differences `forecast` minus the other "
             f"robot, mean ± standard error):\n\n"
             f"{people_table(people_rows(results), policies, goal_error=False)}\n"

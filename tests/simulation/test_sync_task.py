@@ -8,7 +8,8 @@ import pytest
 
 from comanip.simulation import ScenarioSetup, SyncSettings, TrialRecord
 from comanip.simulation.following_arm import FollowedAxes, FollowingArm
-from comanip.simulation.measures import ARRIVAL_PROGRESS, arrival_measures
+from comanip.analysis.speed_profile import SETTLING_FRACTION
+from comanip.simulation.measures import arrival_measures
 from comanip.simulation.person import PersonParameters
 from comanip.simulation.policies import POLICIES
 from comanip.simulation.policies.admittance import AdmittancePolicy
@@ -68,11 +69,12 @@ def test_arrival_measures_match_hand_computations_on_minimum_jerk_axes():
     position = np.column_stack([start[:2] + np.outer(sigma(s_xy), goal[:2] - start[:2]),
                                 start[2] + sigma(s_z) * (goal[2] - start[2])])
     m = arrival_measures(_record(t, position, goal), (0, 1), (2,), mt=1.25)
-    arrival = t[np.argmax(sigma(s_xy) >= ARRIVAL_PROGRESS)]
-    assert m["person_arrival_s"] == pytest.approx(arrival, abs=1e-3)
+    # a minimum-jerk speed 30 s²(1 - s)² / T falls below the fraction f of its peak (1.875 / T) at s(1 - s) = sqrt(1.875 f / 30)
+    s_arrival = (1 + np.sqrt(1 - 4 * np.sqrt(1.875 * SETTLING_FRACTION / 30))) / 2
+    assert m["person_arrival_s"] == pytest.approx(s_arrival, abs=2e-3)
     assert m["arrival_lag_mt"] == pytest.approx(0.2 / 1.25, abs=2e-3)
     assert m["person_peak_speed_s"] == pytest.approx(0.5, abs=2e-3) and m["peak_lag_mt"] == pytest.approx(0.2 / 1.25, abs=2e-3)
-    assert m["height_error_at_arrival_m"] == pytest.approx((1 - sigma(arrival - 0.2)) * 0.3, rel=1e-2)
+    assert m["height_error_at_arrival_m"] == pytest.approx((1 - sigma(s_arrival - 0.2)) * 0.3, rel=1e-2)
 
 
 def _context(start, height=0.2) -> PolicyContext:
@@ -141,11 +143,13 @@ def _median(trials, key):
 
 @pytest.mark.slow
 def test_a_robot_that_leads_the_height_late_loses_to_one_that_leads_it_in_step(task_runs):
+    """Late: its speed peak comes well after the person's, and the person's horizontal arrival waits for the height
+    (the handle still moves while the robot lowers it)."""
     _, runs = task_runs
     in_step, late = runs["onset-minimum-jerk"], runs[LateOnsetPolicy.name]
-    assert abs(_median(late, "arrival_lag_mt")) > abs(_median(in_step, "arrival_lag_mt"))
-    assert abs(_median(late, "peak_lag_mt")) > abs(_median(in_step, "peak_lag_mt"))
-    assert _median(late, "height_error_at_arrival_m") > _median(in_step, "height_error_at_arrival_m")
+    assert _median(late, "peak_lag_mt") > abs(_median(in_step, "peak_lag_mt")) + 0.1
+    assert _median(late, "person_arrival_s") > _median(in_step, "person_arrival_s")
+    assert _median(late, "movement_time_s") > _median(in_step, "movement_time_s")
 
 
 @pytest.mark.slow

@@ -15,11 +15,12 @@ that every robot is passive alike), the other measures over the whole trial.
   p_L(t) = (x_L(t) - x_L(0)) · (g_L - x_L(0)) / ||g_L - x_L(0)||² of each group toward the goal, their
   RMS difference over the movement [0, MT] (dimensionless: 0.1 is 10 % of the reach), and the lag
   (s) between the times each group first passes half its way (positive: the robot's axes come later);
-- **arrival in step** (the paper's synchronisation: peak speeds together, arriving together): the person's
-  horizontal arrival t_p, when p_{L_p} first passes :data:`ARRIVAL_PROGRESS`, and the robot's height arrival t_r,
-  when p_{L_r} does; the arrival lag (t_r - t_p) / MT; the times of the peaks of the speeds ||xdot_{L_p}|| and
-  ||xdot_{L_r}||, and their lag (robot's minus person's) / MT; and the height error ||x_{L_r}(t_p) - g_{L_r}|| (m)
-  at the person's arrival (NaN where an arrival never comes);
+- **arrival in step** (the paper's synchronisation: peak speeds together, arriving together): each group's speed
+  profile, ||xdot_{L_p}|| for the person's axes and ||xdot_{L_r}|| for the robot's, read as docs/formulation.md §6
+  reads the handle's (:func:`comanip.analysis.speed_profile.speed_metrics`): its peak time and its movement time,
+  the arrival (the speed first below 5 % of its peak after it); the person's horizontal arrival t_p, the robot's
+  height arrival t_r, the arrival lag (t_r - t_p) / MT and the lag of the robot's speed peak after the person's / MT;
+  and the height error ||x_{L_r}(t_p) - g_{L_r}|| (m) when the person arrives (NaN where an arrival never comes);
 - **goal-estimate error** ||g_hat(t) - g|| (m) at the first estimate, at 25/50/75 % of MT, its mean over
   [first estimate, MT], and at the end of the trial;
 - **completion time** (s): when the handle comes within w/2 of the goal on every axis and stays there
@@ -35,9 +36,6 @@ import numpy as np
 from comanip.analysis.speed_profile import speed_metrics
 from comanip.arguments import as_positive
 from comanip.simulation.scenario import TrialRecord, reach_times
-
-#: Progress toward the goal (dimensionless) at which a group of axes has arrived.
-ARRIVAL_PROGRESS = 0.95
 
 #: Fractions of the movement time at which the goal-estimate error is reported.
 ERROR_FRACTIONS = (0.25, 0.5, 0.75)
@@ -119,15 +117,13 @@ def arrival_measures(record: TrialRecord, person_axes, robot_axes, mt: float) ->
     axes later), the height error at the person's arrival (m)."""
     t = record.t
     person_axes, robot_axes = list(person_axes), list(robot_axes)
-    arrivals = [first_passage(t, progress_toward(record.position[:, axes], record.goal[axes]), ARRIVAL_PROGRESS)
-                for axes in (person_axes, robot_axes)]
-    peaks = [float(t[np.argmax(np.linalg.norm(record.velocity[:, axes], axis=1))]) for axes in (person_axes, robot_axes)]
+    person, robot = (speed_metrics(t, np.linalg.norm(record.velocity[:, axes], axis=1)) for axes in (person_axes, robot_axes))
     height_error = float("nan")
-    if np.isfinite(arrivals[0]):
-        at = np.array([np.interp(arrivals[0], t, record.position[:, a]) for a in robot_axes])
+    if np.isfinite(person.movement_time):
+        at = np.array([np.interp(person.movement_time, t, record.position[:, a]) for a in robot_axes])
         height_error = float(np.linalg.norm(at - record.goal[robot_axes]))
-    return dict(zip(ARRIVAL_KEYS, [arrivals[0], arrivals[1], (arrivals[1] - arrivals[0]) / mt, peaks[0], peaks[1],
-                                   (peaks[1] - peaks[0]) / mt, height_error]))
+    return dict(zip(ARRIVAL_KEYS, [person.movement_time, robot.movement_time, (robot.movement_time - person.movement_time) / mt,
+                                   person.t_peak, robot.t_peak, (robot.t_peak - person.t_peak) / mt, height_error]))
 
 
 def speed_profiles(record: TrialRecord, grid: np.ndarray, person_axes=(0, 1), robot_axes=(2,)) -> np.ndarray:

@@ -101,6 +101,18 @@ def targets_table(rows: list[dict]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def robots_table(results: dict, guiding_force: tuple[float, float], guiding_people=None) -> str:
+    """Every policy of results as the candidate in turn: per target the pairs meeting it, as a markdown table (what
+    each robot would score on the targets the candidate is held to)."""
+    policies = list(next(iter(next(iter(results.values())).values())))
+    headings = ["robot"] + [REQUIRED[target][0] for target in REQUIRED]
+    lines = ["| " + " | ".join(headings) + " |", "|" + "---|" * len(headings)]
+    for name in policies:
+        summary = target_summary(target_rows(results, guiding_force, name, guiding_people))
+        lines.append("| " + " | ".join([name] + [f"{met} of {asked}" for met, asked, _ in summary.values()]) + " |")
+    return "\n".join(lines) + "\n"
+
+
 def pairs_table(rows: list[dict]) -> str:
     """Per person and goal, the candidate's values and each target's verdict, as a markdown table."""
     headings = ["person", "goal", "n", "RMS force change (N)", "lightest other robot (N)", "peak force change (N)",
