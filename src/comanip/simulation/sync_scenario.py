@@ -5,9 +5,13 @@ a robot policy (:mod:`comanip.simulation.policies`) predicts the goal and a rest
 motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. The default policy,
 ``one-shot``, is the paper's: it estimates the goal and the person's whole trajectory once, at t_o
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
-baselines (prior goal only, constant velocity, minimum-jerk fit), the passive robot, and comanip's online
-estimate, leading along the model's reach to its goal (``continuous``) or along its forecast of the hand
-(``forecast``).
+baselines (prior goal only, constant velocity, minimum-jerk fit, the height on a fixed minimum-jerk clock from the
+onset), the passive robot, an admittance robot that follows the person's force, and comanip's online estimate,
+leading along the model's reach to its goal (``continuous``) or along its forecast of the hand (``forecast``).
+
+The task is the paper's: the person leads x–y and their arm follows the height the robot leads
+(:mod:`comanip.simulation.following_arm`); with a robot that does not lead the height (passive, admittance), or in
+the variant ``SyncSettings.person_leads_height``, the person intends the height too (:func:`person_axes`).
 
 The person is the model's own by default; ``SyncSettings.person`` (:class:`comanip.simulation.person.PersonParameters`) makes them
 move at another pace (``pace``) or along a recorded movement (``hand_path="recorded"``), so that a robot is not
@@ -16,7 +20,8 @@ rewarded only for assuming the person is the model.
 Per trial: the goal estimate, the error between the predicted trajectory and the handle over time
 normalised by the movement time (paper Fig. 7, per axis), the time each axis reaches the goal, the
 velocity profiles of the person's intention and of the robot's end effector, and the co-manipulation
-measures of :mod:`comanip.simulation.measures` (interaction force, work, synchronisation, goal error over time).
+measures of :mod:`comanip.simulation.measures` (interaction force, work, synchronisation, arrival in step, goal error
+over time).
 """
 
 from __future__ import annotations
