@@ -45,8 +45,8 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                       ["studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py", "--trials", "10"]),
     "sync-task": ("the paper's synchronisation task: every robot policy with the model's person at four paces and recorded arm reaches at their speed and slower, the task's targets met or missed, 10 trials × 4 goals × 6 people (about an hour in one process; --people, --save and --load split it)",
                   ["studies/which_robot_policy_helps_the_person_in_sync/make_sync_task_targets.py", "--trials", "10"]),
-    "sync-task-variant": ("the same with a person who intends the height too (about an hour)",
-                          ["studies/which_robot_policy_helps_the_person_in_sync/make_sync_task_targets.py", "--trials", "10", "--variant"]),
+    "sync-task-variant": ("the same with a person who intends the height too, 5 trials × 4 goals × 6 people (about 30 min)",
+                          ["studies/which_robot_policy_helps_the_person_in_sync/make_sync_task_targets.py", "--trials", "5", "--variant"]),
     "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
                "planar,planar_cold,cartesian,cartesian_cold,planar_uncompiled,planar_cold_uncompiled,cartesian_uncompiled,"
