@@ -176,7 +176,7 @@ def robot_forecasts(result) -> list[Forecast]:
             forecasts.append(_forecast(policy.estimator.latest, record, movement_time))
             if len(forecasts) == len(wanted):
                 break
-        policy.observe(t, record.position[k], record.velocity[k])
+        policy.observe(t, record.position[k], record.velocity[k], record.person_force[k])
     return forecasts
 
 

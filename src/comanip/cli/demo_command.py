@@ -115,7 +115,7 @@ def _numbers(plan, prediction, trial, arm, forecasts, observation_time: float, s
     metrics = trial.metrics
     sync_keys = ("goal_error_final_m", "goal_error_50pct_m", "final_error_m", "movement_time_s", "peak_speed_m_per_s",
                  "peak_force_N", "rms_force_N", "peak_force_change_N", "rms_force_change_N", "sync_lag_s",
-                 "person_work_J", "work_against_robot_J")
+                 "person_work_J", "work_against_robot_J", "arrival_lag_mt", "peak_lag_mt", "height_error_at_arrival_m")
     movement_time = metrics["movement_time_s"]
     return {
         "plan": {"model": plan.model_name, "goal_m": list(demo.PLAN_GOAL), "status": plan.status, "success": bool(plan.success),
@@ -175,8 +175,13 @@ arm's inertia at the handle and the object). The person's hand follows the recor
 scaled and turned onto a reach to {[round(v, 2) for v in sync['goal_m']]} m and played 2.5 times slower (`{sync['person']}`):
 people move a heavy handle more slowly than a fingertip, and at the recorded pace the handle's inertia alone
 would take 6 times the force. The handle's movement takes {sync['movement_time_s']:.2f} s, at up to
-{sync['peak_speed_m_per_s']:.2f} m/s. The person leads x–y; from t_o = {sync['observation_time_s']:.1f} s the robot leads the height
-along its online estimate of the person's goal (`{sync['policy']}` policy). The figure shows what this section names:
+{sync['peak_speed_m_per_s']:.2f} m/s. This is the paper's synchronisation task: the person leads x–y and leaves the height to
+the robot, their arm following it; from t_o = {sync['observation_time_s']:.1f} s the robot leads the height along its online
+estimate of the person's goal (`{sync['policy']}` policy), to arrive in step with them. The height arrives
+{sync['arrival_lag_mt']:+.3f} MT after the person's horizontal arrival (over the movement time; negative: before), its speed
+peaks {sync['peak_lag_mt']:+.3f} MT after theirs, and when the person arrives the height is
+{1e3 * sync['height_error_at_arrival_m']:.1f} mm from the table (in step would be within 0.05 MT and 5 mm). The figure shows
+what this section names:
 
 - **{QUANTITIES['goal']}** (top left): at the end of the trial the goal estimate is {1e3 * sync['goal_error_final_m']:.1f} mm
   from the person's goal, at half the movement {100 * sync['goal_error_50pct_m']:.1f} cm; the handle ends
@@ -188,7 +193,7 @@ along its online estimate of the person's goal (`{sync['policy']}` policy). The 
   {sync['rms_force_change_N']:.1f} N), {against_range(sync['peak_force_change_N'], (low, high))} the {low:.0f}–{high:.0f} N people apply to guide a
   partner through a held contact (Sawers et al. 2017); the whole force peaks at {sync['peak_force_N']:.1f} N (RMS
   {sync['rms_force_N']:.1f} N), {against_range(sync['peak_force_N'], (low, high))} that range. Above the weight, the person's force
-  accelerates and brakes the handle and, where the robot's height is not the person's, pushes against the robot.
+  accelerates and brakes the handle and, where the robot moves the height, follows it with a relaxed arm.
 
 Look at how the forecasts close in on the hand's path as the reach goes on while the goal estimate settles, and at
 when the force peaks against the green band of what people apply.

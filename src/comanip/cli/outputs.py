@@ -35,6 +35,7 @@ FILE_KINDS = (
     ("sync_policies.csv", "robot policies compared: per goal and policy, median, q25 and q75 of every measure"),
     ("sync_policies.md", "the policy comparison as a markdown table (median [q25, q75])"),
     ("sync_policies.png", "figure: goal-estimate error over time and the measures per policy"),
+    ("sync_speed_profiles.png", "figure: the person's x–y and the robot's z speed over t / MT per goal and policy, mean ± std"),
     ("*_summary.json", "settings, per-trial metrics and their summaries for every goal"),
     ("handover_*.json", "handover schedule for one goal: transition time and position, stiffness over time"),
     ("handover_*.csv", "handover schedule for one goal, one row per time: rest position and stiffness"),

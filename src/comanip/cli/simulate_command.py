@@ -2,7 +2,9 @@
 under impedance control and a simulated person, in MuJoCo. Writes a figure, one CSV per trial, a summary
 JSON and (where offscreen rendering works) a frame strip per goal. For sync, ``--policy NAME|all`` chooses
 the robot (default: the paper's one-shot estimate) and writes a table (CSV and markdown, median and IQR
-over trials) and a figure comparing the policies over the same trials and person seeds, and ``--person``
+over trials) and figures comparing the policies over the same trials and person seeds (their measures; the
+person's x–y and the robot's z speed over t / MT), ``--person-leads-height`` makes the person intend the height too
+(default: the paper's task, the height the robot's), and ``--person``
 chooses the person (default: the model's own): ``model``, ``recorded`` (a recorded mouse movement), ``arm`` (a
 recorded arm reach of examples/data/arm_reaches), or a folder of your own arm reaches in the TAT-HUM layout,
 each optionally with ``-xP`` to play it P times slower (``arm-x2.5``) or faster (``model-x0.7``)."""
@@ -28,8 +30,12 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--kappa", type=float, help="the person's motor-noise variance (default: the preset's)")
     parser.add_argument("--seed", type=int, default=0, help="seed of the first trial (default: %(default)s)")
     parser.add_argument("--duration", type=float, help="simulated seconds per trial (default: the preset's horizon)")
-    parser.add_argument("--policy", help="sync only: the robot policy, one of passive, prior-only, constant-velocity, "
-                                         "minimum-jerk, one-shot (default), continuous, forecast, or all of them")
+    parser.add_argument("--policy", help="sync only: the robot policy, one of passive, admittance, prior-only, "
+                                         "constant-velocity, onset-minimum-jerk, minimum-jerk, one-shot (default), "
+                                         "continuous, forecast, or all of them")
+    parser.add_argument("--person-leads-height", action="store_true",
+                        help="sync only: the person intends the height too (default: the paper's task, the person "
+                             "leads x–y and follows the height the robot leads)")
     parser.add_argument("--trigger", help="handover only: what releases the robot, goal_distance (default: the handle "
                                           "within T of the known goal) or estimate (within T of the online goal estimate)")
     parser.add_argument("--person", help="sync only: who holds the handle, model (default: the reaching model's "
@@ -97,6 +103,10 @@ def scenario_settings(args) -> ScenarioChoice:
         if args.scenario != "handover":
             raise ValueError(f"--trigger applies to the handover scenario only, got scenario {args.scenario!r}")
         common["release_trigger"] = args.trigger
+    if args.person_leads_height:
+        if args.scenario != "sync":
+            raise ValueError(f"--person-leads-height applies to the sync scenario only, got scenario {args.scenario!r}")
+        common["person_leads_height"] = True
     if args.person is not None:
         if args.scenario != "sync":
             raise ValueError(f"--person applies to the sync scenario only, got scenario {args.scenario!r}")
@@ -133,11 +143,13 @@ def _write_policy_comparison(result, out: Path) -> list[Path]:
     if not result.policies:
         return []
     from comanip.plots.policy_comparison_figure import plot_policy_comparison
+    from comanip.plots.sync_speed_profiles import plot_speed_profiles
     from comanip.simulation.policy_comparison import write_comparison
     from comanip.simulation.report import write_trials
 
     files = write_comparison(result.policy_rows(), out / "sync_policies")
     files.append(plot_policy_comparison(result.policy_trials(), out / "sync_policies.png"))
+    files.append(plot_speed_profiles(result.policy_trials(), out / "sync_speed_profiles.png"))
     for label, goal in result.goals.items():
         files += [path for name, trials in goal.policies.items() if name != goal.settings.policy
                   for path in write_trials([trial.record for trial in trials], out, f"sync_{label}_{name}")]

@@ -91,7 +91,7 @@ class HandoverRobot:
         self.goal_estimate = self.trigger.goal_estimate
         self.controller.translational_stiffness = np.full(3, schedule.leading_stiffness)
 
-    def command(self, t: float, state: RobotState) -> RestTarget:
+    def command(self, t: float, state: RobotState, handle_force: np.ndarray) -> RestTarget:
         schedule = self.schedule
         if self.switch_time is None and self.trigger.due(t, state):
             self.switch_time, self.switch_position = t, state.position.copy()

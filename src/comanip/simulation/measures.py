@@ -15,6 +15,12 @@ that every robot is passive alike), the other measures over the whole trial.
   p_L(t) = (x_L(t) - x_L(0)) · (g_L - x_L(0)) / ||g_L - x_L(0)||² of each group toward the goal, their
   RMS difference over the movement [0, MT] (dimensionless: 0.1 is 10 % of the reach), and the lag
   (s) between the times each group first passes half its way (positive: the robot's axes come later);
+- **arrival in step** (the paper's synchronisation: peak speeds together, arriving together): each group's speed
+  profile, ||xdot_{L_p}|| for the person's axes and ||xdot_{L_r}|| for the robot's, read as docs/formulation.md §6
+  reads the handle's (:func:`comanip.analysis.speed_profile.speed_metrics`): its peak time and its movement time,
+  the arrival (the speed first below 5 % of its peak after it); the person's horizontal arrival t_p, the robot's
+  height arrival t_r, the arrival lag (t_r - t_p) / MT and the lag of the robot's speed peak after the person's / MT;
+  and the height error ||x_{L_r}(t_p) - g_{L_r}|| (m) when the person arrives (NaN where an arrival never comes);
 - **goal-estimate error** ||g_hat(t) - g|| (m) at the first estimate, at 25/50/75 % of MT, its mean over
   [first estimate, MT], and at the end of the trial;
 - **completion time** (s): when the handle comes within w/2 of the goal on every axis and stays there
@@ -89,13 +95,43 @@ def trial_measures(record: TrialRecord, width: float, person_axes=(0, 1), robot_
         p_robot = progress_toward(record.position[:, robot_axes], record.goal[robot_axes])
         measures["sync_error_rms"] = float(np.sqrt(np.mean((p_person - p_robot)[moving] ** 2)))
         measures["sync_lag_s"] = first_passage(t, p_robot, 0.5) - first_passage(t, p_person, 0.5)
+        measures.update(arrival_measures(record, person_axes, robot_axes, mt))
     else:
         measures["sync_error_rms"] = measures["sync_lag_s"] = float("nan")
+        measures.update(dict.fromkeys(ARRIVAL_KEYS, float("nan")))
     measures.update(goal_error_measures(record, mt))
     completion = reach_times(record, width / 2)
     measures["completion_time_s"] = float(np.max(completion)) if np.all(np.isfinite(completion)) else float("nan")
     measures["final_error_m"] = float(np.linalg.norm(record.position[-1] - record.goal))
     return measures
+
+
+#: The keys of :func:`arrival_measures`.
+ARRIVAL_KEYS = ("person_arrival_s", "robot_arrival_s", "arrival_lag_mt", "person_peak_speed_s", "robot_peak_speed_s",
+                "peak_lag_mt", "height_error_at_arrival_m")
+
+
+def arrival_measures(record: TrialRecord, person_axes, robot_axes, mt: float) -> dict:
+    """The arrival-in-step measures of the module docstring (:data:`ARRIVAL_KEYS`) for the axes each leads (lists of
+    indices), MT = mt (s): arrival and speed-peak times (s), their lags over MT (dimensionless, positive: the robot's
+    axes later), the height error at the person's arrival (m)."""
+    t = record.t
+    person_axes, robot_axes = list(person_axes), list(robot_axes)
+    person, robot = (speed_metrics(t, np.linalg.norm(record.velocity[:, axes], axis=1)) for axes in (person_axes, robot_axes))
+    height_error = float("nan")
+    if np.isfinite(person.movement_time):
+        at = np.array([np.interp(person.movement_time, t, record.position[:, a]) for a in robot_axes])
+        height_error = float(np.linalg.norm(at - record.goal[robot_axes]))
+    return dict(zip(ARRIVAL_KEYS, [person.movement_time, robot.movement_time, (robot.movement_time - person.movement_time) / mt,
+                                   person.t_peak, robot.t_peak, (robot.t_peak - person.t_peak) / mt, height_error]))
+
+
+def speed_profiles(record: TrialRecord, grid: np.ndarray, person_axes=(0, 1), robot_axes=(2,)) -> np.ndarray:
+    """The handle's speed on the person's axes, ||xdot_{L_p}||, and on the robot's, ||xdot_{L_r}|| (m/s), at the
+    normalised times grid (P,) = t / MT (the paper's Fig. 7): (P, 2), NaN beyond the trial's end."""
+    mt = movement_time(record)
+    speeds = [np.linalg.norm(record.velocity[:, list(axes)], axis=1) for axes in (person_axes, robot_axes)]
+    return np.column_stack([np.interp(grid * mt, record.t, speed, right=np.nan) for speed in speeds])
 
 
 def goal_error_measures(record: TrialRecord, mt: float) -> dict:

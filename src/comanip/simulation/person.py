@@ -32,6 +32,9 @@ p · replan_interval seconds), their intention x_d(t) = x_model(t / p) with velo
 efference copy stays in the model's units, so a plan from it is the model's plan. Past their planning horizon
 (s > H·h) the reach is over and the person holds the intention where it ended. A person whose intended hand
 path is a recorded movement is :class:`comanip.simulation.recorded_person.RecordedPerson`.
+
+On the axes the person does not lead (``PersonParameters.led_axes``; the paper's task: the height) the intention and
+the force are the following arm's (:mod:`comanip.simulation.following_arm`), whatever the plan does there.
 """
 
 from __future__ import annotations
@@ -46,6 +49,7 @@ from comanip.arguments import as_count, as_matrix, as_positive, as_vector
 from comanip.belief.noise import sample_torque_error
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
+from comanip.simulation.following_arm import FollowedAxes, FollowingArm
 
 
 #: The sources of a simulated person's intended hand motion (:attr:`PersonParameters.hand_path`).
@@ -80,6 +84,12 @@ class PersonParameters:
     """The person's duration relative to their intended motion's (dimensionless): that motion played over pace
     times its duration, positions unchanged, times × pace, velocities ÷ pace (module docstring). 1: the model's
     own pace (or the recording's); 0.7: 30 % faster; 1.3: 30 % slower."""
+    led_axes: tuple = (0, 1, 2)
+    """The axes the person's intention covers (indices of x, y, z). On the others a partner leads and the person's
+    arm follows (:mod:`comanip.simulation.following_arm`): (0, 1) is the paper's synchronisation task, the person
+    leading the horizontal motion and leaving the height to the robot; (0, 1, 2): the person intends every axis."""
+    following: FollowingArm = FollowingArm()
+    """The arm's impedance on the axes the person does not lead."""
     hand_path: Literal["model", "recorded", "recorded-arm"] = "model"
     """Where the intended hand motion comes from: ``"model"``, the reaching model's plan, re-planned every
     ``replan_interval``; ``"recorded"``, a recorded person's mouse movement (development split of the cursory
@@ -96,6 +106,21 @@ class PersonParameters:
         as_positive("pace", self.pace, "dimensionless")
         if self.hand_path not in HAND_PATHS:
             raise ValueError(f"hand_path must be one of {HAND_PATHS}, got {self.hand_path!r}")
+        led = tuple(self.led_axes) if isinstance(self.led_axes, (tuple, list)) else None
+        if not led or len(set(led)) != len(led) or not all(a in (0, 1, 2) for a in led):
+            raise ValueError(f"led_axes must be distinct axis indices among 0, 1, 2 (x, y, z), at least one, got {self.led_axes!r}")
+        object.__setattr__(self, "led_axes", tuple(sorted(led)))
+        if not isinstance(self.following, FollowingArm):
+            raise ValueError(f"following must be a FollowingArm, got {type(self.following).__name__}")
+
+    @property
+    def followed_axes(self) -> tuple:
+        """The axes a partner leads: those not in :attr:`led_axes`."""
+        return tuple(a for a in range(3) if a not in self.led_axes)
+
+    def followed(self) -> FollowedAxes:
+        """The following arm of one reach on :attr:`followed_axes`."""
+        return FollowedAxes(self.followed_axes, self.following, self.impedance_force)
 
     def impedance_force(self, intended_position, intended_velocity, position, velocity) -> np.ndarray:
         """F = K_h (x_d - x) + D_h (xdot_d - xdot), (3,) N, from intended and actual hand states (3,) m, m/s."""
@@ -156,6 +181,7 @@ class SimulatedPerson:
             self._load_inertia = as_matrix("load_inertia", load_inertia, (3, 3), "kg")
         self.plans: list[Plan] = []
         self.replan_times: list[float] = []
+        self._followed = parameters.followed()
 
     def start(self, intended_position, t: float = 0.0) -> None:
         """Begin the reach at time t (s), the intention at rest at intended_position (3,) m (where the person
@@ -167,6 +193,7 @@ class SimulatedPerson:
         self._model_rate = np.zeros(3)        # dx_d/ds, the intention's velocity on the person's clock s
         self._next_replan = 0.0               # on the person's clock s (module docstring)
         self._plan = None
+        self._followed.start(self.intended_position)
 
     def force(self, t: float, position, velocity) -> np.ndarray:
         """Force on the handle (3,), N, with the hand at position (3,) m, velocity (3,) m/s at time t (s);
@@ -177,7 +204,16 @@ class SimulatedPerson:
             # past their planning horizon the person's reach is over: they hold the intention where it ended
             # (re-plans from a hand at rest on the goal long after the reach can leave it)
             self.intended_velocity = np.zeros(3)
-            return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity)
+            force = self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity)
+        else:
+            force = self._intended_force(s, t, position, velocity)
+        self._followed.apply(t, position, velocity, self.intended_position, self.intended_velocity, force)
+        return force
+
+    def _intended_force(self, s: float, t: float, position, velocity) -> np.ndarray:
+        """The force (3,) N of the arm's impedance around the intention at the person's clock s (s) = time t (s),
+        with the load's feedforward; sets the intention."""
+        pace = self.parameters.pace
         if s >= self._next_replan - 1e-9:
             self._replan(s, t, position)
         h = self.planner.model.h

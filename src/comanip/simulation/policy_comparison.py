@@ -41,6 +41,9 @@ COMPARED = {
     "work_against_robot_J": ("work against robot (J)", 1.0),
     "person_work_J": ("person's work beyond holding (J)", 1.0),
     "sync_error_rms": ("sync error (% of reach)", 100.0),
+    "arrival_lag_mt": ("height arrival − person's arrival (/ MT)", 1.0),
+    "peak_lag_mt": ("height speed peak − person's (/ MT)", 1.0),
+    "height_error_at_arrival_m": ("height error at the person's arrival (mm)", 1e3),
     "completion_time_s": ("completion (s)", 1.0),
     "final_error_m": ("placement error (mm)", 1e3),
 }

@@ -201,8 +201,10 @@ class RecordedPerson:
         t, position = recorded_reach(recording, start, goal, up)
         self.duration = float(t[-1] * parameters.pace)
         """The path's duration (s): the playback's (lead, movement time and END_HOLD) times the pace."""
+        displacement = position - position[0]
+        displacement[:, list(parameters.followed_axes)] = 0.0
         rest = [(1, np.zeros(3)), (2, np.zeros(3))]
-        self._path = make_interp_spline(t * parameters.pace, position - position[0], k=5, bc_type=(rest, rest))
+        self._path = make_interp_spline(t * parameters.pace, displacement, k=5, bc_type=(rest, rest))
         self._load_inertia = np.zeros((3, 3))
         if parameters.anticipates_inertia:
             if load_inertia is None:
@@ -211,6 +213,7 @@ class RecordedPerson:
         self.plans: list = []
         """Always empty: this person does not plan (the scenario's records count re-plans from it)."""
         self.replan_times: list[float] = []
+        self._followed = parameters.followed()
 
     def intended_motion(self, t: float) -> IntendedMotion:
         """The path's displacement from its start (3,) m, its velocity (3,) m/s and acceleration (3,) m/s² at
@@ -226,11 +229,14 @@ class RecordedPerson:
         self._hold = np.array(intended_position, dtype=float)
         self._clock_start = t
         self.intended_position, self.intended_velocity = self._hold.copy(), np.zeros(3)
+        self._followed.start(self._hold)
 
     def force(self, t: float, position, velocity) -> np.ndarray:
         """Force on the handle (3,), N, with the hand at position (3,) m, velocity (3,) m/s at time t (s);
         sets the intention (``intended_position``, ``intended_velocity``) to time t."""
         displacement, self.intended_velocity, acceleration = self.intended_motion(t - self._clock_start)
         self.intended_position = self._hold + displacement
-        return self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
+        force = self.parameters.impedance_force(self.intended_position, self.intended_velocity, position, velocity) \
             + self._load_inertia @ acceleration
+        self._followed.apply(t, position, velocity, self.intended_position, self.intended_velocity, force)
+        return force

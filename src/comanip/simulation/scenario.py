@@ -129,8 +129,9 @@ class RobotBehaviour(Protocol):
     goal_estimate: np.ndarray | None
     """Where the robot currently thinks the goal is (3,), m; None while it has no estimate."""
 
-    def command(self, t: float, state: RobotState) -> RestTarget:
-        """The rest position and velocity at time t (s) for the arm in ``state``."""
+    def command(self, t: float, state: RobotState, handle_force: np.ndarray) -> RestTarget:
+        """The rest position and velocity at time t (s) for the arm in ``state``, with the person's force on the
+        handle (3,) N as a wrist force sensor reads it."""
 
 
 @dataclass
@@ -234,7 +235,7 @@ def run_trial(world: CoManipulationWorld, start: SettledStart, person: Simulated
         force = person.force(t[k], position, velocity)
         record["intended_position"][k] = person.intended_position
         record["intended_velocity"][k] = person.intended_velocity
-        rest_position, rest_velocity = robot.command(t[k], state)
+        rest_position, rest_velocity = robot.command(t[k], state, force)
         if robot.goal_estimate is not None:
             goal_estimate[k] = robot.goal_estimate
         record["position"][k], record["velocity"][k] = position, velocity

@@ -5,9 +5,13 @@ a robot policy (:mod:`comanip.simulation.policies`) predicts the goal and a rest
 motion's z as its rest and sets the translational stiffness to [0, 0, 400] N/m. The default policy,
 ``one-shot``, is the paper's: it estimates the goal and the person's whole trajectory once, at t_o
 (:class:`comanip.estimation.GoalEstimator`, Cartesian preset), and never replans; the others are the
-baselines (prior goal only, constant velocity, minimum-jerk fit), the passive robot, and comanip's online
-estimate, leading along the model's reach to its goal (``continuous``) or along its forecast of the hand
-(``forecast``).
+baselines (prior goal only, constant velocity, minimum-jerk fit, the height on a fixed minimum-jerk clock from the
+onset), the passive robot, an admittance robot that follows the person's force, and comanip's online estimate,
+leading along the model's reach to its goal (``continuous``) or along its forecast of the hand (``forecast``).
+
+The task is the paper's: the person leads x–y and their arm follows the height the robot leads
+(:mod:`comanip.simulation.following_arm`); with a robot that does not lead the height (passive, admittance), or in
+the variant ``SyncSettings.person_leads_height``, the person intends the height too (:func:`person_axes`).
 
 The person is the model's own by default; ``SyncSettings.person`` (:class:`comanip.simulation.person.PersonParameters`) makes them
 move at another pace (``pace``) or along a recorded movement (``hand_path="recorded"``), so that a robot is not
@@ -16,7 +20,8 @@ rewarded only for assuming the person is the model.
 Per trial: the goal estimate, the error between the predicted trajectory and the handle over time
 normalised by the movement time (paper Fig. 7, per axis), the time each axis reaches the goal, the
 velocity profiles of the person's intention and of the robot's end effector, and the co-manipulation
-measures of :mod:`comanip.simulation.measures` (interaction force, work, synchronisation, goal error over time).
+measures of :mod:`comanip.simulation.measures` (interaction force, work, synchronisation, arrival in step, goal error
+over time).
 """
 
 from __future__ import annotations
@@ -61,6 +66,12 @@ class SyncSettings(ScenarioSettings):
     """The robot policy, a name of :data:`comanip.simulation.policies.POLICIES` (default: the paper's)."""
     update_interval: float = DEFAULT_UPDATE_INTERVAL
     """Time between the predictions of the continuously updating policies (s)."""
+    person_leads_height: bool = False
+    """The variant of the task: True, the person intends the height too (their intention covers x, y and z, and a
+    robot that leads the height leads it against or with them); False (the paper's task), the person leads x–y
+    only and their arm follows the height the robot leads (:mod:`comanip.simulation.following_arm`). With a robot
+    that does not lead the height (:attr:`RobotPolicy.leads_height` false: passive, admittance) the person intends
+    it either way: someone must move it. The scenario sets the person's ``led_axes`` accordingly."""
     online_preset: str | None = None
     """The reaching model of the continuous policy's online goal estimator, a preset name of
     :mod:`comanip.presets` (e.g. ``"arm"``, a person's arm in 3-D); None: the scenario's model (the Cartesian
@@ -93,15 +104,15 @@ class PolicyRobot:
         self._next_update = settings.observation_time
         self.controller.translational_stiffness = np.zeros(3)
 
-    def command(self, t: float, state: RobotState) -> RestTarget:
+    def command(self, t: float, state: RobotState, handle_force: np.ndarray) -> RestTarget:
         position, velocity = state.position, state.velocity
-        self.policy.observe(t, position, velocity)
+        self.policy.observe(t, position, velocity, handle_force)
         if t >= self._next_update - 1e-9:
             interval = self.policy.update_interval
             self._next_update = np.inf if interval is None else self._next_update + interval
             prediction = self.policy.predict(t)
             if prediction is not None:
-                if self.settings.known_height:
+                if self.settings.known_height and self.policy.leads_height:
                     end_at_height(prediction.rest, self.settings.goal[2])
                 self.prediction, self.goal_estimate = prediction, prediction.goal
                 self.predictions += 1
@@ -217,6 +228,14 @@ def sync_metrics(record: TrialRecord, goal_estimate: np.ndarray | None, estimate
     return SyncMetrics(metrics, grid, error)
 
 
+def person_axes(settings: SyncSettings) -> tuple:
+    """The axes the settings' person leads (indices): x–y in the paper's task, when the robot leads the height; x, y
+    and z when they intend the height too (``person_leads_height``) or the robot does not lead it."""
+    if settings.person_leads_height or not POLICIES[settings.policy].leads_height:
+        return (0, 1, 2)
+    return (0, 1)
+
+
 def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledStart) -> PolicyContext:
     """What every policy knows before the reach, for the settings' prior goal (the prior plan is solved here)."""
     prior = np.asarray(settings.prior_goal)
@@ -238,9 +257,10 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
     first_plan = setup.person_first_plan(start, goal)
     context = policy_context(settings, setup, start)
     trials = []
+    person_parameters = replace(settings.person, led_axes=person_axes(settings))
     for k in progress_bar(f"sync {settings.policy} to {np.round(goal, 2).tolist()}", settings.trials, "trial", progress,
                            iterable=range(settings.trials)):
-        person = setup.person(start, goal, settings.seed + k, first_plan, settings.person)
+        person = setup.person(start, goal, settings.seed + k, first_plan, person_parameters)
         policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials)))
         robot = PolicyRobot(setup.world.controller, policy, settings)
         record = run_trial(setup.world, start, person, robot, context.duration)

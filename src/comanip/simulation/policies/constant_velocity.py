@@ -19,13 +19,14 @@ class ConstantVelocityPolicy:
     """Extrapolates the latest observed hand state over the expected remaining time."""
 
     name = "constant-velocity"
+    leads_height = True
 
     def __init__(self, context: PolicyContext):
         self.context = context
         self.update_interval = context.update_interval
         self.position = self.velocity = None
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         self.position, self.velocity = np.array(position, dtype=float), np.array(velocity, dtype=float)
 
     def predict(self, t: float) -> Prediction:

@@ -60,6 +60,7 @@ class ContinuousPolicy:
     """
 
     name = "continuous"
+    leads_height = True
 
     def __init__(self, context: PolicyContext, prior_std=PRIOR_STD, options: OnlineOptions | None = None):
         self.context = context
@@ -69,7 +70,7 @@ class ContinuousPolicy:
                                              prior_std=prior_std, width=context.online_width, options=options)
         self._next_observation = context.update_interval
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         if t >= self._next_observation - 1e-9:
             self.estimator.update(t, position, velocity)
             self._next_observation += self.update_interval

@@ -62,6 +62,7 @@ class MinimumJerkPolicy:
     """Fits the observed prefix (sampled every ``sample_interval``) at every update."""
 
     name = "minimum-jerk"
+    leads_height = True
 
     def __init__(self, context: PolicyContext, sample_interval: float = 0.005, observation_std: float = 1e-3,
                  prior_std: float = 0.1):
@@ -72,7 +73,7 @@ class MinimumJerkPolicy:
         self.positions: list[np.ndarray] = []
         self.fit: MinimumJerkFit | None = None
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         if not self.times or t >= self.times[-1] + self.sample_interval - 1e-9:
             self.times.append(t)
             self.positions.append(np.array(position, dtype=float))

@@ -17,6 +17,7 @@ class OneShotPolicy:
     """One estimate at t_o from the state at step n_o, then the estimated reach as the rest motion."""
 
     name = "one-shot"
+    leads_height = True
     update_interval = None
 
     def __init__(self, context: PolicyContext):
@@ -27,7 +28,7 @@ class OneShotPolicy:
         """When s_o is taken (s): the model's step n_o."""
         self.observed: np.ndarray | None = None
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         if self.observed is None and t >= self.observation_time - 0.5 * self.context.dt:
             self.observed = np.r_[position, velocity]
 

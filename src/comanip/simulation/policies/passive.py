@@ -12,12 +12,13 @@ class PassivePolicy:
     """Never predicts, never leads."""
 
     name = "passive"
+    leads_height = False
     update_interval = None
 
     def __init__(self, context: PolicyContext):
         self.context = context
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         pass
 
     def predict(self, t: float) -> Prediction | None:

@@ -13,12 +13,13 @@ class PriorOnlyPolicy:
     """Predicts g_hat = g_bar once, at t_o, with the model's reach to it as the rest motion."""
 
     name = "prior-only"
+    leads_height = True
     update_interval = None
 
     def __init__(self, context: PolicyContext):
         self.context = context
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         pass
 
     def predict(self, t: float) -> Prediction:

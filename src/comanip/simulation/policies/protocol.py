@@ -1,7 +1,7 @@
 """What every robot policy of the synchronisation scenario shares: its inputs, its prediction, its protocol.
 
-A policy watches the handle (position m, velocity m/s, robot base frame, time s from the start of the
-person's reach) at every control step, and from t_o on predicts the person's goal and a rest motion for
+A policy watches the handle (position m, velocity m/s, the person's force on it N, robot base frame, time s from
+the start of the person's reach) at every control step, and from t_o on predicts the person's goal and a rest motion for
 the axes the robot leads. The scenario's robot (:class:`comanip.simulation.sync_scenario.PolicyRobot`)
 asks for a prediction at t_o and then every ``update_interval`` seconds, and drives the controller.
 """
@@ -109,9 +109,14 @@ class RobotPolicy(Protocol):
     """The policy's name in :data:`comanip.simulation.policies.POLICIES`."""
     update_interval: float | None
     """Time between predictions after t_o (s); None: one prediction, at t_o."""
+    leads_height: bool
+    """Whether the robot leads the height (the axes the scenario gives it) toward a predicted motion. False (the
+    passive and admittance robots): the person must move the height themselves, and the scenario's person intends
+    it (:attr:`comanip.simulation.sync_scenario.SyncSettings.person_leads_height`)."""
 
-    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray) -> None:
-        """The handle at time t (s): position (3,) m, velocity (3,) m/s; called at every control step."""
+    def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
+        """The handle at time t (s): position (3,) m, velocity (3,) m/s, and the person's force on it (3,) N as a
+        wrist force sensor reads it; called at every control step."""
 
     def predict(self, t: float) -> Prediction | None:
         """The goal and rest motion from what was observed up to time t (s); None: do not lead."""
