@@ -74,31 +74,11 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--arm-reaches", type=Path, default=ARM_REACHES,
                         help="TAT-HUM data folder of the arm people's reaches (default: %(default)s)")
     args = parser.parse_args(argv)
-    if args.load:
-        runs, wall, trials, seed = load_runs(args.load)
-        results = {}
-        for run in runs:
-            results.update(run["results"])
-        results = {label: results[label] for label in PEOPLE if label in results}
-        goals = list(next(iter(results.values())))
-    else:
-        goals = [label for label in args.goals.split(",") if label]
-        people = [label for label in args.people.split(",") if label]
-        unknown = sorted(set(goals) - set(GOALS)) + sorted(set(people) - set(PEOPLE))
-        if unknown:
-            raise ValueError(f"--goals must name goals of {list(GOALS)} and --people people of {list(PEOPLE)}, got {unknown}")
-        trials, seed = args.trials, args.seed
-        settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed) for label in goals}
-        setup = ScenarioSetup(next(iter(settings.values())), arm_reaches=args.arm_reaches)
-        began = time.perf_counter()
-        results = {}
-        for label in people:
-            mine = {goal: replace(goal_settings, online_preset=ONLINE_PRESETS.get(label)) for goal, goal_settings in settings.items()}
-            results.update(compare_with_people(mine, {label: PEOPLE[label]}, list(POLICIES), setup, progress=True))
-        wall = time.perf_counter() - began
-        if args.save:
-            save_run(args.save, results, wall, trials, seed)
-            return 0
+    run = run_or_load(args, PEOPLE)
+    if run is None:
+        return 0
+    results, wall, trials, seed = run
+    goals = list(next(iter(results.values())))
     policies = list(next(iter(next(iter(results.values())).values())))
     rows = people_rows(results)
     _write_csv(rows, HERE / "people_comparison_sync.csv")
@@ -186,6 +166,37 @@ def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
     axes[1, 0].legend(fontsize=7)
     fig.tight_layout()
     return save_figure(fig, path)
+
+
+def run_or_load(args, people: dict, person_leads_height: bool = False):
+    """The comparison's results {person: {goal: {policy: trials}}}, its wall time (s), trials and seed, for the
+    ``people`` {label: PersonParameters} named by ``args.people`` and the goals of ``args.goals``: loaded from the
+    runs of ``args.load``, or simulated (``person_leads_height``: the variant of the task) and, with ``args.save``,
+    saved there instead (then None)."""
+    if args.load:
+        runs, wall, trials, seed = load_runs(args.load)
+        results = {}
+        for run in runs:
+            results.update(run["results"])
+        return {label: results[label] for label in people if label in results}, wall, trials, seed
+    goals = [label for label in args.goals.split(",") if label]
+    chosen = [label for label in args.people.split(",") if label]
+    unknown = sorted(set(goals) - set(GOALS)) + sorted(set(chosen) - set(people))
+    if unknown:
+        raise ValueError(f"--goals must name goals of {list(GOALS)} and --people people of {list(people)}, got {unknown}")
+    settings = {label: SyncSettings(goal=GOALS[label], trials=args.trials, seed=args.seed,
+                                    person_leads_height=person_leads_height) for label in goals}
+    setup = ScenarioSetup(next(iter(settings.values())), arm_reaches=args.arm_reaches)
+    began = time.perf_counter()
+    results = {}
+    for label in chosen:
+        mine = {goal: replace(goal_settings, online_preset=ONLINE_PRESETS.get(label)) for goal, goal_settings in settings.items()}
+        results.update(compare_with_people(mine, {label: people[label]}, list(POLICIES), setup, progress=True))
+    wall = time.perf_counter() - began
+    if args.save:
+        save_run(args.save, results, wall, args.trials, args.seed)
+        return None
+    return results, wall, args.trials, args.seed
 
 
 def _write_csv(rows: list[dict], path: Path) -> None:

@@ -15,8 +15,6 @@ from __future__ import annotations
 import argparse
 import csv
 import sys
-import time
-from dataclasses import replace
 from pathlib import Path
 
 import matplotlib
@@ -26,13 +24,12 @@ import numpy as np  # noqa: E402
 
 from comanip.demo import GUIDING_FORCE_N  # noqa: E402
 from comanip.plots.sync_speed_profiles import plot_speed_profiles  # noqa: E402
-from comanip.simulation import PersonParameters, ScenarioSetup, SyncSettings  # noqa: E402
-from comanip.simulation.policies import POLICIES  # noqa: E402
-from comanip.simulation.policy_comparison import compare_with_people, people_rows, people_table  # noqa: E402
+from comanip.simulation import PersonParameters, SyncSettings  # noqa: E402
+from comanip.simulation.policy_comparison import people_rows, people_table  # noqa: E402
 from comanip.simulation.sync_targets import pairs_table, robots_table, target_rows, targets_table  # noqa: E402
-from studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison import ARM_REACHES, ONLINE_PRESETS  # noqa: E402
+from studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison import ARM_REACHES, run_or_load  # noqa: E402
 from studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison import (  # noqa: E402
-    GOALS, add_run_arguments, load_runs, save_run)
+    GOALS, add_run_arguments)
 
 HERE = Path(__file__).resolve().parent
 
@@ -60,32 +57,10 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--arm-reaches", type=Path, default=ARM_REACHES,
                         help="TAT-HUM data folder of the arm people's reaches (default: %(default)s)")
     args = parser.parse_args(argv)
-    if args.load:
-        runs, wall, trials, seed = load_runs(args.load)
-        results = {}
-        for run in runs:
-            results.update(run["results"])
-        results = {label: results[label] for label in PEOPLE if label in results}
-    else:
-        goals = [label for label in args.goals.split(",") if label]
-        people = [label for label in args.people.split(",") if label]
-        unknown = sorted(set(goals) - set(GOALS)) + sorted(set(people) - set(PEOPLE))
-        if unknown:
-            raise ValueError(f"--goals must name goals of {list(GOALS)} and --people people of {list(PEOPLE)}, got {unknown}")
-        trials, seed = args.trials, args.seed
-        settings = {label: SyncSettings(goal=GOALS[label], trials=trials, seed=seed, person_leads_height=args.variant)
-                    for label in goals}
-        setup = ScenarioSetup(next(iter(settings.values())), arm_reaches=args.arm_reaches)
-        began = time.perf_counter()
-        results = {}
-        for label in people:
-            preset = ONLINE_PRESETS.get(label)
-            mine = {goal: replace(goal_settings, online_preset=preset) for goal, goal_settings in settings.items()}
-            results.update(compare_with_people(mine, {label: PEOPLE[label]}, list(POLICIES), setup, progress=True))
-        wall = time.perf_counter() - began
-        if args.save:
-            save_run(args.save, results, wall, trials, seed)
-            return 0
+    run = run_or_load(args, PEOPLE, person_leads_height=args.variant)
+    if run is None:
+        return 0
+    results, wall, trials, seed = run
     print(block(results, trials, seed, wall, args.variant))
     return 0
 

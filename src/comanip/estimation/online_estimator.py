@@ -57,7 +57,7 @@ from comanip.estimation.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.goal_smoothing import GoalSmoother
 from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.hand_rest import REST_RADIUS_M, has_left, lost_sample, resting_position
+from comanip.estimation.hand_rest import REST_RADIUS_M, lost_sample, resting_position
 from comanip.estimation.model_families import FamilyCache, default_families
 from comanip.estimation.online_options import OnlineOptions
 from comanip.estimation.paced_model import PacedModel
