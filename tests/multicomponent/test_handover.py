@@ -128,7 +128,7 @@ def _release_on_the_exact_path(schedule, trigger):
 
     robot = HandoverRobot(SimpleNamespace(translational_stiffness=None), schedule, 1e-3, trigger)
     for t, position, velocity in zip(schedule.t, schedule.rest_position, schedule.rest_velocity):
-        robot.command(t, SimpleNamespace(position=position, velocity=velocity))
+        robot.command(t, SimpleNamespace(position=position, velocity=velocity), np.zeros(3))
     return robot
 
 
