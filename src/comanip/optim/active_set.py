@@ -106,40 +106,45 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     """
     Hg = solve(g)
     near = np.flatnonzero(c > -margin)
-    working, pinned = near, np.zeros(0, dtype=int)
+    if not len(near):
+        return -Hg, NO_MULTIPLIERS, NO_ROWS, None
+    # every candidate row's H⁻¹ aᵀ once: a working set is a subset of them, and dropping or pinning a row only
+    # selects other columns of these, so the loop below solves nothing more
+    near_rows = A(near)
+    near_HA = solve(near_rows.T)
+    near_schur = near_rows @ near_HA
+    near_rhs = c[near] - near_rows @ Hg
+    working, pinned = np.ones(len(near), dtype=bool), np.zeros(len(near), dtype=bool)
     while True:
-        if len(working):
-            rows = A(working)
-            HA = solve(rows.T)
-            schur = rows @ HA
-            multipliers = np.linalg.lstsq(schur, c[working] - rows @ Hg, rcond=None)[0]
-            dropping = (multipliers < 0) & (c[working] <= tolerance) & ~np.isin(working, pinned)
+        kept = np.flatnonzero(working)
+        if len(kept):
+            multipliers = np.linalg.lstsq(near_schur[np.ix_(kept, kept)], near_rhs[kept], rcond=None)[0]
+            dropping = (multipliers < 0) & (c[near[kept]] <= tolerance) & ~pinned[kept]
             if dropping.any():
-                working = working[~dropping]
+                working[kept[dropping]] = False
                 continue
             multipliers = np.maximum(multipliers, 0.0)
-            step = -(Hg + HA @ multipliers)
+            step = -(Hg + near_HA[:, kept] @ multipliers)
         else:
-            multipliers, step = np.zeros(0), -Hg
+            multipliers, step = NO_MULTIPLIERS, -Hg
         # rows dropped together can push one another out: a dropped row already past its limit (within the
         # tolerance) that the step would drive further out returns to the working set for good (otherwise such
         # rows make the merit rise at first order along every step, and the solve fails short of convergence)
-        if len(working) == len(near):
+        if working.all():
             break
-        dropped = np.setdiff1d(near, working, assume_unique=True)
-        dropped = dropped[c[dropped] > 0]
-        blocking = dropped[A(dropped) @ step > 0] if len(dropped) else dropped
+        dropped = np.flatnonzero(~working & (c[near] > 0))
+        blocking = dropped[near_rows[dropped] @ step > 0]
         if not len(blocking):
             break
-        pinned = np.union1d(pinned, blocking)
-        working = np.union1d(working, blocking)
-    if not len(working):
-        return step, multipliers, working, None
+        pinned[blocking] = working[blocking] = True
+    if not len(kept):
+        return step, multipliers, NO_ROWS, None
+    HA, schur = near_HA[:, kept], near_schur[np.ix_(kept, kept)]
 
     def correct(c_working, HA=HA, schur=schur):
         return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
 
-    return step, multipliers, working, correct
+    return step, multipliers, near[kept], correct
 
 
 def restoration_step(point: Iterate) -> np.ndarray:
