@@ -19,3 +19,37 @@ def test_a_step_never_drives_a_row_past_its_limit_further_out():
     assert g @ step < 0
     assert working.tolist() == [0] and multipliers[0] > 0
     np.testing.assert_allclose(step, [-c[0], -1.0], atol=1e-12)  # row 0 brought back onto its limit
+
+
+def test_the_step_solves_the_quadratic_model_on_the_working_rows_it_returns():
+    """On random positive definite models with independent constraint rows near their limits (some dropped for a negative
+    multiplier, some pinned back), the step and multipliers satisfy the KKT conditions of the quadratic model with the
+    returned working rows as equalities, H d + g + A_Wᵀ λ = 0 and A_W d = -c_W, with λ ≥ 0, checked by a solve of
+    its own; the second-order correction moves onto the working rows' linearisation."""
+    from comanip.optim.active_set import constrained_step
+
+    rng = np.random.default_rng(4)
+    dropped_some = 0
+    for _ in range(200):
+        n = int(rng.integers(3, 12))
+        m = int(rng.integers(1, n))  # independent rows: fewer than the unknowns
+        root = rng.normal(size=(n, n))
+        hessian = root @ root.T + 0.1 * np.eye(n)
+        g, rows = rng.normal(size=n), rng.normal(size=(m, n))
+        c = rng.choice([0.0, 5e-7, -1e-4, -1.0], size=m)  # on, just past, near and far from the limit
+        step, multipliers, working, correct = constrained_step(lambda b: np.linalg.solve(hessian, b), g, c,
+                                                               lambda indices: rows[indices], margin=1e-3,
+                                                               tolerance=1e-6)
+        near = np.flatnonzero(c > -1e-3)
+        assert set(working.tolist()) <= set(near.tolist()) and np.all(np.diff(working) > 0)
+        dropped_some += len(working) < len(near)
+        stationarity = hessian @ step + g + rows[working].T @ multipliers
+        np.testing.assert_allclose(stationarity, 0.0, atol=1e-8 * (1 + np.abs(g).max()))
+        if len(working):
+            np.testing.assert_allclose(rows[working] @ step, -c[working], atol=1e-9)
+            assert np.all(multipliers >= 0)
+            shift = rng.normal(size=len(working))
+            np.testing.assert_allclose(rows[working] @ correct(shift), -shift, atol=1e-9)
+        else:
+            assert correct is None
+    assert dropped_some > 20  # the cases exercise the dropping
