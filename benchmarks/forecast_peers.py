@@ -96,7 +96,9 @@ def motion_frame(velocity: np.ndarray, chord: np.ndarray) -> np.ndarray:
 
 def window_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray, k: int):
     """What the learned forecaster reads at sample k, causally (samples 0 … k only): (features (F,), the frame's
-    rows (d, d), the length scale s = max(peak speed so far, SPEED_FLOOR) m/s)."""
+    rows (d, d), the length scale s = max(peak speed so far, SPEED_FLOOR) m/s). The features are rounded to 1e-9 (they
+    are in units of the length scale), so that round-off, such as a planar reach's out-of-plane part, never splits a
+    tree: a reach turned, moved or scaled reads the same features."""
     now = t[k]
     seen_t, seen_x, seen_v = t[:k + 1], position[:k + 1], velocity[:k + 1]
     back = now - LAGS_S
@@ -104,7 +106,7 @@ def window_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray, k
     scale = max(float(np.linalg.norm(seen_v, axis=1).max()), SPEED_FLOOR)
     frame = motion_frame(v[0] + (x[0] - x[-1]) / LAGS_S[-1], x[len(x) // 2] - 0.5 * (x[0] + x[-1]))
     features = np.r_[((x[1:] - x[0]) @ frame.T).ravel(), (v @ frame.T).ravel()] / scale
-    return features, frame, scale
+    return np.round(features, 9) + 0.0, frame, scale
 
 
 class LearnedForecaster:
