@@ -51,6 +51,12 @@ def tracker_stream(minutes: float, rate: float):
     return t[keep], position[keep], [(r.onset, r.end_time) for r in reaches if r.end_time <= 60.0 * minutes]
 
 
+def nanoseconds(stamp) -> int:
+    """A builtin_interfaces/Time as integer nanoseconds: a goal is matched to its pose by this exact key (float seconds
+    near 1.8e9 s rounded on one side by Python and on the other by NumPy can differ in their last digit)."""
+    return stamp.sec * 1_000_000_000 + stamp.nanosec
+
+
 def resident_mb(pid: int) -> float:
     """The process's resident memory (MB), from /proc (NaN where there is none)."""
     try:
@@ -85,13 +91,13 @@ def live_run(t, position, rate: float, twists: bool, src: Path | None, label: st
     node = subprocess.Popen(command, stderr=subprocess.DEVNULL, env=env)
     rclpy.init(domain_id=domain)
     player = Node("comanip_tracker")
-    received, statuses = {}, []
+    received, statuses = {}, []          # received: {a goal's stamp in integer nanoseconds: its wall time of arrival}
     player.create_subscription(PoseWithCovarianceStamped, "goal/estimate",
-                               lambda m: received.setdefault(round(seconds(m.header.stamp), 6), time.time()), 1000)
+                               lambda m: received.setdefault(nanoseconds(m.header.stamp), time.time()), 1000)
     player.create_subscription(DiagnosticArray, "status", lambda m: statuses.append(status_values(m)), 50)
     pose_pub = player.create_publisher(PoseStamped, "hand/pose", 50)
     twist_pub = player.create_publisher(TwistStamped, "hand/twist", 50)
-    sent = np.full(len(t), np.nan)
+    sent, sent_ns = np.full(len(t), np.nan), [0] * len(t)
     memory = []
     try:
         started = time.time()
@@ -115,7 +121,7 @@ def live_run(t, position, rate: float, twists: bool, src: Path | None, label: st
                 twist.twist.linear.x, twist.twist.linear.y, twist.twist.linear.z = (float(v) for v in velocity)
                 twist_pub.publish(twist)
             pose_pub.publish(pose)
-            sent[k] = seconds(stamp)
+            sent[k], sent_ns[k] = seconds(stamp), nanoseconds(stamp)
             if tk >= next_memory:
                 memory.append((tk, resident_mb(node.pid)))
                 next_memory += 10.0
@@ -131,7 +137,7 @@ def live_run(t, position, rate: float, twists: bool, src: Path | None, label: st
         node.wait(timeout=20)
         player.destroy_node()
         rclpy.try_shutdown()
-    answered = np.array([received.get(round(s, 6), np.nan) for s in sent])
+    answered = np.array([received.get(ns, np.nan) for ns in sent_ns])
     return {"sent": sent, "answered": answered, "memory": memory, "status": statuses[-1] if statuses else {}}
 
 
