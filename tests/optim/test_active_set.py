@@ -1,6 +1,7 @@
 """The working set's constrained step (comanip.optim.active_set)."""
 
 import numpy as np
+import pytest
 
 
 def test_a_step_never_drives_a_row_past_its_limit_further_out():
@@ -13,7 +14,7 @@ def test_a_step_never_drives_a_row_past_its_limit_further_out():
     rows = np.array([[1.0, 0.0], [-1.0, 1.0]])
     g = np.array([-0.9, 1.0])  # multipliers with both rows working: (-0.1, -1.0)
     c = np.array([5e-7, 5e-7])
-    step, multipliers, working, _ = constrained_step(lambda b: b, g, c, lambda indices: rows[indices],
+    step, multipliers, working, _, _ = constrained_step(lambda b: b, g, c, lambda indices: rows[indices],
                                                       margin=1e-3, tolerance=1e-6)
     assert np.all(rows @ step <= 1e-12), rows @ step
     assert g @ step < 0
@@ -37,7 +38,7 @@ def test_the_step_solves_the_quadratic_model_on_the_working_rows_it_returns():
         hessian = root @ root.T + 0.1 * np.eye(n)
         g, rows = rng.normal(size=n), rng.normal(size=(m, n))
         c = rng.choice([0.0, 5e-7, -1e-4, -1.0], size=m)  # on, just past, near and far from the limit
-        step, multipliers, working, correct = constrained_step(lambda b: np.linalg.solve(hessian, b), g, c,
+        step, multipliers, working, correct, optimality = constrained_step(lambda b: np.linalg.solve(hessian, b), g, c,
                                                                lambda indices: rows[indices], margin=1e-3,
                                                                tolerance=1e-6)
         near = np.flatnonzero(c > -1e-3)
@@ -45,6 +46,7 @@ def test_the_step_solves_the_quadratic_model_on_the_working_rows_it_returns():
         dropped_some += len(working) < len(near)
         stationarity = hessian @ step + g + rows[working].T @ multipliers
         np.testing.assert_allclose(stationarity, 0.0, atol=1e-8 * (1 + np.abs(g).max()))
+        assert optimality == pytest.approx(np.abs(g + rows[working].T @ multipliers).max(), rel=1e-12, abs=1e-15)
         if len(working):
             np.testing.assert_allclose(rows[working] @ step, -c[working], atol=1e-9)
             assert np.all(multipliers >= 0)
@@ -53,3 +55,20 @@ def test_the_step_solves_the_quadratic_model_on_the_working_rows_it_returns():
         else:
             assert correct is None
     assert dropped_some > 20  # the cases exercise the dropping
+
+
+def test_rows_that_depend_on_one_another_get_the_least_norm_multipliers():
+    """A working row given twice (a limit met by two rows of the Jacobian at once): the Schur complement is singular,
+    its Cholesky factor is refused, and the multipliers are the least-squares ones, split evenly; the step is that of
+    the row given once."""
+    from comanip.optim.active_set import constrained_step
+
+    hessian = np.diag([2.0, 1.0, 4.0])
+    g, row = np.array([1.0, -2.0, 0.5]), np.array([[1.0, 1.0, 0.0]])
+    solve = lambda b: np.linalg.solve(hessian, b)  # noqa: E731
+    once = constrained_step(solve, g, np.zeros(1), lambda indices: row[np.zeros(len(indices), dtype=int)], 1e-3, 1e-6)
+    twice = constrained_step(solve, g, np.zeros(2), lambda indices: row[np.zeros(len(indices), dtype=int)], 1e-3, 1e-6)
+    assert once[2].tolist() == [0] and twice[2].tolist() == [0, 1]
+    np.testing.assert_allclose(twice[0], once[0], atol=1e-12)
+    np.testing.assert_allclose(twice[1], [once[1][0] / 2] * 2, atol=1e-12)
+    assert np.all(np.isfinite(twice[3](np.array([1e-3, 1e-3]))))

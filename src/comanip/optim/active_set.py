@@ -10,8 +10,13 @@ from typing import Any, Callable
 
 import numpy as np
 
+from comanip.optim.factorisation import shifted_cholesky
+
 NO_ROWS, NO_MULTIPLIERS = np.zeros(0, dtype=int), np.zeros(0)
 """An empty working set and its multipliers (read only)."""
+INDEPENDENT_ROWS = 1e-6
+"""The working rows' Schur complement is solved by its Cholesky factor while the factor's smallest diagonal entry is
+at least this fraction of its largest (a condition number below about 1e12), else by least squares."""
 
 
 @dataclass(slots=True)
@@ -101,13 +106,14 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     the step must restore it), or it is past its limit already and the step without it would move it further
     (then it is kept). (Keeping a row met to within the tolerance but just past its limit holds the
     iterate on the limit while the objective pulls it off: the step vanishes and the solve stalls with a large
-    Lagrangian gradient.) Returns (step,
-    multipliers, working rows, correct), correct(c_W) the least-H-norm move d with A_W d = -c_W.
+    Lagrangian gradient.) Returns (step, multipliers, working rows, correct, optimality): correct(c_W) the
+    least-H-norm move d with A_W d = -c_W, optimality max |g + A_Wᵀ multipliers| (the Lagrangian's gradient at the
+    point, with the step's multipliers).
     """
     Hg = solve(g)
     near = np.flatnonzero(c > -margin)
     if not len(near):
-        return -Hg, NO_MULTIPLIERS, NO_ROWS, None
+        return -Hg, NO_MULTIPLIERS, NO_ROWS, None, float(np.abs(g).max())
     # every candidate row's H⁻¹ aᵀ once: a working set is a subset of them, and dropping or pinning a row only
     # selects other columns of these, so the loop below solves nothing more
     near_rows = A(near)
@@ -118,7 +124,8 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     while True:
         kept = np.flatnonzero(working)
         if len(kept):
-            multipliers = np.linalg.lstsq(near_schur[np.ix_(kept, kept)], near_rhs[kept], rcond=None)[0]
+            schur_solve = _schur_solver(near_schur[np.ix_(kept, kept)])
+            multipliers = schur_solve(near_rhs[kept])
             dropping = (multipliers < 0) & (c[near[kept]] <= tolerance) & ~pinned[kept]
             if dropping.any():
                 working[kept[dropping]] = False
@@ -138,13 +145,26 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
             break
         pinned[blocking] = working[blocking] = True
     if not len(kept):
-        return step, multipliers, NO_ROWS, None
-    HA, schur = near_HA[:, kept], near_schur[np.ix_(kept, kept)]
+        return step, multipliers, NO_ROWS, None, float(np.abs(g).max())
+    HA = near_HA[:, kept]
 
-    def correct(c_working, HA=HA, schur=schur):
-        return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
+    def correct(c_working, HA=HA, schur_solve=schur_solve):
+        return -HA @ schur_solve(c_working)
 
-    return step, multipliers, near[kept], correct
+    return step, multipliers, near[kept], correct, float(np.abs(g + near_rows[kept].T @ multipliers).max())
+
+
+def _schur_solver(schur: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
+    """b -> S⁻¹ b for the working rows' Schur complement S = A_W H⁻¹ A_Wᵀ (k, k), symmetric positive semidefinite: by
+    its Cholesky factor while that is well conditioned (``INDEPENDENT_ROWS``), else the least-squares solution (rows
+    that depend on one another, e.g. a joint's position and velocity limits at the end of a step that binds both:
+    the least-norm multipliers)."""
+    factor = shifted_cholesky(schur, (0.0,))
+    if factor is not None:
+        diagonal = np.abs(np.diag(factor.triangle))
+        if diagonal.min() >= INDEPENDENT_ROWS * diagonal.max():
+            return factor.solve
+    return lambda b: np.linalg.lstsq(schur, b, rcond=None)[0]
 
 
 def restoration_step(point: Iterate) -> np.ndarray:

@@ -251,9 +251,8 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         if state.free:  # the Newton step; its optimality was tested in converged()
             step, multipliers, working, correct = -solve(point.g), NO_MULTIPLIERS, NO_ROWS, None
         else:
-            step, multipliers, working, correct = constrained_step(solve, point.g, point.c, point.rows, self.margin,
-                                                                   self.constraint_tolerance)
-            state.optimality = _lagrangian_optimality(point, working, multipliers)
+            step, multipliers, working, correct, state.optimality = constrained_step(
+                solve, point.g, point.c, point.rows, self.margin, self.constraint_tolerance)
             if np.isnan(state.start_optimality):
                 state.start_optimality = state.optimality
         state.working, state.multipliers = working, multipliers
