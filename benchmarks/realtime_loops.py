@@ -87,10 +87,8 @@ class BudgetedFullSolves:
         began = time.perf_counter()
         warm = shifted_torques(previous.torque, elapsed / self.planner.model.h)
         plan = self.planner.solve(state, goal, width, warm_start=warm, max_wall_time=self.max_wall_time)
-        replan = Replan.of_plan(plan, wall_time=time.perf_counter() - began)
-        if not plan.converged:  # a budgeted full solve says nothing of contraction: flagged as not converged
-            replan.status = Progress.NOT_CONTRACTING
-        return replan
+        # a budgeted full solve says nothing of contraction: one that did not converge is flagged 'not_contracting'
+        return Replan.of_plan(plan, wall_time=time.perf_counter() - began)
 
 
 @dataclass

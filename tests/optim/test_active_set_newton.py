@@ -105,6 +105,43 @@ def test_a_solve_paused_and_resumed_takes_the_iterates_of_one_run(secant):
     assert staged.advance(1000) is resumed  # a finished solve only reports
 
 
+@pytest.mark.parametrize("secant", [False, True])
+def test_a_pause_without_the_gradient_at_its_point_is_completed_to_the_eager_pause(secant):
+    """advance(k, gradient_at_end=False) on the bounded Rosenbrock with a value-only trial function: the same point and
+    objective as advance(k), the gradient there never evaluated (the gradients counted; optimality NaN), and
+    completed() then gives the eager pause's optimality; going on from it takes the iterates of one run."""
+    from comanip.optim import Status, newton_solve
+
+    gradients = []
+
+    def evaluate(x):
+        gradients.append(x.copy())
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
+
+    def value(x):
+        return Evaluation(float(scipy.optimize.rosen(x)), None, x)
+
+    hessian = (lambda x: 0.5 * (scipy.optimize.rosen_hess(x) + np.diag(np.diag(scipy.optimize.rosen_hess(x))))) if secant \
+        else scipy.optimize.rosen_hess
+    arguments = (evaluate, hessian, np.full(6, -1.2), np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5])
+    options = dict(tolerance=1e-10, secant=secant, value=value)
+    whole = newton_solve(*arguments, **options).advance(500)
+    for k in (1, 4, 9):
+        eager = newton_solve(*arguments, **options).advance(k)
+        lazy_solve = newton_solve(*arguments, **options)
+        gradients.clear()
+        lazy = lazy_solve.advance(k, gradient_at_end=False)
+        assert lazy.status == Status.MAX_ITERATIONS and lazy.nit == k and np.isnan(lazy.optimality)
+        np.testing.assert_array_equal(lazy.x, eager.x)
+        assert lazy.fun == eager.fun
+        assert not any(np.array_equal(x, lazy.x) for x in gradients)  # no gradient at the point it ends on
+        done = lazy_solve.completed()
+        assert done.optimality == eager.optimality and np.array_equal(done.x, eager.x) and done.status == eager.status
+        resumed = lazy_solve.advance(500)
+        np.testing.assert_array_equal(resumed.x, whole.x)
+        assert resumed.status == whole.status and resumed.success
+
+
 @pytest.mark.parametrize("bad", [np.nan, np.inf])
 def test_a_start_where_f_or_its_gradient_is_not_finite_fails_with_a_result(bad):
     """A start where the objective or its gradient is not finite ends the solve at once with status 'failed' and

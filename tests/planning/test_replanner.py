@@ -126,3 +126,29 @@ def test_bad_arguments_are_named_before_any_work(planar_planner):
     with pytest.raises(ValueError, match="start"):
         replanner.replan(first, np.zeros(3), elapsed=0.01)
     assert isinstance(first, Replan)
+
+
+def test_an_arm_cycle_evaluates_its_status_when_read_and_it_is_the_status_at_its_plan():
+    """franka_rest, one iteration from a disturbed state: the cycle leaves the gradient at its plan to the first read
+    of its status; read, the optimality is max |∇J| at the plan's torques from an evaluation of its own (no limit
+    binds), the status compares it with the shifted plan's, and the plan's belief is that of an evaluation of its own."""
+    planner = comanip.Planner(comanip.presets.load("franka_rest"))
+    replanner = Replanner(planner, iterations=1)
+    body = planner.model.body
+    start = np.r_[body.home_position, np.zeros(body.n)]                      # the ready pose, at rest
+    hand = np.asarray(body.kinematics_function(body.home_position)[0]).ravel()
+    first = replanner.first_plan(start, hand + [0.1, 0.05, -0.05], 0.02)
+    disturbed = first.params.start.copy()
+    disturbed[planner.model.n:2 * planner.model.n] += 0.05                    # joint velocities, rad/s
+    replan = replanner.replan(first, disturbed, elapsed=0.01)
+    assert "outcome" not in vars(replan)                                      # nothing read yet: not evaluated
+    curvature = planner.solver.curvature
+    own = curvature.evaluate(np.ravel(replan.torque), replan.params)
+    assert replan.optimality == pytest.approx(np.abs(own.gradient).max(), rel=1e-9)
+    expected = Progress.CONVERGING if replan.optimality < replan.start_optimality else Progress.NOT_CONTRACTING
+    assert replan.status is expected and replan.solver_status == "max_iterations" and replan.iterations == 1
+    reference = planner.solver.make_plan(replan.torque, replan.params, status="max_iterations", success=False, message="",
+                                         solve_time=0.0, iterations=1)
+    np.testing.assert_allclose(replan.plan.mean, reference.mean, atol=1e-12)
+    np.testing.assert_allclose(replan.plan.cov, reference.cov, atol=1e-12)
+    assert replan.plan.objective == pytest.approx(reference.objective, rel=1e-12)

@@ -130,8 +130,8 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
         replan = replanning.first_plan(estimates[k], goals[k], width) if replan is None else \
             replanning.replan(replan, estimates[k], period, goals[k], width)
         replan_times[k], iterations_done[k] = replan.wall_time, replan.iterations
-        statuses.append(str(replan.status))
         commanded[k] = replan.torque[0]
+        statuses.append(str(replan.status))  # after the command, as a robot's loop reads it
         error = sample_torque_error(commanded[k], model.kappa, model.noise, rng) if noise else 0.0
         executed[k] = commanded[k] + error
         states[k + 1] = np.asarray(step(states[k], executed[k])).ravel()

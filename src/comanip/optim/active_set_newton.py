@@ -42,6 +42,9 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
   by the Woodbury identity, when it needed no shift and stays positive definite (checked by the inertia of the small
   capacitance matrix), instead of a new factorisation. The gradient is evaluated at every iterate, so the
   convergence test and the optimum are those of k = 1.
+- A last iteration without the gradient (``NewtonSolve.advance(..., gradient_at_end=False)``): the iteration that
+  spends the budget evaluates its trials value-only and accepts its point without the gradient, which only the
+  result's optimality would read; :meth:`~comanip.optim.NewtonSolve.completed`, or a further ``advance``, evaluates it.
 - Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
   the violated constraints' linearisation is taken if it halves the violation.
 - Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
@@ -183,6 +186,9 @@ class SQPState:
     """The working set's multipliers of the last direction computed."""
     repeat: bool = False
     """The pass retries the iteration (a chord step failed): it is not counted again."""
+    gradient_at_step: bool = True
+    """The point the pass accepts is evaluated with its gradient (False on the last pass of a budget whose caller
+    does not need it: :meth:`ActiveSetNewton.last_iteration`)."""
 
 
 @dataclass(slots=True)
@@ -225,8 +231,20 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         return state.iterations
 
     def begin(self, state: SQPState) -> None:
+        self.complete(state)
         state.iterations += not state.repeat
-        state.repeat = False
+        state.repeat, state.gradient_at_step = False, True
+
+    def last_iteration(self, state: SQPState) -> None:
+        """The point this pass accepts is evaluated value-only (its gradient, a full evaluation, waits for
+        :meth:`complete`)."""
+        state.gradient_at_step = False
+
+    def complete(self, state: SQPState) -> None:
+        """The gradient at an iterate accepted value-only."""
+        point = state.point
+        if point.g is None:
+            state.point = self.at(point.x, self.evaluate(point.x))
 
     def converged(self, state: SQPState) -> Stop | None:
         """With no constraint in the working set the Lagrangian's gradient is the gradient, and a converged
@@ -271,7 +289,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         restoration step."""
         point = state.point
         searched = self._line_search(point, direction.step, direction.working, direction.correct,
-                                     state.merit_weight, state.full_steps)
+                                     state.merit_weight, state.full_steps, state.gradient_at_step)
         alpha, accepted = searched.alpha, searched.accepted
         state.full_steps = alpha == 1.0
         if not direction.chord:
@@ -305,7 +323,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         the next direction)."""
         point, optimality = state.point, state.optimality
         if stop.status in BUDGET_SPENT and not state.free:
-            optimality = _lagrangian_optimality(point, state.working, state.multipliers) if point.g is not None else np.inf
+            optimality = _lagrangian_optimality(point, state.working, state.multipliers) if point.g is not None else np.nan
         return SolverResult(point.x, point.f, stop.status, stop.message, state.iterations, optimality, point.violation,
                             LocalModel(state.stepped_with, point.data), state.start_optimality)
 
@@ -337,14 +355,15 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         return float(np.maximum(point.c - 0.5 * self.constraint_tolerance, 0.0).sum())
 
     def _line_search(self, point: Iterate, step: np.ndarray, working: np.ndarray, correct,
-                     merit_weight: float, full_step_likely: bool) -> Backtracked[Iterate]:
+                     merit_weight: float, full_step_likely: bool, gradient: bool = True) -> Backtracked[Iterate]:
         """alpha and the accepted point alpha·``step`` away by Armijo's rule on the l1 merit, with second-order
         corrections; alpha 0 and no point when no step length is accepted.
 
         Trials are evaluated value-only (``value``) and the accepted one then with its gradient, except the full
         step when ``full_step_likely`` (the last line search took its full step) and no constraint is in the
         working set: that trial is evaluated with its gradient at once, saving the value-only call on most iterations
-        for a wasted gradient on the few whose full step fails."""
+        for a wasted gradient on the few whose full step fails. Without ``gradient`` every trial is value-only and
+        the accepted point keeps no gradient."""
         penalty = self._penalty(point)
         merit = point.f + merit_weight * penalty
         slope = point.g @ step - merit_weight * penalty  # directional derivative of the merit
@@ -353,7 +372,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
 
         def attempt(alpha: float, bound: float) -> Iterate | None:
             trial = self._trial(point.x + step if alpha == 1.0 else point.x + alpha * step,
-                                with_gradient=full_step_likely and alpha == 1.0 and not len(working))
+                                with_gradient=gradient and full_step_likely and alpha == 1.0 and not len(working))
             if trial is None:
                 return None
             if len(working) and self._penalty(trial) > penalty:
@@ -365,7 +384,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
                     trial = corrected
             if trial.f + merit_weight * self._penalty(trial) > bound:
                 return None
-            if trial.g is None:  # a trial evaluated with its gradient was checked finite by _trial
+            if trial.g is None and gradient:  # a trial evaluated with its gradient was checked finite by _trial
                 return self.finite_point(trial.x, self.evaluate(trial.x))
             return trial
 

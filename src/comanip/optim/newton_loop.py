@@ -6,7 +6,10 @@ One pass of :func:`newton_iterate`:
 1. when the budget is spent (``max_iterations``) or ``expired()``: stop, as a solution if the iterate is one
    (step 3), else with status ``max_iterations`` or ``max_wall_time``;
 2. ``method.begin(state)``: count the iteration (a method that counts something else, such as linearisations, does
-   nothing here);
+   nothing here) and evaluate what the iterate lacks (``method.complete``); when the caller does not need the
+   gradient at the point the budget ends on (``gradient_at_end=False``) and this pass spends the budget,
+   ``method.last_iteration(state)`` tells the method so: it may accept its next point without the gradient there
+   (a real-time iteration's last point, whose gradient only a status would read);
 3. ``method.converged(state)``: a :class:`Stop` when the iterate is a solution (the test that needs no step); a
    solution then goes through ``method.settle(state, stop)``, the method's last stage at a solution (a last
    Newton step, a new active set): the final :class:`Stop`, or None when the stage moved the iterate, which is
@@ -57,6 +60,14 @@ class NewtonMethod(Protocol[S, D]):
     def begin(self, state: S) -> None:
         """Called once per pass, after the budget checks."""
 
+    def last_iteration(self, state: S) -> None:
+        """This pass spends the budget and the caller does not need the gradient at the point it accepts: the method
+        may leave it unevaluated (``complete`` evaluates it)."""
+
+    def complete(self, state: S) -> None:
+        """Evaluate what an iterate accepted after ``last_iteration`` lacks (nothing for a method that never leaves
+        anything out)."""
+
     def converged(self, state: S) -> Stop | None:
         """A stop when the iterate is a solution, before any direction is computed; only tests."""
 
@@ -88,8 +99,10 @@ def never() -> bool:
 
 
 def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
-                   expired: Callable[[], bool] = never) -> SolverResult:
-    """Run ``method`` from ``state`` until it stops (module docstring); never raises for an unconverged solve."""
+                   expired: Callable[[], bool] = never, gradient_at_end: bool = True) -> SolverResult:
+    """Run ``method`` from ``state`` until it stops (module docstring); never raises for an unconverged solve.
+    ``gradient_at_end=False``: the pass that spends ``max_iterations`` may end on a point without its gradient (the
+    result's optimality NaN, and a solution there not recognised until :meth:`NewtonSolve.completed`)."""
     while True:
         spent = method.iterations(state) >= max_iterations
         if spent or expired():
@@ -99,6 +112,8 @@ def newton_iterate(method: NewtonMethod[S, D], state: S, *, max_iterations: int,
                 Stop(Status.MAX_WALL_TIME, "the wall-time budget ran out"))
             return method.result(state, stop)
         method.begin(state)
+        if not gradient_at_end and method.iterations(state) >= max_iterations:
+            method.last_iteration(state)
         stop = _solution(method, state)
         if stop is None:
             direction = method.direction(state)
@@ -135,17 +150,33 @@ class NewtonSolve(Generic[S]):
     def __init__(self, method: NewtonMethod[S, D] | None, state: S | None, expired: Callable[[], bool] = never,
                  final: SolverResult | None = None):
         self.method, self.state, self.expired, self.final = method, state, expired, final
+        self._last = final
 
     @property
     def finished(self) -> bool:
         """True once the solve has stopped for a reason other than its budget."""
         return self.final is not None
 
-    def advance(self, max_iterations: int) -> SolverResult:
-        """The result after at most ``max_iterations`` iterations in all (the final result once finished)."""
+    def advance(self, max_iterations: int, gradient_at_end: bool = True) -> SolverResult:
+        """The result after at most ``max_iterations`` iterations in all (the final result once finished).
+        ``gradient_at_end=False``: the iteration that spends ``max_iterations`` may leave the gradient at its point
+        unevaluated (:func:`newton_iterate`); :meth:`completed` evaluates it."""
         if self.final is None:
-            result = newton_iterate(self.method, self.state, max_iterations=max_iterations, expired=self.expired)
+            result = newton_iterate(self.method, self.state, max_iterations=max_iterations, expired=self.expired,
+                                    gradient_at_end=gradient_at_end)
             if result.status is not Status.MAX_ITERATIONS:
                 self.final = result
+            self._last = result
             return result
         return self.final
+
+    def completed(self) -> SolverResult:
+        """The last result with everything at its point evaluated (the gradient an ``advance(...,
+        gradient_at_end=False)`` left out): its optimality known, and status 'solved' where the point is a solution."""
+        if self.final is not None:
+            return self.final
+        if self._last is None:
+            raise ValueError("completed() reads the result of an advance(); call advance() first")
+        self.method.complete(self.state)
+        stop = _solution(self.method, self.state) or Stop(self._last.status, self._last.message)
+        return self.method.result(self.state, stop)

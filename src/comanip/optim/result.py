@@ -43,7 +43,8 @@ class SolverResult(Generic[X, M]):
     nit: int
     """Iterations, as the solver counts them (Hessian evaluations, linearisations)."""
     optimality: float
-    """First-order optimality at x: max |gradient of the Lagrangian|, or max |F| for a root finder."""
+    """First-order optimality at x: max |gradient of the Lagrangian|, or max |F| for a root finder; NaN where the
+    gradient at x was left unevaluated (:meth:`~comanip.optim.NewtonSolve.advance` with ``gradient_at_end=False``)."""
     violation: float = 0.0
     """Largest constraint violation at x (units of the constraints)."""
     local_model: M | None = None

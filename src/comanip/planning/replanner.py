@@ -11,7 +11,9 @@ A control loop replans every cycle from the state it measures. A :class:`Replann
    it does not fit the budget, and the cycle then overruns it (its ``wall_time`` says by how much): a cycle that
    stopped before it would send the shifted plan, and a loop of such cycles never converges along the loop;
 3. the best plan comes back as a :class:`Replan` whose ``status`` says how the iterations stand
-   (:class:`~comanip.optim.Progress`: 'converged', 'converging', 'not_contracting').
+   (:class:`~comanip.optim.Progress`: 'converged', 'converging', 'not_contracting'). The point a cycle's last
+   iteration accepts is evaluated value-only: its gradient (a fifth of a Panda cycle) serves only the status and
+   the plan's belief, so it is evaluated when one of those is first read, after the loop has sent tau_0.
 
 What a solve sets up once per planner (the compiled terms, the torque bounds, the joint limits) the replanner
 reuses; what a full solve redoes every time (the start policy's candidates, the reachability witness by inverse
@@ -26,13 +28,13 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from functools import cached_property
+from functools import cache, cached_property
 from typing import Callable, Protocol
 
 import numpy as np
 
 from comanip.arguments import as_count, as_nonnegative, as_optional_positive
-from comanip.optim import Evaluation, Progress, contraction, progress_of
+from comanip.optim import Evaluation, Progress, SolverResult, contraction, progress_of
 from comanip.optim.newton_loop import never
 from comanip.planning.newton_reach_solver import NewtonReachSolver
 from comanip.planning.plan import Plan, PlanStatus, with_reach_check
@@ -59,36 +61,71 @@ def shifted_torques(torque: np.ndarray, steps: float) -> np.ndarray:
     return (1.0 - fraction) * padded[whole:whole + H] + fraction * padded[whole + 1:whole + 1 + H]
 
 
-@dataclass
-class Replan:
-    """One cycle's plan and how its iterations stand. Shapes: H steps, n degrees of freedom."""
+@dataclass(frozen=True)
+class CycleOutcome:
+    """How a cycle's iterations stand (:attr:`Replan.status` and its neighbours read it)."""
 
     status: Progress
-    """'converged' (the plan is optimal for the cycle's state), 'converging' (the budget ran out with the first-order
-    optimality lower than at the shifted plan), 'not_contracting' (neither: the iterations did not lower the
-    optimality, the solve failed, or the goal is out of reach)."""
+    solver_status: str
+    message: str
+    optimality: float = np.nan
+
+
+@dataclass
+class Replan:
+    """One cycle's plan and how its iterations stand. Shapes: H steps, n degrees of freedom.
+
+    A cycle whose last Newton iteration left the gradient at its plan unevaluated (a one-iteration cycle: only the
+    status reads it) evaluates it on the first read of :attr:`status`, :attr:`solver_status`, :attr:`message`,
+    :attr:`optimality` or :attr:`plan`, so that a loop sends tau_0 first; :attr:`wall_time` is the cycle's up to its
+    return."""
+
     torque: np.ndarray
     """The plan's commands tau_i (H, n), N·m (N for point masses); tau_0 is the one to send now."""
     params: ReachParameters
     """The cycle's start (the measured state), goal and width."""
-    solver_status: str
-    """The solver's word for how the cycle ended (:class:`~comanip.optim.Status`: 'solved', 'solved_acceptable',
-    'max_iterations', 'max_wall_time', 'failed', ...), or 'unreachable' for a goal out of an arm's reach."""
-    message: str
-    """The solver's status in words."""
     iterations: int
     """Newton iterations of the cycle."""
     wall_time: float
     """Wall time of the cycle (s): everything from the call to the return."""
-    optimality: float = np.nan
-    """max |gradient of the Lagrangian| of the normalised objective at the plan (NaN where not known)."""
+    judge: Callable[[], CycleOutcome] = field(repr=False, compare=False)
+    """Makes :attr:`outcome` on first use."""
     start_optimality: float = np.nan
-    """The same at the shifted plan the cycle started from."""
+    """max |gradient of the Lagrangian| of the normalised objective at the shifted plan the cycle started from (NaN
+    where not known)."""
     goal_q: np.ndarray | None = None
     """An arm's joint position (n,) within its limits that reaches the goal (the reachability witness); None for point
     masses."""
     build_plan: Callable[[], Plan] | None = field(default=None, repr=False, compare=False)
     """Makes :attr:`plan` on first use (a loop that sends only tau_0 never pays for the belief's rollout)."""
+
+    @cached_property
+    def outcome(self) -> CycleOutcome:
+        """How the cycle's iterations stand (evaluated on first use)."""
+        return self.judge()
+
+    @property
+    def status(self) -> Progress:
+        """'converged' (the plan is optimal for the cycle's state), 'converging' (the budget ran out with the
+        first-order optimality lower than at the shifted plan), 'not_contracting' (neither: the iterations did not
+        lower the optimality, the solve failed, or the goal is out of reach)."""
+        return self.outcome.status
+
+    @property
+    def solver_status(self) -> str:
+        """The solver's word for how the cycle ended (:class:`~comanip.optim.Status`: 'solved', 'solved_acceptable',
+        'max_iterations', 'max_wall_time', 'failed', ...), or 'unreachable' for a goal out of an arm's reach."""
+        return self.outcome.solver_status
+
+    @property
+    def message(self) -> str:
+        """The solver's status in words."""
+        return self.outcome.message
+
+    @property
+    def optimality(self) -> float:
+        """max |gradient of the Lagrangian| of the normalised objective at the plan (NaN where not known)."""
+        return self.outcome.optimality
 
     @property
     def success(self) -> bool:
@@ -108,9 +145,9 @@ class Replan:
     @classmethod
     def of_plan(cls, plan: Plan, goal_q: np.ndarray | None = None, wall_time: float | None = None) -> "Replan":
         """The Replan of a full solve's :class:`Plan` (converged or not by its own status)."""
-        status = Progress.CONVERGED if plan.converged else Progress.NOT_CONTRACTING
-        replan = cls(status, plan.torque, ReachParameters(plan.start, plan.goal, plan.width), plan.status, plan.message,
-                     plan.iterations, plan.solve_time if wall_time is None else wall_time, goal_q=goal_q)
+        outcome = CycleOutcome(Progress.CONVERGED if plan.converged else Progress.NOT_CONTRACTING, plan.status, plan.message)
+        replan = cls(plan.torque, ReachParameters(plan.start, plan.goal, plan.width), plan.iterations,
+                     plan.solve_time if wall_time is None else wall_time, lambda: outcome, goal_q=goal_q)
         replan.plan = plan  # the cached property's value
         return replan
 
@@ -187,28 +224,51 @@ class Replanner:
         solver = planner.solver
         with solver.blas:
             # the real-time iteration: one iteration every cycle, whatever the budget, so that the iterations converge
-            # along the loop; more while a recent iteration's time still fits
+            # along the loop; more while a recent iteration's time still fits. The gradient at the point a cycle's
+            # last iteration accepts serves only its status: it is evaluated when the status is read
             solve = solver.newton_solve(guess, params, np.inf, solver.curvature)
             set_up = time.perf_counter()
-            result = solve.advance(1)
+            result = solve.advance(1, gradient_at_end=self._may_iterate_again(began, set_up))
             if self._iteration_limit > 1 and not solve.finished:
                 solve.expired = self._expired(began, first_iteration=time.perf_counter() - set_up)
-                result = solve.advance(self._iteration_limit)
-            result = solver.finite(result, guess, params)
+                result = solve.advance(self._iteration_limit, gradient_at_end=False)
         ended = time.perf_counter()
         if self.max_wall_time is not None:  # a cycle without iterations counts too, so that old times age out
             self._iteration_times = [*self._iteration_times[1 - RECENT_CYCLES:], (ended - set_up) / result.nit if result.nit else 0.0]
-        torque = np.reshape(result.x, (model.H, model.n))
+        finite = solver.finite(result, guess, params)
+        torque = np.reshape(finite.x, (model.H, model.n))
         solver.count_solving_time(ended - began)
-        data = None if result.local_model is None else result.local_model.data
+
+        @cache
+        def completed() -> SolverResult:
+            if finite is not result:  # the solver's plan was not finite: the guess, failed
+                return finite
+            with solver.blas:
+                return solver.finite(solve.completed(), guess, params)
+
+        def judge() -> CycleOutcome:
+            done = completed()
+            return CycleOutcome(progress_of(done), done.status, done.message, done.optimality)
 
         def build_plan() -> Plan:
-            evaluation = None if data is None else Evaluation(result.fun, None, data)
-            return with_reach_check(solver.make_plan(torque, params, evaluation, status=result.status, success=result.success,
-                                                     message=result.message, solve_time=ended - began, iterations=result.nit))
+            done = completed()
+            data = None if done.local_model is None else done.local_model.data
+            evaluation = None if data is None else Evaluation(done.fun, None, data)
+            return with_reach_check(solver.make_plan(torque, params, evaluation, status=done.status, success=done.success,
+                                                     message=done.message, solve_time=ended - began, iterations=done.nit))
 
-        return Replan(progress_of(result), torque, params, result.status, result.message, result.nit, ended - began,
-                      result.optimality, result.start_optimality, goal_q, build_plan)
+        return Replan(torque, params, result.nit, ended - began, judge, result.start_optimality, goal_q, build_plan)
+
+    def _may_iterate_again(self, began: float, set_up: float) -> bool:
+        """Whether a cycle that began at ``began`` and set up its solve by ``set_up`` (perf_counter, s) may run a second
+        iteration: the iteration limit allows one and, on a budget, two of the recent iterations fit what is left of
+        it (its first iteration then keeps its gradient, which the second starts from)."""
+        if self._iteration_limit == 1:
+            return False
+        if self.max_wall_time is None or not self._iteration_times:
+            return True
+        reserve = float(np.quantile(self._iteration_times, RESERVE_QUANTILE))
+        return set_up - began + 2 * reserve <= self.max_wall_time
 
     def _expired(self, began: float, first_iteration: float) -> Callable[[], bool]:
         """Whether the cycle that began at ``began`` (perf_counter, s) and whose first iteration took
@@ -232,5 +292,5 @@ class Replanner:
             return planner.solver.make_plan(guess, params, status=PlanStatus.UNREACHABLE, success=False, message=message,
                                             solve_time=wall_time, iterations=0)
 
-        return Replan(Progress.NOT_CONTRACTING, guess, params, PlanStatus.UNREACHABLE, message, 0, wall_time,
-                      goal_q=goal_q, build_plan=build_plan)
+        outcome = CycleOutcome(Progress.NOT_CONTRACTING, PlanStatus.UNREACHABLE, message)
+        return Replan(guess, params, 0, wall_time, lambda: outcome, goal_q=goal_q, build_plan=build_plan)
