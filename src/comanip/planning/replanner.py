@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from functools import cache, cached_property
+from functools import cached_property
 from typing import Callable, Protocol
 
 import numpy as np
@@ -239,23 +239,27 @@ class Replanner:
         torque = np.reshape(finite.x, (model.H, model.n))
         solver.count_solving_time(ended - began)
 
-        @cache
+        done: list[SolverResult] = []   # the completed result, once evaluated (the status and the plan share it)
+
         def completed() -> SolverResult:
-            if finite is not result:  # the solver's plan was not finite: the guess, failed
-                return finite
-            with solver.blas:
-                return solver.finite(solve.completed(), guess, params)
+            if not done:
+                if finite is not result:  # the solver's plan was not finite: the guess, failed
+                    done.append(finite)
+                else:
+                    with solver.blas:
+                        done.append(solver.finite(solve.completed(), guess, params))
+            return done[0]
 
         def judge() -> CycleOutcome:
-            done = completed()
-            return CycleOutcome(progress_of(done), done.status, done.message, done.optimality)
+            final = completed()
+            return CycleOutcome(progress_of(final), final.status, final.message, final.optimality)
 
         def build_plan() -> Plan:
-            done = completed()
-            data = None if done.local_model is None else done.local_model.data
-            evaluation = None if data is None else Evaluation(done.fun, None, data)
-            return with_reach_check(solver.make_plan(torque, params, evaluation, status=done.status, success=done.success,
-                                                     message=done.message, solve_time=ended - began, iterations=done.nit))
+            final = completed()
+            data = None if final.local_model is None else final.local_model.data
+            evaluation = None if data is None else Evaluation(final.fun, None, data)
+            return with_reach_check(solver.make_plan(torque, params, evaluation, status=final.status, success=final.success,
+                                                     message=final.message, solve_time=ended - began, iterations=final.nit))
 
         return Replan(torque, params, result.nit, ended - began, judge, result.start_optimality, goal_q, build_plan)
 
