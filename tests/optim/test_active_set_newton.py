@@ -140,6 +140,15 @@ def test_a_pause_without_the_gradient_at_its_point_is_completed_to_the_eager_pau
         resumed = lazy_solve.advance(500)
         np.testing.assert_array_equal(resumed.x, whole.x)
         assert resumed.status == whole.status and resumed.success
+    # a wall budget that runs out on such a point ends the solve there; completed() still evaluates it
+    eager = newton_solve(*arguments, **options).advance(3)
+    budgeted = newton_solve(*arguments, **options)
+    budgeted.advance(3, gradient_at_end=False)
+    budgeted.expired = lambda: True
+    stopped = budgeted.advance(500, gradient_at_end=False)
+    assert stopped.status == Status.MAX_WALL_TIME and budgeted.finished and np.isnan(stopped.optimality)
+    done = budgeted.completed()
+    assert done.optimality == eager.optimality and done.status == Status.MAX_WALL_TIME and budgeted.completed() is done
 
 
 @pytest.mark.parametrize("bad", [np.nan, np.inf])

@@ -152,3 +152,9 @@ def test_an_arm_cycle_evaluates_its_status_when_read_and_it_is_the_status_at_its
     np.testing.assert_allclose(replan.plan.mean, reference.mean, atol=1e-12)
     np.testing.assert_allclose(replan.plan.cov, reference.cov, atol=1e-12)
     assert replan.plan.objective == pytest.approx(reference.objective, rel=1e-12)
+    # on a wall budget too small for a second iteration, a later cycle's wall budget stops it on such a point
+    budgeted = Replanner(planner, iterations=None, max_wall_time=1e-9)
+    second = budgeted.replan(budgeted.replan(first, disturbed, elapsed=0.01), disturbed, elapsed=0.0)
+    assert second.solver_status == "max_wall_time" and second.iterations == 1
+    own = curvature.evaluate(np.ravel(second.torque), second.params)
+    assert second.optimality == pytest.approx(np.abs(own.gradient).max(), rel=1e-9)

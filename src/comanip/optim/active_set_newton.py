@@ -240,11 +240,13 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         :meth:`complete`)."""
         state.gradient_at_step = False
 
-    def complete(self, state: SQPState) -> None:
+    def complete(self, state: SQPState) -> bool:
         """The gradient at an iterate accepted value-only."""
         point = state.point
-        if point.g is None:
-            state.point = self.at(point.x, self.evaluate(point.x))
+        if point.g is not None:
+            return False
+        state.point = self.at(point.x, self.evaluate(point.x))
+        return True
 
     def converged(self, state: SQPState) -> Stop | None:
         """With no constraint in the working set the Lagrangian's gradient is the gradient, and a converged
@@ -295,7 +297,7 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         if not direction.chord:
             state.model_held = alpha == 1.0 and len(direction.working) == 0
             if accepted is None and point.violation > self.constraint_tolerance:
-                accepted = self._restore(point)
+                accepted = self._restore(point, state.gradient_at_step)
             elif accepted is not None:
                 state.recoveries = 0
         if accepted is None:
@@ -397,18 +399,20 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         evaluate = self.evaluate if self.value is None or with_gradient else self.value
         return self.finite_point(x, evaluate(x))
 
-    def _restore(self, point: Iterate) -> Iterate | None:
+    def _restore(self, point: Iterate, gradient: bool = True) -> Iterate | None:
         """A feasibility step when the merit cannot decrease: the least-norm move d with A_V d = -c_V over
-        the violated rows V, halved until the largest violation shrinks; None if it does not."""
+        the violated rows V, halved until the largest violation shrinks; None if it does not. Trials are evaluated
+        value-only (the violation needs no gradient), the accepted one then with its gradient unless not
+        ``gradient``."""
         step = restoration_step(point)
 
         def attempt(alpha: float, bound: float) -> Iterate | None:
             # the violation must halve: the merit's bound does not apply
-            x = point.x + alpha * step
-            evaluation = self.evaluate(x)
-            if not (np.isfinite(evaluation.f) and np.all(np.isfinite(evaluation.gradient))):
+            trial = self._trial(point.x + alpha * step)
+            if trial is None or not trial.violation < 0.5 * point.violation:
                 return None
-            trial = self.at(x, evaluation)
-            return trial if trial.violation < 0.5 * point.violation else None
+            if trial.g is None and gradient:
+                return self.finite_point(trial.x, self.evaluate(trial.x))
+            return trial
 
         return backtrack(attempt, point.violation, 0.0, max_trials=_RESTORATION_TRIALS).accepted

@@ -64,9 +64,10 @@ class NewtonMethod(Protocol[S, D]):
         """This pass spends the budget and the caller does not need the gradient at the point it accepts: the method
         may leave it unevaluated (``complete`` evaluates it)."""
 
-    def complete(self, state: S) -> None:
-        """Evaluate what an iterate accepted after ``last_iteration`` lacks (nothing for a method that never leaves
-        anything out)."""
+    def complete(self, state: S) -> bool:
+        """Evaluate what an iterate accepted after ``last_iteration`` lacks; True when something was (never, for a
+        method that leaves nothing out)."""
+        return False
 
     def converged(self, state: S) -> Stop | None:
         """A stop when the iterate is a solution, before any direction is computed; only tests."""
@@ -172,11 +173,16 @@ class NewtonSolve(Generic[S]):
 
     def completed(self) -> SolverResult:
         """The last result with everything at its point evaluated (the gradient an ``advance(...,
-        gradient_at_end=False)`` left out): its optimality known, and status 'solved' where the point is a solution."""
-        if self.final is not None:
-            return self.final
-        if self._last is None:
+        gradient_at_end=False)`` left out): its optimality known, and status 'solved' where the point is a solution.
+        A solve its wall budget stopped on such a point is completed too."""
+        last = self.final if self.final is not None else self._last
+        if last is None:
             raise ValueError("completed() reads the result of an advance(); call advance() first")
-        self.method.complete(self.state)
-        stop = _solution(self.method, self.state) or Stop(self._last.status, self._last.message)
-        return self.method.result(self.state, stop)
+        if self.method is None or not self.method.complete(self.state):
+            return last
+        stop = _solution(self.method, self.state) or Stop(last.status, last.message)
+        result = self.method.result(self.state, stop)
+        if self.final is not None:
+            self.final = result
+        self._last = result
+        return result
