@@ -59,8 +59,7 @@ def test_the_step_solves_the_quadratic_model_on_the_working_rows_it_returns():
 
 def test_rows_that_depend_on_one_another_get_the_least_norm_multipliers():
     """A working row given twice (a limit met by two rows of the Jacobian at once): the Schur complement is singular,
-    its Cholesky factor is refused, and the multipliers are the least-squares ones, split evenly; the step is that of
-    the row given once."""
+    and the multipliers are the least-norm ones, split evenly; the step is that of the row given once."""
     from comanip.optim.active_set import constrained_step
 
     hessian = np.diag([2.0, 1.0, 4.0])

@@ -10,13 +10,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from comanip.optim.factorisation import shifted_cholesky
-
 NO_ROWS, NO_MULTIPLIERS = np.zeros(0, dtype=int), np.zeros(0)
 """An empty working set and its multipliers (read only)."""
-INDEPENDENT_ROWS = 1e-6
-"""The working rows' Schur complement is solved by its Cholesky factor while the factor's smallest diagonal entry is
-at least this fraction of its largest (a condition number below about 1e12), else by least squares."""
 
 
 @dataclass(slots=True)
@@ -124,8 +119,7 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     while True:
         kept = np.flatnonzero(working)
         if len(kept):
-            schur_solve = _schur_solver(near_schur[np.ix_(kept, kept)])
-            multipliers = schur_solve(near_rhs[kept])
+            multipliers = np.linalg.lstsq(near_schur[np.ix_(kept, kept)], near_rhs[kept], rcond=None)[0]
             dropping = (multipliers < 0) & (c[near[kept]] <= tolerance) & ~pinned[kept]
             if dropping.any():
                 working[kept[dropping]] = False
@@ -146,25 +140,14 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
         pinned[blocking] = working[blocking] = True
     if not len(kept):
         return step, multipliers, NO_ROWS, None, float(np.abs(g).max())
-    HA = near_HA[:, kept]
+    HA, schur = near_HA[:, kept], near_schur[np.ix_(kept, kept)]
 
-    def correct(c_working, HA=HA, schur_solve=schur_solve):
-        return -HA @ schur_solve(c_working)
+    def correct(c_working, HA=HA, schur=schur):
+        # least squares: the working rows can depend on one another (a joint's position limit at one step and its
+        # velocity limits at the steps around it), and then the least-norm multipliers are the ones wanted
+        return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
 
     return step, multipliers, near[kept], correct, float(np.abs(g + near_rows[kept].T @ multipliers).max())
-
-
-def _schur_solver(schur: np.ndarray) -> Callable[[np.ndarray], np.ndarray]:
-    """b -> S⁻¹ b for the working rows' Schur complement S = A_W H⁻¹ A_Wᵀ (k, k), symmetric positive semidefinite: by
-    its Cholesky factor while that is well conditioned (``INDEPENDENT_ROWS``), else the least-squares solution (rows
-    that depend on one another, e.g. a joint's position and velocity limits at the end of a step that binds both:
-    the least-norm multipliers)."""
-    factor = shifted_cholesky(schur, (0.0,))
-    if factor is not None:
-        diagonal = np.abs(np.diag(factor.triangle))
-        if diagonal.min() >= INDEPENDENT_ROWS * diagonal.max():
-            return factor.solve
-    return lambda b: np.linalg.lstsq(schur, b, rcond=None)[0]
 
 
 def restoration_step(point: Iterate) -> np.ndarray:
