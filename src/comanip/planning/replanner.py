@@ -239,16 +239,13 @@ class Replanner:
         torque = np.reshape(finite.x, (model.H, model.n))
         solver.count_solving_time(ended - began)
 
-        done: list[SolverResult] = []   # the completed result, once evaluated (the status and the plan share it)
-
         def completed() -> SolverResult:
-            if not done:
-                if finite is not result:  # the solver's plan was not finite: the guess, failed
-                    done.append(finite)
-                else:
-                    with solver.blas:
-                        done.append(solver.finite(solve.completed(), guess, params))
-            return done[0]
+            """The cycle's result with the gradient at its plan evaluated (once: the solve keeps its completed result,
+            which the status and the plan share)."""
+            if finite is not result:  # the solver's plan was not finite: the guess, failed
+                return finite
+            with solver.blas:
+                return solver.finite(solve.completed(), guess, params)
 
         def judge() -> CycleOutcome:
             final = completed()
