@@ -106,7 +106,7 @@ def window_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray, k
     scale = max(float(np.linalg.norm(seen_v, axis=1).max()), SPEED_FLOOR)
     frame = motion_frame(v[0] + (x[0] - x[-1]) / LAGS_S[-1], x[len(x) // 2] - 0.5 * (x[0] + x[-1]))
     features = np.r_[((x[1:] - x[0]) @ frame.T).ravel(), (v @ frame.T).ravel()] / scale
-    return np.round(features, 9) + 0.0, frame, scale
+    return np.round(features, 9), frame, scale
 
 
 class LearnedForecaster:
