@@ -9,9 +9,19 @@ from dataclasses import dataclass, field
 from typing import Any, Callable
 
 import numpy as np
+from scipy.linalg import lstsq
 
 NO_ROWS, NO_MULTIPLIERS = np.zeros(0, dtype=int), np.zeros(0)
 """An empty working set and its multipliers (read only)."""
+
+
+def least_norm(matrix: np.ndarray, rhs: np.ndarray) -> np.ndarray:
+    """The least-norm least-squares solution of matrix (m, m) · y = rhs (m,): the working rows can depend on one
+    another (a joint's position limit at one step and its velocity limits at the steps around it), and then the
+    least-norm multipliers are the ones wanted. By LAPACK's complete orthogonal factorisation (gelsy: QR with
+    column pivoting), a quarter of the SVD's time on the Panda's 40-70 working rows; singular values below
+    m·eps of the largest count as zero, as in ``numpy.linalg.lstsq``."""
+    return lstsq(matrix, rhs, cond=np.finfo(float).eps * len(rhs), lapack_driver="gelsy", check_finite=False)[0]
 
 
 @dataclass(slots=True)
@@ -119,7 +129,7 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     while True:
         kept = np.flatnonzero(working)
         if len(kept):
-            multipliers = np.linalg.lstsq(near_schur[np.ix_(kept, kept)], near_rhs[kept], rcond=None)[0]
+            multipliers = least_norm(near_schur[np.ix_(kept, kept)], near_rhs[kept])
             dropping = (multipliers < 0) & (c[near[kept]] <= tolerance) & ~pinned[kept]
             if dropping.any():
                 working[kept[dropping]] = False
@@ -143,9 +153,7 @@ def constrained_step(solve, g, c, A, margin: float, tolerance: float):
     HA, schur = near_HA[:, kept], near_schur[np.ix_(kept, kept)]
 
     def correct(c_working, HA=HA, schur=schur):
-        # least squares: the working rows can depend on one another (a joint's position limit at one step and its
-        # velocity limits at the steps around it), and then the least-norm multipliers are the ones wanted
-        return -HA @ np.linalg.lstsq(schur, c_working, rcond=None)[0]
+        return -HA @ least_norm(schur, c_working)
 
     return step, multipliers, near[kept], correct, float(np.abs(g + near_rows[kept].T @ multipliers).max())
 
@@ -154,4 +162,4 @@ def restoration_step(point: Iterate) -> np.ndarray:
     """The least-norm move d with A_V d = -c_V onto the linearisation of the violated rows V at ``point``."""
     violated = np.flatnonzero(point.c > 0)
     rows = point.rows(violated)
-    return -rows.T @ np.linalg.lstsq(rows @ rows.T, point.c[violated], rcond=None)[0]
+    return -rows.T @ least_norm(rows @ rows.T, point.c[violated])
