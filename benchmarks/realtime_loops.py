@@ -25,9 +25,11 @@ Per preset and loop: the executed cost (:func:`comanip.execution.executed_cost`)
 same problem, in units of the objective's scale |J_best(w)| (the best attainable J, the solver's normaliser; the
 converged loop's own J can be near zero, where a ratio to it says nothing): the mean over the problems of
 (J - J_converged) / |J_best| and the largest (lower is better); reach
-successes (the hand within w of the final goal at the end); every cycle's wall time after the first plan (median, p99,
-largest), the wall time per Newton iteration of the cycles that iterated (their set-up included: median) and the first
-plans' (cold, median); the share of cycles flagged 'not_contracting'; and the slowest cycles.
+successes (the hand within w of the final goal at the end); every cycle's wall time after the first plan, from the
+measured state to tau_0 (median, p99, largest), the wall time per Newton iteration of the cycles that iterated (their
+set-up included: median), the preparation of the next cycle that each cycle runs after sending tau_0
+(:meth:`Replanner.prepare`: median, p99), the p99 of a cycle's time with its preparation (what must fit the control
+period) and the first plans' (cold, median); the share of cycles flagged 'not_contracting'; and the slowest cycles.
 Wall times are of the machine this runs on, with its load (the 1-minute load average is printed).
 """
 
@@ -90,6 +92,10 @@ class BudgetedFullSolves:
         # a budgeted full solve says nothing of contraction: one that did not converge is flagged 'not_contracting'
         return Replan.of_plan(plan, wall_time=time.perf_counter() - began)
 
+    def prepare(self, replan: Replan, elapsed: float) -> float:
+        """Nothing: a full solve prepares nothing for the next."""
+        return 0.0
+
 
 @dataclass
 class LoopRuns:
@@ -100,7 +106,10 @@ class LoopRuns:
     """|J_best(w)| of each problem (the objective's scale at its width)."""
     successes: list[bool] = field(default_factory=list)
     cycle_times: list[np.ndarray] = field(default_factory=list)
-    """Per problem, its cycles' wall times after the first plan (s)."""
+    """Per problem, its cycles' wall times after the first plan (s), from the state to tau_0."""
+    preparation_times: list[np.ndarray] = field(default_factory=list)
+    """Per problem, the wall times of its cycles' preparations of the next cycle (s), after tau_0, the first plan's
+    and the last cycle's left out."""
     first_times: list[float] = field(default_factory=list)
     iteration_times: list[np.ndarray] = field(default_factory=list)
     """Per problem, the wall time per Newton iteration (s) of its cycles after the first plan that iterated."""
@@ -152,6 +161,9 @@ def run_preset(preset: str, count: int, rate: float | None, budget: float | None
             record.scales.append(planner.problem.normaliser(problem.width))
             record.successes.append(bool(np.linalg.norm(run.ee[-1] - run.goals[-1]) <= problem.width))
             record.cycle_times.append(run.replan_times[1:])
+            # the code before the preparation phase records none
+            prepared = getattr(run, "preparation_times", None)
+            record.preparation_times.append(np.zeros(steps - 2) if prepared is None else prepared[1:-1])
             record.first_times.append(float(run.replan_times[0]))
             iterated = run.replan_iterations[1:] > 0
             record.iteration_times.append(run.replan_times[1:][iterated] / run.replan_iterations[1:][iterated])
@@ -170,12 +182,17 @@ def summary(runs: dict[tuple[str, bool], LoopRuns]) -> dict[tuple[str, bool], di
         reference = np.array(runs["converged", noise].costs)
         relative = (np.array(record.costs) - reference) / np.array(record.scales)
         times, per_iteration = np.concatenate(record.cycle_times), np.concatenate(record.iteration_times)
+        preparations = np.concatenate(record.preparation_times)
+        with_preparation = np.concatenate([t[:-1] + p for t, p in zip(record.cycle_times, record.preparation_times)])
         slowest = sorted(((t, problem, cycle + 1) for problem, cycle_times in zip(record.problems, record.cycle_times)
                           for cycle, t in enumerate(cycle_times)), reverse=True)[:SLOWEST]
         out[name, noise] = {"total": float(relative.mean()),
                             "largest": float(relative.max()), "successes": sum(record.successes), "problems": len(relative),
                             "median_ms": 1e3 * float(np.median(times)), "p99_ms": 1e3 * float(np.percentile(times, 99)),
                             "largest_ms": 1e3 * float(times.max()), "first_ms": 1e3 * float(np.median(record.first_times)),
+                            "preparation_ms": 1e3 * float(np.median(preparations)),
+                            "preparation_p99_ms": 1e3 * float(np.percentile(preparations, 99)),
+                            "with_preparation_p99_ms": 1e3 * float(np.percentile(with_preparation, 99)),
                             "iteration_ms": 1e3 * float(np.median(per_iteration)) if len(per_iteration) else None,
                             "flagged": record.flagged / record.cycles, "cycles": record.cycles,
                             "slowest": [(1e3 * t, p, c) for t, p, c in slowest], "budget": record.budget}
@@ -198,15 +215,17 @@ def markdown(results: dict[str, dict], kinds: dict[str, str], args) -> str:
     lines = [f"Measured by `benchmarks/realtime_loops.py --markdown --presets {args.presets} --problems {args.problems} "
              f"--rate {args.rate}` ({cycle} of 1.5 H·h, each problem's goal jumping by 5 or 20 cm at "
              f"0.3 H·h; executed cost minus the converged loop's with the same noise, over |J_best|, the mean over the "
-             f"problems and the largest; cycle times after the first plan; 1-minute load average "
+             f"problems and the largest; cycle times after the first plan, from the state to tau_0, and the preparation of "
+             f"the next cycle after tau_0; 1-minute load average "
              f"{os.getloadavg()[0]:.1f} on {os.cpu_count()} cores at the end):", "",
-             "| preset | loop | executed cost vs converged (of \\|J_best\\|), mean / largest | reached | cycle median | p99 | largest | per iteration, median | first plan (cold), median | flagged 'not_contracting' |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "| preset | loop | executed cost vs converged (of \\|J_best\\|), mean / largest | reached | cycle median | p99 | largest | per iteration, median | preparation after tau_0, median / p99 | cycle and preparation, p99 | first plan (cold), median | flagged 'not_contracting' |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for preset, rows in results.items():
         for key, row in rows.items():
             lines.append(f"| {preset} | {loop_label(key, row)} | {100 * row['total']:+.3f} % / {100 * row['largest']:+.3f} % "
                          f"| {row['successes']}/{row['problems']} | {row['median_ms']:.2f} ms | {row['p99_ms']:.2f} ms "
                          f"| {row['largest_ms']:.1f} ms | {per_iteration_text(row['iteration_ms'])} "
+                         f"| {row['preparation_ms']:.2f} / {row['preparation_p99_ms']:.2f} ms | {row['with_preparation_p99_ms']:.2f} ms "
                          f"| {row['first_ms']:.1f} ms | {100 * row['flagged']:.1f} % |")
     lines += ["", f"Targets: every cycle within the budget at p99 ({', '.join(f'{1e3 * b:g} ms for {PLURALS[k]}' for k, b in BUDGETS.items())}), "
               f"the executed cost with motor noise no more than {100 * COST_TARGET:g} % of |J_best| above the converged loop's, as many "

@@ -6,7 +6,8 @@ import pytest
 import scipy.optimize
 
 from comanip.optim import Evaluation
-from comanip.optim.active_set_newton import newton_minimize
+from comanip.optim.active_set_newton import newton_minimize, newton_solve
+from comanip.optim.hessian_models import prepare_hessian
 
 
 def test_newton_matches_scipy_on_a_bounded_rosenbrock():
@@ -165,3 +166,50 @@ def test_a_start_where_f_or_its_gradient_is_not_finite_fails_with_a_result(bad):
     assert result.status == Status.FAILED and not result.success and result.nit == 0
     np.testing.assert_array_equal(result.x, np.ones(3))
     assert "not finite at the start" in result.message
+
+
+@pytest.mark.parametrize("secant", [False, True])
+def test_a_prepared_hessian_at_the_start_takes_the_iterates_of_a_solve_that_assembles_it(secant):
+    """The prepared first Hessian made at x0 itself is the one the solve would assemble there: the same iterates and
+    one assembly fewer."""
+    def evaluate(x):
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
+
+    def hessian(x):
+        assemblies.append(x)
+        return scipy.optimize.rosen_hess(x)
+
+    lb, ub = np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5]
+    x0 = np.full(6, -1.2)
+    results = {}
+    for name in ("assembled", "prepared"):
+        assemblies = []
+        prepared = prepare_hessian(scipy.optimize.rosen_hess(x0)) if name == "prepared" else None
+        solve = newton_solve(evaluate, hessian, x0, lb, ub, tolerance=1e-8, secant=secant, prepared=prepared)
+        results[name] = ([solve.advance(k).x.copy() for k in range(1, 6)], solve.advance(200), len(assemblies))
+    (steps, result, assembled), (prepared_steps, prepared_result, prepared_assembled) = results["assembled"], results["prepared"]
+    for ours, theirs in zip(prepared_steps, steps):
+        np.testing.assert_array_equal(ours, theirs)
+    assert result.success and prepared_result.status == result.status and prepared_result.nit == result.nit
+    np.testing.assert_array_equal(prepared_result.x, result.x)
+    assert prepared_assembled == assembled - 1
+
+
+@pytest.mark.parametrize("secant", [False, True])
+def test_a_hessian_prepared_elsewhere_reaches_the_minimiser_of_the_start_s_own_gradient(secant):
+    """A first Hessian from a point far from x0, or x0's own scaled a thousandfold down (a step a thousand times too
+    long, which the line search cuts back), changes the first step, not the minimiser: the gradient is x0's own."""
+    def evaluate(x):
+        return Evaluation(float(scipy.optimize.rosen(x)), scipy.optimize.rosen_der(x), x)
+
+    lb, ub = np.full(6, -2.0), np.r_[np.full(5, 2.0), 0.5]
+    x0 = np.full(6, -1.2)
+    reference = newton_minimize(evaluate, scipy.optimize.rosen_hess, x0, lb, ub, tolerance=1e-8, max_iterations=200)
+    for matrix in (scipy.optimize.rosen_hess(np.full(6, 0.3)), 1e-3 * scipy.optimize.rosen_hess(x0)):
+        solve = newton_solve(evaluate, scipy.optimize.rosen_hess, x0, lb, ub, tolerance=1e-8, secant=secant,
+                             prepared=prepare_hessian(matrix))
+        first, result = solve.advance(1).x.copy(), solve.advance(300)
+        assert result.success, result.message
+        np.testing.assert_allclose(result.x, reference.x, atol=1e-6)
+        assert not np.allclose(first, newton_solve(evaluate, scipy.optimize.rosen_hess, x0, lb, ub, tolerance=1e-8,
+                                                   secant=secant).advance(1).x)

@@ -158,3 +158,73 @@ def test_an_arm_cycle_evaluates_its_status_when_read_and_it_is_the_status_at_its
     assert second.solver_status == "max_wall_time" and second.iterations == 1
     own = curvature.evaluate(np.ravel(second.torque), second.params)
     assert second.optimality == pytest.approx(np.abs(own.gradient).max(), rel=1e-9)
+
+
+def _counting_hessians(planner) -> list:
+    """Counts the Hessian assemblies of the planner's Newton terms from now on (one entry per assembly)."""
+    curvature, calls = planner.solver.curvature, []
+    assemble = curvature.hessian
+
+    def counted(data):
+        calls.append(1)
+        return assemble(data)
+
+    curvature.hessian = counted
+    return calls
+
+
+@pytest.mark.parametrize("preset", ["planar", "franka_rest"])
+def test_a_prepared_cycle_at_the_predicted_state_takes_the_iterates_of_one_that_assembles_its_own(preset):
+    """A cycle that measures the state its preparation predicted (the body's step under tau_0, as a loop without
+    motor noise executes it) steps with the prepared Hessian, assembles none of its own, and ends on the plan of a
+    cycle without preparation; a cycle whose goal moved ignores the preparation."""
+    planner = comanip.Planner(comanip.presets.load(preset))
+    body, period = planner.model.body, 0.01
+    start = np.r_[body.home_position, np.zeros(body.n)] if preset == "franka_rest" else np.zeros(4)
+    hand = np.asarray(body.kinematics_function(start[:body.n])[0]).ravel()
+    goal = hand + ([0.1, 0.05, -0.05] if preset == "franka_rest" else [0.3, 0.1])
+    first = Replanner(planner, iterations=1).first_plan(start, goal, 0.02)
+    measured = np.asarray(body.step_function(period)(first.params.start, first.torque[0])).ravel()
+    calls = _counting_hessians(planner)
+    alone = Replanner(planner, iterations=1).replan(first, measured, elapsed=period)
+    assert len(calls) == 1
+    prepared = Replanner(planner, iterations=1)
+    assert prepared.prepare(first, period) > 0 and len(calls) == 2
+    replan = prepared.replan(first, measured, elapsed=period)
+    assert len(calls) == 2
+    np.testing.assert_allclose(replan.torque, alone.torque, rtol=0, atol=1e-9 * np.abs(alone.torque).max())
+    assert replan.status is alone.status
+    prepared.prepare(replan, period)
+    prepared.replan(replan, measured, elapsed=period, goal=goal + 0.01)
+    assert len(calls) == 4  # the preparation's and the moved cycle's own
+
+
+def test_prepared_cycles_from_a_state_off_the_prediction_converge_to_that_state_s_optimum(planar_planner):
+    """The same disturbed state every cycle, each cycle prepared at a state 1 mm/s off it (motor noise's size over a
+    cycle): the prepared curvature is the prediction's, the gradient the measured state's, so the cycles converge
+    to the measured state's optimum, not the predicted one's."""
+    replanner = Replanner(planar_planner, iterations=1)
+    replan = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    disturbed, predicted = np.array([0.001, -0.001, 0.01, 0.005]), np.array([0.001, -0.001, 0.01, 0.004])
+    for _ in range(6):
+        replanner.prepare(replan, 0.0, state=predicted)
+        replan = replanner.replan(replan, disturbed, elapsed=0.0)
+    converged = planar_planner.solve(disturbed, GOAL, WIDTH)
+    assert replan.status is Progress.CONVERGED
+    assert replan.plan.objective == pytest.approx(converged.objective, rel=1e-8)
+
+
+def test_a_preparation_is_checked_and_serves_only_the_cycle_after_its_plan(planar_planner):
+    replanner = Replanner(planar_planner, iterations=1)
+    first = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
+    with pytest.raises(ValueError, match="elapsed"):
+        replanner.prepare(first, -0.01)
+    with pytest.raises(ValueError, match="replan must be a Replan"):
+        replanner.prepare(first.torque, 0.01)
+    with pytest.raises(ValueError, match="start"):
+        replanner.prepare(first, 0.01, state=np.zeros(3))
+    other = replanner.replan(first, np.zeros(4), elapsed=0.0)
+    calls = _counting_hessians(planar_planner)
+    replanner.prepare(other, 0.01)
+    replanner.replan(first, np.zeros(4), elapsed=0.01)  # not the prepared plan's successor: assembles its own
+    assert len(calls) == 2

@@ -81,9 +81,7 @@ def sample_trajectories(body: Body, h: float, kappa: float, s0, torque, n_sample
     s0 (nx,), torque (H, n) -> states (n_samples, H+1, nx). Each sample draws its own E at every step.
     """
     check_noise_form(noise)
-    s = ca.SX.sym("s", body.state_size)
-    tau = ca.SX.sym("tau", body.n)
-    step = ca.Function("step", [s, tau], [body.discrete_step(s, tau, h)]).map(n_samples)
+    step = body.step_function(h).map(n_samples)
     torque = np.atleast_2d(np.asarray(torque, dtype=float))
     states = np.zeros((n_samples, len(torque) + 1, body.state_size))
     states[:, 0] = s0

@@ -61,6 +61,11 @@ class Body(ABC):
         qddot = ca.ldl_solve(tau - ca.mtimes(self.damping, qdot) - self.gravity(q), D, Lt, p)
         return ca.vertcat(q + h * qdot, qdot + h * qddot)
 
+    def step_function(self, h: float) -> ca.Function:
+        """Numeric :meth:`discrete_step` of length h (s): ``(s (state_size,), tau (n,)) -> s_next (state_size,)``."""
+        s, tau = ca.SX.sym("s", self.state_size), ca.SX.sym("tau", self.n)
+        return ca.Function("step", [s, tau], [self.discrete_step(s, tau, h)])
+
     def command_for_force(self, force: np.ndarray, h: float) -> np.ndarray:
         """Commands (H, n) under which the body feels the torques ``force`` (H, n): the same, for a bare body."""
         return np.asarray(force, dtype=float)

@@ -4,6 +4,7 @@ or as a robot's controller does at its own rate.
 Every cycle of ``period`` seconds (the model's h by default) the loop replans the full H-step problem from the state
 s_k, starting from the previous plan shifted to the cycle's time (:class:`~comanip.planning.replanner.Replanner`:
 until it converges, or on a budget of Newton iterations or wall time per cycle); the plan's first torque tau_0 is
+sent, the next cycle is prepared (:meth:`~comanip.planning.replanner.Replanner.prepare`), and tau_0 is
 executed for the cycle with signal-dependent noise, s_{k+1} = f(s_k, (I + E_k) tau_0) with the forward-Euler step of
 the cycle's length, E_k drawn as the model's noise form says. The receding window keeps its length H, so the person
 always looks H·h seconds ahead. The first plan is a full solve from the start. By default the replan starts from the
@@ -53,7 +54,11 @@ class Execution:
     goals: np.ndarray | None = None
     """The goal each cycle's replan aimed at (K, d), m."""
     replan_times: np.ndarray | None = None
-    """Wall time of each cycle's replan (K,), s; the first is the loop's first plan, a full solve."""
+    """Wall time of each cycle's replan (K,), s, from the state to tau_0; the first is the loop's first plan, a full
+    solve."""
+    preparation_times: np.ndarray | None = None
+    """Wall time of each cycle's preparation of the next (K,), s, after tau_0 is sent (the replanning's
+    ``prepare``)."""
     replan_statuses: list[str] | None = None
     """Each cycle's :class:`~comanip.optim.Progress` ('converged', 'converging', 'not_contracting'), K of them."""
     replan_iterations: np.ndarray | None = None
@@ -113,8 +118,8 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
                    for time, to in goal_jumps)
     rng = rng if rng is not None else np.random.default_rng()
     body, n = model.body, model.n
-    s_sym, tau_sym = ca.SX.sym("s", model.state_size), ca.SX.sym("tau", n)
-    step = ca.Function("step", [s_sym, tau_sym], [body.discrete_step(s_sym, tau_sym, period)])
+    step = body.step_function(period)
+    s_sym = ca.SX.sym("s", model.state_size)
     velocity = ca.Function("ee_velocity", [s_sym], [ca.mtimes(body.jacobian(s_sym[:n]), s_sym[n:2 * n])])
 
     states = np.zeros((steps + 1, model.state_size))
@@ -123,7 +128,8 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     states[0] = estimates[0] = start
     estimator = None if observation is None else DelayedKalmanFilter(model, observation, start)
     commanded, executed, goals = np.zeros((steps, n)), np.zeros((steps, n)), np.zeros((steps, model.d))
-    replan_times, iterations_done, statuses = np.zeros(steps), np.zeros(steps, dtype=int), []
+    replan_times, preparation_times = np.zeros(steps), np.zeros(steps)
+    iterations_done, statuses = np.zeros(steps, dtype=int), []
     replan = None
     for k in range(steps):
         goals[k] = next((to for time, to in reversed(jumps) if time <= k * period + 1e-12), goal)
@@ -132,6 +138,8 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
         replan_times[k], iterations_done[k] = replan.wall_time, replan.iterations
         commanded[k] = replan.torque[0]
         statuses.append(str(replan.status))  # after the command, as a robot's loop reads it
+        if k + 1 < steps:  # the next cycle's preparation, while this one's command runs
+            preparation_times[k] = replanning.prepare(replan, period)
         error = sample_torque_error(commanded[k], model.kappa, model.noise, rng) if noise else 0.0
         executed[k] = commanded[k] + error
         states[k + 1] = np.asarray(step(states[k], executed[k])).ravel()
@@ -143,7 +151,7 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     return Execution(t=period * np.arange(steps + 1), states=states, commanded=commanded, executed=executed,
                      ee=ee, ee_velocity=ee_velocity, failed_replans=sum(status != Progress.CONVERGED for status in statuses),
                      estimates=None if observation is None else estimates, goals=goals, replan_times=replan_times,
-                     replan_statuses=statuses, replan_iterations=iterations_done)
+                     preparation_times=preparation_times, replan_statuses=statuses, replan_iterations=iterations_done)
 
 
 def executed_cost(planner: Planner, run: Execution, width: float | None = None) -> float:

@@ -45,6 +45,10 @@ Hessian strategies :mod:`comanip.optim.hessian_models`, the working set :mod:`co
 - A last iteration without the gradient (``NewtonSolve.advance(..., gradient_at_end=False)``): the iteration that
   spends the budget evaluates its trials value-only and accepts its point without the gradient, which only the
   result's optimality would read; :meth:`~comanip.optim.NewtonSolve.completed`, or a further ``advance``, evaluates it.
+- A prepared first Hessian (``prepared``): the first step uses a Hessian and factor made ahead of the solve at a
+  point near its start (a real-time iteration's preparation phase, run while the controller executes the last
+  command); the gradient is the start's own, so the optimum is unchanged and only the first step's curvature is
+  approximate. A failed line search assembles the Hessian at the start again.
 - Restoration: when no step decreases the merit while a constraint is violated, the least-norm step onto
   the violated constraints' linearisation is taken if it halves the violation.
 - Recovery: when no step decreases the merit otherwise, the secant corrections are dropped and the step is
@@ -72,7 +76,7 @@ from comanip.arguments import as_count
 from comanip.optim.active_set import NO_MULTIPLIERS, NO_ROWS, ConstraintSet, Iterate, constrained_step, restoration_step
 from comanip.optim.evaluation import Evaluation
 from comanip.optim.factorisation import CholeskyFactor
-from comanip.optim.hessian_models import ExactHessian, SecantHessian
+from comanip.optim.hessian_models import ExactHessian, PreparedHessian, SecantHessian
 from comanip.optim.line_search import Backtracked, backtrack
 from comanip.optim.newton_loop import NewtonMethod, NewtonSolve, Stop, never
 from comanip.optim.result import LocalModel, SolverResult
@@ -106,7 +110,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
                  constraint_tolerance: float = 1e-6, margin: float = 1e-3,
                  expired: Callable[[], bool] = never,
                  value: Callable[[np.ndarray], Evaluation] | None = None,
-                 hessian_refresh: int = 1) -> NewtonSolve[SQPState]:
+                 hessian_refresh: int = 1, prepared: PreparedHessian | None = None) -> NewtonSolve[SQPState]:
     """The solve of f over the box [lb, ub] and c(x) ≤ 0 from x0, to run in stages (:class:`NewtonSolve`: its
     ``advance(max_iterations)`` gives the result); f is evaluated at x0 here.
 
@@ -129,6 +133,9 @@ def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
             was not a full, unconstrained one), keeping the last one with updated secant corrections in between; 1:
             every iteration. Must be 1 without ``secant`` (an exact Hessian is assembled at every iteration, chord
             steps apart).
+        prepared: the first step's Hessian and its factor, made ahead of the solve at a point near x0
+            (:func:`~comanip.optim.hessian_models.prepare_hessian`; a real-time iteration's preparation) in place of
+            ``hessian`` at x0; None: assembled at x0.
 
     Results (of ``advance``):
         A :class:`~comanip.optim.SolverResult`: x the best point (N,), fun its f, nit the iterations,
@@ -140,7 +147,7 @@ def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
     if hessian_refresh > 1 and not secant:
         raise ValueError(f"hessian_refresh must be 1 without secant corrections (an exact Hessian is assembled at "
                          f"every iteration), got {hessian_refresh}")
-    hessians = SecantHessian(hessian, hessian_refresh) if secant else ExactHessian(hessian)
+    hessians = SecantHessian(hessian, hessian_refresh, prepared) if secant else ExactHessian(hessian, prepared)
     method = ActiveSetNewton(evaluate, hessians, ConstraintSet(lb, ub, constraints), value, tolerance=tolerance,
                              constraint_tolerance=constraint_tolerance, margin=margin)
     x = np.array(x0, dtype=float) if method.problem.unbounded else np.clip(np.asarray(x0, dtype=float), lb, ub)

@@ -2,8 +2,9 @@
 steps with: :class:`ExactHessian` assembles the caller's Hessian at every iteration and reuses its factor for
 chord steps; :class:`SecantHessian` corrects an approximate Hessian with symmetric rank-one (SR1) updates,
 drops them where they leave it indefinite, assembles it lazily and carries the updates into the last factor by
-the Woodbury identity. Both regularise by
-IPOPT's growing shifts, more strongly after a failed line search."""
+the Woodbury identity. Both regularise by IPOPT's growing shifts, more strongly after a failed line search, and
+both can take their first Hessian and its factor made ahead of the solve (:class:`PreparedHessian`: a real-time
+iteration's preparation)."""
 
 from __future__ import annotations
 
@@ -26,14 +27,42 @@ CORRECTED_SHIFT_LIMIT = 0.1
 dropped and the assembled Hessian alone is factored, with the shifts it needs."""
 
 
+@dataclass(frozen=True)
+class PreparedHessian:
+    """A Hessian (N, N) assembled and factored ahead of the solve whose first step uses it, at a point near that
+    solve's start (:func:`prepare_hessian`)."""
+
+    matrix: np.ndarray
+    factor: CholeskyFactor
+    """Its regularised factor, shifted as the schedule of a fresh solve shifts it."""
+
+
+def prepare_hessian(matrix: np.ndarray) -> PreparedHessian | None:
+    """``matrix`` (N, N) and its factor with the shifts a fresh solve would try; None where none gives a factor."""
+    factor = shifted_cholesky(matrix, growing_shifts(0.0))
+    return None if factor is None else PreparedHessian(matrix, factor)
+
+
 class _Regularised:
-    """The shifted Cholesky factorisation with IPOPT's shift schedule, remembering the last shift needed."""
+    """The shifted Cholesky factorisation with IPOPT's shift schedule, remembering the last shift needed; the first
+    matrix is the prepared one where there is one."""
 
     shift_last = 0.0
 
+    def __init__(self, hessian: Callable, prepared: PreparedHessian | None):
+        self.hessian, self.prepared = hessian, prepared
+
+    def _assembled(self, point) -> np.ndarray:
+        """The Hessian at ``point``: the prepared one until its factor has been used."""
+        return self.hessian(point.data) if self.prepared is None else self.prepared.matrix
+
     def _factored(self, matrix: np.ndarray, recoveries: int, below: float = np.inf) -> CholeskyFactor | None:
         """The factor of matrix with the first shift of the schedule that makes it positive definite, among the
-        shifts ``below`` this one; None if none does."""
+        shifts ``below`` this one; None if none does. The prepared matrix's factor is taken as it is, once."""
+        prepared, self.prepared = self.prepared, None
+        if prepared is not None and matrix is prepared.matrix and not recoveries and prepared.factor.shift < below:
+            self.shift_last = prepared.factor.shift or self.shift_last
+            return prepared.factor
         # after a failed line search, a stronger shift turns the step towards steepest descent
         least = RECOVERY_SHIFT * 10.0 ** (recoveries - 1) if recoveries else 0.0
         factor = shifted_cholesky(matrix, itertools.takewhile(lambda delta: delta < below,
@@ -48,8 +77,8 @@ class ExactHessian(_Regularised):
     the last step cut max |∇f| at least tenfold (``REUSE_RATIO``), the next step reuses that step's factor
     instead of a new Hessian (Kelley 2003, sec. 5.4)."""
 
-    def __init__(self, hessian: Callable):
-        self.hessian = hessian
+    def __init__(self, hessian: Callable, prepared: PreparedHessian | None = None):
+        super().__init__(hessian, prepared)
         self.kept = None
         """The factor of the last free step and the optimality where it was taken, for chord steps."""
 
@@ -63,7 +92,7 @@ class ExactHessian(_Regularised):
     def factor(self, point, recoveries: int, model_held: bool) -> UpdatedFactor | Stop:
         """The regularised Hessian at ``point``, factored (with no updates), or why there is none."""
         self.kept = None
-        hessian = self.hessian(point.data)
+        hessian = self._assembled(point)
         factor = self._factored(hessian, recoveries)
         if factor is None:
             return _not_factored(hessian)
@@ -83,8 +112,9 @@ class SecantHessian(_Regularised):
     """An approximate Hessian with secant corrections, assembled every ``refresh`` iterations (module docstring
     of :mod:`comanip.optim.active_set_newton`)."""
 
-    def __init__(self, hessian: Callable, refresh: int):
-        self.hessian, self.refresh = hessian, refresh
+    def __init__(self, hessian: Callable, refresh: int, prepared: PreparedHessian | None = None):
+        super().__init__(hessian, prepared)
+        self.refresh = refresh
         self.correction = None
         self.previous = None
         """(x, g) before the last step."""
@@ -103,7 +133,7 @@ class SecantHessian(_Regularised):
         working set."""
         reused = self.assembled is not None and self.age < self.refresh and model_held
         if not reused:
-            self.assembled, self.age = self.hessian(point.data), 0
+            self.assembled, self.age = self._assembled(point), 0
         self.age += 1
         self.correction = np.zeros_like(self.assembled) if self.correction is None else self.correction
         update = None

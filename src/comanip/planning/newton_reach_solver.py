@@ -11,6 +11,7 @@ import numpy as np
 
 from comanip.optim import CONVERGED, Evaluation, LocalModel, NewtonSolve, SolverResult
 from comanip.optim.active_set_newton import newton_solve
+from comanip.optim.hessian_models import PreparedHessian, prepare_hessian
 from comanip.optim.newton_loop import never
 from comanip.planning.goal_sensitivity import GoalSensitivity
 from comanip.planning.linearised_curvature import LinearisedCurvature
@@ -48,16 +49,24 @@ class NewtonReachSolver(ReachSolver):
     def run(self, guess: np.ndarray, params: ReachParameters, deadline: float) -> SolverResult[np.ndarray, LocalModel]:
         return self._as_torques(self.newton_solve(guess, params, deadline, self.curvature).advance(self.max_iterations))
 
-    def newton_solve(self, guess: np.ndarray, params: ReachParameters, deadline: float, curvature: Curvature) -> NewtonSolve:
+    def newton_solve(self, guess: np.ndarray, params: ReachParameters, deadline: float, curvature: Curvature,
+                     prepared: PreparedHessian | None = None) -> NewtonSolve:
         """The Newton method's solve from torques guess (H, n) until ``deadline`` (perf_counter, s), evaluated with
-        ``curvature`` (these terms or a start's own copy of them), to run in stages."""
+        ``curvature`` (these terms or a start's own copy of them), to run in stages; its first step with the
+        ``prepared`` Hessian (:meth:`prepared_hessian`) where one is given."""
         value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
         return newton_solve(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                             *self.torque_bounds, tolerance=self.tolerance, secant=not curvature.exact,
                             hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,
                             constraints=self.limits.for_newton(curvature) if self.limits.active else None,
-                            constraint_tolerance=LIMIT_TOLERANCE, value=value,
+                            constraint_tolerance=LIMIT_TOLERANCE, value=value, prepared=prepared,
                             expired=(lambda: time.perf_counter() > deadline) if deadline < np.inf else never)
+
+    def prepared_hessian(self, guess: np.ndarray, params: ReachParameters) -> PreparedHessian | None:
+        """The Hessian of the normalised objective at torques guess (H, n) for ``params``, assembled and factored
+        for a later solve from near there (None where it has no factor: a guess where the objective is not finite)."""
+        curvature = self.curvature
+        return prepare_hessian(curvature.hessian(curvature.evaluate(np.ravel(guess), params).data))
 
     def search(self, guesses: list[np.ndarray], params: ReachParameters, deadline: float) -> list[SolverResult[np.ndarray, LocalModel]]:
         """Every guess's solve, side by side on the start threads if there are any (``SolverOptions.threads``).

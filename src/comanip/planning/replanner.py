@@ -7,13 +7,22 @@ A control loop replans every cycle from the state it measures. A :class:`Replann
 2. from them and the measured state, one Newton iteration every cycle (the real-time iteration), then more up to a
    fixed number (``iterations``) or while they fit a wall budget (``max_wall_time``, every cost of the cycle
    included: the shift, the checks, the evaluation at the shifted plan and the iterations; a further iteration
-   starts only when a recent iteration's time, its 90th percentile, still fits). The first iteration runs even where
+   starts only when the longest of the recent iterations would still fit, a prepared cycle's first iteration counted
+   with its preparation). The first iteration runs even where
    it does not fit the budget, and the cycle then overruns it (its ``wall_time`` says by how much): a cycle that
    stopped before it would send the shifted plan, and a loop of such cycles never converges along the loop;
 3. the best plan comes back as a :class:`Replan` whose ``status`` says how the iterations stand
    (:class:`~comanip.optim.Progress`: 'converged', 'converging', 'not_contracting'). The point a cycle's last
    iteration accepts is evaluated value-only: its gradient (a fifth of a Panda cycle) serves only the status and
-   the plan's belief, so it is evaluated when one of those is first read, after the loop has sent tau_0.
+   the plan's belief, so it is evaluated when one of those is first read, after the loop has sent tau_0;
+4. after sending tau_0, the loop may call :meth:`Replanner.prepare`: the preparation phase of the next cycle (acados'
+   RTI split into preparation and feedback). It predicts the state the next cycle will measure (the body's step
+   under tau_0 for the cycle's length), shifts the plan to that time, and assembles and factors the Hessian there
+   (half of a Panda cycle's work). The next cycle's first iteration then steps with that factor and the gradient at
+   the state it measures, so that between the measurement and tau_0 there is one evaluation, a back-substitution
+   and the line search. The gradient is exact, so the optimum is unchanged; only the first step's curvature is
+   that of the predicted state (exact where the prediction is, as without motor noise). A cycle whose goal or
+   width moved, or that does not follow the prepared plan, assembles its own.
 
 What a solve sets up once per planner (the compiled terms, the torque bounds, the joint limits) the replanner
 reuses; what a full solve redoes every time (the start policy's candidates, the reachability witness by inverse
@@ -35,6 +44,7 @@ import numpy as np
 
 from comanip.arguments import as_count, as_nonnegative, as_optional_positive
 from comanip.optim import Evaluation, Progress, SolverResult, contraction, progress_of
+from comanip.optim.hessian_models import PreparedHessian
 from comanip.optim.newton_loop import never
 from comanip.planning.newton_reach_solver import NewtonReachSolver
 from comanip.planning.plan import Plan, PlanStatus, with_reach_check
@@ -42,11 +52,13 @@ from comanip.planning.planner import Planner
 from comanip.planning.reach_parameters import ReachParameters
 
 RECENT_CYCLES = 50
-"""Cycles over which a budgeted replanner remembers its time per Newton iteration."""
-RESERVE_QUANTILE = 0.9
-"""The quantile of the recent times per iteration that a budgeted cycle reserves for its next iteration: the
-longest would let one stalled iteration (the process descheduled) stop the iterations of the next RECENT_CYCLES
-cycles."""
+"""Cycles over which a budgeted replanner remembers its times per Newton iteration."""
+RESERVE_QUANTILE = 1.0
+"""The quantile of the recent times per iteration that a budgeted cycle reserves for its next iteration: the longest,
+so that a further iteration starts only where the slowest of the recent ones would still fit (a Panda iteration's
+time varies by half with its working set; the 90th percentile overran the budget in 1 % of the cycles). A stalled
+iteration (the process descheduled) then holds the cycles to their one iteration until it ages out, RECENT_CYCLES
+cycles later."""
 
 
 def shifted_torques(torque: np.ndarray, steps: float) -> np.ndarray:
@@ -152,9 +164,21 @@ class Replan:
         return replan
 
 
+@dataclass(frozen=True)
+class Preparation:
+    """What :meth:`Replanner.prepare` made for the cycle after ``previous``."""
+
+    previous: Replan
+    hessian: PreparedHessian
+    wall_time: float
+    """Its wall time (s): an evaluation, the Hessian's assembly and its factorisation, most of what an iteration on a
+    Hessian of its own costs."""
+
+
 class Replanning(Protocol):
     """What a control loop asks of its replanning (:func:`comanip.execution.execute_receding_horizon`): the planner,
-    a first plan, and a plan for each cycle from the last one."""
+    a first plan, a plan for each cycle from the last one, and the preparation of the next cycle after tau_0 is
+    sent."""
 
     planner: Planner
 
@@ -163,6 +187,10 @@ class Replanning(Protocol):
 
     def replan(self, previous: Replan, state, elapsed: float, goal=None, width: float | None = None) -> Replan:
         """The cycle's plan from the measured state (nx,), ``elapsed`` seconds after ``previous`` started."""
+
+    def prepare(self, replan: Replan, elapsed: float) -> float:
+        """Work for the cycle expected ``elapsed`` seconds after ``replan`` started, done after its tau_0 is sent; the
+        wall time it took (s)."""
 
 
 class Replanner:
@@ -177,6 +205,7 @@ class Replanner:
 
     >>> replanner = Replanner(comanip.Planner(comanip.presets.load("franka_rest")), iterations=1)
     >>> replan = replanner.first_plan(start, goal, 0.02)
+    >>> replanner.prepare(replan, elapsed=0.01)                           # after sending replan.torque[0]
     >>> replan = replanner.replan(replan, measured_state, elapsed=0.01)   # every cycle; send replan.torque[0]
     """
 
@@ -191,7 +220,13 @@ class Replanner:
         self.max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         self._iteration_limit = self.iterations if self.iterations is not None else planner.solver.max_iterations
         self._iteration_times: list[float] = []
-        """Seconds per Newton iteration of each of the last RECENT_CYCLES budgeted cycles (0 for a cycle without one)."""
+        """Seconds per Newton iteration that assembles its own Hessian, one per each of the last RECENT_CYCLES budgeted
+        cycles (0 for a cycle without iterations, so that old times age out): an iteration on a prepared Hessian costs
+        less, and would under-reserve for the next, so a prepared cycle counts its preparation with it."""
+        self._preparation: Preparation | None = None
+        """The last :meth:`prepare`'s work, for the next cycle (used once)."""
+        self._step: tuple[float, Callable] | None = None
+        """(cycle length (s), the body's step of that length), the last one :meth:`prepare` predicted with."""
 
     def first_plan(self, start, goal, width: float | None = None) -> Replan:
         """The loop's first plan: a full solve from start (nx,) to goal (d,) of width w (m; the model's when None)."""
@@ -211,9 +246,13 @@ class Replanner:
         goal = previous.params.goal if goal is None else goal
         width = previous.params.width if width is None else width
         params = ReachParameters(*planner.check_inputs(state, goal, width))
+        preparation, self._preparation = self._preparation, None
         guess = shifted_torques(previous.torque, elapsed / model.h)
         goal_q = previous.goal_q
         moved = not (np.array_equal(params.goal, previous.params.goal) and params.width == previous.params.width)
+        if preparation is not None and (preparation.previous is not previous or moved):
+            preparation = None
+        prepared = None if preparation is None else preparation.hessian
         if goal_q is not None and moved:
             goal_q = planner.goal_joints(params, near=goal_q)
             if not planner.reaches(goal_q, params):
@@ -226,15 +265,20 @@ class Replanner:
             # the real-time iteration: one iteration every cycle, whatever the budget, so that the iterations converge
             # along the loop; more while a recent iteration's time still fits. The gradient at the point a cycle's
             # last iteration accepts serves only its status: it is evaluated when the status is read
-            solve = solver.newton_solve(guess, params, np.inf, solver.curvature)
+            solve = solver.newton_solve(guess, params, np.inf, solver.curvature, prepared)
             set_up = time.perf_counter()
             result = solve.advance(1, gradient_at_end=self._may_iterate_again(began, set_up))
+            first_done = time.perf_counter()
             if self._iteration_limit > 1 and not solve.finished:
-                solve.expired = self._expired(began, first_iteration=time.perf_counter() - set_up)
+                solve.expired = self._expired(began, self._first_iteration_time(set_up, first_done, preparation))
                 result = solve.advance(self._iteration_limit, gradient_at_end=False)
         ended = time.perf_counter()
-        if self.max_wall_time is not None:  # a cycle without iterations counts too, so that old times age out
-            self._iteration_times = [*self._iteration_times[1 - RECENT_CYCLES:], (ended - set_up) / result.nit if result.nit else 0.0]
+        if self.max_wall_time is not None:
+            if result.nit > 1:
+                time_per_iteration = (ended - first_done) / (result.nit - 1)
+            else:
+                time_per_iteration = self._first_iteration_time(set_up, first_done, preparation) if result.nit else 0.0
+            self._iteration_times = [*self._iteration_times[1 - RECENT_CYCLES:], time_per_iteration]
         finite = solver.finite(result, guess, params)
         torque = np.reshape(finite.x, (model.H, model.n))
         solver.count_solving_time(ended - began)
@@ -260,6 +304,46 @@ class Replanner:
 
         return Replan(torque, params, result.nit, ended - began, judge, result.start_optimality, goal_q, build_plan)
 
+    def prepare(self, replan: Replan, elapsed: float, state=None) -> float:
+        """The preparation phase of the cycle expected ``elapsed`` (s, ≥ 0) after ``replan`` started, to run once its
+        tau_0 is sent (module docstring, step 4): the Hessian at the plan shifted by ``elapsed`` from the state the
+        next cycle is expected to measure, assembled and factored for :meth:`replan`'s first iteration when its
+        ``previous`` is ``replan`` and its goal and width are ``replan``'s. ``state`` (nx,): that expected state (a
+        robot's own prediction); None: the body's step from ``replan``'s start under tau_0 for ``elapsed``. Returns
+        its wall time (s). A replanner without a budget (``iterations=None`` and no ``max_wall_time``) prepares
+        nothing: its cycles converge, and a prepared first step would only move their plans within the tolerance.
+
+        >>> replan = replanner.replan(replan, state, elapsed=0.01)
+        >>> send(replan.torque[0]); replanner.prepare(replan, 0.01)
+        """
+        began = time.perf_counter()
+        if not isinstance(replan, Replan):
+            raise ValueError(f"replan must be a Replan of this replanner (first_plan or replan), got {type(replan).__name__}")
+        elapsed = as_nonnegative("elapsed", elapsed, "s")
+        planner = self.planner
+        if state is not None:
+            state = planner.check_inputs(state, replan.params.goal, replan.params.width)[0]
+        self._preparation = None
+        if self.iterations is None and self.max_wall_time is None:
+            return time.perf_counter() - began
+        with planner.solver.blas:
+            if state is None:
+                if self._step is None or self._step[0] != elapsed:
+                    self._step = (elapsed, planner.model.body.step_function(elapsed))
+                state = np.asarray(self._step[1](replan.params.start, replan.torque[0])).ravel()
+            params = ReachParameters(state, replan.params.goal, replan.params.width)
+            hessian = planner.solver.prepared_hessian(shifted_torques(replan.torque, elapsed / planner.model.h), params)
+        wall_time = time.perf_counter() - began
+        if hessian is not None:
+            self._preparation = Preparation(replan, hessian, wall_time)
+        return wall_time
+
+    @staticmethod
+    def _first_iteration_time(set_up: float, first_done: float, preparation: Preparation | None) -> float:
+        """What a cycle's first iteration, from ``set_up`` to ``first_done`` (perf_counter, s), would have cost on a
+        Hessian of its own: with the preparation's time where it stepped on a prepared one."""
+        return first_done - set_up + (0.0 if preparation is None else preparation.wall_time)
+
     def _may_iterate_again(self, began: float, set_up: float) -> bool:
         """Whether a cycle that began at ``began`` and set up its solve by ``set_up`` (perf_counter, s) may run a second
         iteration: the iteration limit allows one and, on a budget, two of the recent iterations fit what is left of
@@ -272,10 +356,10 @@ class Replanner:
         return set_up - began + 2 * reserve <= self.max_wall_time
 
     def _expired(self, began: float, first_iteration: float) -> Callable[[], bool]:
-        """Whether the cycle that began at ``began`` (perf_counter, s) and whose first iteration took
-        ``first_iteration`` seconds may start no more Newton iterations: past the budget's end less the
-        RESERVE_QUANTILE of the recent times per iteration, this one's included, so that the cycle ends within its
-        budget where an iteration fits in it (never, without a budget)."""
+        """Whether the cycle that began at ``began`` (perf_counter, s) and whose first iteration would have taken
+        ``first_iteration`` seconds on a Hessian of its own may start no more Newton iterations: past the budget's
+        end less the RESERVE_QUANTILE of the recent times per iteration, this one's included, so that the cycle ends
+        within its budget where an iteration fits in it (never, without a budget)."""
         if self.max_wall_time is None:
             return never
         reserve = float(np.quantile([*self._iteration_times, first_iteration], RESERVE_QUANTILE))
