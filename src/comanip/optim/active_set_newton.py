@@ -155,7 +155,9 @@ def newton_solve(evaluate: Callable[[np.ndarray], Evaluation],
     point = method.finite_point(x, start)
     if point is None:
         return NewtonSolve(None, None, final=SolverResult(x, start.f, Status.FAILED, "objective or gradient not finite at the start", 0, np.inf))
-    return NewtonSolve(method, SQPState(point, history=[point.f]), expired)
+    state = SQPState(point, history=[point.f])
+    method.place(state, point)
+    return NewtonSolve(method, state, expired)
 
 
 def _lagrangian_optimality(point: Iterate, working: np.ndarray, multipliers: np.ndarray) -> float:
@@ -247,21 +249,27 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
         :meth:`complete`)."""
         state.gradient_at_step = False
 
+    def place(self, state: SQPState, point: Iterate) -> None:
+        """Makes ``point`` the iterate, with what the convergence test reads there: whether no constraint is in the
+        working set, and then the Lagrangian's gradient, the gradient (NaN without it; a constrained point's is
+        known once its direction has found the multipliers); the start's, once known."""
+        state.point = point
+        state.free = point.largest <= -self.margin
+        state.optimality = point.steepest if state.free else np.inf
+        if state.free and np.isnan(state.start_optimality):
+            state.start_optimality = state.optimality
+
     def complete(self, state: SQPState) -> bool:
         """The gradient at an iterate accepted value-only."""
         point = state.point
         if point.g is not None:
             return False
-        state.point = self.at(point.x, self.evaluate(point.x))
+        self.place(state, self.at(point.x, self.evaluate(point.x)))
         return True
 
     def converged(self, state: SQPState) -> Stop | None:
         """With no constraint in the working set the Lagrangian's gradient is the gradient, and a converged
         point needs no Hessian (the last iteration of a warm solve)."""
-        state.free = state.point.largest <= -self.margin
-        state.optimality = state.point.steepest if state.free else np.inf
-        if state.free and np.isnan(state.start_optimality):
-            state.start_optimality = state.optimality
         return self._converged(state) if state.free else None
 
     def direction(self, state: SQPState) -> SQPDirection | Stop:
@@ -309,7 +317,8 @@ class ActiveSetNewton(NewtonMethod[SQPState, SQPDirection]):
                 state.recoveries = 0
         if accepted is None:
             return False
-        state.point, state.stepped_with = accepted, direction.factor
+        self.place(state, accepted)
+        state.stepped_with = direction.factor
         state.history.append(accepted.f)
         return True
 
