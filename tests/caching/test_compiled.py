@@ -137,3 +137,28 @@ def test_the_fingerprint_starts_from_the_modules_that_compile():
     modules = compiled_module.compiling_modules()
     assert {"comanip.planning.curvature", "comanip.planning.linearised_curvature"} <= modules
     assert not modules & {"comanip.caching.compiled", "comanip.validation.arm_section"}
+
+
+def test_a_python_that_exits_with_a_compiler_running_stops_it(tmp_path):
+    """A process's compilers are stopped when Python exits (a background build's daemon thread dies with Python and
+    would leave its compiler running): a Python that exits with one running leaves no such process behind."""
+    import os
+    import sys
+
+    scratch = tmp_path / "scratch"
+    scratch.mkdir()
+    script = (f"import subprocess; from comanip.caching import compiled\n"
+              f"process = subprocess.Popen(['sleep', '60'], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)\n"
+              f"compiled.compilers().running[process] = {str(scratch)!r}\n"
+              f"print(process.pid, flush=True)\n")
+    run = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert run.returncode == 0, run.stderr
+    pid = int(run.stdout.split()[0])
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        pass  # stopped and reaped
+    else:
+        os.kill(pid, 9)
+        raise AssertionError(f"the compiler process {pid} outlived the Python that started it")
+    assert not scratch.exists()

@@ -23,7 +23,6 @@ and a compiler still running when Python exits is stopped and its scratch folder
 
 from __future__ import annotations
 
-import atexit
 import hashlib
 import os
 import shlex
@@ -229,15 +228,21 @@ class Compilers:
 
     def stop_running(self) -> None:
         """Stop the compilers still running and remove their scratch folders."""
-        for process, scratch in list(self.running.items()):
-            process.kill()
-            process.wait()
-            shutil.rmtree(scratch, ignore_errors=True)
+        _stop(self.running)
+
+
+def _stop(running: dict[subprocess.Popen, str]) -> None:
+    """Stop the compiler processes of ``running`` and remove their scratch folders."""
+    for process, scratch in list(running.items()):
+        process.kill()
+        process.wait()
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def _started_compilers() -> Compilers:
+    """Compilers whose processes are stopped when they are dropped or, at the latest, when Python exits."""
     made = Compilers()
-    atexit.register(made.stop_running)
+    weakref.finalize(made, _stop, made.running)
     return made
 
 
