@@ -1,6 +1,7 @@
 """The process's default caches: one per kind, made once even when threads ask at once; their memoised functions;
 and no other module-level state in the package (no ``global`` statement, no cache object made at import, no
-memoisation, no module-level container written by a function), with the check itself tried on added state."""
+memoisation, no module-level container written by a function, directly or through an alias, no class-body container
+written by its methods), with the check itself tried on added state."""
 
 import ast
 import threading
@@ -83,11 +84,52 @@ def test_a_memoised_function_keeps_its_latest_results_in_the_process_caches():
         memoised(0)
 
 
+def _memoiser_applied(value: ast.expr | None) -> bool:
+    """A memoiser applied by a call, not as a decorator: ``lru_cache(maxsize=8)(f)``, ``cache(f)``."""
+    if not isinstance(value, ast.Call):
+        return False
+    if isinstance(value.func, ast.Call):
+        return _last_name(value.func) in MEMOISERS
+    return _last_name(value) in MEMOISERS and bool(value.args)
+
+
+def _class_memos(tree: ast.Module) -> list[str]:
+    """Containers made in a class body (shared by every instance) that its methods write into through ``self``,
+    ``cls`` or the class's name, where no method gives the instance one of its own (``self.NAME = ...``)."""
+    found = []
+    for cls in (node for node in ast.walk(tree) if isinstance(node, ast.ClassDef)):
+        shared = {}
+        for node in cls.body:
+            value = node.value if isinstance(node, (ast.Assign, ast.AnnAssign)) else None
+            if _is_container(value):
+                targets = node.targets if isinstance(node, ast.Assign) else [node.target]
+                shared.update({target.id: node.lineno for target in targets if isinstance(target, ast.Name)})
+        owners = {"self", "cls", cls.name}
+
+        def attribute(node):
+            return node.attr if isinstance(node, ast.Attribute) and isinstance(node.value, ast.Name) \
+                and node.value.id in owners else None
+
+        own = {attribute(target) for node in ast.walk(cls) if isinstance(node, ast.Assign) for target in node.targets}
+        for node in ast.walk(cls):
+            targets = node.targets if isinstance(node, (ast.Assign, ast.Delete)) else \
+                [node.target] if isinstance(node, ast.AugAssign) else []
+            written = [attribute(target.value) for target in targets if isinstance(target, ast.Subscript)]
+            if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute) and node.func.attr in MUTATORS:
+                written.append(attribute(node.func.value))
+            for name in written:
+                if name in shared and name not in own:
+                    found.append(f"{cls.name}.{name} (line {shared[name]}) written in a method (line {node.lineno})")
+    return found
+
+
 def module_state(source: str) -> list[str]:
     """What the module of ``source`` keeps between calls at module level: global statements, cache objects made at
-    import (a call of a class named ...Cache or ...Caches), memoising decorators (functools' ``cache`` and
-    ``lru_cache``, bounded or not, and their look-alikes), module-level containers that a function writes into (a
-    memo dict, a registry filled on use), and functions whose default argument is a container they write into."""
+    import (a call of a class named ...Cache or ...Caches), memoisers (functools' ``cache`` and ``lru_cache``,
+    bounded or not, and their look-alikes) as decorators or applied by a call at import, module-level containers that
+    a function writes into, directly or through a local name bound to them (a memo dict, a registry filled on use),
+    containers in a class body that its methods write into, and functions whose default argument is a container they
+    write into."""
     tree = ast.parse(source)
     found = [f"global {', '.join(node.names)} (line {node.lineno})" for node in ast.walk(tree) if isinstance(node, ast.Global)]
     containers = {}
@@ -95,6 +137,8 @@ def module_state(source: str) -> list[str]:
         value = node.value if isinstance(node, (ast.Assign, ast.AnnAssign)) else None
         if isinstance(value, ast.Call) and _last_name(value).endswith(("Cache", "Caches")):
             found.append(f"{_last_name(value)}() at import (line {node.lineno})")
+        if _memoiser_applied(value):
+            found.append(f"{ast.unparse(value)} at import (line {node.lineno})")
         if _is_container(value):
             targets = node.targets if isinstance(node, ast.Assign) else [node.target]
             containers.update({target.id: node.lineno for target in targets if isinstance(target, ast.Name)})
@@ -104,8 +148,12 @@ def module_state(source: str) -> list[str]:
         defaulted = [*zip(positional[len(positional) - len(function.args.defaults):], function.args.defaults),
                      *zip(function.args.kwonlyargs, function.args.kw_defaults)]
         mutable_defaults = {argument.arg for argument, default in defaulted if _is_container(default)}
+        aliases = {target.id: inner.value.id for inner in ast.walk(function) if isinstance(inner, ast.Assign)
+                   and isinstance(inner.value, ast.Name) and inner.value.id in containers
+                   for target in inner.targets if isinstance(target, ast.Name)}
         for inner in ast.walk(function):
             name = _written(inner)
+            name = aliases.get(name, name)
             if name in containers:
                 found.append(f"{name} (line {containers[name]}) written in a function (line {inner.lineno})")
             elif name in mutable_defaults:
@@ -113,7 +161,7 @@ def module_state(source: str) -> list[str]:
         for decorator in getattr(function, "decorator_list", []):
             if _last_name(decorator) in MEMOISERS:
                 found.append(f"@{ast.unparse(decorator)} on {function.name} (line {function.lineno})")
-    return list(dict.fromkeys(found))
+    return list(dict.fromkeys(found + _class_memos(tree)))
 
 
 OWNER = "caching/process_caches.py"
@@ -146,6 +194,11 @@ def scale_of(unit):
     ("def f(x, _memo={}):\n    _memo[x] = x\n    return _memo[x]\n", "default _memo"),
     ("from comanip.caching.model_cache import ModelCache\nCACHE = ModelCache()\n", "ModelCache() at import"),
     ("_N = 0\n\ndef count():\n    global _N\n    _N += 1\n", "global _N"),
+    ("class Scales:\n    _known = {}\n\n    def of(self, unit):\n        self._known[unit] = 1.0\n", "Scales._known"),
+    ("class Scales:\n    seen = []\n\n    @classmethod\n    def see(cls, x):\n        cls.seen.append(x)\n", "Scales.seen"),
+    ("import functools\n\ndef _f(x):\n    return x\n\nf = functools.lru_cache(maxsize=8)(_f)\n", "functools.lru_cache(maxsize=8)(_f) at import"),
+    ("from functools import cache\n\ndef _f(x):\n    return x\n\nf = cache(_f)\n", "cache(_f) at import"),
+    ("_SEEN = {}\n\ndef see(k):\n    table = _SEEN\n    table[k] = True\n", "_SEEN (line"),
 ])
 def test_module_state_is_found_when_added_to_a_module(added, kind):
     """The check above, tried: each way of keeping state between calls, added to the source of units.py, is
@@ -157,7 +210,11 @@ def test_module_state_is_found_when_added_to_a_module(added, kind):
 
 def test_constant_tables_and_import_time_filling_are_not_state():
     """A module-level table read by functions, or filled once while the module is imported, keeps nothing between
-    calls."""
+    calls; nor does a class-body container an instance replaces with one of its own, or a memoiser an instance
+    applies to its own method."""
     source = ('NAMES = {"a": 1}\nORDER = []\nfor name in NAMES:\n    ORDER.append(name)\n\n'
-              'def lookup(key, table={}):\n    local = {}\n    local[key] = NAMES[key]\n    return table.get(key, local[key])\n')
+              'def lookup(key, table={}):\n    local = {}\n    local[key] = NAMES[key]\n    return table.get(key, local[key])\n\n'
+              'class Owner:\n    items = []\n\n    def __init__(self):\n        self.items = []\n'
+              '        self.square = functools.lru_cache(maxsize=4)(self._square)\n\n'
+              '    def add(self, x):\n        self.items.append(x)\n')
     assert module_state(source) == []
