@@ -160,8 +160,8 @@ def test_an_arm_cycle_evaluates_its_status_when_read_and_it_is_the_status_at_its
     assert second.optimality == pytest.approx(np.abs(own.gradient).max(), rel=1e-9)
 
 
-def _counting_hessians(planner) -> list:
-    """Counts the Hessian assemblies of the planner's Newton terms from now on (one entry per assembly)."""
+def _counting_hessians(planner, monkeypatch) -> list:
+    """Counts the Hessian assemblies of the planner's Newton terms until the test ends (one entry per assembly)."""
     curvature, calls = planner.solver.curvature, []
     assemble = curvature.hessian
 
@@ -169,12 +169,12 @@ def _counting_hessians(planner) -> list:
         calls.append(1)
         return assemble(data)
 
-    curvature.hessian = counted
+    monkeypatch.setattr(curvature, "hessian", counted)
     return calls
 
 
 @pytest.mark.parametrize("preset", ["planar", "franka_rest"])
-def test_a_prepared_cycle_at_the_predicted_state_takes_the_iterates_of_one_that_assembles_its_own(preset):
+def test_a_prepared_cycle_at_the_predicted_state_takes_the_iterates_of_one_that_assembles_its_own(preset, monkeypatch):
     """A cycle that measures the state its preparation predicted (the body's step under tau_0, as a loop without
     motor noise executes it) steps with the prepared Hessian, assembles none of its own, and ends on the plan of a
     cycle without preparation; a cycle whose goal moved ignores the preparation."""
@@ -185,7 +185,7 @@ def test_a_prepared_cycle_at_the_predicted_state_takes_the_iterates_of_one_that_
     goal = hand + ([0.1, 0.05, -0.05] if preset == "franka_rest" else [0.3, 0.1])
     first = Replanner(planner, iterations=1).first_plan(start, goal, 0.02)
     measured = np.asarray(body.step_function(period)(first.params.start, first.torque[0])).ravel()
-    calls = _counting_hessians(planner)
+    calls = _counting_hessians(planner, monkeypatch)
     alone = Replanner(planner, iterations=1).replan(first, measured, elapsed=period)
     assert len(calls) == 1
     prepared = Replanner(planner, iterations=1)
@@ -214,7 +214,7 @@ def test_prepared_cycles_from_a_state_off_the_prediction_converge_to_that_state_
     assert replan.plan.objective == pytest.approx(converged.objective, rel=1e-8)
 
 
-def test_a_preparation_is_checked_and_serves_only_the_cycle_after_its_plan(planar_planner):
+def test_a_preparation_is_checked_and_serves_only_the_cycle_after_its_plan(planar_planner, monkeypatch):
     replanner = Replanner(planar_planner, iterations=1)
     first = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
     with pytest.raises(ValueError, match="elapsed"):
@@ -224,7 +224,7 @@ def test_a_preparation_is_checked_and_serves_only_the_cycle_after_its_plan(plana
     with pytest.raises(ValueError, match="start"):
         replanner.prepare(first, 0.01, state=np.zeros(3))
     other = replanner.replan(first, np.zeros(4), elapsed=0.0)
-    calls = _counting_hessians(planar_planner)
+    calls = _counting_hessians(planar_planner, monkeypatch)
     replanner.prepare(other, 0.01)
     replanner.replan(first, np.zeros(4), elapsed=0.01)  # not the prepared plan's successor: assembles its own
     assert len(calls) == 2
