@@ -61,9 +61,6 @@ class ReachCurvature:
 
     exact = True
     """The Hessian is exact."""
-    cheap_value = True
-    """:meth:`value` runs a function of f alone, 10-20 times cheaper than :meth:`evaluate` (line searches and
-    the ranking of initial guesses use it)."""
     carries_belief = False
     """The data holds no mean path: a point mass's belief comes from the problem's expanded rollout."""
 

@@ -59,8 +59,6 @@ class LinearisedCurvature:
 
     exact = False
     """The Hessian is an approximation (the solver adds secant corrections)."""
-    cheap_value = True
-    """:meth:`value_and_data` is the forward rollout alone, a fraction of :meth:`evaluate`'s cost."""
     carries_belief = True
     """The data holds the mean path, its sensitivities and the covariances."""
 

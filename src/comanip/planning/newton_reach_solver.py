@@ -54,7 +54,9 @@ class NewtonReachSolver(ReachSolver):
         """The Newton method's solve from torques guess (H, n) until ``deadline`` (perf_counter, s), evaluated with
         ``curvature`` (these terms or a start's own copy of them), to run in stages; its first step with the
         ``prepared`` Hessian (:meth:`prepared_hessian`) where one is given."""
-        value = (lambda x: curvature.value_and_data(x, params)) if curvature.cheap_value else None
+        def value(x):  # line-search trials value-only: for either kind of body a fraction of an evaluation
+            return curvature.value_and_data(x, params)
+
         return newton_solve(lambda x: curvature.evaluate(x, params), curvature.hessian, np.ravel(guess),
                             *self.torque_bounds, tolerance=self.tolerance, secant=not curvature.exact,
                             hessian_refresh=1 if curvature.exact else self.options.hessian_refresh,

@@ -126,8 +126,6 @@ class Curvature(Protocol):
     exact: bool
     """The Hessian is exact (Newton converges quadratically); False: an approximation the solver corrects
     with secant updates."""
-    cheap_value: bool
-    """:meth:`value_and_data` costs much less than :meth:`evaluate` (line-search trials use it then)."""
     carries_belief: bool
     """The data holds the mean path and its sensitivities (:meth:`mean_path`, :meth:`mean_sensitivities`,
     :meth:`trajectory`); False: the belief comes from the problem's expanded rollout."""
