@@ -5,6 +5,7 @@ imports no other command)."""
 COMMAND_HELP = {
     "demo": "plan a reach, predict a recorded person's goal online, run a robot beside them",
     "plan": "plan one reach",
+    "replan": "replan a reach in closed loop at a controller's rate, beside the converged loop",
     "validate": "compare the model with the paper's validation analyses (and the calibration study, the Franka section)",
     "transition": "transition-point data, model and figure (multi-component reaching)",
     "handover": "robot→person authority handover at the predicted transition",

@@ -6,6 +6,7 @@ from comanip.cli.command_help import COMMAND_HELP
 COMMANDS = {name: (module, COMMAND_HELP[name]) for name, module in (
     ("demo", "comanip.cli.demo_command"),
     ("plan", "comanip.cli.plan_command"),
+    ("replan", "comanip.cli.replan_command"),
     ("validate", "comanip.cli.validate_command"),
     ("transition", "comanip.cli.transition_command"),
     ("handover", "comanip.cli.handover_command"),

@@ -23,6 +23,9 @@ MANIFEST = "manifest.json"
 FILE_KINDS = (
     ("plan.json", "the plan: status, success, objective, times, state and end-effector mean and covariance, torques"),
     ("plan.csv", "the plan, one row per step: t, q, qdot, activation-stage forces (if any), hand position, velocity and std, torque"),
+    ("replan.json", "the closed loop replanned at a controller's rate: cycle times, executed cost against the converged loop, final errors"),
+    ("replan.csv", "the closed loop, one row per control cycle: its replan and preparation times, iterations, the hand, its status"),
+    ("replan.png", "figure: cycle times against the period, and the hand's speed beside the converged loop"),
     ("estimate.json", "the goal estimate: estimated goal ('goal'), status, and the plan through the observation"),
     ("estimate.csv", "the estimate's predicted trajectory, one row per step (columns as a plan CSV)"),
     ("posterior.json", "posterior over the candidate goals after each observation prefix, with entropies"),
