@@ -65,3 +65,17 @@ def test_a_replanner_brings_its_own_budget(planar_planner):
 
     with pytest.raises(ValueError, match="its own budget"):
         execute_receding_horizon(Replanner(planar_planner), np.zeros(4), [0.3, 0.0], 0.02, iterations=2)
+
+
+def test_a_replanning_without_a_preparation_is_named_before_the_loop_runs(planar_planner):
+    class OnlyReplans:  # what a replanning needed before cycles were prepared after the command
+        planner = planar_planner
+
+        def first_plan(self, start, goal, width=None):
+            raise AssertionError("the loop must not start")
+
+        def replan(self, previous, state, elapsed, goal=None, width=None):
+            raise AssertionError("the loop must not start")
+
+    with pytest.raises(ValueError, match="OnlyReplans has no prepare"):
+        execute_receding_horizon(OnlyReplans(), np.zeros(4), [0.3, 0.0], 0.02)

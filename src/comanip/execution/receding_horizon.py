@@ -99,6 +99,10 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
     if not isinstance(planner, Planner) and (iterations is not None or max_wall_time is not None):
         raise ValueError("iterations and max_wall_time go with a Planner; a Replanner has its own budget")
     replanning = planner if not isinstance(planner, Planner) else Replanner(planner, iterations, max_wall_time)
+    missing = [name for name in ("planner", "first_plan", "replan", "prepare") if not hasattr(replanning, name)]
+    if missing:
+        raise ValueError(f"planner must be a comanip.Planner or a replanning of one (a Replanner: planner, first_plan, "
+                         f"replan and prepare); {type(replanning).__name__} has no {', '.join(missing)}")
     planner = replanning.planner
     model = planner.model
     observation = Observation.of(model) if observation is None else observation
