@@ -226,3 +226,18 @@ def test_the_model_at_its_own_pace_misfits_a_hand_beyond_its_best_reach():
         assert first.verdict is Verdict.MISFITS and first.misfit == np.inf and quick.explanations[1].ruled_out is not None
         assert np.linalg.norm(answer.unsmoothed_goal - reach.position[0]) <= 1.01 * shortest
         assert np.linalg.norm(reach.position[k] - reach.position[0]) > shortest
+
+
+def test_the_model_at_its_own_pace_cannot_tell_before_movement_and_the_next_explanation_answers(planner):
+    """Before any observation shows movement the model at its own pace is undecided (not the prior as its account):
+    the next explanation gives the estimate; once the hand moves, the model explains it and the next is not asked."""
+    t, position, velocity = reach_samples(planner, np.array([0.3, 0.1, 0.0]))
+    after = FixedGoal([0.2, 0.2, 0.2], True)
+    estimator = OnlineGoalEstimator(planner, np.zeros(6), explanations=[ModelAtOwnPace(planner.model, OnlineOptions()), after])
+    resting = estimator.update(0.01, np.zeros(3), np.zeros(3))
+    assert after.asked == 1 and resting.status == Status.SOLVED
+    np.testing.assert_array_equal(resting.goal, after.goal)
+    for k in range(len(t)):
+        moving = estimator.update(0.01 + t[k], position[k], velocity[k])
+    assert after.asked < 1 + len(t)                                   # the model explained the moving hand
+    assert np.linalg.norm(moving.goal - [0.3, 0.1, 0.0]) < 0.05       # its goal, not the fixed one 0.2 m away

@@ -16,8 +16,10 @@ goal's covariance is the Laplace approximation with a 1-D quadrature along the r
 still poorly known (:meth:`~comanip.estimation.map_goal.MapProblem.distance_spread`). Axes someone else moves
 (``OnlineOptions.led_axes``) count for less while they move.
 
-It always explains the hand, and says how well: its misfit is the mean squared whitened residual per observed
-number. The estimator's default chain rules it out for the rest of the reach once that misfit exceeds
+Once an observation shows movement it explains the hand, and says how well: its misfit is the mean squared
+whitened residual per observed number (before, it cannot tell: verdict UNDECIDED, and the next explanation is
+asked). A Newton iteration that fails keeps its previous estimate with status FAILED: that is its account, and the
+chain's veto of its infinite misfit rules it out where another explanation can answer. The estimator's default chain rules it out for the rest of the reach once that misfit exceeds
 ``OnlineOptions.mismatch_threshold`` or its reach at the person's pace contradicts its timing
 (:mod:`comanip.estimation.explanations.vetoed`). Beyond the reach family's distances or a person's hand speeds
 no other explanation does better, so there its account cannot be contested.
@@ -134,11 +136,10 @@ class ModelAtOwnPace:
                              self._sums[steps] / counts[:, None], self._weights[steps] / counts[:, None])
         previous = self._last
         try:
-            if previous is None or previous.status in (EstimateStatus.UNINFORMATIVE, Status.FAILED):
+            if previous is None or previous.verdict is Verdict.UNDECIDED or previous.status == Status.FAILED:
                 goal = problem.cold_goal(hand.last_observation, options.observation_std, self._R[None] / counts[:, None, None])
                 if goal is None:
-                    return Explained.explaining(reach.prior_mean, reach.prior_cov, EstimateStatus.UNINFORMATIVE,
-                                                "no observation shows movement: the estimate is the prior")
+                    return Explained.not_explaining(reach, Verdict.UNDECIDED, "no observation shows movement yet")
             else:
                 goal = previous.goal
             if give_up_above is not None and self._behind_the_hand(goal, hand):
