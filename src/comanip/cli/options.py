@@ -34,6 +34,18 @@ def add_reach_arguments(parser: argparse.ArgumentParser, start_default: str, out
     parser.add_argument("--png", action="store_true", help=f"also save {figures}")
 
 
+def reach_of(model: ReachingModel, start, goal, reach_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """The start (at rest at the body's home position when None) and goal (``reach_m`` along x from the start's hand
+    when None) of a command's reach, as given otherwise; checked by the caller."""
+    from comanip.planning.planner import reach_inputs
+
+    start = np.concatenate([model.body.home_position, np.zeros(model.n)]) if start is None else start
+    if goal is None:
+        start_q = reach_inputs(model, start, np.zeros(model.d), None)[0][: model.n]
+        goal = np.asarray(model.body.kinematics_function(start_q)[0]).ravel() + reach_m * np.eye(model.d)[0]
+    return start, goal
+
+
 def add_unit_check_argument(parser: argparse.ArgumentParser, what: str) -> None:
     """--skip-unit-check: read ``what`` as s and m even when its times look like ms or its positions like mm."""
     parser.add_argument("--skip-unit-check", dest="check_units", action="store_false",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from comanip.cli.command_help import command_help
-from comanip.cli.options import add_model_arguments, add_reach_arguments, load_model, vector
+from comanip.cli.options import add_model_arguments, add_reach_arguments, load_model, reach_of, vector
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
 
 
@@ -23,11 +23,7 @@ def run(args) -> int:
     from comanip.planning.planner import Planner, reach_inputs
 
     model = load_model(args)
-    start = np.concatenate([model.body.home_position, np.zeros(model.n)]) if args.start is None else args.start
-    goal = args.goal
-    if goal is None:
-        start_q = reach_inputs(model, start, np.zeros(model.d), None)[0][: model.n]
-        goal = np.asarray(model.body.kinematics_function(start_q)[0]).ravel() + 0.3 * np.eye(model.d)[0]
+    start, goal = reach_of(model, args.start, args.goal, 0.3)
     reach_inputs(model, start, goal, args.width)  # every input checked before the folder is made
     as_optional_positive("max_wall_time", args.max_wall_time, "s")
     out = output_dir(args.out, "plan", args.force)

@@ -9,7 +9,7 @@ import json
 import numpy as np
 
 from comanip.cli.command_help import command_help
-from comanip.cli.options import add_model_arguments, load_model, vector
+from comanip.cli.options import add_model_arguments, load_model, reach_of, vector
 from comanip.cli.outputs import add_output_arguments, output_dir, point_text, report, write_manifest
 
 
@@ -45,11 +45,7 @@ def run(args) -> int:
     from comanip.planning.solver_options import SolverOptions
 
     model = load_model(args)
-    start = np.concatenate([model.body.home_position, np.zeros(model.n)]) if args.start is None else args.start
-    goal = args.goal
-    if goal is None:
-        start_q = reach_inputs(model, start, np.zeros(model.d), None)[0][: model.n]
-        goal = np.asarray(model.body.kinematics_function(start_q)[0]).ravel() + 0.15 * np.eye(model.d)[0]
+    start, goal = reach_of(model, args.start, args.goal, 0.15)
     start, goal, width = reach_inputs(model, start, goal, args.width)  # every input checked before the folder is made
     period = 1.0 / as_optional_positive("rate", args.rate, "Hz")
     budget = as_optional_positive("budget", args.budget, "s")
