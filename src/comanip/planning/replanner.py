@@ -18,7 +18,7 @@ A control loop replans every cycle from the state it measures. A :class:`Replann
 4. after sending tau_0, the loop may call :meth:`Replanner.prepare`: the preparation phase of the next cycle (acados'
    RTI split into preparation and feedback). It predicts the state the next cycle will measure (the body's step
    under tau_0 for the cycle's length), shifts the plan to that time, and assembles and factors the Hessian there
-   (half of a Panda cycle's work). The next cycle's first iteration then steps with that factor and the gradient at
+   (on an arm most of a cycle's work). The next cycle's first iteration then steps with that factor and the gradient at
    the state it measures, so that between the measurement and tau_0 there is one evaluation, a back-substitution
    and the line search. The gradient is exact, so the optimum is unchanged; only the first step's curvature is
    that of the predicted state (exact where the prediction is, as without motor noise). A cycle whose goal or
@@ -55,8 +55,8 @@ RECENT_CYCLES = 50
 """Cycles over which a budgeted replanner remembers its times per Newton iteration."""
 RESERVE_QUANTILE = 1.0
 """The quantile of the recent times per iteration that a budgeted cycle reserves for its next iteration: the longest,
-so that a further iteration starts only where the slowest of the recent ones would still fit (a Panda iteration's
-time varies by half with its working set; the 90th percentile overran the budget in 1 % of the cycles). A stalled
+so that a further iteration starts only where the slowest of the recent ones would still fit (an arm's iteration
+takes longer the more joint limits bind; a lower quantile lets the cycles that meet such an iteration overrun). A stalled
 iteration (the process descheduled) then holds the cycles to their one iteration until it ages out, RECENT_CYCLES
 cycles later."""
 
@@ -220,7 +220,7 @@ class Replanner:
         self.max_wall_time = as_optional_positive("max_wall_time", max_wall_time, "s")
         self._iteration_limit = self.iterations if self.iterations is not None else planner.solver.max_iterations
         self._iteration_times: list[float] = []
-        """Seconds per Newton iteration that assembles its own Hessian, one per each of the last RECENT_CYCLES budgeted
+        """Seconds per Newton iteration that assembles its own Hessian, one for each of the last RECENT_CYCLES budgeted
         cycles (0 for a cycle without iterations, so that old times age out): an iteration on a prepared Hessian costs
         less, and would under-reserve for the next, so a prepared cycle counts its preparation with it."""
         self._preparation: Preparation | None = None
