@@ -7,6 +7,11 @@ or from a ROS 2 bag or a Vicon Nexus trajectories export of the hand's position 
 positions, times from the onset):
 its last row at or before ``--t-obs`` is the observation, a row at t = 0 is the start, and every row up
 to the horizon feeds the posterior.
+
+With ``--online`` every row of ``--observations`` is streamed, as a tracker delivers it, through the online estimator
+over a stream of reaches (:class:`~comanip.ReachStream`: each reach found in the motion, its goal revised with every
+sample, its forecast of the hand): one row per sample with the goal, its spread and where the hand will be
+``--leads`` seconds on; the last estimate as JSON.
 """
 
 from __future__ import annotations
@@ -49,6 +54,10 @@ def add_parser(subparsers) -> None:
                              "paper's W from the goal width (default: 10 m, a weak prior)")
     parser.add_argument("--method", choices=METHODS, default="regret", help="'regret' (default) or 'paper' (eq. 11 as printed)")
     parser.add_argument("--candidates", type=candidate_list, help="candidate goals for a posterior, e.g. '0.3,0;0.2,0.2' (m)")
+    parser.add_argument("--online", action="store_true", help="stream every row of --observations through the online "
+                        "estimator (reaches found in the motion, a forecast of the hand) instead of estimating once at --t-obs")
+    parser.add_argument("--leads", type=vector, default=np.array([0.1, 0.2, 0.3]),
+                        help="with --online: how far ahead (s) the forecast columns look, comma-separated (default: 0.1,0.2,0.3)")
     parser.set_defaults(func=run)
 
 
@@ -86,6 +95,8 @@ def check_inputs(args, model, start, observed, t_obs) -> None:
 
 def run(args) -> int:
     model = load_model(args)
+    if args.online:
+        return run_online(args, model)
     body, n = model.body, model.n
     at_rest = np.r_[body.home_position, np.zeros(n)]
     times = states = None
@@ -144,3 +155,66 @@ def run(args) -> int:
         lines.append(f"most likely candidate: {int(posterior.most_likely[-1])} (p = {posterior.probabilities[-1].max():.3g})")
     report(args, lines, summary, out, written)
     return 0 if estimate.success else 1
+
+
+def run_online(args, model) -> int:
+    """``--online`` (module docstring): every row of ``--observations`` through a :class:`~comanip.ReachStream`."""
+    from comanip.estimation.reach_stream import ReachStream
+
+    if args.observations is None:
+        raise ValueError("--online streams --observations: give a CSV of timestamped states, a ROS 2 bag or a Nexus export")
+    for name, value in (("--observed", args.observed), ("--candidates", args.candidates), ("--start", args.start)):
+        if value is not None:
+            raise ValueError(f"{name} does not go with --online (each reach starts where the stream finds it)")
+    leads = np.atleast_1d(args.leads)
+    if not (np.all(np.isfinite(leads)) and np.all(leads > 0)):
+        raise ValueError(f"--leads must be times ahead > 0 s, comma-separated, got {args.leads.tolist()}")
+    n = model.n
+    times, states = read_hand_states(args.observations, n, check_units=args.check_units, joint_angles=not model.body.is_linear,
+                                     name="--observations", topic=args.topic, frame=args.frame, marker=args.marker,
+                                     max_gap=args.max_gap)
+    width = reach_inputs(model, np.zeros(model.state_size), np.zeros(model.d), args.width)[2]
+    prior_covariance(args.prior_std, model, width)
+    if args.prior is not None:
+        as_vector("prior_goal", args.prior, model.d, "task-space position, m")
+    out = output_dir(args.out, "estimate", args.force, create=False)
+    stream = ReachStream(model, prior_goal=args.prior, prior_std=args.prior_std, width=args.width)   # refuses an arm
+    axes = "xyz"[: model.d]
+    header = ["t_s", "reach", "moving", "status", *(f"goal_{a}_m" for a in axes), *(f"goal_std_{a}_m" for a in axes),
+              *(f"forecast_{lead:g}s_{a}_m" for lead in leads for a in axes)]
+    rows, latest = [], None
+    for t, state in zip(times, states):
+        latest = stream.update(float(t), state[:n], state[n:2 * n])
+        estimate = latest.estimate
+        if estimate is None:
+            rows.append([t, latest.reach, int(latest.moving), ""] + [np.nan] * (2 + len(leads)) * model.d)
+            continue
+        ahead = (np.full((len(leads), model.d), np.nan) if estimate.forecast is None
+                 else estimate.forecast.at(estimate.t_obs + leads).position)
+        rows.append([t, latest.reach, int(latest.moving), str(estimate.status), *estimate.goal,
+                     *np.sqrt(np.diag(estimate.goal_covariance)), *ahead.ravel()])
+    out.mkdir(parents=True, exist_ok=True)
+    csv_path = out / "online.csv"
+    with open(csv_path, "w", encoding="utf-8") as file:
+        file.write(",".join(header) + "\n")
+        for row in rows:
+            file.write(",".join(value if isinstance(value, str) else f"{value:.9g}" for value in row) + "\n")
+    written = [csv_path]
+    final = latest.estimate if latest is not None else None
+    if final is not None:
+        written.append(final.save_json(out / "estimate.json"))
+    if args.png:
+        from comanip.plots.streamed_estimates_figure import plot_streamed_estimates
+
+        goals = np.array([row[4:4 + model.d] if row[3] else [np.nan] * model.d for row in rows], dtype=float)
+        written.append(plot_streamed_estimates(times, states[:, :n], goals, out / "online.png",
+                                               f"{model.name}: the online estimate of every sample"))
+    write_manifest(out, "estimate", written)
+    summary = {"model": model.name, "samples": len(rows), "reaches": 0 if latest is None else latest.reach,
+               "final_goal": None if final is None else final.goal.tolist(),
+               "final_status": None if final is None else str(final.status), "leads_s": leads.tolist(),
+               "files": [str(p) for p in written]}
+    lines = [f"estimate --online ({model.name}): {len(rows)} samples, {summary['reaches']} reach(es) found"
+             + ("" if final is None else f", last goal {point_text(final.goal)} m ({final.status})")]
+    report(args, lines, summary, out, written)
+    return 0 if final is not None else 1

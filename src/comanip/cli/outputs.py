@@ -28,6 +28,8 @@ FILE_KINDS = (
     ("replan.png", "figure: cycle times against the period, and the hand's speed beside the converged loop"),
     ("estimate.json", "the goal estimate: estimated goal ('goal'), status, and the plan through the observation"),
     ("estimate.csv", "the estimate's predicted trajectory, one row per step (columns as a plan CSV)"),
+    ("online.csv", "the stream through the online estimator, one row per sample: reach, goal, its spread, the forecast ahead"),
+    ("online.png", "figure: the hand's path with the goal estimated at each sample, and both over time"),
     ("posterior.json", "posterior over the candidate goals after each observation prefix, with entropies"),
     ("posterior.png", "figure: posterior probability of each candidate goal over time"),
     ("fit.json", "fitted values, standard errors, residuals per condition and the fit's status"),
