@@ -200,9 +200,9 @@ def test_a_prepared_cycle_at_the_predicted_state_takes_the_iterates_of_one_that_
 
 
 def test_prepared_cycles_from_a_state_off_the_prediction_converge_to_that_state_s_optimum(planar_planner):
-    """The same disturbed state every cycle, each cycle prepared at a state 1 mm/s off it (motor noise's size over a
-    cycle): the prepared curvature is the prediction's, the gradient the measured state's, so the cycles converge
-    to the measured state's optimum, not the predicted one's."""
+    """The same disturbed state every cycle, each cycle prepared at a state 1 mm/s off it: the prepared curvature is
+    the prediction's, the gradient the measured state's, so the cycles converge to the measured state's optimum, not
+    the predicted one's."""
     replanner = Replanner(planar_planner, iterations=1)
     replan = replanner.first_plan(np.zeros(4), GOAL, WIDTH)
     disturbed, predicted = np.array([0.001, -0.001, 0.01, 0.005]), np.array([0.001, -0.001, 0.01, 0.004])
