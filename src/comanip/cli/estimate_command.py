@@ -25,7 +25,7 @@ from comanip.arguments import as_optional_positive, as_vector
 from comanip.cli.command_help import command_help
 from comanip.cli.options import (add_bag_arguments, add_marker_arguments, add_model_arguments, add_reach_arguments,
                                  add_unit_check_argument, input_file_or_bag, load_model, vector)
-from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest
+from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest, write_table
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.goal_estimator import METHODS, check_method
 from comanip.estimation.goal_prior import PAPER_PRIOR, prior_covariance
@@ -182,31 +182,26 @@ def run_online(args, model) -> int:
     axes = "xyz"[: model.d]
     header = ["t_s", "reach", "moving", "status", *(f"goal_{a}_m" for a in axes), *(f"goal_std_{a}_m" for a in axes),
               *(f"forecast_{lead:g}s_{a}_m" for lead in leads for a in axes)]
-    rows, latest = [], None
-    for t, state in zip(times, states):
+    rows, goals, latest = [], np.full((len(times), model.d), np.nan), None
+    for k, (t, state) in enumerate(zip(times, states)):
         latest = stream.update(float(t), state[:n], state[n:2 * n])
         estimate = latest.estimate
         if estimate is None:
             rows.append([t, latest.reach, int(latest.moving), ""] + [np.nan] * (2 + len(leads)) * model.d)
             continue
+        goals[k] = estimate.goal
         ahead = (np.full((len(leads), model.d), np.nan) if estimate.forecast is None
                  else estimate.forecast.at(estimate.t_obs + leads).position)
         rows.append([t, latest.reach, int(latest.moving), str(estimate.status), *estimate.goal,
                      *np.sqrt(np.diag(estimate.goal_covariance)), *ahead.ravel()])
     out.mkdir(parents=True, exist_ok=True)
-    csv_path = out / "online.csv"
-    with open(csv_path, "w", encoding="utf-8") as file:
-        file.write(",".join(header) + "\n")
-        for row in rows:
-            file.write(",".join(value if isinstance(value, str) else f"{value:.9g}" for value in row) + "\n")
-    written = [csv_path]
+    written = [write_table(out / "online.csv", header, rows)]
     final = latest.estimate if latest is not None else None
     if final is not None:
         written.append(final.save_json(out / "estimate.json"))
     if args.png:
         from comanip.plots.streamed_estimates_figure import plot_streamed_estimates
 
-        goals = np.array([row[4:4 + model.d] if row[3] else [np.nan] * model.d for row in rows], dtype=float)
         written.append(plot_streamed_estimates(times, states[:, :n], goals, out / "online.png",
                                                f"{model.name}: the online estimate of every sample"))
     write_manifest(out, "estimate", written)

@@ -126,6 +126,15 @@ def report(args: argparse.Namespace, lines: Sequence[str], full, out: Path, file
     print(f"wrote {len(files)} file{'s' if len(files) != 1 else ''} to {out} (listed in {Path(out) / MANIFEST}; --verbose prints the full results)")
 
 
+def write_table(path: Path, header: Sequence[str], rows) -> Path:
+    """A CSV with a header row: each row's numbers to 9 significant digits (NaN as 'nan'), its text as it is."""
+    with open(path, "w", encoding="utf-8") as file:
+        file.write(",".join(header) + "\n")
+        for row in rows:
+            file.write(",".join(value if isinstance(value, str) else f"{float(value):.9g}" for value in row) + "\n")
+    return Path(path)
+
+
 def point_text(x) -> str:
     """A point (d,) as '(0.3, 0.1)' for a summary line."""
     return "(" + ", ".join(f"{float(v):.4g}" for v in x) + ")"

@@ -10,7 +10,7 @@ import numpy as np
 
 from comanip.cli.command_help import command_help
 from comanip.cli.options import add_model_arguments, load_model, reach_of, vector
-from comanip.cli.outputs import add_output_arguments, output_dir, point_text, report, write_manifest
+from comanip.cli.outputs import add_output_arguments, output_dir, point_text, report, write_manifest, write_table
 
 
 def add_parser(subparsers) -> None:
@@ -74,15 +74,11 @@ def run(args) -> int:
 
     cycles = 1e3 * fast.replan_times[1:]
     preparations = 1e3 * fast.preparation_times[1:-1]
-    rows = np.column_stack([fast.t[:-1], 1e3 * fast.replan_times, 1e3 * fast.preparation_times, fast.replan_iterations,
-                            fast.ee[:-1], fast.ee_speed[:-1], 1e3 * converged.replan_times])
-    header = ",".join(["t_s", "cycle_ms", "preparation_ms", "iterations", *(f"hand_{a}_m" for a in "xyz"[: model.d]),
-                       "hand_speed_m_s", "converged_cycle_ms", "status"])
-    csv_path = out / "replan.csv"
-    with open(csv_path, "w", encoding="utf-8") as file:
-        file.write(header + "\n")
-        for row, status in zip(rows, fast.replan_statuses):
-            file.write(",".join(f"{v:.9g}" for v in row) + f",{status}\n")
+    numbers = np.column_stack([fast.t[:-1], 1e3 * fast.replan_times, 1e3 * fast.preparation_times, fast.replan_iterations,
+                               fast.ee[:-1], fast.ee_speed[:-1], 1e3 * converged.replan_times])
+    header = ["t_s", "cycle_ms", "preparation_ms", "iterations", *(f"hand_{a}_m" for a in "xyz"[: model.d]),
+              "hand_speed_m_s", "converged_cycle_ms", "status"]
+    csv_path = write_table(out / "replan.csv", header, ([*row, status] for row, status in zip(numbers, fast.replan_statuses)))
     final_goal = fast.goals[-1]
     summary = {"model": model.name, "rate_hz": 1.0 / period, "cycles": steps, "iterations_per_cycle": iterations,
                "budget_s": budget, "noise": args.noise, "seed": args.seed, "goal": final_goal.tolist(), "width": width,
