@@ -251,7 +251,7 @@ def main(argv=None):
         parser.error(f"leave-one-person-out needs at least two people; {args.tathum} and {args.ue_adl} hold {len(people)}")
     counts = {person: len(recordings) for person, recordings in people.items()}
     print(f"{len(people)} people, {sum(counts.values())} reaches read in {time.perf_counter() - begin:.0f} s", file=log, flush=True)
-    from comanip.estimation.people_model import PeopleModel
+    from comanip.estimation.people.people_model import PeopleModel
 
     def fit(recordings):
         return (LearnedForecaster(max_iter=args.max_iter, every=args.every).fit(recordings),

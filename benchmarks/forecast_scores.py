@@ -4,7 +4,7 @@ forecasters given the same inputs, for ``real_people.py``.
 From the update at 25 % and 50 % of a movement's MT, each forecaster's position at +LEADS s is compared with the
 recorded hand's (held at its endpoint after the movement ends): error / D. The kinematic forecasters get the
 hand's position and velocity of that update and the acceleration from its last velocities
-(:func:`comanip.estimation.path_baselines.recent_acceleration`); minimum jerk also gets the estimate's own goal and
+(:func:`comanip.estimation.forecast.path_baselines.recent_acceleration`); minimum jerk also gets the estimate's own goal and
 stop time. The forecast's 95 % region (its covariance) is checked on the recorded position.
 """
 
@@ -13,8 +13,8 @@ from __future__ import annotations
 import numpy as np
 from scipy.stats import chi2
 
-from comanip.estimation import path_baselines as kinematic
-from comanip.estimation.hand_forecast import continued_reach
+from comanip.estimation.forecast import path_baselines as kinematic
+from comanip.estimation.forecast.hand_forecast import continued_reach
 
 LEADS = (0.1, 0.2, 0.3)
 FROM = (0.25, 0.5)

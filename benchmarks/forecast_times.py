@@ -112,7 +112,7 @@ def timed_reach(model, reach, stages: dict | None = None) -> list[tuple]:
     reach, a fresh estimator for it; with ``stages`` (a dict), each stage's wall times (s) are appended to
     ``stages[name]`` ("the rest": the update less its explanations)."""
     import comanip
-    from comanip.estimation.hand_forecast import continued_reach
+    from comanip.estimation.forecast.hand_forecast import continued_reach
     t, position, velocity = reach
     estimator = comanip.OnlineGoalEstimator(model, np.r_[position[0], np.zeros(model.state_size - model.n)])
     # a checkout from before the family held the model's step map passes it to the forecast

@@ -16,7 +16,7 @@ on a shared machine inflate less):
 - online first (cold): the first update whose observations show movement (the estimator's cold start);
 - online update (warm): every later update, each using all observations so far;
 - ", corrected": the same with the options of a person who corrects deviations from their plan
-  (comanip.estimation.corrected_deviation, as the sync scenario's continuous policy uses them).
+  (comanip.estimation.online.corrected_deviation, as the sync scenario's continuous policy uses them).
 
 The online estimator's reach family is built once per model and width (in the constructor, timed apart
 as "build"); the one-shot estimator's compiled planner likewise.
@@ -32,7 +32,7 @@ import numpy as np
 import comanip
 from comanip.belief import sample_trajectories
 from comanip.estimation import GoalEstimator, OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
+from comanip.estimation.online.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
 
 OBSERVATION_STD = (1e-3, 1e-2)
 PRIOR_OFFSET = 0.1   # m, also the prior's std

@@ -1,5 +1,5 @@
 """Calibration over a person's successive reaches: does what the online estimator learns of a person from their
-finished reaches (:mod:`comanip.estimation.person_calibration`) carry it to people it was not fitted on?
+finished reaches (:mod:`comanip.estimation.calibration.person_calibration`) carry it to people it was not fitted on?
 
 People it has not met, made from what the repository has (the development arm reaches of one person, and the
 reaching model's own reaches):

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 from scipy.stats import chi2
 
-from comanip.estimation.endpoint_baselines import EndpointPrediction, PrefixPredictor
+from comanip.estimation.people.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402  (beside this script)
@@ -44,8 +44,8 @@ FORECAST_EXAMPLES = 4
 def predictors(model_names, library, exclude_self: bool, people_for):
     """{name: factory(recording) -> online predictor with update(t, position, velocity)}."""
     import comanip
-    from comanip.estimation.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
-    from comanip.estimation.template_matching import TemplateMatching
+    from comanip.estimation.people.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
+    from comanip.estimation.people.template_matching import TemplateMatching
 
     made = {
         "current position": lambda r: CurrentPosition(r.position[0]),
@@ -298,8 +298,8 @@ def main(argv=None):
     parser.add_argument("--figure", type=Path, default=None, help="also save the figure here (e.g. under docs/figures)")
     args = parser.parse_args(argv)
     log = sys.stderr if args.markdown else sys.stdout
-    from comanip.estimation.template_matching import TemplateLibrary
-    from comanip.estimation.people_model import PeopleModel, shipped_people_model
+    from comanip.estimation.people.template_matching import TemplateLibrary
+    from comanip.estimation.people.people_model import PeopleModel, shipped_people_model
     from comanip.recordings import load_cursory, load_tathum
     from comanip.recordings.cursory_data import SCALE
 

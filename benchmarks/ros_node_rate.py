@@ -37,7 +37,7 @@ from pathlib import Path
 
 import numpy as np
 
-from comanip.estimation.estimation_planner import estimation_planner
+from comanip.estimation.model_reaches.estimation_planner import estimation_planner
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.ros.replay import Replay, private_domain
 from comanip.ros.node_settings import NodeSettings

@@ -234,12 +234,12 @@ def posterior_case(preset: str, new_start: bool) -> Callable[[], Case]:
     """Posterior over 5 candidate goals 0.1–0.2 m apart from the first 4 observed states of a noisy reach
     to one of them. ``new_start``: each call starts from a different state, so the 5 plans are re-solved
     (warm); otherwise they are reused and a call only scores the observations (a reach in progress). The
-    planner is the one ``goal_posterior(model, ...)`` builds (terms compiled, comanip.estimation.estimation_planner)."""
+    planner is the one ``goal_posterior(model, ...)`` builds (terms compiled, comanip.estimation.model_reaches.estimation_planner)."""
 
     def make() -> Case:
         from comanip.belief import sample_trajectories
         from comanip.estimation import goal_posterior
-        from comanip.estimation.estimation_planner import estimation_planner
+        from comanip.estimation.model_reaches.estimation_planner import estimation_planner
 
         model = comanip.presets.load(preset)
         planner, build = timed(lambda: estimation_planner(model))

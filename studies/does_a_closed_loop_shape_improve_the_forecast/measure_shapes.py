@@ -1,6 +1,6 @@
 """Does a closed-loop shape improve the forecast? The forecast's shape against minimum jerk, given the recorded end.
 
-The online estimator's forecast (:func:`comanip.estimation.hand_forecast.continued_reach`) continues the model's
+The online estimator's forecast (:func:`comanip.estimation.forecast.hand_forecast.continued_reach`) continues the model's
 open-loop plan from rest (the reach family's member at the reach's distance), re-phased to the hand's state. That
 plan peaks late (t_peak/MT near 0.48 for the `arm` preset), while a person, and the model executed as a person
 executes it (replanning every step), peak earlier. Here each development arm reach, streamed as a live tracker
@@ -12,7 +12,7 @@ end time (so that only the shape differs), by:
   reach executed in closed loop, replanned every step from the exact state, without noise
   (:func:`comanip.execution.execute_receding_horizon`), to the member's distance;
 - **minimum jerk**: the quintic from the hand's position, velocity and acceleration to rest at the endpoint at the
-  end time (:func:`comanip.estimation.path_baselines.minimum_jerk_to`).
+  end time (:func:`comanip.estimation.forecast.path_baselines.minimum_jerk_to`).
 
 Printed as a markdown block (progress on stderr): each shape's t_peak/MT at the reaches' median distance, and the
 error / D (median over reaches) of where the hand is at +0.1, +0.2 and +0.3 s.
@@ -28,8 +28,9 @@ import numpy as np
 
 import comanip
 from comanip.analysis.speed_profile import movement_timing
-from comanip.estimation import OnlineGoalEstimator, path_baselines
-from comanip.estimation.hand_forecast import continued_reach
+from comanip.estimation import OnlineGoalEstimator
+from comanip.estimation.forecast import path_baselines
+from comanip.estimation.forecast.hand_forecast import continued_reach
 from comanip.execution import Observation, execute_receding_horizon
 
 from studies.arm_reaches import streamed_arm_reaches  # noqa: E402

@@ -65,7 +65,7 @@ def main() -> None:
             f"Measured by `PYTHONPATH=src python -m studies.does_a_correcting_person_belief_stop_the_drift.measure_online_drift --trials {args.trials}` "
             f"({time.time() - t_begin:.0f} s; sync scenario, person seeds 0–{args.trials - 1}, the continuous policy "
             "with the online estimator's belief set as in the first two columns; "
-            "`comanip.estimation.corrected_deviation`). Medians over the trials:\n\n" + "\n".join(lines) +
+            "`comanip.estimation.online.corrected_deviation`). Medians over the trials:\n\n" + "\n".join(lines) +
             "\n\nGoal error (mm) over time of one trial (far goal, seed 0):\n\n" + "\n".join(trace) + "\n")
     (DOCS / "online_drift.md").write_text(text)
     print(f"wrote {DOCS / 'online_drift.md'}")

@@ -6,13 +6,13 @@ people model fitted on the other half of the split (the reaches of the other par
 
 1. **A shape fitted at the person's pace.** The goal from fitting a speed profile's shape to the hand so far
    (variable projection over movement time and onset, log T ~ N(log T_ref, 0.35²), as
-   :func:`comanip.estimation.profile_fit.fit_profile`): x(t) = x_0 + Delta r(phi) along a straight line, or
+   :func:`comanip.estimation.model_reaches.profile_fit.fit_profile`): x(t) = x_0 + Delta r(phi) along a straight line, or
    with a bow, + B 4 r(phi) (1 - r(phi)), which leaves the start and reaches the goal along a curved path.
    Two shapes: the `arm` preset's mean reach (T_ref its movement time) and, as a ceiling for a model's mean
    reach fitted this way, the recorded people's own mean profile along their line (T_ref their median
    movement time), both from the other half.
 2. **A blend.** The people model's goal moved a fraction w of the way to the estimator's paced fit
-   (:class:`comanip.estimation.paced_model.PacedModel`), for the best w.
+   (:class:`comanip.estimation.model_reaches.paced_model.PacedModel`), for the best w.
 3. **The model as features.** The people model's along regressor (the share of the path still to go) given
    the paced fit's goal (along and across the direction of motion, over the path so far), its log pace and log
    misfit beside its own features.
@@ -31,12 +31,12 @@ import sys
 import numpy as np
 
 import comanip
-from comanip.estimation.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.paced_model import PACE_STD, PacedModel
-from comanip.estimation.people_model import (FEATURES, KINDS, PeopleModel, _along_regressor, beyond_over_path,
+from comanip.estimation.people.endpoint_baselines import MOVING_SPEED
+from comanip.estimation.model_reaches.paced_model import PACE_STD, PacedModel
+from comanip.estimation.people.people_model import (FEATURES, KINDS, PeopleModel, _along_regressor, beyond_over_path,
                                              movement_features, share_to_go)
-from comanip.estimation.profile_fit import detected_onset
-from comanip.estimation.reach_profile import ReachProfile
+from comanip.estimation.model_reaches.profile_fit import detected_onset
+from comanip.estimation.model_reaches.reach_profile import ReachProfile
 
 from studies.arm_reaches import streamed_arm_reaches  # noqa: E402
 

@@ -15,7 +15,7 @@ import argparse
 from importlib import resources
 from pathlib import Path
 
-from comanip.estimation.people_model import KINDS, PeopleModel
+from comanip.estimation.people.people_model import KINDS, PeopleModel
 from comanip.recordings import load_cursory, load_tathum
 
 

@@ -8,7 +8,7 @@
    and the median goal error.
 2. The same for the sync robot's belief (comanip.simulation.policies.continuous.ROBOT_BELIEF: a person who
    corrects deviations, the robot-led z, the covariance scaled), on Cartesian reaches sampled from the process
-   that belief assumes (the plan's mean plus errors of comanip.estimation.corrected_deviation, every axis the
+   that belief assumes (the plan's mean plus errors of comanip.estimation.online.corrected_deviation, every axis the
    person's), at 0.2, 0.4, 0.6 and 0.8 s and pooled over those times; the same belief without the scale beside it.
 3. Exact observation with a rough prior: five Cartesian reaches 0.2–0.45 m, a prior goal 0.2–0.45 m off, the
    plan's own state at 0.165 s (step 3) observed exactly. Prints the largest error (% of the distance) of
@@ -33,7 +33,7 @@ import comanip
 from comanip.belief import sample_trajectories
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation import GoalEstimator, OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.corrected_deviation import correction_factor, sample_corrected_deviations
+from comanip.estimation.online.corrected_deviation import correction_factor, sample_corrected_deviations
 from comanip.simulation.policies.continuous import ROBOT_BELIEF
 
 CHECK_TIMES = (0.1, 0.2, 0.3, 0.5)   # s, within both presets' horizons (planar: 0.6 s)
@@ -50,7 +50,7 @@ def calibration(preset: str, reaches: int, seed: int = 1, options: OnlineOptions
                 check_times=CHECK_TIMES) -> dict:
     """{t: (coverage of the 95 % ellipsoid, median goal error m)} over ``reaches`` noisy reaches sampled from
     the belief of ``options`` (None: the open-loop model's own noisy dynamics; with a correction time: the
-    plan's mean plus errors of the corrected process, comanip.estimation.corrected_deviation), estimated with
+    plan's mean plus errors of the corrected process, comanip.estimation.online.corrected_deviation), estimated with
     those options and the default prior."""
     model = comanip.presets.load(preset)
     n, d = model.n, model.d

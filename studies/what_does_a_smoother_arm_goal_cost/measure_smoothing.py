@@ -9,7 +9,7 @@ at the onset), moves less per update and lags the evidence. Each reach is stream
 delivers it (as in benchmarks/real_people.py --source arms) and scored with a people model fitted on the
 other half of the split (the reaches of the other parity).
 
-Beside the average, the estimator's own rule (:mod:`comanip.estimation.goal_smoothing`): the goal's motion up
+Beside the average, the estimator's own rule (:mod:`comanip.estimation.calibration.goal_smoothing`): the goal's motion up
 to a free rate (reach distances per second) passes on at once, and only the excess is averaged, so a goal
 drifting as evidence accrues is not delayed while a step is spread out.
 
@@ -26,8 +26,8 @@ import sys
 
 import numpy as np
 
-from comanip.estimation.goal_smoothing import GoalSmoother, GoalSmoothing
-from comanip.estimation.people_model import PeopleModel
+from comanip.estimation.calibration.goal_smoothing import GoalSmoother, GoalSmoothing
+from comanip.estimation.people.people_model import PeopleModel
 
 from studies.arm_reaches import streamed_arm_reaches  # noqa: E402
 
@@ -53,7 +53,7 @@ def people_goals(recording, people: PeopleModel) -> tuple[np.ndarray, np.ndarray
 
 
 def free_rate_smoothed(recording, times, goals, covariances, free_rate: float, time_constant: float) -> np.ndarray:
-    """The goals as :class:`~comanip.estimation.goal_smoothing.GoalSmoother` smooths them."""
+    """The goals as :class:`~comanip.estimation.calibration.goal_smoothing.GoalSmoother` smooths them."""
     smoother = GoalSmoother(GoalSmoothing(free_rate, time_constant), recording.position[0])
     hands = np.array([recording.position_at(t) for t in times])
     return np.array([smoother.smooth(t, g, c, x)[0] for t, g, c, x in zip(times, goals, covariances, hands)])

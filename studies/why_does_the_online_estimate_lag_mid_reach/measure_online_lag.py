@@ -25,7 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.online_options import CORRECTING_PERSON
+from comanip.estimation.online.online_options import CORRECTING_PERSON
 from comanip.simulation import ScenarioSetup, SyncSettings
 from comanip.simulation.policies.continuous import PRIOR_STD, ROBOT_BELIEF
 from comanip.simulation.policy_comparison import compare_sync_policies

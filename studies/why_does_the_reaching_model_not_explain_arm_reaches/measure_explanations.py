@@ -19,10 +19,10 @@ import numpy as np
 
 import comanip
 from comanip.estimation import OnlineOptions
-from comanip.estimation.explanations import (HandAtRest, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople, Verdict,
+from comanip.estimation.online.explanations import (HandAtRest, ModelAtOwnPace, ModelAtPersonPace, RecordedPeople, Verdict,
                                              vetoed_own_pace)
-from comanip.estimation.paced_model import PacedModel
-from comanip.estimation.people_model import shipped_people_model
+from comanip.estimation.model_reaches.paced_model import PacedModel
+from comanip.estimation.people.people_model import shipped_people_model
 from comanip.optim import Status
 
 from studies.arm_reaches import streamed_arm_reaches  # noqa: E402

@@ -120,7 +120,7 @@ def test_the_compile_cache_survives_an_edit_outside_what_the_compiled_functions_
     package = tmp_path / "comanip"
     shutil.copytree(compiled_module.PACKAGE, package, ignore=shutil.ignore_patterns("__pycache__", "*.pkl", "*.npz"))
     before = compiled_module._source_fingerprint(package)
-    for outside in ("estimation/people_model.py", "estimation/online_estimator.py", "plots/plan_figure.py", "plots/__init__.py",
+    for outside in ("estimation/people/people_model.py", "estimation/online/online_estimator.py", "plots/plan_figure.py", "plots/__init__.py",
                     "cli/main.py", "simulation/sync_scenario.py", "recordings/recording.py"):
         (package / outside).write_text((package / outside).read_text() + "\n# an edit\n")
         assert compiled_module._source_fingerprint.__wrapped__(package) == before, outside

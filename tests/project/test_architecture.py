@@ -1,22 +1,30 @@
 """The layers of docs/architecture.md against the package's import graph (read from the source by
 comanip.caching.module_imports, imports inside functions and names handed to import_module included): every package
-is drawn once, imports only packages drawn below it, and its row lists exactly what it imports; no module imports
-itself through others; and every symbol the page names exists in the package."""
+(and every room of a package drawn room by room, tools.architecture_layers.ROOMED) is drawn once, imports only
+packages drawn below it, and its row lists exactly what it imports; no module imports itself through others; and
+every symbol the page names exists in the package."""
 
 import ast
 import re
 from pathlib import Path
 
 from comanip.caching.module_imports import PACKAGE, import_graph, module_files
-from tools.architecture_layers import ARCHITECTURE, layer_table, package_graph, package_layers
+import pytest
+
+from tools.architecture_layers import ARCHITECTURE, ROOMED, layer_table, package_graph, package_layers
 ROW = re.compile(r"^\|\s*(\d+)\s*\|\s*`([^`]+)`\s*\|(.*)\|\s*$")
 
 
-def drawn_layers() -> dict[str, tuple[int, set[str]]]:
-    """Each package drawn in the layer table (``cli/``, ``model.py``, ``__init__.py`` for ``import comanip``) with its
-    layer (1 at the top) and the packages its row says it imports."""
+TABLES = [(None, "layers"), *((package, f"{package}-rooms") for package in ROOMED)]
+"""(package drawn room by room or None for the whole, its block on the page)."""
+tables = pytest.mark.parametrize("package, block", TABLES, ids=[block for _, block in TABLES])
+
+
+def drawn_layers(block: str = "layers") -> dict[str, tuple[int, set[str]]]:
+    """Each package drawn in the layer table ``block`` (``cli/``, ``model.py``, ``__init__.py`` for ``import comanip``;
+    a room table's rooms) with its layer (1 at the top) and the packages its row says it imports."""
     text = ARCHITECTURE.read_text()
-    table = text[text.index("<!-- layers:begin -->"):text.index("<!-- layers:end -->")]
+    table = text[text.index(f"<!-- {block}:begin -->"):text.index(f"<!-- {block}:end -->")]
     drawn = {}
     for line in table.splitlines():
         match = ROW.match(line)
@@ -27,22 +35,25 @@ def drawn_layers() -> dict[str, tuple[int, set[str]]]:
     return drawn
 
 
-def test_every_package_is_drawn_once():
-    drawn, graph = drawn_layers(), package_graph()
+@tables
+def test_every_package_is_drawn_once(package, block):
+    drawn, graph = drawn_layers(block), package_graph(package)
     assert set(drawn) == set(graph), f"drawn but absent: {sorted(set(drawn) - set(graph))}; " \
                                      f"absent from the drawing: {sorted(set(graph) - set(drawn))}"
 
 
-def test_no_package_imports_one_drawn_beside_or_above_it():
-    drawn, graph = drawn_layers(), package_graph()
+@tables
+def test_no_package_imports_one_drawn_beside_or_above_it(package, block):
+    drawn, graph = drawn_layers(block), package_graph(package)
     upward = [f"{package} (layer {drawn[package][0]}) imports {other} (layer {drawn[other][0]}): {module} imports {target}"
               for package, edges in graph.items() for other, (module, target) in edges.items()
               if package in drawn and other in drawn and drawn[other][0] <= drawn[package][0]]
     assert not upward, "\n".join(upward)
 
 
-def test_each_row_lists_what_its_package_imports():
-    drawn, graph = drawn_layers(), package_graph()
+@tables
+def test_each_row_lists_what_its_package_imports(package, block):
+    drawn, graph = drawn_layers(block), package_graph(package)
     differ = {package for package in graph if package in drawn and drawn[package][1] != set(graph[package])}
     assert not differ, f"rows of {sorted(differ)} differ from the import graph (python -m tools.architecture_layers " \
         f"rewrites them); the table should read:\n" + layer_table(package_layers(graph), graph)
@@ -55,6 +66,11 @@ def test_the_test_folders_mirror_the_packages():
                if path.is_dir() and not path.name.startswith((".", "__"))}
     packages = {package.rstrip("/") for package in package_graph() if package.endswith("/")}
     assert folders - {"project", "data"} <= packages, sorted(folders - {"project", "data"} - packages)
+    for package in ROOMED:     # and a package drawn room by room has a folder of tests for each room it tests
+        inside = {path.name for path in ARCHITECTURE.parents[1].joinpath("tests", package).iterdir()
+                  if path.is_dir() and not path.name.startswith((".", "__"))}
+        rooms = {room.rstrip("/") for room in package_graph(package) if room.endswith("/")}
+        assert inside <= rooms, f"tests/{package}/: {sorted(inside - rooms)} are not rooms of {package}/"
 
 
 def import_circles(graph: dict[str, set[str]]) -> list[list[str]]:

@@ -10,15 +10,15 @@ rclpy = pytest.importorskip("rclpy", reason="the ROS 2 node needs the 'ros' extr
 from geometry_msgs.msg import PointStamped  # noqa: E402
 
 import comanip  # noqa: E402
-from comanip.estimation.model_families import FamilyCache  # noqa: E402
-from comanip.estimation.estimation_planner import estimation_planner  # noqa: E402
+from comanip.estimation.model_reaches.model_families import FamilyCache  # noqa: E402
+from comanip.estimation.model_reaches.estimation_planner import estimation_planner  # noqa: E402
 from comanip.multicomponent.handover import plan_handover  # noqa: E402
 from comanip.estimation import CalibrationSettings, PersonCalibration  # noqa: E402
 from comanip.multicomponent.transition_model import TransitionModel  # noqa: E402
 from comanip.ros.node import reach_estimator  # noqa: E402
 from comanip.ros.replay import BASE_STAMP, Replay, replay_csv  # noqa: E402
 from comanip.ros.node_settings import NodeSettings  # noqa: E402
-from tests.estimation.test_estimation_loop import three_reaches  # noqa: E402
+from tests.estimation.streaming.test_estimation_loop import three_reaches  # noqa: E402
 
 GOAL = np.array([0.4, 0.25, -0.1])
 

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 import comanip
-from comanip.estimation.reach_timing import ReachTiming
+from comanip.estimation.model_reaches.reach_timing import ReachTiming
 from comanip.simulation.rest_trajectory import RestTrajectory
 
 
@@ -14,7 +14,7 @@ def test_the_rest_passes_through_the_plan_and_holds_its_ends(timing):
     estimator = comanip.OnlineGoalEstimator(model, np.zeros(model.state_size), prior_goal=np.array([0.2, 0.1, 0.0]))
     plan = estimator.update(0.0, np.zeros(3), np.zeros(3))                       # the prior's reach, at rest
     if timing is not None:                                                       # the same reach played later and slower
-        from comanip.estimation.reach_timing import timed_plan
+        from comanip.estimation.model_reaches.reach_timing import timed_plan
         timed = timed_plan(plan.mean, plan.cov, plan.torque, model.h, model.n, timing)
         plan.t, plan.ee_mean, plan.ee_velocity = timed.t, timed.mean[:, :3], timed.mean[:, 3:6]
     dt = 0.001

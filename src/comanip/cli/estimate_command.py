@@ -27,7 +27,7 @@ from comanip.cli.options import (add_bag_arguments, add_marker_arguments, add_mo
                                  add_unit_check_argument, input_file_or_bag, load_model, vector)
 from comanip.cli.outputs import output_dir, point_text, report, warn, write_manifest, write_table
 from comanip.estimation import GoalEstimator, goal_posterior
-from comanip.estimation.goal_estimator import METHODS, check_method
+from comanip.estimation.one_shot.goal_estimator import METHODS, check_method
 from comanip.estimation.goal_prior import PAPER_PRIOR, prior_covariance
 from comanip.estimation.observation import observation_step, observed_state
 from comanip.planning.planner import reach_inputs
@@ -159,7 +159,7 @@ def run(args) -> int:
 
 def run_online(args, model) -> int:
     """``--online`` (module docstring): every row of ``--observations`` through a :class:`~comanip.ReachStream`."""
-    from comanip.estimation.reach_stream import ReachStream
+    from comanip.estimation.streaming.reach_stream import ReachStream
 
     if args.observations is None:
         raise ValueError("--online streams --observations: give a CSV of timestamped states, a ROS 2 bag or a Nexus export")

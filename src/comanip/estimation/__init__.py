@@ -1,16 +1,16 @@
 """Estimation from observed reaching: the goal of a reach in progress, and a posterior over candidate goals."""
 
 from comanip.estimation.goal_estimate import GoalEstimate
-from comanip.estimation.goal_estimator import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
-from comanip.estimation.goal_posterior import GoalPosterior, goal_posterior
-from comanip.estimation.online_estimator import OnlineGoalEstimator
-from comanip.estimation.goal_smoothing import GoalSmoothing
-from comanip.estimation.online_options import OnlineOptions
-from comanip.estimation.person_calibration import CalibrationSettings, PersonCalibration
-from comanip.estimation.recorded_trials import estimate_recordings
-from comanip.estimation.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep
-from comanip.estimation.reach_segmentation import ReachSegmenter, ReachStart, SegmentationSettings
-from comanip.estimation.reach_stream import ReachStream, StreamEstimate
+from comanip.estimation.one_shot.goal_estimator import EstimatorCache, EstimatorOptions, GoalEstimator, estimate_goal
+from comanip.estimation.one_shot.goal_posterior import GoalPosterior, goal_posterior
+from comanip.estimation.online.online_estimator import OnlineGoalEstimator
+from comanip.estimation.calibration.goal_smoothing import GoalSmoothing
+from comanip.estimation.online.online_options import OnlineOptions
+from comanip.estimation.calibration.person_calibration import CalibrationSettings, PersonCalibration
+from comanip.estimation.streaming.recorded_trials import estimate_recordings
+from comanip.estimation.streaming.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep
+from comanip.estimation.streaming.reach_segmentation import ReachSegmenter, ReachStart, SegmentationSettings
+from comanip.estimation.streaming.reach_stream import ReachStream, StreamEstimate
 
 __all__ = ["CalibrationSettings", "EstimationLoop", "EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator",
            "GoalPosterior", "GoalSmoothing", "LoopEvent", "LoopSettings", "LoopStep", "estimate_goal", "estimate_recordings",

@@ -14,7 +14,7 @@ class EstimateStatus(StrEnum):
     UNINFORMATIVE = "uninformative"
     """The observation says nothing about the goal (it is the start itself)."""
     PEOPLE_MODEL = "people_model"
-    """A goal estimate from the model fitted to recorded people (:mod:`comanip.estimation.people_model`): the
+    """A goal estimate from the model fitted to recorded people (:mod:`comanip.estimation.people.people_model`): the
     reaching model at its own pace does not explain the observed hand."""
     AT_RANGE_END = "at_range_end"
     """The online MAP goal sits at the largest distance its reach family covers: the observations point farther

@@ -10,8 +10,8 @@ import numpy as np
 from comanip.planning.plan import Plan
 
 if TYPE_CHECKING:
-    from comanip.estimation.hand_forecast import HandForecast
-    from comanip.estimation.reach_timing import TimedPlan
+    from comanip.estimation.forecast.hand_forecast import HandForecast
+    from comanip.estimation.model_reaches.reach_timing import TimedPlan
 
 
 @dataclass
@@ -46,21 +46,21 @@ class GoalEstimate(Plan):
     """Covariance of the estimated goal (d, d), m²: the Laplace approximation of the posterior ('regret' and
     'paper': the Gauss–Newton curvature of the observation's negative log-likelihood under the model's belief,
     plus the prior's; 'online': the inverse Hessian, its spread along the reach from a quadrature early on,
-    :mod:`comanip.estimation.online_estimator`)."""
+    :mod:`comanip.estimation.online.online_estimator`)."""
     unsmoothed_goal: np.ndarray | None = None
     """'online': the goal the explanation gave (d,), m, before the smoothing that gives ``goal``
-    (``OnlineOptions.goal_smoothing``, :mod:`comanip.estimation.goal_smoothing`); the same as ``goal`` without it."""
+    (``OnlineOptions.goal_smoothing``, :mod:`comanip.estimation.calibration.goal_smoothing`); the same as ``goal`` without it."""
     unsmoothed_goal_covariance: np.ndarray | None = None
     """'online': that goal's covariance (d, d), m²; ``goal_covariance`` adds the smoothed goal's offset from it."""
     forecast: "HandForecast | None" = None
     """'online': the forecast of the rest of the reach from the hand's state at t_obs
-    (:class:`~comanip.estimation.hand_forecast.HandForecast`; ``forecast.at(t)`` gives the hand's mean position,
+    (:class:`~comanip.estimation.forecast.hand_forecast.HandForecast`; ``forecast.at(t)`` gives the hand's mean position,
     velocity and covariance at any time t). The estimate's plan fields (``t``, ``mean``, ``ee_mean``, ``ee_cov``,
     ``ee_velocity``) are its grid, from t_obs on; before the first observation (None) they are the model's reach
     from the start."""
     timed_reach: "TimedPlan | None" = None
     """'online': the model's whole reach from the start to g_hat, played at the estimate's timing
-    (:func:`~comanip.estimation.reach_timing.timed_plan`): what the forecast continues from the hand."""
+    (:func:`~comanip.estimation.model_reaches.reach_timing.timed_plan`): what the forecast continues from the hand."""
     plan_status: str | None = None
     """For an 'uninformative' estimate (observation at step 0): the status of the plan to the prior goal."""
 

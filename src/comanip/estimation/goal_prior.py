@@ -7,7 +7,7 @@
   little about the distance: on the Cartesian preset a state seen exactly at 0.165 s (step 3 of a ~1 s reach)
   leaves the goal's distance uncertain by 0.3–0.7 m (one standard deviation, the model's own motor noise),
   so a 1 m prior 0.2–0.45 m off still pulls that estimate by up to 3 % of the distance; the 10 m default by
-  at most 0.2 % (tests/estimation/test_online_estimator.py).
+  at most 0.2 % (tests/estimation/online/test_online_estimator.py).
 - a number s > 0 (m): s² I; a sequence of d numbers (m): diag(s_1², ..., s_d²).
 - ``"width"`` (:data:`PAPER_PRIOR`): the paper's weighting, W from the goal width (W = w² I by default; the
   model's ``goal_covariance`` form): the prior is then as uncertain as the goal is wide, which dominates the

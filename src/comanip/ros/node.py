@@ -2,10 +2,10 @@
 
 Inputs (topic names are parameters, :class:`~comanip.ros.node_settings.NodeSettings`): the hand's pose and, if the
 tracker sends one, its twist, a prior goal, a reset. The node converts each checked message into a sample of an
-:class:`~comanip.estimation.estimation_loop.EstimationLoop`, which does the rest as it does for
+:class:`~comanip.estimation.streaming.estimation_loop.EstimationLoop`, which does the rest as it does for
 :class:`~comanip.estimation.ReachStream`. The hand's velocity (``velocity_source``) is the twist of (nearly) the
 same stamp as the pose (``twist_tolerance``), or a backward difference of the poses over ``velocity_window``
-(:class:`~comanip.estimation.derived_velocity.DerivedVelocity`, the rule the recorded people the model is fitted on
+(:class:`~comanip.estimation.streaming.derived_velocity.DerivedVelocity`, the rule the recorded people the model is fitted on
 were streamed with); by default the poses' until the first twist arrives. A reach starts at the first hand pose
 (after startup, a reset, or a gap in the input longer than ``input_timeout``), at rest at that pose's position,
 its stamp t = 0; every pose goes to the reach segmenter, and when the hand has rested (within ``rest_radius`` for
@@ -72,13 +72,13 @@ except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.estimation import GoalEstimate, OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.derived_velocity import DerivedVelocity
-from comanip.estimation.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep, Reach, Update
-from comanip.estimation.reach_segmentation import SegmentationSettings
-from comanip.estimation.model_families import FamilyCache
-from comanip.estimation.online_options import CORRECTING_PERSON
-from comanip.estimation.person_calibration import CalibrationSettings, PersonCalibration
-from comanip.estimation.estimation_planner import estimation_planner
+from comanip.estimation.streaming.derived_velocity import DerivedVelocity
+from comanip.estimation.streaming.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep, Reach, Update
+from comanip.estimation.streaming.reach_segmentation import SegmentationSettings
+from comanip.estimation.model_reaches.model_families import FamilyCache
+from comanip.estimation.online.online_options import CORRECTING_PERSON
+from comanip.estimation.calibration.person_calibration import CalibrationSettings, PersonCalibration
+from comanip.estimation.model_reaches.estimation_planner import estimation_planner
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
@@ -148,7 +148,7 @@ class GoalNode(Node):
             LoopSettings(SegmentationSettings(radius=s.rest_radius, window=s.rest_window), rate=s.estimation_rate,
                          pairing_tolerance=s.twist_tolerance, horizon=self._horizon, restart_after=s.input_timeout,
                          first_sample_starts_reach=True))
-        """The node's loop (:mod:`comanip.estimation.estimation_loop`): its callbacks feed it under the node's lock,
+        """The node's loop (:mod:`comanip.estimation.streaming.estimation_loop`): its callbacks feed it under the node's lock,
         the guard condition's callback runs the updates it makes due."""
         self._last_pose: float | None = None
         self._last_twist: float | None = None

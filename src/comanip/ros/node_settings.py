@@ -79,23 +79,23 @@ class NodeSettings:
     """Input older than this (s) makes the estimate stale; a pose after a longer gap starts a new reach."""
     rest_radius: float = REST_RADIUS_M
     """A hand pose farther than this (m) from where the hand rests starts the next reach; a hand whose poses stay
-    within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.reach_segmentation`)."""
+    within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.streaming.reach_segmentation`)."""
     rest_window: float = REST_WINDOW_S
     """How long (s) the hand must stay still to rest between reaches."""
     person: str = "recorded"
     """Whom the estimator expects (:data:`PERSONS`): "recorded", a person who may not move as the model does (the
     model at its own pace, at the person's, and the model of recorded people:
     :class:`comanip.estimation.OnlineOptions` as it comes); "correcting", the model's own plan with deviations
-    corrected (the simulated scenarios' person, :data:`comanip.estimation.online_options.CORRECTING_PERSON`)."""
+    corrected (the simulated scenarios' person, :data:`comanip.estimation.online.online_options.CORRECTING_PERSON`)."""
     learn_person: bool = True
     """Learn the person's amplitude, pace and spread from each finished reach and apply them to the next
-    (:mod:`comanip.estimation.person_calibration`); false: every reach is a person not seen yet."""
+    (:mod:`comanip.estimation.calibration.person_calibration`); false: every reach is a person not seen yet."""
     twist_tolerance: float = 0.005
     """Largest stamp difference (s) between a pose and the twist paired with it."""
     velocity_source: str = "auto"
     """Where the hand's velocity comes from (:data:`VELOCITY_SOURCES`): "twist", the twist stamped nearest each pose
     (within ``twist_tolerance``; a pose without one is rejected); "poses", a backward difference of the poses over
-    ``velocity_window`` (:mod:`comanip.estimation.derived_velocity`; twists are ignored); "auto", from the poses until
+    ``velocity_window`` (:mod:`comanip.estimation.streaming.derived_velocity`; twists are ignored); "auto", from the poses until
     the first twist arrives, then from the twists."""
     velocity_window: float = VELOCITY_WINDOW_S
     """Span (s) of the backward difference that derives the velocity from the poses."""

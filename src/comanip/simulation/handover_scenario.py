@@ -25,7 +25,7 @@ import numpy as np
 from comanip.arguments import as_positive
 from comanip.control.impedance import CartesianImpedanceController, RobotState
 from comanip.estimation import OnlineGoalEstimator
-from comanip.estimation.online_options import CORRECTING_PERSON
+from comanip.estimation.online.online_options import CORRECTING_PERSON
 from comanip.multicomponent.perpendicular_dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel

@@ -54,7 +54,7 @@ class RestTrajectory:
     @classmethod
     def from_timed_reach(cls, reach, dt: float, duration: float) -> "RestTrajectory":
         """A point mass's reach played at a person's timing (a
-        :class:`~comanip.estimation.reach_timing.TimedPlan` of a 3-D point mass, on the estimator's clock) as the
+        :class:`~comanip.estimation.model_reaches.reach_timing.TimedPlan` of a 3-D point mass, on the estimator's clock) as the
         rest motion, as :meth:`from_plan` plays a plan from time 0."""
         return cls._through(reach.t, reach.mean[:, :3], reach.mean[0, 3:6], reach.mean[-1, 3:6], 0.0, dt, duration)
 

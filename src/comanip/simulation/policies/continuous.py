@@ -12,7 +12,7 @@ import dataclasses
 import numpy as np
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.online_options import CORRECTING_PERSON
+from comanip.estimation.online.online_options import CORRECTING_PERSON
 from comanip.simulation.policies.protocol import PolicyContext, Prediction
 from comanip.simulation.rest_trajectory import RestTrajectory
 
@@ -55,7 +55,7 @@ class ContinuousPolicy:
     prior_std: the prior goal's standard deviation (m), as :class:`OnlineGoalEstimator` takes it (None: the
     estimator's weak default; default :data:`PRIOR_STD`). options: the estimator's :class:`OnlineOptions`;
     default :data:`ROBOT_BELIEF`: a person who corrects deviations from their plan (``CORRECTING_PERSON``:
-    :mod:`comanip.estimation.corrected_deviation`), as the simulated person does by replanning, with the
+    :mod:`comanip.estimation.online.corrected_deviation`), as the simulated person does by replanning, with the
     robot-led z read as less informative (:data:`ROBOT_LED_AXES`) from t_o on, when the robot starts leading.
     """
 
