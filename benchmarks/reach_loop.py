@@ -176,7 +176,7 @@ def live(preset: str, rate: float, seconds: float, t, position, velocity):
 
     keep = (t <= seconds) & np.all(np.isfinite(position), axis=1) & np.all(np.isfinite(velocity), axis=1)
     run = two_processes(rate, t[keep], np.c_[position, velocity][keep], goal=position[keep][-1],
-                        parameters={"preset": preset, "person": "recorded"})
+                        parameters={"preset": preset, "estimator": "recorded"})
     stamps = sorted(run["goals"])
     starts, goals, numbers = published(run["statuses"], stamps, [run["goals"][s][1] for s in stamps], t, run["begin"])
     goals[t > seconds] = np.nan

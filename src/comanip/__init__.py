@@ -12,7 +12,7 @@ _EXPORTS = {
     "presets": "comanip.presets", "ReachingModel": "comanip.model", "Plan": "comanip.planning", "Planner": "comanip.planning",
     "SolverOptions": "comanip.planning", "plan_reach": "comanip.planning", "TransitionModel": "comanip.multicomponent.transition_model",
     "estimate_goal": "comanip.estimation", "goal_posterior": "comanip.estimation", "OnlineGoalEstimator": "comanip.estimation",
-    "ReachStream": "comanip.estimation", "fit_model": "comanip.fitting", "fit_movement_times": "comanip.fitting", "fit_timing": "comanip.fitting", "FitResult": "comanip.fitting",
+    "ReachStream": "comanip.estimation", "OnlineSettings": "comanip.estimation", "fit_model": "comanip.fitting", "fit_movement_times": "comanip.fitting", "fit_timing": "comanip.fitting", "FitResult": "comanip.fitting",
 }
 
 
@@ -32,4 +32,4 @@ def __dir__() -> list[str]:
 __version__ = "0.1.0"
 
 __all__ = ["presets", "ReachingModel", "Plan", "Planner", "SolverOptions", "plan_reach", "TransitionModel", "estimate_goal", "goal_posterior", "OnlineGoalEstimator",
-           "ReachStream", "fit_model", "fit_movement_times", "fit_timing", "FitResult"]
+           "ReachStream", "OnlineSettings", "fit_model", "fit_movement_times", "fit_timing", "FitResult"]

@@ -4,7 +4,8 @@
    hand's uncertainty and its speed);
 2. **predict a recorded person's goal online**: a recorded movement of the ``cursory`` data (a person's mouse
    reach, scaled to m), shifted to start at the origin, fed sample by sample as it happens (time since the
-   onset s, position m, velocity m/s) to :class:`comanip.OnlineGoalEstimator` of the planar preset; each
+   onset s, position m, velocity m/s) through the loop of an online estimator of the planar preset (the
+   ``recorded`` description, :mod:`comanip.estimation.streaming.online_settings`); each
    update's goal is compared with where the person was aiming (the recording's target, which these recordings
    hold and the arm recordings of step 3 do not);
 3. **run the robot beside a person guiding the handle** in the synchronisation scenario
@@ -24,7 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from comanip import presets
-from comanip.estimation import OnlineGoalEstimator
+from comanip.estimation.streaming import online_settings
+from comanip.estimation.streaming.estimation_loop import LoopSettings
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 from comanip.recordings.recording import Recording
@@ -106,11 +108,14 @@ def predict_online(recording: Recording, model=None) -> OnlinePrediction:
         raise ValueError(f"the recording must be {model.d}-D with a known target, got {recording.position.shape[1]}-D "
                          f"and target {recording.target}")
     origin = recording.start
-    estimator = OnlineGoalEstimator(model, np.zeros(2 * model.n))
+    settings = online_settings.load("recorded").replace(model="planar", loop=LoopSettings(segmentation=None))   # one reach
+    loop = settings.estimation_loop(model=model)
+    loop.begin(0.0, np.zeros(model.d))                   # the reach, at rest at the origin at its onset
     keep = np.flatnonzero((recording.t > recording.onset + 1e-9) & (recording.t <= recording.end_time + 1e-9))
     t, goals, stds, statuses = [], [], [], []
     for k in keep:
-        estimate = estimator.update(recording.t[k] - recording.onset, recording.position[k] - origin, recording.velocity[k])
+        loop.add_sample(recording.t[k] - recording.onset, recording.position[k] - origin, recording.velocity[k])
+        estimate = loop.estimate(loop.take_due())
         t.append(recording.t[k] - recording.onset)
         goals.append(np.asarray(estimate.goal, dtype=float))
         stds.append(np.sqrt(np.clip(np.diag(np.asarray(estimate.goal_covariance, dtype=float)), 0.0, None)))

@@ -6,7 +6,7 @@
    default noise (1 mm, 1 cm/s), default (weak) prior. Prints, at 0.1, 0.2, 0.3 and 0.5 s, the fraction of
    reaches whose true goal lies inside the 95 % ellipsoid of the estimate (chi-square, d degrees of freedom)
    and the median goal error.
-2. The same for the sync robot's belief (comanip.simulation.policies.continuous.ROBOT_BELIEF: a person who
+2. The same for the sync robot's belief (the ``sync_robot`` description of comanip.estimation.streaming.online_settings: a person who
    corrects deviations, the robot-led z, the covariance scaled), on Cartesian reaches sampled from the process
    that belief assumes (the plan's mean plus errors of comanip.estimation.online.corrected_deviation, every axis the
    person's), at 0.2, 0.4, 0.6 and 0.8 s and pooled over those times; the same belief without the scale beside it.
@@ -34,7 +34,10 @@ from comanip.belief import sample_trajectories
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation import GoalEstimator, OnlineGoalEstimator, OnlineOptions
 from comanip.estimation.online.corrected_deviation import correction_factor, sample_corrected_deviations
-from comanip.simulation.policies.continuous import ROBOT_BELIEF
+from comanip.estimation.streaming import online_settings
+
+ROBOT_BELIEF = online_settings.load("sync_robot").options
+"""The sync robot's belief (the ``sync_robot`` description)."""
 
 CHECK_TIMES = (0.1, 0.2, 0.3, 0.5)   # s, within both presets' horizons (planar: 0.6 s)
 #: When the robot's belief is checked (s): from t_o through the middle of a ~1 s Cartesian reach.

@@ -25,14 +25,16 @@ from pathlib import Path
 import numpy as np
 
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.online.online_options import CORRECTING_PERSON
+from comanip.estimation.streaming import online_settings
 from comanip.simulation import ScenarioSetup, SyncSettings
-from comanip.simulation.policies.continuous import PRIOR_STD, ROBOT_BELIEF
 from comanip.simulation.policy_comparison import compare_sync_policies
 from make_policy_comparison import GOALS
 
 DOCS = Path(__file__).resolve().parent
 TIMES = (0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.0, 1.2, 1.5, 2.0)
+ROBOT = online_settings.load("sync_robot")
+PRIOR_STD, ROBOT_BELIEF, CORRECTING_PERSON = ROBOT.prior_std, ROBOT.options, online_settings.load("correcting").options
+"""The sync robot's prior std and belief, and a person who corrects (the shipped descriptions)."""
 #: label -> (prior std m, options) of the replayed estimator.
 REPLAYS = {
     "the policy's (ROBOT_BELIEF: prior 0.25 m, a person who corrects, robot-led z)": (PRIOR_STD, ROBOT_BELIEF),

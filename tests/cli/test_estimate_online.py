@@ -53,9 +53,30 @@ def test_every_sample_gets_a_row_and_the_reach_ends_on_its_goal(observations, tm
     (["--online", "--observations", "{obs}", "--candidates", "0.3,0;0.2,0.2"], ["--candidates does not go with --online"]),
     (["--online", "--observations", "{obs}", "--leads", "0.1,-0.2"], ["--leads must be times ahead > 0 s"]),
     (["--online", "--observations", "{obs}", "--prior", "0.3"], ["prior_goal must have shape (2,)"]),
+    (["--online", "--observations", "{obs}", "--forecast-horizon", "-0.1"], ["--forecast-horizon must be a time ahead > 0 s"]),
+    (["--online", "--observations", "{obs}", "--estimator", "nobody"], ["--estimator", "recorded", ".yaml"]),
 ])
 def test_a_mistake_is_one_line_before_the_folder_is_made(argv, fragments, observations, tmp_path, capsys):
     out = tmp_path / "online"
     argv = [a.format(obs=observations[0]) for a in argv]
     assert_one_line_error(*run_cli(["estimate", *argv, "--out", str(out)], capsys), *fragments)
     assert not out.exists()
+
+
+def test_the_forecast_horizon_is_one_option_and_bounds_the_path(observations, tmp_path, capsys):
+    """Streamed up to mid-reach, the last estimate's path (its plan fields, what a robot follows) reaches
+    --forecast-horizon seconds ahead, on the forecast; without it, on to where the forecast stops."""
+    path, t, states = observations
+    mid = tmp_path / "mid.csv"
+    lines = path.read_text().splitlines()
+    mid.write_text("\n".join(lines[:1 + int(np.searchsorted(t, 0.3 + 0.2))]) + "\n")
+    paths = {}
+    for name, extra in (("bounded", ["--forecast-horizon", "0.1"]), ("whole", [])):
+        out = tmp_path / name
+        assert main(["estimate", "--online", "--observations", str(mid), "--out", str(out), *extra]) == 0, capsys.readouterr()
+        paths[name] = json.loads((out / "estimate.json").read_text())
+    bounded, whole = paths["bounded"], paths["whole"]
+    assert bounded["t"][-1] == pytest.approx(bounded["t_obs"] + 0.1, abs=1e-9)
+    assert whole["t"][-1] > whole["t_obs"] + 0.2
+    common = np.array(bounded["t"][:-1])
+    np.testing.assert_allclose(np.array(bounded["ee_mean"])[:-1], np.array(whole["ee_mean"])[:len(common)], atol=1e-12)

@@ -133,12 +133,14 @@ def _release_on_the_exact_path(schedule, trigger):
 
 
 def _estimate_release(plan, transition_model, settle_fraction, fallback_time):
-    from comanip.estimation import OnlineGoalEstimator, OnlineOptions
+    from comanip.estimation import LoopSettings
+    from comanip.estimation.streaming import online_settings
     from comanip.simulation.handover_release import EstimateRelease
 
-    estimator = OnlineGoalEstimator(comanip.presets.cartesian(), plan.start, prior_goal=GOAL, width=plan.width,
-                                    options=OnlineOptions(correction_time=0.3, deviation_time=0.15))
-    return EstimateRelease(estimator, transition_model, plan.width, 0.02, settle_fraction, fallback_time)
+    described = online_settings.load("correcting").replace(width=plan.width, loop=LoopSettings(segmentation=None, rate=50.0))
+    loop = described.estimation_loop(plan.start, prior_goal=GOAL)
+    loop.begin(0.0, plan.start[:3])
+    return EstimateRelease(loop, transition_model, plan.width, settle_fraction, fallback_time)
 
 
 def test_estimate_triggered_release_follows_the_goal_distance_one_on_an_exact_reach(plan, transition_model):

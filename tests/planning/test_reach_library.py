@@ -7,7 +7,8 @@ import pytest
 import comanip
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.solver_options import SolverOptions
-from comanip.planning.starts.reach_library import is_symmetric, reflection_onto
+from comanip.planning.reflection import reflection_onto
+from comanip.planning.starts.reach_library import is_symmetric
 
 RELATIVE = 1e-6
 """Objectives of the ranked and the full search agree to this (relative)."""

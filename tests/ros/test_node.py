@@ -15,7 +15,6 @@ from comanip.estimation.model_reaches.estimation_planner import estimation_plann
 from comanip.multicomponent.handover import plan_handover  # noqa: E402
 from comanip.estimation import CalibrationSettings, PersonCalibration  # noqa: E402
 from comanip.multicomponent.transition_model import TransitionModel  # noqa: E402
-from comanip.ros.node import reach_estimator  # noqa: E402
 from comanip.ros.replay import BASE_STAMP, Replay, replay_csv  # noqa: E402
 from comanip.ros.node_settings import NodeSettings  # noqa: E402
 from tests.estimation.streaming.test_estimation_loop import three_reaches  # noqa: E402
@@ -51,7 +50,7 @@ def replayed(reach, transition, tmp_path_factory):
 def library(reach):
     """What the library gives for the same observations fed to the same estimator in the same order."""
     settings, planner, plan = reach
-    estimator = reach_estimator(planner, FamilyCache(), plan.mean[0], None, settings.width)
+    estimator = settings.online_settings().estimator(plan.mean[0], model=planner, cache=FamilyCache())
     horizon = plan.t[-1]
     estimates = [estimator.update(t, s[:3], s[3:]) for t, s in zip(plan.t[1:], plan.mean[1:]) if t < horizon]
     return [(t, e) for t, e in zip(plan.t[1:], estimates) if e.success]

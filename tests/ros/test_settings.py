@@ -19,7 +19,7 @@ from comanip.ros.node_settings import NodeSettings
     ({"hand_pose_topic": ""}, "hand_pose_topic must be a non-empty string"),
     ({"equilibrium_orientation": [1, 1, 0, 0]}, "equilibrium_orientation must be a unit quaternion"),
     ({"estimation_rat": 3}, "unknown parameter(s) ['estimation_rat']"),
-    ({"person": "mouse"}, "person must be one of ('recorded', 'correcting'), got 'mouse'"),
+    ({"estimator": "mouse"}, "estimator: an online estimator must be one of"),
     ({"velocity_source": "imu"}, "velocity_source must be one of ('auto', 'twist', 'poses'), got 'imu'"),
     ({"velocity_window": -0.02}, "velocity_window must be a finite number > 0 (s)"),
 ])

@@ -10,13 +10,16 @@ to the horizon feeds the posterior.
 
 With ``--online`` every row of ``--observations`` is streamed, as a tracker delivers it, through the online estimator
 over a stream of reaches (:class:`~comanip.ReachStream`: each reach found in the motion, its goal revised with every
-sample, its forecast of the hand): one row per sample with the goal, its spread and where the hand will be
-``--leads`` seconds on; the last estimate as JSON.
+sample, its forecast of the hand), described by ``--estimator`` (a shipped description or a YAML file,
+:mod:`comanip.estimation.streaming.online_settings`; ``--preset``, ``--width``, ``--prior-std``,
+``--forecast-horizon`` and ``--leads`` replace its settings): one row per sample with the goal, its spread and where
+the hand will be ``--leads`` seconds on; the last estimate (its path ``--forecast-horizon`` seconds ahead) as JSON.
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 
 import numpy as np
@@ -29,6 +32,7 @@ from comanip.cli.outputs import output_dir, point_text, report, warn, write_mani
 from comanip.estimation import GoalEstimator, goal_posterior
 from comanip.estimation.one_shot.goal_estimator import METHODS, check_method
 from comanip.estimation.goal_prior import PAPER_PRIOR, prior_covariance
+from comanip.estimation.streaming import online_settings
 from comanip.estimation.observation import observation_step, observed_state
 from comanip.planning.planner import reach_inputs
 from comanip.plausibility import human_plausibility
@@ -56,8 +60,15 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--candidates", type=candidate_list, help="candidate goals for a posterior, e.g. '0.3,0;0.2,0.2' (m)")
     parser.add_argument("--online", action="store_true", help="stream every row of --observations through the online "
                         "estimator (reaches found in the motion, a forecast of the hand) instead of estimating once at --t-obs")
-    parser.add_argument("--leads", type=vector, default=np.array([0.1, 0.2, 0.3]),
-                        help="with --online: how far ahead (s) the forecast columns look, comma-separated (default: 0.1,0.2,0.3)")
+    parser.add_argument("--estimator", default="recorded",
+                        help=f"with --online: the online estimator, one of {', '.join(online_settings.names())} or a YAML "
+                             "file of the same shape (default: %(default)s, a person who may not move as the model does)")
+    parser.add_argument("--forecast-horizon", type=float, default=None,
+                        help="with --online: how far ahead (s) each estimate's path reaches (default: the estimator's; "
+                             "to where the hand stops)")
+    parser.add_argument("--leads", type=vector, default=None,
+                        help="with --online: how far ahead (s) the forecast columns look, comma-separated (default: the "
+                             "estimator's, 0.1,0.2,0.3)")
     parser.set_defaults(func=run)
 
 
@@ -157,6 +168,29 @@ def run(args) -> int:
     return 0 if estimate.success else 1
 
 
+def online_description(args):
+    """The online estimation ``--online`` runs: ``--estimator`` with the settings the other arguments give; a one-line
+    ValueError naming the argument."""
+    try:
+        settings = online_settings.load(args.estimator)
+    except ValueError as error:
+        raise ValueError(f"--estimator: {error}") from None
+    changes = {"model": args.preset}
+    for name, value in (("width", args.width), ("prior_std", args.prior_std)):
+        if value is not None:
+            changes[name] = value
+    if args.leads is not None:
+        leads = np.atleast_1d(args.leads)
+        if not (np.all(np.isfinite(leads)) and np.all(leads > 0)):
+            raise ValueError(f"--leads must be times ahead > 0 s, comma-separated, got {args.leads.tolist()}")
+        changes["forecast_leads"] = tuple(leads.tolist())
+    if args.forecast_horizon is not None:
+        if not (np.isfinite(args.forecast_horizon) and args.forecast_horizon > 0):
+            raise ValueError(f"--forecast-horizon must be a time ahead > 0 s, got {args.forecast_horizon!r}")
+        changes["options"] = dataclasses.replace(settings.options, forecast_horizon=args.forecast_horizon)
+    return settings.replace(**changes)
+
+
 def run_online(args, model) -> int:
     """``--online`` (module docstring): every row of ``--observations`` through a :class:`~comanip.ReachStream`."""
     from comanip.estimation.streaming.reach_stream import ReachStream
@@ -166,19 +200,16 @@ def run_online(args, model) -> int:
     for name, value in (("--observed", args.observed), ("--candidates", args.candidates), ("--start", args.start)):
         if value is not None:
             raise ValueError(f"{name} does not go with --online (each reach starts where the stream finds it)")
-    leads = np.atleast_1d(args.leads)
-    if not (np.all(np.isfinite(leads)) and np.all(leads > 0)):
-        raise ValueError(f"--leads must be times ahead > 0 s, comma-separated, got {args.leads.tolist()}")
+    settings = online_description(args)
+    leads = np.array(settings.forecast_leads)
     n = model.n
     times, states = read_hand_states(args.observations, n, check_units=args.check_units, joint_angles=not model.body.is_linear,
                                      name="--observations", topic=args.topic, frame=args.frame, marker=args.marker,
                                      max_gap=args.max_gap)
-    width = reach_inputs(model, np.zeros(model.state_size), np.zeros(model.d), args.width)[2]
-    prior_covariance(args.prior_std, model, width)
     if args.prior is not None:
         as_vector("prior_goal", args.prior, model.d, "task-space position, m")
     out = output_dir(args.out, "estimate", args.force, create=False)
-    stream = ReachStream(model, prior_goal=args.prior, prior_std=args.prior_std, width=args.width)   # refuses an arm
+    stream = ReachStream(model, settings, prior_goal=args.prior)   # refuses an arm
     axes = "xyz"[: model.d]
     header = ["t_s", "reach", "moving", "status", *(f"goal_{a}_m" for a in axes), *(f"goal_std_{a}_m" for a in axes),
               *(f"forecast_{lead:g}s_{a}_m" for lead in leads for a in axes)]

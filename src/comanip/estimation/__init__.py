@@ -11,8 +11,9 @@ from comanip.estimation.streaming.recorded_trials import estimate_recordings
 from comanip.estimation.streaming.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep
 from comanip.estimation.streaming.reach_segmentation import ReachSegmenter, ReachStart, SegmentationSettings
 from comanip.estimation.streaming.reach_stream import ReachStream, StreamEstimate
+from comanip.estimation.streaming.online_settings import OnlineSettings
 
 __all__ = ["CalibrationSettings", "EstimationLoop", "EstimatorCache", "EstimatorOptions", "GoalEstimate", "GoalEstimator",
            "GoalPosterior", "GoalSmoothing", "LoopEvent", "LoopSettings", "LoopStep", "estimate_goal", "estimate_recordings",
-           "goal_posterior", "OnlineGoalEstimator", "OnlineOptions", "PersonCalibration", "ReachSegmenter", "ReachStart",
+           "goal_posterior", "OnlineGoalEstimator", "OnlineOptions", "OnlineSettings", "PersonCalibration", "ReachSegmenter", "ReachStart",
            "ReachStream", "SegmentationSettings", "StreamEstimate"]

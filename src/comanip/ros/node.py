@@ -71,18 +71,14 @@ try:  # the 'ros' extra; without it, one line naming the extra
 except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
-from comanip.estimation import GoalEstimate, OnlineGoalEstimator, OnlineOptions
+from comanip.estimation import GoalEstimate
 from comanip.estimation.streaming.derived_velocity import DerivedVelocity
-from comanip.estimation.streaming.estimation_loop import EstimationLoop, LoopEvent, LoopSettings, LoopStep, Reach, Update
-from comanip.estimation.streaming.reach_segmentation import SegmentationSettings
+from comanip.estimation.streaming.estimation_loop import LoopEvent, LoopStep, Reach, Update
 from comanip.estimation.model_reaches.model_families import FamilyCache
-from comanip.estimation.online.online_options import CORRECTING_PERSON
-from comanip.estimation.calibration.person_calibration import CalibrationSettings, PersonCalibration
 from comanip.estimation.model_reaches.estimation_planner import estimation_planner
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.multicomponent.handover import HandoverSchedule, plan_handover
 from comanip.multicomponent.transition_model import TransitionModel
-from comanip.planning.planner import Planner
 from comanip.ros.messages import (RejectedMessage, goal_message, path_message, pose_of, read_vector, schedule_message, stamp_of,
                                   status_message)
 from comanip.ros.node_settings import NodeSettings
@@ -97,16 +93,6 @@ RATE_WINDOW = 1.0
 QUIET_PUBLISHER, QUIET_SUBSCRIPTION = (PublisherEventCallbacks(use_default_callbacks=False),
                                       SubscriptionEventCallbacks(use_default_callbacks=False))
 """No QoS-event handlers on the node's topics (each would be visited on every wake of the executor)."""
-
-
-def reach_estimator(planner: Planner, families: FamilyCache, start, prior_goal, width, person: str = "recorded",
-                    calibration: PersonCalibration | None = None) -> OnlineGoalEstimator:
-    """The node's goal estimator, from ``start`` (2n,) at rest (its loop resets it for every reach), for the ``person``
-    of :attr:`NodeSettings.person`, with what is known of them (``calibration``, shared by the node's reaches): the
-    one place that names the estimator."""
-    options = CORRECTING_PERSON if person == "correcting" else OnlineOptions()
-    return OnlineGoalEstimator(planner, start, prior_goal=prior_goal, width=width, cache=families, options=options,
-                               person=calibration)
 
 
 @dataclass
@@ -140,14 +126,9 @@ class GoalNode(Node):
         self._d = model.d
         self._horizon = model.H * model.h
         self._transition = transition_model if transition_model is not None else TransitionModel()
-        person = PersonCalibration(CalibrationSettings(learns=s.learn_person))   # shared by the node's reaches
         prior = None if s.prior_goal is None else np.array(s.prior_goal)
-        self.loop = EstimationLoop(
-            reach_estimator(estimation_planner(model), FamilyCache(size=1), np.zeros(model.state_size), prior, s.width, s.person,
-                            person),
-            LoopSettings(SegmentationSettings(radius=s.rest_radius, window=s.rest_window), rate=s.estimation_rate,
-                         pairing_tolerance=s.twist_tolerance, horizon=self._horizon, restart_after=s.input_timeout,
-                         first_sample_starts_reach=True))
+        self.loop = s.online_settings().estimation_loop(prior_goal=prior, model=estimation_planner(model),
+                                                        cache=FamilyCache(size=1))
         """The node's loop (:mod:`comanip.estimation.streaming.estimation_loop`): its callbacks feed it under the node's lock,
         the guard condition's callback runs the updates it makes due."""
         self._last_pose: float | None = None

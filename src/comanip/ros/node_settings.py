@@ -7,6 +7,7 @@ ValueError as on the command line, naming the parameter. Needs no ROS installati
 
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass, fields
 from pathlib import Path
 
@@ -14,6 +15,10 @@ import yaml
 
 from comanip import presets
 from comanip.estimation.hand_rest import REST_RADIUS_M, REST_WINDOW_S
+from comanip.estimation.streaming import online_settings
+from comanip.estimation.streaming.estimation_loop import LoopSettings
+from comanip.estimation.streaming.online_settings import OnlineSettings
+from comanip.estimation.streaming.reach_segmentation import SegmentationSettings
 from comanip.recordings.motion_capture import VELOCITY_WINDOW_S
 from comanip.arguments import as_goal_width, as_nonnegative, as_positive, as_vector
 from comanip.bodies.point_mass import PointMass
@@ -21,8 +26,6 @@ from comanip.model import ReachingModel
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, LEADING_STIFFNESS, check_schedule_arguments
 
 
-PERSONS = ("recorded", "correcting")
-"""The values of :attr:`NodeSettings.person`."""
 VELOCITY_SOURCES = ("auto", "twist", "poses")
 """The values of :attr:`NodeSettings.velocity_source`."""
 
@@ -82,11 +85,12 @@ class NodeSettings:
     within it of their mean for ``rest_window`` rests (:mod:`comanip.estimation.streaming.reach_segmentation`)."""
     rest_window: float = REST_WINDOW_S
     """How long (s) the hand must stay still to rest between reaches."""
-    person: str = "recorded"
-    """Whom the estimator expects (:data:`PERSONS`): "recorded", a person who may not move as the model does (the
-    model at its own pace, at the person's, and the model of recorded people:
-    :class:`comanip.estimation.OnlineOptions` as it comes); "correcting", the model's own plan with deviations
-    corrected (the simulated scenarios' person, :data:`comanip.estimation.online.online_options.CORRECTING_PERSON`)."""
+    estimator: str = "recorded"
+    """The online estimation the node runs: a shipped description's name or a description YAML
+    (:func:`comanip.estimation.streaming.online_settings.load`; e.g. "recorded", a person who may not move as the
+    model does, or "correcting", the model's own plan with deviations corrected, the simulated scenarios' person).
+    The node's own parameters above and below (``preset``, ``width``, ``estimation_rate``, ``rest_radius``, ...)
+    replace the description's (:meth:`online_settings`)."""
     learn_person: bool = True
     """Learn the person's amplitude, pace and spread from each finished reach and apply them to the next
     (:mod:`comanip.estimation.calibration.person_calibration`); false: every reach is a person not seen yet."""
@@ -127,8 +131,10 @@ class NodeSettings:
         object.__setattr__(self, "twist_tolerance", as_nonnegative("twist_tolerance", self.twist_tolerance, "s"))
         if self.velocity_source not in VELOCITY_SOURCES:
             raise ValueError(f"velocity_source must be one of {VELOCITY_SOURCES}, got {self.velocity_source!r}")
-        if self.person not in PERSONS:
-            raise ValueError(f"person must be one of {PERSONS}, got {self.person!r}")
+        try:
+            self.online_settings()
+        except ValueError as error:
+            raise ValueError(f"estimator: {error}") from None
         if not isinstance(self.learn_person, bool):
             raise ValueError(f"learn_person must be true or false, got {self.learn_person!r}")
         check_schedule_arguments(self.ramp_time, self.leading_stiffness, None)
@@ -136,6 +142,17 @@ class NodeSettings:
         if abs(float(quaternion @ quaternion) - 1.0) > 1e-6:
             raise ValueError(f"equilibrium_orientation must be a unit quaternion (x, y, z, w), got {quaternion.tolist()}")
         object.__setattr__(self, "equilibrium_orientation", tuple(quaternion.tolist()))
+
+    def online_settings(self) -> OnlineSettings:
+        """The node's online estimation: the description :attr:`estimator` names, with the node's model, width,
+        learning, rate, rest, pairing and restart settings, the model's horizon, and the first pose starting a reach."""
+        described = online_settings.load(self.estimator)
+        segmentation = described.loop.segmentation or SegmentationSettings()
+        model = self.model()
+        loop = LoopSettings(dataclasses.replace(segmentation, radius=self.rest_radius, window=self.rest_window),
+                            rate=self.estimation_rate, pairing_tolerance=self.twist_tolerance, horizon=model.H * model.h,
+                            restart_after=self.input_timeout, first_sample_starts_reach=True)
+        return described.replace(model=self.preset, width=self.width, learn_person=self.learn_person, loop=loop)
 
     def model(self) -> ReachingModel:
         """The model named by ``preset``; a ValueError names the parameter."""

@@ -2,9 +2,9 @@
 
 - ``goal_distance`` (:class:`GoalDistanceRelease`): the handle is within the schedule's predicted transition
   distance T of the goal the robot planned to (the known goal).
-- ``estimate`` (:class:`EstimateRelease`): every ``interval`` (s) the robot feeds the handle's position and
-  velocity to an :class:`~comanip.estimation.OnlineGoalEstimator` (a person who corrects deviations, as the
-  sync scenario's continuous policy assumes) and releases when the handle is within T_hat of the ESTIMATED
+- ``estimate`` (:class:`EstimateRelease`): the robot feeds the handle's position and velocity to an
+  :class:`~comanip.estimation.EstimationLoop`, which updates its online estimator at the loop's rate (a person who
+  corrects deviations, as the sync scenario's continuous policy assumes) and releases when the handle is within T_hat of the ESTIMATED
   goal g_hat, T_hat the transition model's distance for the estimated reach (|g_hat - x_0|, w). Only a
   settled estimate counts: a successful update whose goal covariance has its largest standard deviation at
   most ``settle_fraction`` · T_hat, so an early, wrong and uncertain estimate cannot release at once. If no
@@ -21,7 +21,7 @@ import warnings
 import numpy as np
 
 from comanip.control.impedance import RobotState
-from comanip.estimation import OnlineGoalEstimator
+from comanip.estimation import EstimationLoop
 from comanip.multicomponent.handover import HandoverSchedule
 from comanip.multicomponent.transition_model import ExtrapolationWarning, TransitionModel
 
@@ -69,18 +69,18 @@ class GoalDistanceRelease:
 class EstimateRelease:
     """Release when the handle is within T_hat of a settled online goal estimate (module docstring).
 
-    estimator: a fresh :class:`OnlineGoalEstimator` of this reach; transition_model: gives T_hat; width: the
-    goal width w (m) for it; interval: time between observations fed to the estimator (s); settle_fraction:
-    largest goal std allowed, as a fraction of T_hat; fallback_time: when to release anyway (s).
+    loop: a fresh :class:`~comanip.estimation.EstimationLoop` of this reach (one reach from the first sample, at the
+    rate its estimator is updated); transition_model: gives T_hat; width: the goal width w (m) for it;
+    settle_fraction: largest goal std allowed, as a fraction of T_hat; fallback_time: when to release anyway (s).
     """
 
     name = "estimate"
 
-    def __init__(self, estimator: OnlineGoalEstimator, transition_model: TransitionModel, width: float, interval: float,
-                 settle_fraction: float, fallback_time: float):
-        self.estimator, self.transition_model, self.width = estimator, transition_model, width
-        self.interval, self.settle_fraction, self.fallback_time = interval, settle_fraction, fallback_time
-        self._next_observation = interval
+    def __init__(self, loop: EstimationLoop, transition_model: TransitionModel, width: float, settle_fraction: float,
+                 fallback_time: float):
+        self.loop, self.estimator = loop, loop.estimator
+        self.transition_model, self.width = transition_model, width
+        self.settle_fraction, self.fallback_time = settle_fraction, fallback_time
         self.transition_distance = float("nan")
         """T_hat (m) of the latest estimate."""
         self.goal_std = float("inf")
@@ -88,8 +88,8 @@ class EstimateRelease:
         self.settled = False
         self.cause: str | None = None
 
-    def _observe(self, t: float, state: RobotState) -> None:
-        estimate = self.estimator.update(t, state.position, state.velocity)
+    def _estimate(self, update) -> None:
+        estimate = self.loop.estimate(update)
         covariance = np.asarray(estimate.goal_covariance)
         self.goal_std = float(np.sqrt(np.max(np.linalg.eigvalsh(covariance)))) if covariance.size else float("inf")
         distance = max(float(np.linalg.norm(estimate.goal - self.estimator.start_position)), 1e-6)
@@ -100,9 +100,10 @@ class EstimateRelease:
                             self.goal_std <= self.settle_fraction * self.transition_distance)
 
     def due(self, t: float, state: RobotState) -> bool:
-        if t >= self._next_observation - 1e-9:
-            self._observe(t, state)
-            self._next_observation += self.interval
+        self.loop.add_sample(t, state.position, state.velocity)
+        update = self.loop.take_due()
+        if update is not None:
+            self._estimate(update)
             goal = self.estimator.latest.goal
             if self.settled and np.linalg.norm(state.position - goal) <= self.transition_distance:
                 self.cause = self.name

@@ -16,16 +16,15 @@ velocity mean ± std against the distance to the goal, with the transition marke
 
 from __future__ import annotations
 
-from typing import NamedTuple
-
+import dataclasses
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from comanip.arguments import as_positive
 from comanip.control.impedance import CartesianImpedanceController, RobotState
-from comanip.estimation import OnlineGoalEstimator
-from comanip.estimation.online.online_options import CORRECTING_PERSON
+from comanip.estimation.streaming import online_settings
 from comanip.multicomponent.perpendicular_dispersion import DispersionProfile, values_at_first_passage, perpendicular_dispersion_profile
 from comanip.multicomponent.handover import DEFAULT_RAMP_TIME, HandoverSchedule, plan_handover, stiffness_profile
 from comanip.multicomponent.transition_model import TransitionModel
@@ -41,6 +40,8 @@ from comanip.simulation.scenario import ScenarioSettings, TrialRecord, run_trial
 from comanip.simulation.setup import ScenarioSetup
 
 #: Half-width (s) of the window over which a velocity change counts as one jump: v(t + 25 ms) - v(t - 25 ms).
+RELEASE_ESTIMATOR = "correcting"
+"""The description of the estimate trigger's estimator (:func:`comanip.estimation.streaming.online_settings.load`)."""
 JUMP_HALF_WINDOW = 0.025
 #: Points of the distance-to-goal grid of the scenario's profiles.
 PROFILE_POINTS = 101
@@ -199,16 +200,18 @@ def speed_profile(paths: np.ndarray, speeds: np.ndarray, goal: np.ndarray, grid:
 
 def release_trigger(settings: HandoverSettings, setup: ScenarioSetup, start: np.ndarray, transition_model: TransitionModel,
                     schedule: HandoverSchedule, plan: Plan) -> GoalDistanceRelease | EstimateRelease:
-    """One trial's release trigger as the settings ask. The estimate trigger's estimator starts from the
-    settled start [x; 0] (6,) with the robot's goal as its prior mean (weak default std) and assumes a person
-    who corrects deviations from their plan (CORRECTING_PERSON, as the sync scenario's
-    continuous policy); it falls back to releasing at the plan's end."""
+    """One trial's release trigger as the settings ask. The estimate trigger's estimator (the ``correcting``
+    description, :mod:`comanip.estimation.streaming.online_settings`: a person who corrects deviations from their
+    plan) starts from the settled start [x; 0] (6,) with the robot's goal as its prior mean (weak default std),
+    fed every ``estimate_interval`` by its loop; it falls back to releasing at the plan's end."""
     if settings.release_trigger == "goal_distance":
         return GoalDistanceRelease(schedule)
-    estimator = OnlineGoalEstimator(setup.model, start, prior_goal=schedule.goal, width=setup.width,
-                                    options=CORRECTING_PERSON)
-    return EstimateRelease(estimator, transition_model, setup.width, settings.estimate_interval, settings.settle_fraction,
-                           fallback_time=float(plan.t[-1]))
+    described = online_settings.load(RELEASE_ESTIMATOR)
+    described = described.replace(width=setup.width, loop=dataclasses.replace(described.loop, segmentation=None,
+                                                                              rate=1.0 / settings.estimate_interval))
+    loop = described.estimation_loop(start, prior_goal=schedule.goal, model=setup.model)
+    loop.begin(0.0, start[:setup.model.n])                  # the trial's reach, from its start at t = 0
+    return EstimateRelease(loop, transition_model, setup.width, settings.settle_fraction, fallback_time=float(plan.t[-1]))
 
 
 def run_handover(settings: HandoverSettings, setup: ScenarioSetup | None = None, transition_model: TransitionModel | None = None,

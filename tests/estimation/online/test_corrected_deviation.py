@@ -8,12 +8,16 @@ from scipy.stats import chi2
 
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation import OnlineGoalEstimator, OnlineOptions
-from comanip.estimation.online.corrected_deviation import (CORRECTION_TIME, DEVIATION_TIME, corrected_covariance,
-                                                    corrected_powers, correction_factor, sample_corrected_deviations)
-from comanip.simulation.policies.continuous import ROBOT_BELIEF
+from comanip.estimation.online.corrected_deviation import (corrected_covariance, corrected_powers, correction_factor,
+                                                           sample_corrected_deviations)
+from comanip.estimation.streaming import online_settings
 
 OBSERVATION_STD = np.r_[np.full(3, 1e-3), np.full(3, 1e-2)]   # the default R (m, m/s)
-CORRECTING = OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME)
+CORRECTING = online_settings.load("correcting").options
+"""A person who corrects, as the scenarios' person (the ``correcting`` description)."""
+CORRECTION_TIME, DEVIATION_TIME = CORRECTING.correction_time, CORRECTING.deviation_time
+ROBOT_BELIEF = online_settings.load("sync_robot").options
+"""The sync robot's belief (the ``sync_robot`` description)."""
 
 
 @pytest.fixture(scope="module")

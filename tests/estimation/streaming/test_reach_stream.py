@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 import comanip
-from comanip.estimation import ReachStream, SegmentationSettings
+from comanip.estimation import OnlineSettings, ReachStream, SegmentationSettings
 
 
 def successive_reaches(count: int, rate: float = 100.0, rest: float = 0.5, duration: float = 0.5, noise: float = 5e-4,
@@ -63,7 +63,7 @@ def test_a_stream_refuses_time_going_back_and_skips_lost_samples():
 
 def test_bad_estimator_options_are_refused_when_the_stream_is_made():
     with pytest.raises(ValueError, match="width"):
-        ReachStream(comanip.presets.arm(), width=-0.01)
+        ReachStream(comanip.presets.arm(), OnlineSettings(model="arm", width=-0.01))
 
 
 def test_a_stream_learns_the_person_from_every_reach_that_ends_at_rest():

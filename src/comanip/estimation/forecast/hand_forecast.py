@@ -124,6 +124,22 @@ class HandForecast:
         return ForecastPoint(times, position + rest_position, velocity + rest_velocity, covariance)
 
 
+def within_horizon(forecast: HandForecast, horizon: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The forecast's grid (times (K+1,) s, mean states (K+1, nx), covariances (K+1, nx, nx)) up to ``horizon`` s
+    after its first time, its last point there (between grid points, linearly between them); None: the whole grid."""
+    t, mean, cov = forecast.t, forecast.mean, forecast.cov
+    if horizon is None or t[0] + horizon >= t[-1]:
+        return t, mean, cov
+    end = t[0] + horizon
+    k = int(np.searchsorted(t, end, side="right"))         # t[k - 1] <= end < t[k]
+    weight = (end - t[k - 1]) / (t[k] - t[k - 1])
+    last_mean = (1 - weight) * mean[k - 1] + weight * mean[k]
+    last_cov = (1 - weight) * cov[k - 1] + weight * cov[k]
+    if weight <= 1e-12:
+        return t[:k], mean[:k], cov[:k]
+    return np.r_[t[:k], end], np.vstack([mean[:k], last_mean]), np.concatenate([cov[:k], last_cov[None]])
+
+
 def _hermite(t: np.ndarray, x: np.ndarray, m: np.ndarray, times: np.ndarray, k: np.ndarray):
     """Position and velocity (M, d) at ``times`` (M,) s, in intervals ``k`` (M,), of the cubic Hermite curve through
     positions x (K+1, d) m with slopes m (K+1, d) m/s at times t (K+1,) s."""

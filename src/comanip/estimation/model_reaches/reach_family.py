@@ -31,7 +31,7 @@ from scipy.interpolate import CubicSpline
 from comanip.belief.propagation import linearised_step_function
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
-from comanip.planning.starts.reach_library import reflection_onto
+from comanip.planning.reflection import reflection_onto
 
 INVARIANCE_TOLERANCE = 1e-4
 """Largest difference between an oblique plan and the turned member, in each state entry relative to its largest

@@ -92,11 +92,3 @@ def sample_corrected_deviations(cov: np.ndarray, A: np.ndarray, rho: float, mean
         errors[:, i + 1] = errors[:, i] @ decayed.T + rng.normal(size=(count, nx)) @ factor.T
     return errors
 
-
-CORRECTION_TIME = 0.3
-"""tau (s) for a person who corrects, as the sync scenario's continuous policy takes it: about the simulated
-person's replanning interval (0.22 s) plus their arm's lag; chosen with DEVIATION_TIME on the sync scenario
-(3 trials per goal, tau in 0.055–1 s, sigma_t in 0–0.2 s; docs/online_drift.md)."""
-
-DEVIATION_TIME = 0.15
-"""sigma_t (s) for a person who corrects, as the sync scenario's continuous policy takes it (CORRECTION_TIME)."""

@@ -48,11 +48,11 @@ import numpy as np
 
 from comanip.arguments import as_vector
 from comanip.estimation.model_reaches.estimation_planner import checked_model
-from comanip.estimation.online.explanations import (Explained, Explanation, HandAtRest, HandTrace, ModelAtOwnPace, ModelAtPersonPace,
-                                             Reach, RecordedPeople, vetoed_own_pace)
+from comanip.estimation.online.explanations import (Explained, Explanation, HandAtRest, HandTrace, Reach)
 from comanip.estimation.online.explanations.base import grid_position
+from comanip.estimation.online.explanations.default_chain import default_explanations
 from comanip.estimation.goal_estimate import GoalEstimate
-from comanip.estimation.forecast.hand_forecast import continued_reach
+from comanip.estimation.forecast.hand_forecast import continued_reach, within_horizon
 from comanip.estimation.forecast.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.calibration.goal_smoothing import GoalSmoother
@@ -60,9 +60,7 @@ from comanip.estimation.people.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.hand_rest import REST_RADIUS_M, lost_sample, resting_position
 from comanip.estimation.model_reaches.model_families import FamilyCache, default_families
 from comanip.estimation.online.online_options import OnlineOptions
-from comanip.estimation.model_reaches.paced_model import PacedModel
 from comanip.estimation.model_reaches.reach_timing import timed_plan
-from comanip.estimation.people.people_model import shipped_people_model
 from comanip.estimation.calibration.person_calibration import FORECAST_LEADS, FinishedReach, PersonCalibration, ReachFactors
 from comanip.model import ReachingModel
 from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
@@ -126,24 +124,12 @@ class OnlineGoalEstimator:
         self.family = families.family(width, o.family_distances, o.family_size, o.family_tolerance)
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
-        self.explanations = list(explanations) if explanations is not None else self._explanations(d)
+        self.explanations = (list(explanations) if explanations is not None
+                             else default_explanations(self.model, self.options, self.family))
         self._at_rest_first = bool(self.explanations) and isinstance(self.explanations[0], HandAtRest)
         self._blas = SingleThreadBlas()
         self._hand = HandTrace(d)
         self.reset(start)
-
-    def _explanations(self, d: int) -> list[Explanation]:
-        """The explanations ``options.timing`` names (module docstring)."""
-        if self.options.timing == "model":
-            return [ModelAtOwnPace(self.model, self.options)]
-        people = self.options.people_model or shipped_people_model("arm" if d == 3 else "mouse")
-        if d == 3 and people.kind == "mouse":
-            raise ValueError("options.people_model was fitted to mouse movements; a 3-D reach is an arm's: fit one "
-                             "to arm reaches (PeopleModel.fit(recordings, kind='arm')) or leave it None")
-        if self.options.timing == "estimated":
-            return [HandAtRest(), vetoed_own_pace(self.model, self.options), RecordedPeople(people)]
-        person_pace = ModelAtPersonPace(PacedModel(self.family), self.options)
-        return [HandAtRest(), vetoed_own_pace(self.model, self.options, person_pace), person_pace, RecordedPeople(people)]
 
     def reset(self, start=None, *, prior_goal=_SAME) -> None:
         """Forget every observation and start a new reach from ``start`` (nx,) or [q; qdot] (2n,), at rest (None:
@@ -431,7 +417,7 @@ class OnlineGoalEstimator:
                 self._forecasts.append((ahead.position, ahead.covariance))
             if self.person.forecast_spread != 1.0:
                 forecast = dataclasses.replace(forecast, cov=self.person.forecast_spread * forecast.cov)
-            t, mean, cov = forecast.t, forecast.mean, forecast.cov
+            t, mean, cov = within_horizon(forecast, self.options.forecast_horizon)
             torque = np.zeros((len(t) - 1, n))
         plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),
                     objective=prediction.objective, solve_time=time.perf_counter() - t_begin, iterations=explained.iterations,

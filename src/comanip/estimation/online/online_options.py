@@ -8,7 +8,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from comanip.arguments import as_count, as_positive
-from comanip.estimation.online.corrected_deviation import CORRECTION_TIME, DEVIATION_TIME
 from comanip.estimation.calibration.goal_smoothing import GoalSmoothing
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance
 from comanip.estimation.people.people_model import PeopleModel
@@ -43,11 +42,11 @@ class OnlineOptions:
     correction_time: float | None = None
     """Time constant (s) with which the person corrects a deviation from their plan
     (:mod:`comanip.estimation.online.corrected_deviation`); None: the plan's open-loop belief, a deviation persists.
-    The sync scenario's continuous policy uses CORRECTION_TIME (0.3 s) of that module (ROBOT_BELIEF)."""
+    The ``correcting`` and ``sync_robot`` descriptions (:mod:`comanip.estimation.streaming.online_settings`) use 0.3 s."""
     deviation_time: float = 0.0
     """With a correction time: the person strays from the plan by about this many seconds (s) of their motion,
     in any direction (ahead, behind, across; :mod:`comanip.estimation.online.corrected_deviation`); 0: only motor noise.
-    The sync scenario's continuous policy uses DEVIATION_TIME (0.15 s) of that module."""
+    The ``correcting`` and ``sync_robot`` descriptions use 0.15 s."""
     led_axes: tuple[int, ...] = ()
     """Axes (indices into the hand position, 0..d-1) along which someone else moves the hand, e.g. the robot
     that leads z in the sync scenario: there the observed motion is partly theirs, not the person's reach, and
@@ -63,7 +62,7 @@ class OnlineOptions:
     """The reported goal covariance is the Laplace (and quadrature) one times this factor (the estimate itself
     is unchanged). 1: as computed, calibrated for the open-loop belief. Under a correction time most
     ellipsoids are too wide and some far too narrow (docs/results/calibration.md); the sync robot's belief
-    uses 3 (comanip.simulation.policies.continuous.ROBOT_BELIEF)."""
+    uses 3 (the ``sync_robot`` description, :mod:`comanip.estimation.streaming.online_settings`)."""
 
     timing: str = "estimated"
     """"model": the reach starts at t = 0 and moves at the model's pace (the estimate above, exact for the
@@ -85,6 +84,11 @@ class OnlineOptions:
     paced_threshold: float = 0.05
     """With ``timing="paced"``: the largest misfit (chi² per observed number, :mod:`comanip.estimation.model_reaches.profile_fit`)
     at which the model's reach at the person's pace explains the observations."""
+    forecast_horizon: float | None = None
+    """How far ahead (s) of each update the estimate's path reaches: its plan fields (``t``, ``mean``, ``ee_mean``,
+    ...; the path a robot or the ROS node's path topic follows) hold the forecast from the update to this many seconds
+    on, where the forecast's last point is (the forecast itself, ``estimate.forecast.at``, still answers any time);
+    None: to the forecast's stop."""
     goal_smoothing: GoalSmoothing | None = GoalSmoothing()
     """How the estimate's ``goal`` is smoothed over updates for a robot to follow
     (:mod:`comanip.estimation.calibration.goal_smoothing`; the explanation's own goal stays as ``unsmoothed_goal``); None: not
@@ -94,6 +98,8 @@ class OnlineOptions:
         observation_covariance(self.observation_std, 1)
         if self.goal_smoothing is not None and not isinstance(self.goal_smoothing, GoalSmoothing):
             raise ValueError(f"goal_smoothing must be a GoalSmoothing or None, got {type(self.goal_smoothing).__name__}")
+        if self.forecast_horizon is not None:
+            as_positive("forecast_horizon", self.forecast_horizon, "s ahead (or None: to the forecast's stop)")
         if self.timing not in TIMINGS:
             raise ValueError(f"timing must be one of {TIMINGS}, got {self.timing!r}")
         as_positive("mismatch_threshold", self.mismatch_threshold, "mean squared whitened residual")
@@ -124,7 +130,3 @@ class OnlineOptions:
         if not (math.isfinite(self.deviation_time) and self.deviation_time >= 0):
             raise ValueError(f"deviation_time must be a finite time ≥ 0 s, got {self.deviation_time!r}")
 
-
-CORRECTING_PERSON = OnlineOptions(correction_time=CORRECTION_TIME, deviation_time=DEVIATION_TIME)
-"""The options for a person who corrects deviations from their plan (:mod:`comanip.estimation.online.corrected_deviation`):
-what the sync scenario's continuous policy, the handover's estimate trigger and the ROS node use."""

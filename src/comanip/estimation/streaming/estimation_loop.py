@@ -15,7 +15,10 @@ says so in a :class:`LoopStep` (its :class:`LoopEvent`):
    first sample (after construction, :meth:`EstimationLoop.restart`, or a gap longer than ``restart_after``)
    starts one instead, at rest where it is, its clock at its stamp; the hand's first departure from that rest
    belongs to it (unless it comes past the reach's ``horizon``: then it starts the next). A reach finishes (``FINISHED``) when the hand rests again; until the next reach starts, the
-   samples are only segmented (``AT_REST``).
+   samples are only segmented (``AT_REST``). Without segmentation (``LoopSettings.segmentation`` None: a
+   stream that is one reach, such as a simulated trial) the first sample starts the reach as with
+   ``first_sample_starts_reach`` (or :meth:`EstimationLoop.begin` starts it where the front end knows its clock
+   and start) and every later one belongs to it.
 3. **Due times.** Within a reach, ``rate`` updates per second of stream time are due (``DUE``), on a grid of
    1 / rate from the reach's clock: the sample nearest each due time (the first within half the sample spacing
    of it) is due, so a tracker whose stamps jitter still gets the rate (a rule of 'one period since the last
@@ -74,8 +77,9 @@ class LoopEvent(Enum):
 class LoopSettings:
     """How the loop pairs, segments and paces a stream (module docstring)."""
 
-    segmentation: SegmentationSettings = field(default_factory=SegmentationSettings)
-    """Rests and reaches (:class:`~comanip.estimation.streaming.reach_segmentation.SegmentationSettings`)."""
+    segmentation: SegmentationSettings | None = field(default_factory=SegmentationSettings)
+    """Rests and reaches (:class:`~comanip.estimation.streaming.reach_segmentation.SegmentationSettings`); None: the
+    stream is one reach, from its first sample (module docstring, step 2)."""
     rate: float | None = None
     """Most updates per second of stream time (Hz); None: every sample of a reach."""
     pairing_tolerance: float = 0.005
@@ -89,8 +93,8 @@ class LoopSettings:
     """True: the first sample starts a reach (module docstring, step 2); False: only the hand leaving its rest."""
 
     def __post_init__(self):
-        if not isinstance(self.segmentation, SegmentationSettings):
-            raise ValueError(f"segmentation must be a SegmentationSettings, got {type(self.segmentation).__name__}")
+        if self.segmentation is not None and not isinstance(self.segmentation, SegmentationSettings):
+            raise ValueError(f"segmentation must be a SegmentationSettings or None, got {type(self.segmentation).__name__}")
         if self.rate is not None:
             as_positive("rate", self.rate, "Hz")
         as_nonnegative("pairing_tolerance", self.pairing_tolerance, "s")
@@ -171,7 +175,9 @@ class EstimationLoop:
         self.settings = settings or LoopSettings()
         if not isinstance(self.settings, LoopSettings):
             raise ValueError(f"settings must be a LoopSettings, got {type(self.settings).__name__}")
-        self.segmenter = ReachSegmenter(self.settings.segmentation)
+        segmentation = self.settings.segmentation
+        self.segmenter = None if segmentation is None else ReachSegmenter(segmentation)
+        """The segmenter of the stream's reaches; None without segmentation."""
         self.prior_goal: np.ndarray | None = estimator.prior_goal
         """The prior goal (d,) m of the reaches started from now on; None: each reach's start."""
         self.replaced = 0
@@ -181,7 +187,8 @@ class EstimationLoop:
 
     def restart(self) -> None:
         """Start over: no reach, nothing waiting or due (what the estimator knows of the person stays)."""
-        self.segmenter.reset()
+        if self.segmenter is not None:
+            self.segmenter.reset()
         self._velocities: deque = deque(maxlen=PAIRING_DEPTH)    # (stamp, velocity), in stamp order
         self._waiting: list[tuple[float, np.ndarray, float | None, float]] = []   # (stamp, position, previous stamp, received)
         self._previous: float | None = None           # stamp of the latest position
@@ -193,10 +200,19 @@ class EstimationLoop:
         self.due: Update | None = None
         """The update due and not yet taken (:meth:`take_due`)."""
 
+    def begin(self, clock: float, start) -> Reach:
+        """Start a reach at stream time ``clock`` (s), at rest at ``start`` (d,) m, where a front end knows when and
+        where its stream's reach starts (a simulated trial): without segmentation, every later sample is its own
+        (module docstring, step 2) and the due times count from ``clock``."""
+        start = np.array(start, dtype=float)
+        self._start(Reach(1 if self.reach is None else self.reach.number + 1, float(clock), start, self.prior_goal, ()))
+        return self.reach
+
     @property
     def moving(self) -> bool:
-        """True while the hand moves (the segmenter has found it leaving its rest and not yet resting again)."""
-        return self.segmenter.moving
+        """True while the hand moves (the segmenter has found it leaving its rest and not yet resting again; without
+        segmentation, while the stream's reach is under way)."""
+        return self.under_way if self.segmenter is None else self.segmenter.moving
 
     @property
     def waiting(self) -> int:
@@ -253,16 +269,20 @@ class EstimationLoop:
         s = self.settings
         gap = previous is not None and s.restart_after is not None and sample.stamp - previous > s.restart_after
         if gap:
-            self.segmenter.reset()
+            if self.segmenter is not None:
+                self.segmenter.reset()
             self.under_way = False
-        if s.first_sample_starts_reach and (self.reach is None or gap):
-            self.segmenter.update(sample.stamp, sample.position, sample.velocity)
+        if (s.first_sample_starts_reach or self.segmenter is None) and (self.reach is None or gap):
+            if self.segmenter is not None:
+                self.segmenter.update(sample.stamp, sample.position, sample.velocity)
             self._start(Reach(1 if self.reach is None else self.reach.number + 1, sample.stamp, sample.position.copy(),
                               self.prior_goal, ()))
             return LoopStep(LoopEvent.STARTED, sample.stamp)
+        within = self.reach is not None and sample.stamp - self.reach.clock < s.horizon
+        if self.segmenter is None:
+            return self._pace(sample, previous, within)
         was_moving = self.segmenter.moving
         started = self.segmenter.update(sample.stamp, sample.position, sample.velocity)
-        within = self.reach is not None and sample.stamp - self.reach.clock < s.horizon
         if started is not None and not (s.first_sample_starts_reach and started.number == 1 and within):
             self._start(Reach(1 if self.reach is None else self.reach.number + 1, started.clock, started.start, self.prior_goal,
                               tuple(HandSample(*kept) for kept in started.samples[:-1])))
@@ -273,6 +293,11 @@ class EstimationLoop:
         if was_moving and not self.segmenter.moving:
             self.under_way = False
             return self._make_due(LoopEvent.FINISHED, sample.stamp, sample if within else None, finishes=True)
+        return self._pace(sample, previous, within)
+
+    def _pace(self, sample: HandSample, previous: float | None, within: bool) -> LoopStep:
+        """A sample of the reach under way: past its horizon, between due times, or due (step 3)."""
+        s = self.settings
         if not within:
             return LoopStep(LoopEvent.PAST_HORIZON, sample.stamp)
         half_spacing = 0.5 * (sample.stamp - previous) if previous is not None else 0.0

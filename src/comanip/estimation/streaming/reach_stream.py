@@ -15,12 +15,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-import numpy as np
 
-from comanip.estimation.streaming.estimation_loop import EstimationLoop, LoopEvent, LoopSettings
+from comanip.estimation.calibration.person_calibration import PersonCalibration
 from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.model_reaches.model_families import FamilyCache
 from comanip.estimation.online.online_estimator import OnlineGoalEstimator
-from comanip.estimation.streaming.reach_segmentation import SegmentationSettings
+from comanip.estimation.streaming import online_settings
+from comanip.estimation.streaming.estimation_loop import LoopEvent
+from comanip.estimation.streaming.online_settings import OnlineSettings
 
 
 @dataclass(frozen=True)
@@ -41,22 +43,27 @@ class ReachStream:
     """Goal estimates over a stream of successive reaches (module docstring).
 
     Args:
-        model: a ReachingModel or Planner of a point mass, as :class:`OnlineGoalEstimator` takes.
-        settings: :class:`~comanip.estimation.streaming.reach_segmentation.SegmentationSettings`.
-        estimator_options: keyword arguments for the stream's :class:`OnlineGoalEstimator` (``prior_std``,
-            ``width``, ``options``, ``cache``, ``person``; each reach's start comes from the stream).
+        model: a ReachingModel or Planner of a point mass, as :class:`OnlineGoalEstimator` takes it; None: the one
+            ``settings`` names.
+        settings: the online estimation (:class:`~comanip.estimation.streaming.online_settings.OnlineSettings`, or
+            the name or YAML path of one, :func:`~comanip.estimation.streaming.online_settings.load`); default
+            ``recorded``, a person who may not move as the model does.
+        prior_goal: g_bar (d,) m of every reach; None: each reach's start.
+        cache: where the reach family is kept (the process's when None).
+        person: what is known of the person (:class:`~comanip.estimation.calibration.person_calibration.PersonCalibration`);
+            None: a person not seen yet.
 
     The model's reach family is built here (a second or so, once per model and width, kept in the cache), so
-    that the first reach of the stream starts as fast as the others; bad options are refused here too.
+    that the first reach of the stream starts as fast as the others; bad settings are refused here too.
     """
 
-    def __init__(self, model, settings: SegmentationSettings | None = None, **estimator_options):
-        self.model = model
-        body_model = getattr(model, "model", model)
-        estimator = OnlineGoalEstimator(model, np.zeros(body_model.state_size), **estimator_options)
-        self.loop = EstimationLoop(estimator, LoopSettings(segmentation=settings or SegmentationSettings()))
+    def __init__(self, model=None, settings: OnlineSettings | str = "recorded", *, prior_goal=None,
+                 cache: FamilyCache | None = None, person: PersonCalibration | None = None):
+        self.settings = online_settings.load(settings)
+        self.loop = self.settings.estimation_loop(prior_goal=prior_goal, model=model, cache=cache, person=person)
         """The stream's loop: its reaches, segmenter and estimator."""
-        self.person = estimator.person
+        self.model = self.loop.estimator.model if model is None else model
+        self.person = self.loop.estimator.person
         """What the stream's reaches have taught of the person."""
         self.reset()
 

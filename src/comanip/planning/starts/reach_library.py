@@ -30,6 +30,7 @@ from comanip.optim import CONVERGED
 from comanip.planning.path_limits import LIMIT_TOLERANCE
 from comanip.planning.reach_parameters import ReachParameters
 from comanip.planning.reach_problem import ReachProblem
+from comanip.planning.reflection import reflection_onto
 from comanip.planning.reach_solver import ReachSolver, rank
 
 GRID_RATIO = 1.4
@@ -48,18 +49,6 @@ LOCAL_OPTIMUM_TOLERANCE = 1e-6
 optimum (an entry keeps one plan per local optimum)."""
 SYMMETRY_TOLERANCE = 1e-9
 """Relative objective difference under a random turn and shift below which a model counts as symmetric."""
-
-
-def reflection_onto(direction: np.ndarray) -> np.ndarray:
-    """Orthogonal (d, d) matrix taking e_1 to the unit vector ``direction`` (d,): a Householder reflection
-    (the identity when direction is e_1). Reflections are symmetries too: the isotropic model has no
-    handedness."""
-    d = direction.size
-    v = np.eye(d)[0] - direction
-    norm2 = float(v @ v)
-    if norm2 < 1e-24:
-        return np.eye(d)
-    return np.eye(d) - 2.0 * np.outer(v, v) / norm2
 
 
 def at_pace(torque: np.ndarray, pace: float) -> np.ndarray:

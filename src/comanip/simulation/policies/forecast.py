@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from comanip.simulation.policies.continuous import ROBOT_LED_AXES, ContinuousPolicy
+from comanip.simulation.policies.continuous import ContinuousPolicy
 from comanip.simulation.policies.protocol import Prediction
 
 LEAD_SHARE = 0.3
@@ -66,7 +66,7 @@ class ForecastPolicy(ContinuousPolicy):
         forecast = estimate.forecast.at(times)
         position, velocity = forecast.position.copy(), forecast.velocity.copy()
         height = goal[2] if c.goal_height is None else c.goal_height
-        person_axes = [a for a in range(3) if a not in ROBOT_LED_AXES]
+        person_axes = [a for a in range(3) if a not in self.settings.options.led_axes]
         _, position[:, 2] = height_along(position, c.start[:3], goal, np.asarray(estimate.goal_covariance), height,
                                          person_axes)
         velocity[:, 2] = np.gradient(position[:, 2], c.dt)

@@ -4,11 +4,12 @@ vetoes that rule an explanation out for the rest of the reach."""
 
 from comanip.estimation.online.explanations.at_rest import HandAtRest
 from comanip.estimation.online.explanations.base import Explained, Explanation, HandTrace, Reach, Verdict
-from comanip.estimation.online.explanations.own_pace import ModelAtOwnPace, vetoed_own_pace
+from comanip.estimation.online.explanations.default_chain import default_explanations, vetoed_own_pace
+from comanip.estimation.online.explanations.own_pace import ModelAtOwnPace
 from comanip.estimation.online.explanations.people import RecordedPeople
 from comanip.estimation.online.explanations.person_pace import ModelAtPersonPace, PaceContradiction
 from comanip.estimation.online.explanations.vetoed import MisfitAbove, Veto, Vetoed
 
 __all__ = ["Explained", "Explanation", "HandAtRest", "HandTrace", "MisfitAbove", "ModelAtOwnPace", "ModelAtPersonPace",
            "PaceContradiction", "Reach", "RecordedPeople", "Verdict", "Veto", "Vetoed",
-           "vetoed_own_pace"]
+           "default_explanations", "vetoed_own_pace"]

@@ -35,8 +35,6 @@ import numpy as np
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.online.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
 from comanip.estimation.online.explanations.base import Explained, HandTrace, Reach, Verdict, grid_position
-from comanip.estimation.online.explanations.person_pace import ModelAtPersonPace, PaceContradiction
-from comanip.estimation.online.explanations.vetoed import MisfitAbove, Vetoed
 from comanip.estimation.goal_estimate import GoalEstimate
 from comanip.estimation.online.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import observation_covariance
@@ -225,11 +223,3 @@ class ModelAtOwnPace:
             noise = noise + mean_fraction**2 * (cov[i + 1] - A @ cov[i] @ A.T)[:m, :m]
         return noise
 
-
-def vetoed_own_pace(model: ReachingModel, options: OnlineOptions, person_pace: ModelAtPersonPace | None = None) -> Vetoed:
-    """The model at its own pace as the estimator's default chains ask it: ruled out for the rest of the reach
-    where its misfit exceeds ``options.mismatch_threshold`` (:class:`MisfitAbove`) or, given ``person_pace``, where
-    that contradicts its timing (:class:`PaceContradiction`)."""
-    misfit = MisfitAbove(options.mismatch_threshold, "the model at its own pace")
-    own_pace = ModelAtOwnPace(model, options, give_up_above=GIVE_UP_FACTOR * options.mismatch_threshold)
-    return Vetoed(own_pace, (misfit,) if person_pace is None else (PaceContradiction(person_pace), misfit))
