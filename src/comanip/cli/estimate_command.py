@@ -104,13 +104,11 @@ def check_inputs(args, model, start, observed, t_obs) -> None:
                          f"got {args.candidates.shape[1]}")
 
 
-def run(args) -> int:
-    model = load_model(args)
-    if args.online:
-        return run_online(args, model)
+def observation_of(args, model):
+    """The start, the observed state and its time (s) from ``--observed`` or ``--observations`` (with every row's
+    times (K,) s and states (K, 2n), None for ``--observed``); a one-line ValueError without one."""
     body, n = model.body, model.n
     at_rest = np.r_[body.home_position, np.zeros(n)]
-    times = states = None
     if args.observations is not None:
         times, states = read_hand_states(args.observations, n, check_units=args.check_units, joint_angles=not body.is_linear,
                                          name="--observations", topic=args.topic, frame=args.frame, marker=args.marker,
@@ -118,13 +116,19 @@ def run(args) -> int:
         before = np.flatnonzero((times > 0) & (times <= args.t_obs))
         if before.size == 0:
             raise ValueError(f"--observations has no row with 0 < t_s ≤ --t-obs = {args.t_obs:g} s")
-        observed, t_obs = states[before[-1]], times[before[-1]]
         start = args.start if args.start is not None else (states[0] if times[0] == 0 else at_rest)
-    elif args.observed is not None:
-        observed, t_obs = args.observed, args.t_obs
-        start = args.start if args.start is not None else at_rest
-    else:
-        raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+        return start, states[before[-1]], times[before[-1]], times, states
+    if args.observed is not None:
+        return (args.start if args.start is not None else at_rest), args.observed, args.t_obs, None, None
+    raise ValueError("give the observation: --observed (with --t-obs) or --observations CSV")
+
+
+def run(args) -> int:
+    model = load_model(args)
+    if args.online:
+        return run_online(args, model)
+    body, n = model.body, model.n
+    start, observed, t_obs, times, states = observation_of(args, model)
     check_inputs(args, model, start, observed, t_obs)
     out = output_dir(args.out, "estimate", args.force, create=False)
     estimator = GoalEstimator(model)   # built (and compiled on first use) only once every input is checked

@@ -184,8 +184,8 @@ def names() -> list[str]:
 
 
 def load(name_or_path: str | Path) -> OnlineSettings:
-    """A shipped description by name (:func:`names`) or one from a YAML file; a one-line ValueError for an unknown
-    name, an unreadable or invalid file, and unknown or bad settings."""
+    """A shipped description by name (:func:`names`) or one from a YAML file (an OnlineSettings is returned as it
+    is); a one-line ValueError for an unknown name, an unreadable or invalid file, and unknown or bad settings."""
     if isinstance(name_or_path, OnlineSettings):
         return name_or_path
     if isinstance(name_or_path, str) and name_or_path in names():
