@@ -186,8 +186,7 @@ def continued_reach(family: ReachFamily, reach_start: np.ndarray, t_now: float,
     its phase). ``member``: the family's member at the goal's distance where the caller has read it already
     (:attr:`~comanip.estimation.model_reaches.reach_family.ReachPrediction.member`), else it is read here."""
     model = family.model
-    n, nx, H, h = family.n, family.nx, family.H, model.h
-    blocks = nx // n
+    n, H, h = family.n, family.H, model.h
     to_goal = goal - position
     r = float(np.linalg.norm(to_goal))
     D = float(np.linalg.norm(goal - reach_start))
@@ -217,22 +216,50 @@ def continued_reach(family: ReachFamily, reach_start: np.ndarray, t_now: float,
     # 2. the continuation: the member from its phase on, on the model's grid, turned, scaled and played at p
     steps = tau[(tau > phase + 0.25 * h) & (tau <= end)]           # no sliver of a first step
     model_times = np.concatenate(([phase], steps))
-    tail = np.array([np.interp(model_times, tau, along[:, b]) for b in range(blocks)]).T     # (K+1, blocks)
-    left_now = max(a[last] - tail[0, 0], LAST_SHARE * (a[last] - a[first]), 1e-12)
-    scale = r / left_now
-    per_block = np.array([1.0, 1.0 / pace] + [pace ** -2] * (blocks - 2))
-    block_scale = scale * per_block
-    shifted = tail.copy()
-    shifted[:, 0] -= tail[0, 0]
-    shifted *= block_scale
     t = t_now + pace * (model_times - phase)
-    mean = (shifted[:, :, None] * u).reshape(len(t), blocks * n)
-    mean[:, :n] += position
+    mean, block_scale = _turned_tail(along, tau, model_times, (first, last), r, pace, u, position)
 
     # 3. the rest of the velocity and acceleration, gone by the stop
     if len(t) == 1:                          # a hand at or past the stop: the continuation holds still
         t, mean = np.array([t[0], t[0] + remaining]), np.vstack([mean, mean])
         mean[1, n:] = 0.0
+    continuation, dv, da = _add_rest(t, mean, n, t_now, remaining, velocity, acceleration)
+
+    # 4. the covariance: the motor noise still to come, and the goal's uncertainty along the way
+    covered = np.clip(((mean[:, :n] - position) @ u) / max(r, 1e-12), 0.0, None)
+    cov = _forecast_covariance(family, member, phase, model_times, len(t), np.repeat(block_scale, n), u)
+    cov[:, :n, :n] += covered[:, None, None] ** 2 * goal_covariance
+    arrival = t_now + pace * (end - phase)
+    return HandForecast(t=t, mean=mean, cov=cov, stop_time=float(arrival), pace=float(pace), phase=float(phase), d=n,
+                        continuation=continuation, velocity_rest=dv, acceleration_rest=da)
+
+
+def _turned_tail(along: np.ndarray, tau: np.ndarray, model_times: np.ndarray, span: tuple[int, int], r: float,
+                 pace: float, u: np.ndarray, position: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Step 2 of the module docstring: the member's states along its axis ``along`` (H+1, blocks) at grid times
+    ``tau`` (H+1,) s, read at ``model_times`` (K+1,) s, from the hand at ``position`` (d,) m, scaled to the distance
+    left ``r`` (m; the member moving over the steps ``span``), played at ``pace`` and turned onto ``u`` (d,). Returns
+    the mean states (K+1, blocks·d) and each block's scale (blocks,)."""
+    blocks, n = along.shape[1], u.size
+    first, last = span
+    a = along[:, 0]
+    tail = np.array([np.interp(model_times, tau, along[:, b]) for b in range(blocks)]).T     # (K+1, blocks)
+    left_now = max(a[last] - tail[0, 0], LAST_SHARE * (a[last] - a[first]), 1e-12)
+    block_scale = r / left_now * np.array([1.0, 1.0 / pace] + [pace ** -2] * (blocks - 2))
+    shifted = tail.copy()
+    shifted[:, 0] -= tail[0, 0]
+    shifted *= block_scale
+    mean = (shifted[:, :, None] * u).reshape(len(model_times), blocks * n)
+    mean[:, :n] += position
+    return mean, block_scale
+
+
+def _add_rest(t: np.ndarray, mean: np.ndarray, n: int, t_now: float, remaining: float, velocity: np.ndarray,
+              acceleration: np.ndarray | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Step 3 of the module docstring on the continuation's mean states (K+1, nx) at times ``t`` (K+1,) s, in place:
+    its velocities become the chord slopes plus the rest of the hand's ``velocity`` (d,) m/s and ``acceleration``
+    (d,) m/s² (None: none), gone by ``remaining`` s after ``t_now``. Returns the continuation alone (positions and
+    slopes, (K+1, 2d)), dv (d,) m/s and da (d,) m/s²."""
     slopes = _chord_slopes(t, mean[:, :n])
     continuation = np.hstack([mean[:, :n], slopes])
     dv = velocity - slopes[0]
@@ -242,23 +269,25 @@ def continued_reach(family: ReachFamily, reach_start: np.ndarray, t_now: float,
     rest_position, rest_velocity = _rest_terms(t - t_now, remaining, dv, da)
     mean[:, n:2 * n] = slopes + rest_velocity
     mean[:, :n] += rest_position
+    return continuation, dv, da
 
-    # 4. the covariance: the motor noise still to come, and the goal's uncertainty along the way
+
+def _forecast_covariance(family: ReachFamily, member: FamilyMember, phase: float, model_times: np.ndarray, count: int,
+                         scales: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """The motor noise still to come (module docstring, step 4) at ``count`` forecast times, the first ones at the
+    member's ``model_times`` (s of model time, from ``phase`` on) and any after them at the last: the member's belief
+    given its state at the phase, scaled per state entry by ``scales`` (nx,) and turned onto the direction ``u``
+    (d,); (count, nx, nx)."""
+    h, H = family.model.h, family.H
     k0 = int(min(round(phase / h), H))
-    frame = family.frame(u)
     grid_steps = np.round(model_times / h).astype(int)
     grid_steps[0] = k0
-    grid_steps = np.concatenate((grid_steps, [grid_steps[-1]] * (len(t) - len(grid_steps)))).astype(int)
+    grid_steps = np.concatenate((grid_steps, [grid_steps[-1]] * (count - len(grid_steps)))).astype(int)
     powers = family.transition_powers[grid_steps - k0]                # A^(j - k0) (K+1, nx, nx)
     cov = member.covariance[grid_steps] - powers @ member.covariance[k0] @ powers.transpose(0, 2, 1)
     cov = 0.5 * (cov + cov.transpose(0, 2, 1))
-    scales = np.repeat(block_scale, n)
-    cov = frame @ (cov * np.outer(scales, scales)) @ frame.T
-    covered = np.clip(((mean[:, :n] - position) @ u) / max(r, 1e-12), 0.0, None)
-    cov[:, :n, :n] += covered[:, None, None] ** 2 * goal_covariance
-    arrival = t_now + pace * (end - phase)
-    return HandForecast(t=t, mean=mean, cov=cov, stop_time=float(arrival), pace=float(pace), phase=float(phase), d=n,
-                        continuation=continuation, velocity_rest=dv, acceleration_rest=da)
+    frame = family.frame(u)
+    return frame @ (cov * np.outer(scales, scales)) @ frame.T
 
 
 def _phase(tau: np.ndarray, phi: np.ndarray, hand_phi: float, guess: float) -> float:
