@@ -80,8 +80,7 @@ class OnlineSettings:
             object.__setattr__(self, "width", as_goal_width("width", self.width))
         if isinstance(self.prior_std, (list, tuple, np.ndarray)):
             object.__setattr__(self, "prior_std", tuple(float(v) for v in self.prior_std))
-        prior_covariance(self.prior_std if not isinstance(self.prior_std, tuple) else np.array(self.prior_std), model,
-                         self.width or model.width)
+        prior_covariance(self._prior_std(), model, self.width or model.width)
         if not isinstance(self.options, OnlineOptions):
             raise ValueError(f"options must be an OnlineOptions, got {type(self.options).__name__}")
         if not isinstance(self.loop, LoopSettings):
