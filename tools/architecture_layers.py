@@ -34,7 +34,7 @@ def package_of(module: str) -> str:
 
 def room_of(module: str, package: str) -> str | None:
     """The room of ``package`` a module belongs to (``comanip.estimation.online.x`` -> ``online/``,
-    ``comanip.estimation.goal_estimate`` -> ``goal_estimate.py``, ``comanip.estimation`` -> ``__init__.py``); None
+    ``comanip.estimation.hand_rest`` -> ``hand_rest.py``, ``comanip.estimation`` -> ``__init__.py``); None
     for a module outside the package."""
     parts = module.split(".")
     if parts[:2] != ["comanip", package]:

@@ -191,5 +191,5 @@ def _forecast(estimate, record, movement_time: float) -> Forecast:
     made_at = float(estimate.t_obs)
     keep = (record.t >= made_at - 1e-9) & (record.t <= movement_time + 1e-9)
     t = record.t[keep]
-    path = np.column_stack([np.interp(t, estimate.t, estimate.ee_mean[:, a]) for a in range(3)])
+    path = np.column_stack([np.interp(t, estimate.path.t, estimate.path.position[:, a]) for a in range(3)])
     return Forecast(made_at, np.array(estimate.goal, dtype=float), t, path, record.position[keep])

@@ -64,7 +64,7 @@ def test_a_mistake_is_one_line_before_the_folder_is_made(argv, fragments, observ
 
 
 def test_the_forecast_horizon_is_one_option_and_bounds_the_path(observations, tmp_path, capsys):
-    """Streamed up to mid-reach, the last estimate's path (its plan fields, what a robot follows) reaches
+    """Streamed up to mid-reach, the last estimate's path (what a robot follows) reaches
     --forecast-horizon seconds ahead, on the forecast; without it, on to where the forecast stops."""
     path, t, states = observations
     mid = tmp_path / "mid.csv"
@@ -76,7 +76,8 @@ def test_the_forecast_horizon_is_one_option_and_bounds_the_path(observations, tm
         assert main(["estimate", "--online", "--observations", str(mid), "--out", str(out), *extra]) == 0, capsys.readouterr()
         paths[name] = json.loads((out / "estimate.json").read_text())
     bounded, whole = paths["bounded"], paths["whole"]
-    assert bounded["t"][-1] == pytest.approx(bounded["t_obs"] + 0.1, abs=1e-9)
-    assert whole["t"][-1] > whole["t_obs"] + 0.2
-    common = np.array(bounded["t"][:-1])
-    np.testing.assert_allclose(np.array(bounded["ee_mean"])[:-1], np.array(whole["ee_mean"])[:len(common)], atol=1e-12)
+    assert bounded["path"]["t_s"][-1] == pytest.approx(bounded["t_obs"] + 0.1, abs=1e-9)
+    assert whole["path"]["t_s"][-1] > whole["t_obs"] + 0.2
+    common = np.array(bounded["path"]["t_s"][:-1])
+    np.testing.assert_allclose(np.array(bounded["path"]["position_m"])[:-1],
+                               np.array(whole["path"]["position_m"])[:len(common)], atol=1e-12)

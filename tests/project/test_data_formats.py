@@ -24,8 +24,8 @@ from comanip.belief.noise import NOISE_FORMS
 from comanip.bodies import BODY_TYPES, body_from_config
 from comanip.recordings.observation_files import read_observations
 from comanip.cli.outputs import write_manifest
-from comanip.estimation import GoalEstimator, goal_posterior
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation import GoalEstimator, OnlineEstimate, OnlineGoalEstimator, goal_posterior
+from comanip.estimation.one_shot.goal_estimate import GoalEstimate
 from comanip.fitting.movement_times import MT_COLUMNS
 from comanip.recordings.trial_files import load_recordings
 from comanip.planning.starts.arm_reach_library import bundled_library
@@ -267,6 +267,23 @@ def test_goal_estimate_and_posterior_json_keys_and_shapes(planar_planner, planar
     data = json.loads(json.dumps(posterior.to_dict()))
     assert names("Posterior JSON") == list(data)
     check_shapes(data, documented_shapes("Posterior JSON", {"K": 3, "C": 2, "d": 2}))
+
+
+def test_online_estimate_json_keys_and_shapes(planar_planner, planar_plan, tmp_path):
+    """Mid-reach on a plan's own hand: every documented key in order, the documented shapes, the path's too."""
+    estimator = OnlineGoalEstimator(planar_planner, np.zeros(4))
+    for k in range(1, 12):
+        estimate = estimator.update(planar_plan.t[k], planar_plan.ee_mean[k], planar_plan.ee_velocity[k])
+    assert estimate.success and estimate.forecast is not None
+    data = json.loads(estimate.save_json(tmp_path / "estimate.json").read_text())
+    assert list(data) == names("Online estimate JSON") == ["success", *OnlineEstimate.__dataclass_fields__]
+    check_shapes(data, documented_shapes("Online estimate JSON", {"n": 2, "d": 2, "nx": 4}))
+    K1 = len(data["path"]["t_s"])
+    assert K1 > 2 and data["path"]["t_s"][0] == pytest.approx(planar_plan.t[11])
+    shapes = {"position_m": (K1, 2), "velocity_m_s": (K1, 2), "covariance_m2": (K1, 2, 2)}
+    assert {key: np.shape(data["path"][key]) for key in shapes} == shapes
+    assert np.shape(data["timed_reach"]["mean"]) == (len(data["timed_reach"]["t"]), 4)
+    assert set(data["forecast"]) == {"stop_time_s", "pace", "phase_s"}
 
 
 def test_handover_schedule_csv_and_json(tmp_path):

@@ -72,17 +72,17 @@ def test_the_published_prediction_and_schedule_are_the_librarys(reach, replayed,
     recording, _ = replayed
     last = library[-1][1]
     path = recording.paths[max(recording.paths)]
-    np.testing.assert_allclose(path[:, 0] - BASE_STAMP, last.t, atol=1e-6)       # the forecast, stamped in ns
-    np.testing.assert_allclose(path[:, 1:], last.ee_mean, atol=1e-9)
-    assert last.t[0] == pytest.approx(library[-1][0]) and last.t[-1] == pytest.approx(last.forecast.stop_time)
+    np.testing.assert_allclose(path[:, 0] - BASE_STAMP, last.path.t, atol=1e-6)  # the forecast, stamped in ns
+    np.testing.assert_allclose(path[:, 1:], last.path.position, atol=1e-9)
+    assert last.path.t[0] == pytest.approx(library[-1][0]) and last.path.t[-1] == pytest.approx(last.forecast.stop_time)
     schedule = plan_handover(last, transition, ramp_time=settings.ramp_time, leading_stiffness=settings.leading_stiffness)
     rows = recording.schedules[-1]
     np.testing.assert_allclose(rows[:, 1], schedule.t, atol=1e-9)
     np.testing.assert_allclose(rows[:, 2:5], schedule.rest_position, atol=1e-9)
     np.testing.assert_allclose(rows[:, 8], schedule.stiffness, atol=1e-9)
     # the hand hands over where its forecast comes within the transition distance, now at the latest
-    assert schedule.status in ("within_plan", "at_start") and last.t[0] <= schedule.transition_time < last.t[-1]
-    assert (schedule.status == "at_start") == (np.linalg.norm(last.ee_mean[0] - last.goal) <= schedule.transition_distance)
+    assert schedule.status in ("within_plan", "at_start") and last.path.t[0] <= schedule.transition_time < last.path.t[-1]
+    assert (schedule.status == "at_start") == (np.linalg.norm(last.path.position[0] - last.goal) <= schedule.transition_distance)
 
 
 def test_the_commands_sample_a_published_schedule_at_the_nodes_clock(reach, replayed):

@@ -1,22 +1,22 @@
 """A plan as the rest motion: through the plan's points at its times, holding its first and last points outside."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 
 import comanip
-from comanip.estimation.model_reaches.reach_timing import ReachTiming
+from comanip.estimation.model_reaches.reach_timing import ReachTiming, timed_plan
 from comanip.simulation.rest_trajectory import RestTrajectory
 
 
 @pytest.mark.parametrize("timing", [None, ReachTiming(0.3, 0.5)])
 def test_the_rest_passes_through_the_plan_and_holds_its_ends(timing):
     model = comanip.presets.arm()
-    estimator = comanip.OnlineGoalEstimator(model, np.zeros(model.state_size), prior_goal=np.array([0.2, 0.1, 0.0]))
-    plan = estimator.update(0.0, np.zeros(3), np.zeros(3))                       # the prior's reach, at rest
+    plan = comanip.Planner(model).solve(np.zeros(model.state_size), [0.2, 0.1, 0.0])
     if timing is not None:                                                       # the same reach played later and slower
-        from comanip.estimation.model_reaches.reach_timing import timed_plan
         timed = timed_plan(plan.mean, plan.cov, plan.torque, model.h, model.n, timing)
-        plan.t, plan.ee_mean, plan.ee_velocity = timed.t, timed.mean[:, :3], timed.mean[:, 3:6]
+        plan = dataclasses.replace(plan, t=timed.t, ee_mean=timed.mean[:, :3], ee_velocity=timed.mean[:, 3:6])
     dt = 0.001
     rest = RestTrajectory.from_plan(plan, 0.0, dt, plan.t[-1] + 0.2)
     for k in range(0, len(plan.t), 7):

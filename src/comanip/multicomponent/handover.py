@@ -35,6 +35,7 @@ from scipy.interpolate import CubicSpline
 from scipy.optimize import brentq
 
 from comanip.arguments import as_optional_positive, as_positive
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.multicomponent.transition_model import TransitionModel
 from comanip.planning.plan import Plan
 
@@ -161,45 +162,50 @@ def check_schedule_arguments(ramp_time, leading_stiffness, rate) -> tuple[float,
             as_optional_positive("rate", rate, "Hz"))
 
 
-def plan_handover(plan: Plan, model: TransitionModel, ramp_time: float = DEFAULT_RAMP_TIME,
+def plan_handover(plan: Plan | OnlineEstimate, model: TransitionModel, ramp_time: float = DEFAULT_RAMP_TIME,
                   leading_stiffness: float = LEADING_STIFFNESS, rate: float | None = None) -> HandoverSchedule:
     """When and where the robot hands the reach over, and the schedule its impedance controller follows.
 
     Args:
-        plan: the robot's plan (e.g. ``Planner(presets.cartesian()).solve(...)``); its mean hand path is the
-            rest position and its goal and width are the reach's.
+        plan: the robot's plan (e.g. ``Planner(presets.cartesian()).solve(...)``), its mean hand path the rest
+            position, or an online estimate (:class:`~comanip.estimation.OnlineEstimate`), its path of the hand
+            from the latest observation on; their goal and width are the reach's.
         model: the transition model; queried at the plan's goal distance D (m) and width w (m).
         ramp_time: T_r (s) ≥ 0 of the stiffness ramp to 0 (0: instantaneous switch).
         leading_stiffness: K_0 (N/m) > 0 while the robot leads.
         rate: controller rate (Hz) to resample at (e.g. 1000); None keeps the plan's grid (plus t_h, t_h + T_r).
     """
-    if not isinstance(plan, Plan):
-        raise ValueError(f"plan must be a comanip.Plan (from Planner.solve), got {type(plan).__name__}")
+    if isinstance(plan, OnlineEstimate):
+        times, positions, velocities = plan.path.t, plan.path.position, plan.path.velocity
+    elif isinstance(plan, Plan):
+        times, positions, velocities = plan.t, plan.ee_mean, plan.ee_velocity
+    else:
+        raise ValueError(f"plan must be a comanip.Plan (from Planner.solve) or an online estimate, got {type(plan).__name__}")
     if not isinstance(model, TransitionModel) or not model.is_fitted:
         raise ValueError("model must be a fitted comanip.TransitionModel (e.g. comanip.TransitionModel())")
     ramp_time, leading_stiffness, rate = check_schedule_arguments(ramp_time, leading_stiffness, rate)
-    if not np.all(np.isfinite(plan.ee_mean)):
+    if not np.all(np.isfinite(positions)):
         raise ValueError(f"plan holds a non-finite hand path (status '{plan.status}'); replan before handing over")
 
     goal = np.asarray(plan.goal, dtype=float)
-    path = CubicSpline(plan.t, plan.ee_mean, bc_type=((1, plan.ee_velocity[0]), (1, plan.ee_velocity[-1])))
+    path = CubicSpline(times, positions, bc_type=((1, velocities[0]), (1, velocities[-1])))
     goal_distance = plan.reach_distance
     mean, std = model.predict(goal_distance, plan.width)
-    transition_time, status = _first_time_within(path, goal, mean, plan.t[0], plan.t[-1])
-    end = max(plan.t[-1], transition_time + ramp_time)
+    transition_time, status = _first_time_within(path, goal, mean, times[0], times[-1])
+    end = max(times[-1], transition_time + ramp_time)
     if rate is None:
-        t = np.union1d(plan.t, [transition_time, transition_time + ramp_time])
+        t = np.union1d(times, [transition_time, transition_time + ramp_time])
     else:
-        t = np.arange(plan.t[0], end + 0.5 / rate, 1.0 / rate)
-    held = t > plan.t[-1]
-    position = path(np.minimum(t, plan.t[-1]))
-    velocity = np.where(held[:, None], 0.0, path(np.minimum(t, plan.t[-1]), 1))
+        t = np.arange(times[0], end + 0.5 / rate, 1.0 / rate)
+    held = t > times[-1]
+    position = path(np.minimum(t, times[-1]))
+    velocity = np.where(held[:, None], 0.0, path(np.minimum(t, times[-1]), 1))
     return HandoverSchedule(
         t=t, rest_position=position, rest_velocity=velocity,
         stiffness=stiffness_profile(t, transition_time, ramp_time, leading_stiffness),
         goal=goal, width=float(plan.width), goal_distance=goal_distance, transition_distance=float(mean),
         transition_distance_std=float(std), transition_time=float(transition_time),
-        transition_position=np.asarray(path(min(transition_time, plan.t[-1]))), ramp_time=ramp_time,
+        transition_position=np.asarray(path(min(transition_time, times[-1]))), ramp_time=ramp_time,
         leading_stiffness=leading_stiffness, status=status, rate=rate)
 
 

@@ -24,7 +24,7 @@ except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
 from comanip.multicomponent.handover import HandoverSchedule
-from comanip.planning.plan import Plan
+from comanip.estimation.online.online_estimate import OnlineEstimate
 
 #: columns of the schedule message, one row per sample (stamp_s is the ROS time of the sample)
 SCHEDULE_COLUMNS = ("stamp_s", "t_s", "rest_x_m", "rest_y_m", "rest_z_m", "rest_vx_m_per_s", "rest_vy_m_per_s",
@@ -95,11 +95,11 @@ def goal_message(goal, covariance, stamp: Time, frame_id: str) -> PoseWithCovari
     return message
 
 
-def path_message(plan: Plan, start_stamp: float, frame_id: str) -> Path:
-    """The plan's mean hand path ``ee_mean`` (H+1, d) m, each pose stamped start_stamp + t_i."""
+def path_message(estimate: OnlineEstimate, start_stamp: float, frame_id: str) -> Path:
+    """The estimate's path of the hand, ``estimate.path.position`` (K+1, d) m, each pose stamped start_stamp + t_i."""
     message = Path()
     message.header.stamp, message.header.frame_id = stamp_of(start_stamp), frame_id
-    for t, position in zip(plan.t, plan.ee_mean):
+    for t, position in zip(estimate.path.t, estimate.path.position):
         pose = PoseStamped()
         pose.header.stamp, pose.header.frame_id = stamp_of(start_stamp + float(t)), frame_id
         pose.pose = pose_of(position)

@@ -71,7 +71,7 @@ try:  # the 'ros' extra; without it, one line naming the extra
 except ModuleNotFoundError as error:
     raise MissingExtra("ros", error.name or "rclpy") from None
 
-from comanip.estimation import GoalEstimate
+from comanip.estimation import OnlineEstimate
 from comanip.estimation.streaming.derived_velocity import DerivedVelocity
 from comanip.estimation.streaming.estimation_loop import LoopEvent, LoopStep, Reach, Update
 from comanip.estimation.model_reaches.model_families import FamilyCache
@@ -100,7 +100,7 @@ class GoodEstimate:
     """The last successful estimate, the last schedule built (on it or an estimate before it, ``schedule_rate``), the
     stamps (s) of the pose the estimate answers and of the one whose estimate the schedule was built on."""
 
-    estimate: GoalEstimate
+    estimate: OnlineEstimate
     schedule: HandoverSchedule
     reach: Reach
     stamp: float
@@ -311,7 +311,7 @@ class GoalNode(Node):
         if estimate.status == EstimateStatus.UNINFORMATIVE:  # the hand has not moved yet: nothing to estimate, nothing failed
             self._last.update(solve_status=estimate.status, event=f"waiting for movement at t = {job.t:.3f} s")
             return float("nan")
-        ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.ee_mean)))
+        ok = bool(estimate.success and np.all(np.isfinite(estimate.goal)) and np.all(np.isfinite(estimate.path.position)))
         self._last.update(solve_ok=ok, solve_status=estimate.status, solve_time_s=estimate.solve_time)
         if estimate.solve_time > s.max_wall_time:
             self._counts["late"] += 1

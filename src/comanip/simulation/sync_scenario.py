@@ -36,6 +36,7 @@ from comanip import presets
 from comanip.analysis.speed_profile import speed_metrics
 from comanip.arguments import as_positive, as_vector
 from comanip.control.impedance import CartesianImpedanceController, RobotState
+from comanip.estimation import OnlineEstimate
 from comanip.planning.plan import Plan
 from comanip.progress import progress_bar
 from comanip.simulation.rest_trajectory import RestTarget
@@ -147,9 +148,9 @@ class SyncTrial:
     record: TrialRecord
     policy: str
     """The robot policy's name."""
-    estimate: Plan | None
-    """The model's estimated trajectory behind the last prediction (``estimate.goal`` is g_hat), for the
-    model-based policies; None for the others."""
+    estimate: Plan | OnlineEstimate | None
+    """The model's estimate behind the last prediction (``estimate.goal`` is g_hat), for the model-based
+    policies; None for the others."""
     estimated_position: np.ndarray
     """The last prediction's rest motion at the record's times (K, 3), m (with the known height, when
     used); NaN for a policy that never predicts."""
@@ -269,15 +270,16 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
         metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time,
                                             robot.history)
         metrics["predictions"] = robot.predictions
-        if prediction is not None and prediction.plan is not None and prediction.plan is not context.prior_plan:
-            estimate = prediction.plan
+        if prediction is not None and prediction.estimate is not None and prediction.estimate is not context.prior_plan:
+            estimate = prediction.estimate
             metrics.update(estimate_success=bool(estimate.success), estimate_status=str(estimate.status),
                            estimate_time_s=float(estimate.solve_time))
-        trials.append(SyncTrial(record, settings.policy, None if prediction is None else prediction.plan, estimated,
+        trials.append(SyncTrial(record, settings.policy, None if prediction is None else prediction.estimate, estimated,
                                 metrics, grid, error))
     return trials
 
 
 def _successful_estimate(trials: list[SyncTrial]) -> Plan | None:
-    """The last trial's estimate if it converged (a good start for the next solve), else None."""
-    return trials[-1].estimate if trials and trials[-1].estimate is not None and trials[-1].estimate.success else None
+    """The last trial's one-shot estimate if it converged (a good start for the next solve), else None."""
+    estimate = trials[-1].estimate if trials else None
+    return estimate if isinstance(estimate, Plan) and estimate.success else None

@@ -113,8 +113,11 @@ def test_the_online_estimate_carries_the_forecast_from_the_observed_hand():
     person = comanip.Planner(model).solve(np.zeros(model.state_size), [0.2, 0.05, 0.0], model.width)
     for i in range(1, 9):
         estimate = estimator.update(person.t[i], person.ee_mean[i], person.ee_velocity[i])
-    assert estimate.t[0] == pytest.approx(person.t[8])
-    np.testing.assert_allclose(estimate.ee_mean[0], person.ee_mean[8], atol=1e-12)
+    assert estimate.path.t[0] == pytest.approx(person.t[8])
+    np.testing.assert_allclose(estimate.path.position[0], person.ee_mean[8], atol=1e-12)
+    np.testing.assert_allclose(estimate.path.velocity[0], person.ee_velocity[8], atol=1e-12)
+    ahead = estimate.forecast.at(estimate.path.t)         # the path is the forecast on its own grid
+    np.testing.assert_allclose(estimate.path.position, ahead.position, atol=1e-12)
     np.testing.assert_allclose(estimate.forecast.at(person.t[12]).position[0], person.ee_mean[12], atol=5e-3)
 
 

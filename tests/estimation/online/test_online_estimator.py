@@ -207,10 +207,10 @@ def test_updates_at_any_time_use_every_observation(online):
     for position in (s[:3], s[:3] + 0.01):                                     # the same time again, any sample
         with pytest.raises(ValueError, match="repeats the previous observation's time"):
             estimator.update(times[-1], position, s[3:])
-    assert estimate.success and estimate.method == "online"
+    assert estimate.success and not isinstance(estimate, comanip.Plan)
     assert np.linalg.norm(estimate.goal - goal) < 1e-3
     # the predicted path is the forecast from the last observation: the rest of the model's plan to the estimate
-    assert estimate.t[0] == times[-1] and estimate.mean.shape[1] == 6
+    assert estimate.path.t[0] == times[-1] and estimate.path.position.shape[1] == 3
     rest = planner.solve(np.zeros(6), estimate.goal)
     later = rest.t[(rest.t > times[-1]) & (rest.t < estimate.forecast.stop_time)]
     # within 5 mm: the forecast's curve between the model's coarse 55 ms steps, and a slope of the last velocities
@@ -233,7 +233,7 @@ def test_no_movement_is_uninformative_and_failures_stay_finite(online):
     # an observation far beyond anything the model reaches: the estimate stops at the family's range, says so
     far = fresh(online).update(0.2, np.array([5.0, 0.0, 0.0]), np.array([20.0, 0.0, 0.0]))
     assert not far.success and far.status == "at_range_end" and "largest distance" in far.message
-    assert all(np.all(np.isfinite(v)) for v in (far.goal, far.goal_covariance, far.mean, far.cov, far.torque))
+    assert all(np.all(np.isfinite(v)) for v in (far.goal, far.goal_covariance, *far.path[1:], far.timed_reach.mean))
     # a capped iteration reports it
     plan = online.planner.solve(np.zeros(6), [0.3, 0.1, 0.05])
     s = state_at(plan.mean, online.model.h, 0.3)
@@ -384,7 +384,7 @@ def test_arbitrary_observations_never_raise(online):
     for t in np.sort(rng.uniform(0, 4.0, 40)):
         scale = 10.0 ** rng.uniform(-4, 1)
         estimate = estimator.update(t, rng.normal(size=3) * scale, rng.normal(size=3) * 10 * scale)
-        assert all(np.all(np.isfinite(v)) for v in (estimate.goal, estimate.goal_covariance, estimate.mean, estimate.cov))
+        assert all(np.all(np.isfinite(v)) for v in (estimate.goal, estimate.goal_covariance, *estimate.path[1:]))
         assert estimate.success == (estimate.status in ESTIMATED)
 
 
@@ -487,7 +487,7 @@ def test_observations_whose_estimates_are_not_read_leave_the_later_estimates_and
     assert read.t_obs == theirs.t_obs and read.status == theirs.status
     for k in range(60, len(t)):
         mine, theirs = lead.update(t[k], x[k], v[k]), full.update(t[k], x[k], v[k])
-        np.testing.assert_array_equal(mine.ee_mean, theirs.ee_mean)
+        np.testing.assert_array_equal(mine.path.position, theirs.path.position)
         np.testing.assert_array_equal(mine.goal, theirs.goal)
         np.testing.assert_array_equal(mine.goal_covariance, theirs.goal_covariance)
     assert "uninformative" in statuses[:30] and set(statuses[50:]) != {"uninformative"}   # the lead rests, then moves

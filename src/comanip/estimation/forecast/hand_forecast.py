@@ -124,20 +124,22 @@ class HandForecast:
         return ForecastPoint(times, position + rest_position, velocity + rest_velocity, covariance)
 
 
-def within_horizon(forecast: HandForecast, horizon: float | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The forecast's grid (times (K+1,) s, mean states (K+1, nx), covariances (K+1, nx, nx)) up to ``horizon`` s
-    after its first time, its last point there (between grid points, linearly between them); None: the whole grid."""
-    t, mean, cov = forecast.t, forecast.mean, forecast.cov
-    if horizon is None or t[0] + horizon >= t[-1]:
-        return t, mean, cov
-    end = t[0] + horizon
-    k = int(np.searchsorted(t, end, side="right"))         # t[k - 1] <= end < t[k]
-    weight = (end - t[k - 1]) / (t[k] - t[k - 1])
-    last_mean = (1 - weight) * mean[k - 1] + weight * mean[k]
-    last_cov = (1 - weight) * cov[k - 1] + weight * cov[k]
-    if weight <= 1e-12:
-        return t[:k], mean[:k], cov[:k]
-    return np.r_[t[:k], end], np.vstack([mean[:k], last_mean]), np.concatenate([cov[:k], last_cov[None]])
+def within_horizon(forecast: HandForecast, horizon: float | None) -> ForecastPoint:
+    """The forecast's grid up to ``horizon`` s after its first time, its last point there (between grid points,
+    linearly between them; None: the whole grid): times (K+1,) s, the hand's mean positions (K+1, d) m and
+    velocities (K+1, d) m/s and position covariances (K+1, d, d) m²."""
+    t, mean, cov, d = forecast.t, forecast.mean, forecast.cov, forecast.d
+    if horizon is not None and t[0] + horizon < t[-1]:
+        end = t[0] + horizon
+        k = int(np.searchsorted(t, end, side="right"))     # t[k - 1] <= end < t[k]
+        weight = (end - t[k - 1]) / (t[k] - t[k - 1])
+        if weight <= 1e-12:
+            t, mean, cov = t[:k], mean[:k], cov[:k]
+        else:
+            t = np.r_[t[:k], end]
+            mean = np.vstack([mean[:k], (1 - weight) * mean[k - 1] + weight * mean[k]])
+            cov = np.concatenate([cov[:k], ((1 - weight) * cov[k - 1] + weight * cov[k])[None]])
+    return ForecastPoint(t, mean[:, :d], mean[:, d:2 * d], cov[:, :d, :d])
 
 
 def _hermite(t: np.ndarray, x: np.ndarray, m: np.ndarray, times: np.ndarray, k: np.ndarray):

@@ -52,7 +52,7 @@ from threadpoolctl import ThreadpoolController
 from comanip.arguments import as_count, as_matrix, as_optional_positive, as_positive, as_vector
 from comanip.belief.propagation import linearised_step_function
 from comanip.caching.process_caches import PROCESS_CACHES
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.one_shot.goal_estimate import GoalEstimate
 from comanip.estimation.goal_prior import GoalPrior, prior_covariance
 from comanip.estimation.one_shot.initial_goal import search_along_observed_direction, task_space_state
 from comanip.estimation.observation import OBSERVATION_STD, observation_covariance, observation_step, observed_rows, observed_state

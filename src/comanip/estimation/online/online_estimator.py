@@ -2,8 +2,9 @@
 
 A person at rest at s_0 reaches for an unknown goal g; positions and velocities of their hand arrive one at a
 time, at any times t_k ≥ 0. After each, :meth:`OnlineGoalEstimator.update` returns an estimate of g, its
-covariance and the model's predicted reach to it, played when the explanation that gives it says the hand moves
-(:mod:`~comanip.estimation.model_reaches.reach_timing`). The estimate comes from explanations of the hand
+covariance and the forecast of where the hand will be (an
+:class:`~comanip.estimation.online.online_estimate.OnlineEstimate`), from the model's reach to it played when the
+explanation that gives it says the hand moves (:mod:`~comanip.estimation.model_reaches.reach_timing`). The estimate comes from explanations of the hand
 (:mod:`comanip.estimation.online.explanations`), asked in order; **the first that explains the hand gives the
 estimate** (none: the prior, status ``uninformative``). With ``OnlineOptions(timing="estimated")`` (the default):
 
@@ -33,7 +34,7 @@ an update needs no plan solve.
 
 >>> estimator = OnlineGoalEstimator(comanip.presets.cartesian(), np.zeros(6))
 >>> estimate = estimator.update(0.1, position, velocity)
->>> estimate.goal, estimate.goal_covariance, estimate.mean
+>>> estimate.goal, estimate.goal_covariance, estimate.path.position
 """
 
 from __future__ import annotations
@@ -51,21 +52,20 @@ from comanip.estimation.model_reaches.estimation_planner import checked_model
 from comanip.estimation.online.explanations import (Explained, Explanation, HandAtRest, HandTrace, Reach)
 from comanip.estimation.online.explanations.base import grid_position
 from comanip.estimation.online.explanations.default_chain import default_explanations
-from comanip.estimation.goal_estimate import GoalEstimate
-from comanip.estimation.forecast.hand_forecast import continued_reach, within_horizon
+from comanip.estimation.forecast.hand_forecast import ForecastPoint, continued_reach, within_horizon
 from comanip.estimation.forecast.path_baselines import recent_acceleration
 from comanip.estimation.goal_prior import prior_covariance
 from comanip.estimation.calibration.goal_smoothing import GoalSmoother
 from comanip.estimation.people.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.hand_rest import REST_RADIUS_M, lost_sample, resting_position
 from comanip.estimation.model_reaches.model_families import FamilyCache, default_families
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.online.online_options import OnlineOptions
 from comanip.estimation.model_reaches.reach_timing import timed_plan
 from comanip.estimation.calibration.person_calibration import FORECAST_LEADS, FinishedReach, PersonCalibration, ReachFactors
 from comanip.model import ReachingModel
-from comanip.estimation.estimate_status import ESTIMATED, EstimateStatus
+from comanip.estimation.estimate_status import EstimateStatus
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
-from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner
 from comanip.planning.single_thread_blas import SingleThreadBlas
 from comanip.units import MAX_REACH_DURATION_S, MAX_REACH_SPAN_M
@@ -164,7 +164,7 @@ class OnlineGoalEstimator:
         self._last_time = -math.inf
         self._planned = None      # (goal and timing, prediction, timed plan) of the last estimate's reach
         self._warned = False
-        self._latest: GoalEstimate | None = None
+        self._latest: OnlineEstimate | None = None
         self._rest_pending = False     # an at-rest observation's estimate not made yet (observe)
 
     def finish_reach(self) -> ReachFactors | None:
@@ -195,7 +195,7 @@ class OnlineGoalEstimator:
         """Observations received so far."""
         return self._hand.count
 
-    def update(self, time_s, position, velocity) -> GoalEstimate:
+    def update(self, time_s, position, velocity) -> OnlineEstimate:
         """Add an observation and re-estimate the goal.
 
         Args:
@@ -211,9 +211,10 @@ class OnlineGoalEstimator:
         hand beyond a person's reach (1 m) are warned about, once per reach.
 
         Returns:
-            A :class:`GoalEstimate`: the predicted reach from the start to g_hat (a Plan), ``goal_covariance``
-            (d, d) m², ``t_obs`` the latest time, ``observation_residual`` the predicted [q; qdot] at that time
-            minus the observed one (2n,). Never raises for a failed solve: then ``success`` is False, the status
+            An :class:`~comanip.estimation.online.online_estimate.OnlineEstimate`: g_hat (d,) m and its
+            ``goal_covariance`` (d, d) m², ``t_obs`` the latest time, the forecast of the hand and its ``path``
+            (what a robot follows), ``observation_residual`` the model's [q; qdot] at that time minus the
+            observed one (2n,). Never raises for a failed solve: then ``success`` is False, the status
             says why and the goal and covariance are the previous estimate's (or the prior's).
         """
         t_begin = time.perf_counter()
@@ -287,7 +288,7 @@ class OnlineGoalEstimator:
                     and (velocities * velocities).sum(axis=1).max() <= (10 * MAX_HUMAN_HAND_SPEED_M_S) ** 2)
 
     @property
-    def latest(self) -> GoalEstimate | None:
+    def latest(self) -> OnlineEstimate | None:
         """The last estimate, None before the first update."""
         if self._rest_pending:
             self._rest_pending = False
@@ -296,7 +297,7 @@ class OnlineGoalEstimator:
         return self._latest
 
     def _added_and_estimated(self, t_begin: float, time_s: float, position: np.ndarray, velocity: np.ndarray,
-                             forecast: bool) -> GoalEstimate:
+                             forecast: bool) -> OnlineEstimate:
         """A checked observation added and estimated (the at-rest estimate before it made first, since the
         explanations read it): the estimate."""
         if self._rest_pending:
@@ -354,7 +355,7 @@ class OnlineGoalEstimator:
             self._warned = True
             warnings.warn(problem, stacklevel=3)
 
-    def _estimate(self, t_begin: float, forecast: bool) -> GoalEstimate:
+    def _estimate(self, t_begin: float, forecast: bool) -> OnlineEstimate:
         """The first explanation that explains the hand gives the estimate; none: the prior."""
         reasons = []
         for explanation in self.explanations:
@@ -386,7 +387,7 @@ class OnlineGoalEstimator:
         return self._planned[1], self._planned[2]
 
     def _result(self, explained: Explained, t_begin: float, reasons: Sequence[str] = (),
-                with_forecast: bool = True) -> GoalEstimate:
+                with_forecast: bool = True) -> OnlineEstimate:
         """The estimate of ``explained``, with the model's predicted reach to its goal and the forecast of the hand
         (``with_forecast``: :meth:`update`'s ``forecast``); its message follows why the explanations asked before it did not explain
         the hand."""
@@ -405,10 +406,10 @@ class OnlineGoalEstimator:
             else:
                 goal, covariance = self._smoother.smooth(self._last_time, goal, covariance, observed[:n])
         prediction, timed = self._planned_reach(goal, explained.timing)
-        before, fraction = grid_position(max(self._last_time - timed.t[0], 0.0), timed.t[1] - timed.t[0], model.H)
-        predicted = (1 - fraction) * timed.mean[before, :2 * n] + fraction * timed.mean[min(before + 1, model.H), :2 * n]
+        step, fraction = grid_position(max(self._last_time - timed.t[0], 0.0), timed.t[1] - timed.t[0], model.H)
+        predicted = (1 - fraction) * timed.mean[step, :2 * n] + fraction * timed.mean[min(step + 1, model.H), :2 * n]
         forecast = None
-        t, mean, cov, torque = timed.t, timed.mean, timed.cov, timed.torque
+        path = ForecastPoint(timed.t, timed.mean[:, :n], timed.mean[:, n:2 * n], timed.cov[:, :n, :n])
         if self._hand.count and (with_forecast or status != EstimateStatus.UNINFORMATIVE):
             forecast = continued_reach(self.family, self.start_position, self._last_time, observed[:n], observed[n:], goal,
                                        covariance, stop, self._person_acceleration(), member=prediction.member)
@@ -417,14 +418,11 @@ class OnlineGoalEstimator:
                 self._forecasts.append((ahead.position, ahead.covariance))
             if self.person.forecast_spread != 1.0:
                 forecast = dataclasses.replace(forecast, cov=self.person.forecast_spread * forecast.cov)
-            t, mean, cov = within_horizon(forecast, self.options.forecast_horizon)
-            torque = np.zeros((len(t) - 1, n))
-        plan = Plan(success=status in ESTIMATED, status=status, message="; ".join([*reasons, explained.message]),
-                    objective=prediction.objective, solve_time=time.perf_counter() - t_begin, iterations=explained.iterations,
-                    t=t, mean=mean, cov=cov, torque=torque, ee_mean=mean[:, :n].copy(),
-                    ee_cov=cov[:, :n, :n].copy(), ee_velocity=mean[:, n:2 * n].copy(), start=self.start.copy(),
-                    goal=goal, width=self.width, model_name=model.name)
-        return GoalEstimate.of(plan, t_obs=self._last_time, observed_step=before, observed_state=observed,
-                               observation_residual=predicted - observed, prior_goal=self.prior_goal, method="online",
-                               goal_covariance=covariance, unsmoothed_goal=unsmoothed[0],
-                               unsmoothed_goal_covariance=unsmoothed[1], forecast=forecast, timed_reach=timed)
+            path = within_horizon(forecast, self.options.forecast_horizon)
+        return OnlineEstimate(goal=goal, goal_covariance=covariance, status=status,
+                              message="; ".join([*reasons, explained.message]), t_obs=self._last_time, path=path,
+                              forecast=forecast, timed_reach=timed, observed_state=observed,
+                              observation_residual=predicted - observed, prior_goal=self.prior_goal,
+                              unsmoothed_goal=unsmoothed[0], unsmoothed_goal_covariance=unsmoothed[1],
+                              start=self.start.copy(), width=self.width, model_name=model.name,
+                              solve_time=time.perf_counter() - t_begin, iterations=explained.iterations)

@@ -33,7 +33,7 @@ class OnlineOptions:
     """A Newton goal step shorter than this (m), or one that lowers -log p by less than 1e-6 (taken, then stop), ends an update."""
     max_iterations: int = 20
     """Newton iterations per round under one whitening (an update runs up to three rounds, rebuilding the
-    whitening when the estimate moved; ``GoalEstimate.iterations`` counts them all)."""
+    whitening when the estimate moved; ``OnlineEstimate.iterations`` counts them all)."""
     step_fraction: float = 0.5
     """Largest goal step, as a fraction of the distance from the start to the current goal (at least one width)."""
     covariance_tolerance: float = 0.05

@@ -50,7 +50,7 @@ from enum import Enum
 import numpy as np
 
 from comanip.arguments import as_nonnegative, as_positive
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.hand_rest import lost_sample
 from comanip.estimation.online.online_estimator import OnlineGoalEstimator
 from comanip.estimation.streaming.reach_segmentation import ReachSegmenter, SegmentationSettings
@@ -331,7 +331,7 @@ class EstimationLoop:
         return update
 
     # ---- step 5: the estimator
-    def estimate(self, update: Update) -> GoalEstimate | None:
+    def estimate(self, update: Update) -> OnlineEstimate | None:
         """Run ``update`` on the estimator (module docstring, step 5): its latest estimate (None before any)."""
         reach = update.reach
         if self._estimated is not reach:

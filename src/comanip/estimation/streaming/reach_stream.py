@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 
 from comanip.estimation.calibration.person_calibration import PersonCalibration
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.model_reaches.model_families import FamilyCache
 from comanip.estimation.online.online_estimator import OnlineGoalEstimator
 from comanip.estimation.streaming import online_settings
@@ -33,7 +33,7 @@ class StreamEstimate:
     """Reaches started so far (0 before the first); the estimate is the latest reach's."""
     moving: bool
     """True while a reach is under way; False at rest (before the first reach, or after one ended)."""
-    estimate: GoalEstimate | None
+    estimate: OnlineEstimate | None
     """The latest reach's latest estimate (its plan, goal and covariance); None before the first reach."""
     reach_start: float | None
     """Stream time (s) at which the latest reach's estimator clock starts (its ``time_s`` 0); None before it."""

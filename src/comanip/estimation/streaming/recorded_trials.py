@@ -8,7 +8,7 @@ estimator per recording (a person not seen yet), the model's reach family built 
 
 from __future__ import annotations
 
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.model_reaches.model_families import FamilyCache
 from comanip.estimation.streaming import online_settings
 from comanip.estimation.streaming.estimation_loop import LoopSettings
@@ -16,7 +16,7 @@ from comanip.estimation.streaming.online_settings import OnlineSettings
 
 
 def estimate_recordings(model, recordings, settings: OnlineSettings | str = "recorded", *, prior_goal=None,
-                        cache: FamilyCache | None = None) -> list[list[GoalEstimate]]:
+                        cache: FamilyCache | None = None) -> list[list[OnlineEstimate]]:
     """The estimate after every sample of every recording (module docstring).
 
     Args:

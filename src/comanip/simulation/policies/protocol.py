@@ -15,7 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from comanip.analysis.speed_profile import speed_metrics
-from comanip.estimation import GoalEstimator
+from comanip.estimation import GoalEstimator, OnlineEstimate
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
 from comanip.simulation.rest_trajectory import RestTrajectory
@@ -90,8 +90,9 @@ class Prediction:
     """The predicted goal g_hat (3,), m."""
     rest: RestTrajectory
     """The rest motion the robot leads along (its z is used in the sync scenario), real time."""
-    plan: Plan | None = None
-    """The model's estimate behind the prediction, for the model-based policies."""
+    estimate: Plan | OnlineEstimate | None = None
+    """The model's estimate behind the prediction, for the model-based policies: the one-shot estimate (a
+    :class:`~comanip.estimation.GoalEstimate`, a plan), the online one or the prior's plan."""
     lead_share: float = 1.0
     """How far the robot's rest goes from the handle towards the rest motion on the axes it leads, in [0, 1]:
     rest = x + s (rest motion - x), and likewise its velocity, x the handle. 1: the rest motion itself; below 1

@@ -8,7 +8,7 @@ status ``uninformative``."""
 from __future__ import annotations
 
 from comanip.estimation.online.explanations.base import Explained, HandTrace, Reach, Verdict
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.hand_rest import REST_RADIUS_M
 from comanip.estimation.estimate_status import EstimateStatus
 
@@ -19,7 +19,7 @@ class HandAtRest:
     def reset(self, reach: Reach) -> None:
         self.reach = reach
 
-    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+    def explain(self, hand: HandTrace, latest: OnlineEstimate | None) -> Explained:
         reach = self.reach
         if hand.has_left(reach.start_position):
             return Explained.not_explaining(reach, Verdict.MISFITS, "the hand has left its start")

@@ -16,7 +16,7 @@ from typing import NamedTuple, Protocol
 import numpy as np
 
 from comanip.estimation.people.endpoint_baselines import MOVING_SPEED
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.hand_rest import has_left
 from comanip.estimation.model_reaches.profile_fit import detected_onset
 from comanip.estimation.model_reaches.reach_family import ReachFamily, ReachPrediction
@@ -208,7 +208,7 @@ class Explanation(Protocol):
     def reset(self, reach: Reach) -> None:
         """Start a new reach."""
 
-    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+    def explain(self, hand: HandTrace, latest: OnlineEstimate | None) -> Explained:
         """The goal this explanation gives for the observations so far; ``latest`` is the estimator's last
         estimate (None before the first)."""
 

@@ -35,7 +35,7 @@ import numpy as np
 from comanip.belief.propagation import linearised_step_function
 from comanip.estimation.online.corrected_deviation import corrected_covariance, corrected_powers, correction_factor
 from comanip.estimation.online.explanations.base import Explained, HandTrace, Reach, Verdict, grid_position
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.online.map_goal import MapNewton, MapProblem
 from comanip.estimation.observation import observation_covariance
 from comanip.estimation.online.observation_whitening import ObservationWhitening
@@ -93,7 +93,7 @@ class ModelAtOwnPace:
         self._whitened = 0                          # observations the whitening holds
         self._last: Explained | None = None         # the last estimate this explanation gave
 
-    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+    def explain(self, hand: HandTrace, latest: OnlineEstimate | None) -> Explained:
         self._add(hand)
         humanlike = self._humanlike(hand)
         self._last = estimate = self._estimate(hand, self.give_up_above if humanlike else None)

@@ -6,7 +6,7 @@ hand's onset to when the people model says it stops (a model that does not say w
 from __future__ import annotations
 
 from comanip.estimation.online.explanations.base import Explained, HandTrace, Reach, Verdict
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.people.people_model import PeopleModel
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.estimation.model_reaches.reach_timing import ReachTiming
@@ -21,7 +21,7 @@ class RecordedPeople:
     def reset(self, reach: Reach) -> None:
         self.reach = reach
 
-    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+    def explain(self, hand: HandTrace, latest: OnlineEstimate | None) -> Explained:
         reach = self.reach
         predicted = self.people.predict(hand.t, hand.position, hand.velocity, reach.start_position)
         if predicted is None:

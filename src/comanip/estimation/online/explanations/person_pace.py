@@ -17,7 +17,7 @@ import numpy as np
 from scipy.stats import chi2
 
 from comanip.estimation.online.explanations.base import Explained, HandTrace, Reach, Verdict
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.online.online_options import OnlineOptions
 from comanip.estimation.model_reaches.paced_model import PacedFit, PacedModel
 from comanip.optim import Status
@@ -59,7 +59,7 @@ class ModelAtPersonPace:
         self._fitted = (hand.count, fitted)
         return fitted
 
-    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+    def explain(self, hand: HandTrace, latest: OnlineEstimate | None) -> Explained:
         reach = self.reach
         if hand.onset() is None:
             return Explained.not_explaining(reach, Verdict.UNDECIDED, "nor does it at the person's pace (no movement seen)")

@@ -19,7 +19,7 @@ from dataclasses import replace
 from typing import Protocol
 
 from comanip.estimation.online.explanations.base import Explained, Explanation, HandTrace, Reach, Verdict
-from comanip.estimation.goal_estimate import GoalEstimate
+from comanip.estimation.online.online_estimate import OnlineEstimate
 
 
 class Veto(Protocol):
@@ -63,7 +63,7 @@ class Vetoed:
         self.ruled_out: str | None = None
         """Why the explanation is out for the rest of this reach; None while it is in."""
 
-    def explain(self, hand: HandTrace, latest: GoalEstimate | None) -> Explained:
+    def explain(self, hand: HandTrace, latest: OnlineEstimate | None) -> Explained:
         if self.ruled_out is not None:
             return Explained.not_explaining(self.reach, Verdict.RULED_OUT, self.ruled_out)
         explained = self.explanation.explain(hand, latest)
