@@ -38,27 +38,13 @@ def add_parser(subparsers) -> None:
 
 
 def run(args) -> int:
-    from comanip.arguments import as_count, as_nonnegative, as_optional_positive, as_position
     from comanip.execution import Observation, execute_receding_horizon, executed_cost
-    from comanip.planning.planner import Planner, reach_inputs
+    from comanip.planning.planner import Planner
     from comanip.planning.replanner import Replanner
     from comanip.planning.solver_options import SolverOptions
 
     model = load_model(args)
-    start, goal = reach_of(model, args.start, args.goal, 0.15)
-    start, goal, width = reach_inputs(model, start, goal, args.width)  # every input checked before the folder is made
-    period = 1.0 / as_optional_positive("rate", args.rate, "Hz")
-    budget = as_optional_positive("budget", args.budget, "s")
-    iterations = as_count("iterations", 1 if args.iterations is None and budget is None else args.iterations,
-                          optional=True, unit="Newton iterations per cycle")
-    duration = model.H * model.h * 1.5 if args.duration is None else as_optional_positive("duration", args.duration, "s")
-    if (args.jump_at is None) != (args.jump_to is None):
-        raise ValueError("--jump-at and --jump-to go together: the time (s) the goal jumps and where to (m)")
-    jumps = [] if args.jump_at is None else \
-        [(as_nonnegative("jump_at", args.jump_at, "s"), as_position("jump_to", args.jump_to, model.d))]
-    if jumps:
-        reach_inputs(model, start, jumps[0][1], width)
-    steps = max(1, round(duration / period))
+    start, goal, width, period, budget, iterations, jumps, steps = _checked_loop(args, model)
     out = output_dir(args.out, "replan", args.force)
 
     planner = Planner(model, SolverOptions(compile=True))
@@ -104,6 +90,28 @@ def run(args) -> int:
              f"loop, hand ends {1e3 * summary['final_error_m']:.3g} mm from the goal {point_text(final_goal)} m"]
     report(args, lines, summary, out, written)
     return 0 if summary["final_error_m"] <= width else 1
+
+
+def _checked_loop(args, model) -> tuple:
+    """Every input of the loop checked before the folder is made: (start (nx,), goal (d,) m, width m, period s,
+    budget s or None, iterations per cycle or None, goal jumps [(time s, goal (d,) m)], cycles)."""
+    from comanip.arguments import as_count, as_nonnegative, as_optional_positive, as_position
+    from comanip.planning.planner import reach_inputs
+
+    start, goal = reach_of(model, args.start, args.goal, 0.15)
+    start, goal, width = reach_inputs(model, start, goal, args.width)
+    period = 1.0 / as_optional_positive("rate", args.rate, "Hz")
+    budget = as_optional_positive("budget", args.budget, "s")
+    iterations = as_count("iterations", 1 if args.iterations is None and budget is None else args.iterations,
+                          optional=True, unit="Newton iterations per cycle")
+    duration = model.H * model.h * 1.5 if args.duration is None else as_optional_positive("duration", args.duration, "s")
+    if (args.jump_at is None) != (args.jump_to is None):
+        raise ValueError("--jump-at and --jump-to go together: the time (s) the goal jumps and where to (m)")
+    jumps = [] if args.jump_at is None else \
+        [(as_nonnegative("jump_at", args.jump_at, "s"), as_position("jump_to", args.jump_to, model.d))]
+    if jumps:
+        reach_inputs(model, start, jumps[0][1], width)
+    return start, goal, width, period, budget, iterations, jumps, max(1, round(duration / period))
 
 
 def _spread(milliseconds: np.ndarray) -> dict:

@@ -24,6 +24,7 @@ from comanip.arguments import as_nonnegative, as_optional_positive, as_position
 from comanip.belief.noise import sample_torque_error
 from comanip.execution.kalman_filter import DelayedKalmanFilter
 from comanip.execution.delayed_observation import Observation
+from comanip.model import ReachingModel
 from comanip.objectives.reach_objective import velocity_cost
 from comanip.optim import Progress
 from comanip.planning.planner import Planner
@@ -96,36 +97,22 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
         goal_jumps: (time (s), goal (d,)) pairs, in any order: from each time on, the replans aim at that goal (a
             target that jumps mid-reach).
     """
-    if not isinstance(planner, Planner) and (iterations is not None or max_wall_time is not None):
-        raise ValueError("iterations and max_wall_time go with a Planner; a Replanner has its own budget")
-    replanning = planner if not isinstance(planner, Planner) else Replanner(planner, iterations, max_wall_time)
-    missing = [name for name in ("planner", "first_plan", "replan", "prepare") if not hasattr(replanning, name)]
-    if missing:
-        raise ValueError(f"planner must be a comanip.Planner or a replanning of one (a Replanner: planner, first_plan, "
-                         f"replan and prepare); {type(replanning).__name__} has no {', '.join(missing)}")
+    replanning = _replanning(planner, iterations, max_wall_time)
     planner = replanning.planner
     model = planner.model
-    observation = Observation.of(model) if observation is None else observation
     start, goal, width = planner.check_inputs(start, goal, width)
-    period = model.h if period is None else as_optional_positive("period", period, "s")
-    steps = round(model.H * model.h / period) if steps is None else int(steps)
-    if steps < 1:
-        raise ValueError(f"steps must be ≥ 1, got {steps}")
-    if observation is not None and not isinstance(observation, Observation):
-        raise ValueError(f"observation must be None or a comanip.execution.Observation, got {type(observation).__name__}")
-    if observation is not None and not np.isclose(period, model.h):
-        if observation.position_std or observation.velocity_std or observation.delay:
-            raise ValueError(f"a noisy or delayed observation needs cycles of the model's step h = {model.h} s, got "
-                             f"period {period} s (Observation(0, 0) replans from the exact state at any period)")
-        observation = None
+    observation, period, steps = _loop_timing(model, observation, period, steps)
     jumps = sorted((as_nonnegative("goal jump time", time, "s"), as_position("goal jump goal", to, model.d))
                    for time, to in goal_jumps)
-    rng = rng if rng is not None else np.random.default_rng()
-    body, n = model.body, model.n
-    step = body.step_function(period)
-    s_sym = ca.SX.sym("s", model.state_size)
-    velocity = ca.Function("ee_velocity", [s_sym], [ca.mtimes(body.jacobian(s_sym[:n]), s_sym[n:2 * n])])
+    return _closed_loop(replanning, start, goal, width, jumps, steps, period, observation, noise,
+                        rng if rng is not None else np.random.default_rng())
 
+
+def _closed_loop(replanning: Replanning, start: np.ndarray, goal: np.ndarray, width: float, jumps: list, steps: int,
+                 period: float, observation: Observation | None, noise: bool, rng: np.random.Generator) -> Execution:
+    """:func:`execute_receding_horizon`'s loop on checked inputs: ``jumps`` sorted (time s, goal (d,) m) pairs."""
+    model = replanning.planner.model
+    n, step = model.n, model.body.step_function(period)
     states = np.zeros((steps + 1, model.state_size))
     # the replans start from the person's estimate of the state: without an observation model, the state itself
     estimates = states if observation is None else np.zeros_like(states)
@@ -150,12 +137,51 @@ def execute_receding_horizon(planner: Planner | Replanning, start, goal, width: 
         if estimator is not None:
             seen = observation.measure(states[max(0, k + 1 - estimator.delay)], n, rng)
             estimates[k + 1] = estimator.update(commanded[k], seen)
-    ee = np.array([np.asarray(body.kinematics_function(s[:n])[0]).ravel() for s in states])
-    ee_velocity = np.array([np.asarray(velocity(s)).ravel() for s in states])
+    ee, ee_velocity = _hand_path(model, states)
     return Execution(t=period * np.arange(steps + 1), states=states, commanded=commanded, executed=executed,
                      ee=ee, ee_velocity=ee_velocity, failed_replans=sum(status != Progress.CONVERGED for status in statuses),
                      estimates=None if observation is None else estimates, goals=goals, replan_times=replan_times,
                      preparation_times=preparation_times, replan_statuses=statuses, replan_iterations=iterations_done)
+
+
+def _replanning(planner, iterations: int | None, max_wall_time: float | None) -> Replanning:
+    """The replanning :func:`execute_receding_horizon` runs: a :class:`Replanner` of a Planner with that budget,
+    or the given replanning (which has its own); a one-line ValueError otherwise."""
+    if not isinstance(planner, Planner) and (iterations is not None or max_wall_time is not None):
+        raise ValueError("iterations and max_wall_time go with a Planner; a Replanner has its own budget")
+    replanning = planner if not isinstance(planner, Planner) else Replanner(planner, iterations, max_wall_time)
+    missing = [name for name in ("planner", "first_plan", "replan", "prepare") if not hasattr(replanning, name)]
+    if missing:
+        raise ValueError(f"planner must be a comanip.Planner or a replanning of one (a Replanner: planner, first_plan, "
+                         f"replan and prepare); {type(replanning).__name__} has no {', '.join(missing)}")
+    return replanning
+
+
+def _loop_timing(model: ReachingModel, observation, period, steps) -> tuple[Observation | None, float, int]:
+    """The loop's observation (the model's when None; none at all when exact and the cycle is not h), its period
+    (s, h when None) and its number of cycles (H·h / period when None), checked."""
+    observation = Observation.of(model) if observation is None else observation
+    period = model.h if period is None else as_optional_positive("period", period, "s")
+    steps = round(model.H * model.h / period) if steps is None else int(steps)
+    if steps < 1:
+        raise ValueError(f"steps must be ≥ 1, got {steps}")
+    if observation is not None and not isinstance(observation, Observation):
+        raise ValueError(f"observation must be None or a comanip.execution.Observation, got {type(observation).__name__}")
+    if observation is not None and not np.isclose(period, model.h):
+        if observation.position_std or observation.velocity_std or observation.delay:
+            raise ValueError(f"a noisy or delayed observation needs cycles of the model's step h = {model.h} s, got "
+                             f"period {period} s (Observation(0, 0) replans from the exact state at any period)")
+        observation = None
+    return observation, period, steps
+
+
+def _hand_path(model: ReachingModel, states: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The hand's positions (K, d) m and velocities J(q) qdot (K, d) m/s of states (K, nx)."""
+    body, n = model.body, model.n
+    s_sym = ca.SX.sym("s", model.state_size)
+    velocity = ca.Function("ee_velocity", [s_sym], [ca.mtimes(body.jacobian(s_sym[:n]), s_sym[n:2 * n])])
+    ee = np.array([np.asarray(body.kinematics_function(s[:n])[0]).ravel() for s in states])
+    return ee, np.array([np.asarray(velocity(s)).ravel() for s in states])
 
 
 def executed_cost(planner: Planner, run: Execution, width: float | None = None) -> float:

@@ -94,6 +94,13 @@ def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], p
         except Exception as error:  # the fit never raises once planning started: report it as failed
             return failed_result(model, space, f"{type(error).__name__}: {error}", residuals.evaluations,
                                  time.perf_counter() - t_begin, CHI2_KIND)
+    return _timing_result(model, space, result, predicted, recorded, len(conditions), residuals.evaluations, t_begin)
+
+
+def _timing_result(model: ReachingModel, space: ParameterSpace, result, predicted: np.ndarray, recorded: "RecordedTiming",
+                   condition_count: int, evaluations: int, t_begin: float) -> FitResult:
+    """The :class:`FitResult` of a finished ``least_squares`` ``result`` (its status, values, standard errors and
+    whether each is identified) with the ``predicted`` timings of the conditions."""
     status = FitStatus.CONVERGED if result.status > 0 else FitStatus.MAX_EVALUATIONS
     values = space.values(result.x)
     std_errors = space.natural_std_errors(result.x, least_squares_std(result.fun, result.jac, whitened=True))
@@ -107,9 +114,9 @@ def fit_timing(model: ReachingModel, recordings: str | Path | Sequence[Trial], p
     return FitResult(
         success=status == FitStatus.CONVERGED and settled, status=status, message=message,
         model=fitted_model(space.model_for(result.x), model, f"the timing of {recorded.trial_count} recorded trials in "
-                           f"{len(conditions)} conditions"),
+                           f"{condition_count} conditions"),
         values=values, initial_values=space.start_values, std_errors=std_errors, laplace_std_errors=dict(std_errors),
-        objective=float(np.sum(result.fun**2)), objective_kind=CHI2_KIND, evaluations=residuals.evaluations,
+        objective=float(np.sum(result.fun**2)), objective_kind=CHI2_KIND, evaluations=evaluations,
         fit_time=time.perf_counter() - t_begin, conditions=recorded.rows(predicted))
 
 

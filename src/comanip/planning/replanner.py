@@ -282,26 +282,7 @@ class Replanner:
         finite = solver.finite(result, guess, params)
         torque = np.reshape(finite.x, (model.H, model.n))
         solver.count_solving_time(ended - began)
-
-        def completed() -> SolverResult:
-            """The cycle's result with the gradient at its plan evaluated (once: the solve keeps its completed result,
-            which the status and the plan share)."""
-            if finite is not result:  # the solver's plan was not finite: the guess, failed
-                return finite
-            with solver.blas:
-                return solver.finite(solve.completed(), guess, params)
-
-        def judge() -> CycleOutcome:
-            final = completed()
-            return CycleOutcome(progress_of(final), final.status, final.message, final.optimality)
-
-        def build_plan() -> Plan:
-            final = completed()
-            data = None if final.local_model is None else final.local_model.data
-            evaluation = None if data is None else Evaluation(final.fun, None, data)
-            return with_reach_check(solver.make_plan(torque, params, evaluation, status=final.status, success=final.success,
-                                                     message=final.message, solve_time=ended - began, iterations=final.nit))
-
+        judge, build_plan = _deferred(solver, solve, result, finite, guess, params, torque, ended - began)
         return Replan(torque, params, result.nit, ended - began, judge, result.start_optimality, goal_q, build_plan)
 
     def prepare(self, replan: Replan, elapsed: float, state=None) -> float:
@@ -379,3 +360,27 @@ class Replanner:
 
         outcome = CycleOutcome(Progress.NOT_CONTRACTING, PlanStatus.UNREACHABLE, message)
         return Replan(guess, params, 0, wall_time, lambda: outcome, goal_q=goal_q, build_plan=build_plan)
+
+
+def _deferred(solver: NewtonReachSolver, solve, result: SolverResult, finite: SolverResult, guess: np.ndarray,
+              params: ReachParameters, torque: np.ndarray, solve_time: float) -> tuple[Callable, Callable]:
+    """A cycle's outcome and plan, computed when first asked (:class:`Replan`'s ``judge`` and ``build_plan``): both
+    read the cycle's result with the gradient at its plan evaluated, once (the solve keeps its completed result)."""
+    def completed() -> SolverResult:
+        if finite is not result:  # the solver's plan was not finite: the guess, failed
+            return finite
+        with solver.blas:
+            return solver.finite(solve.completed(), guess, params)
+
+    def judge() -> CycleOutcome:
+        final = completed()
+        return CycleOutcome(progress_of(final), final.status, final.message, final.optimality)
+
+    def build_plan() -> Plan:
+        final = completed()
+        data = None if final.local_model is None else final.local_model.data
+        evaluation = None if data is None else Evaluation(final.fun, None, data)
+        return with_reach_check(solver.make_plan(torque, params, evaluation, status=final.status, success=final.success,
+                                                 message=final.message, solve_time=solve_time, iterations=final.nit))
+
+    return judge, build_plan

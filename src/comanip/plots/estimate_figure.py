@@ -32,9 +32,39 @@ def plot_estimate(plan: Plan, path: str | Path, observed_points=None, observed_t
     """
     n_o = plan.observed_step
     x, t, d = plan.ee_mean, plan.t, plan.ee_mean.shape[1]
-    y = x[:, 1] if d > 1 else np.zeros(len(x))
     fig, (ax_path, ax_pos, ax_speed) = plt.subplots(1, 3, figsize=(14, 4.3))
 
+    _draw_path(ax_path, plan, observed_points, true_goal)
+    goal = np.asarray(plan.goal)
+
+    for k in range(d):
+        ax_pos.plot(t[: n_o + 1], x[: n_o + 1, k], "-", color=f"C{k}", lw=2)
+        ax_pos.plot(t[n_o:], x[n_o:, k], "--", color=f"C{k}", label=_AXES[k] if k < 3 else str(k))
+        ax_pos.axhline(goal[k], color=f"C{k}", lw=0.6, alpha=0.5)
+        if observed_points is not None and observed_times is not None:
+            ax_pos.plot(observed_times, np.atleast_2d(observed_points)[:, k], ".", color="k", ms=5)
+    ax_pos.axvline(plan.t[n_o], color="0.5", lw=0.8)
+    ax_pos.set(xlabel="t (s)", ylabel="position (m)", title="position (thin: estimated goal)")
+    ax_pos.legend(fontsize=8)
+
+    speed = plan.ee_speed
+    ax_speed.plot(t[: n_o + 1], speed[: n_o + 1], "-", color="C0", lw=2, label="observed prefix (model)")
+    ax_speed.plot(t[n_o:], speed[n_o:], "--", color="C1", label="predicted remainder")
+    ax_speed.axvline(plan.t[n_o], color="0.5", lw=0.8, label="observation")
+    ax_speed.set(xlabel="t (s)", ylabel="speed (m/s)", title="end-effector speed")
+    ax_speed.legend(fontsize=8)
+
+    method = plan.method
+    return save_figure(fig, path, title or f"{plan.model_name} goal estimate ({method}): goal {np.round(goal, 3).tolist()} m, "
+                                           f"{plan.status}, {1e3 * plan.solve_time:.0f} ms")
+
+
+def _draw_path(ax_path, plan: Plan, observed_points, true_goal) -> None:
+    """The path panel of :func:`plot_estimate`: the observed prefix and the predicted remainder with its ±2σ
+    circles, the estimated goal, the prior and true goals and the observations."""
+    n_o = plan.observed_step
+    x, d = plan.ee_mean, plan.ee_mean.shape[1]
+    y = x[:, 1] if d > 1 else np.zeros(len(x))
     ax_path.plot(x[: n_o + 1, 0], y[: n_o + 1], "-", color="C0", lw=2, label="observed prefix (model)")
     ax_path.plot(x[n_o:, 0], y[n_o:], "--", color="C1", lw=1.5, label="predicted remainder")
     drawn = None
@@ -61,27 +91,6 @@ def plot_estimate(plan: Plan, path: str | Path, observed_points=None, observed_t
     ax_path.set(xlabel="x (m)", ylabel="y (m)", title="path (±2σ on the remainder)")
     ax_path.axis("equal")
     ax_path.legend(fontsize=7, loc="best")
-
-    for k in range(d):
-        ax_pos.plot(t[: n_o + 1], x[: n_o + 1, k], "-", color=f"C{k}", lw=2)
-        ax_pos.plot(t[n_o:], x[n_o:, k], "--", color=f"C{k}", label=_AXES[k] if k < 3 else str(k))
-        ax_pos.axhline(goal[k], color=f"C{k}", lw=0.6, alpha=0.5)
-        if observed_points is not None and observed_times is not None:
-            ax_pos.plot(observed_times, np.atleast_2d(observed_points)[:, k], ".", color="k", ms=5)
-    ax_pos.axvline(plan.t[n_o], color="0.5", lw=0.8)
-    ax_pos.set(xlabel="t (s)", ylabel="position (m)", title="position (thin: estimated goal)")
-    ax_pos.legend(fontsize=8)
-
-    speed = plan.ee_speed
-    ax_speed.plot(t[: n_o + 1], speed[: n_o + 1], "-", color="C0", lw=2, label="observed prefix (model)")
-    ax_speed.plot(t[n_o:], speed[n_o:], "--", color="C1", label="predicted remainder")
-    ax_speed.axvline(plan.t[n_o], color="0.5", lw=0.8, label="observation")
-    ax_speed.set(xlabel="t (s)", ylabel="speed (m/s)", title="end-effector speed")
-    ax_speed.legend(fontsize=8)
-
-    method = plan.method
-    return save_figure(fig, path, title or f"{plan.model_name} goal estimate ({method}): goal {np.round(goal, 3).tolist()} m, "
-                                           f"{plan.status}, {1e3 * plan.solve_time:.0f} ms")
 
 
 def plot_posterior(posterior, path: str | Path, title: str | None = None) -> Path:
