@@ -32,17 +32,20 @@ from scipy.stats import chi2
 from comanip.estimation.people.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402  (beside this script)
+from forecast_peers import people_reaches  # noqa: E402  (beside this script)
+from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
+UE_ADL = ARMS.parents[1] / "ue_adl"
 WORSE_MARGIN = 0.05
 FORECAST_EXAMPLES = 4
 """Movements whose forecasts the forecast figure shows (the first of the set)."""
 
 
-def predictors(model_names, library, exclude_self: bool, people_for):
-    """{name: factory(recording) -> online predictor with update(t, position, velocity)}."""
+def predictors(model_names, library_for, exclude_self: bool, people_for):
+    """{name: factory(recording) -> online predictor with update(t, position, velocity)}; ``library_for(recording)``
+    and ``people_for(recording)``: the template library and the people model that recording is scored with."""
     import comanip
     from comanip.estimation.people.endpoint_baselines import ConstantVelocity, CurrentPosition, MinimumJerkFit
     from comanip.estimation.people.template_matching import TemplateMatching
@@ -51,7 +54,7 @@ def predictors(model_names, library, exclude_self: bool, people_for):
         "current position": lambda r: CurrentPosition(r.position[0]),
         "constant velocity": lambda r: ConstantVelocity(r.position[0]),
         "minimum jerk": lambda r: MinimumJerkFit(r.position[0]),
-        "template matching": lambda r: TemplateMatching(r.position[0], library, exclude=r.name if exclude_self else None),
+        "template matching": lambda r: TemplateMatching(r.position[0], library_for(r), exclude=r.name if exclude_self else None),
         "people model": lambda r: _People(people_for(r), r.position[0]),
     }
     from comanip.estimation import OnlineOptions
@@ -150,6 +153,33 @@ def simulated_recordings(model_name: str, count: int, seed: int):
     return recordings
 
 
+def leave_one_person_out(tathum: Path, ue_adl: Path, limit: int | None, log):
+    """The eleven arm people's reaches (``forecast_peers.people_reaches``) as one list of movements, the person of
+    each (by name), and for each movement the people model and the template library fitted on the other people's
+    reaches only (fitted once per person, when first asked)."""
+    from comanip.estimation.people.people_model import PeopleModel
+    from comanip.estimation.people.template_matching import TemplateLibrary
+
+    people = people_reaches(tathum, ue_adl, limit)
+    if len(people) < 2:
+        sys.exit(f"leave-one-person-out needs at least two people; {tathum} and {ue_adl} hold {len(people)}")
+    person_of = {r.name: person for person, recordings in people.items() for r in recordings}
+    if len(person_of) != sum(map(len, people.values())):
+        sys.exit("two reaches share a name: the people's reaches must be told apart by name")
+    fitted = {}
+
+    def others(recording):
+        person = person_of[recording.name]
+        if person not in fitted:
+            print(f"  fitting the people model and templates without {person} ...", flush=True, file=log)
+            rest = [r for other, recordings in people.items() if other != person for r in recordings]
+            fitted[person] = PeopleModel.fit(rest, kind="arm"), TemplateLibrary(rest, step=0.01)
+        return fitted[person]
+
+    movements = [r for recordings in people.values() for r in recordings]
+    return movements, person_of, lambda r: others(r)[0], lambda r: others(r)[1]
+
+
 def summarise(rows, names):
     """{predictor: {fraction: {median, q25, q75, coverage, worse}}} from the per-movement rows."""
     summary = {}
@@ -242,6 +272,69 @@ def aims_markdown(name, summary, latency, diagnosed) -> str:
     return "\n".join(lines)
 
 
+BASELINES = ("current position", "constant velocity", "minimum jerk", "template matching")
+"""The simple rules an online estimator is judged against, person by person (the people model alone is a part of it)."""
+PEOPLE_FRACTIONS = (0.25, 0.5, 0.75, 0.9)
+
+
+def people_markdown(name: str, rows, diagnosed) -> str:
+    """Person by person: the online estimator ``name``'s median error / D against the best of the simple rules at
+    each fraction, its 95 % coverage (a new person's first reach: the estimator learns nothing across reaches here)
+    and its goal jumps, then the targets over people."""
+    people = list(dict.fromkeys(r["person"] for r in rows))
+    rules = [rule for rule in BASELINES if any(r["predictor"] == rule for r in rows)]
+
+    def median(predictor, person, f):
+        errors = [r["error"] for r in rows if r["predictor"] == predictor and r["fraction"] == f
+                  and person in (None, r["person"])]
+        return float(np.median(errors)) if errors else math.nan
+
+    def coverage(person, f):
+        held = [r["covered"] for r in rows if r["predictor"] == name and r["fraction"] == f and r["covered"] is not None
+                and person in (None, r["person"])]
+        return float(np.mean(held)) if held else math.nan
+
+    lines = [f"`{name}` person by person, each scored with the people model and templates of the other people only: "
+             "median error / D at 25 / 50 / 75 / 90 % of MT, the best simple rule's (its name at 50 %), the 95 % region's "
+             "coverage of a new person's first reach, and the share of updates after 25 % of MT that move the goal by "
+             "> 0.1 D", "",
+             "| person | reaches | estimator | best rule | best rule at 50 % | below every rule at 50 % | coverage | goal jumps |",
+             "|---|---|---|---|---|---|---|---|"]
+    below_at_half, jumps_by_person, covered_by_person = [], {}, {}
+    for person in [*people, None]:
+        mine = [median(name, person, f) for f in PEOPLE_FRACTIONS]
+        best = [min(median(rule, person, f) for rule in rules) for f in PEOPLE_FRACTIONS]
+        best_rule = min(rules, key=lambda rule: median(rule, person, 0.5))
+        below = mine[1] < best[1]
+        jumps = float(np.nanmean([d["jumps"] for d in diagnosed if person in (None, d["person"])]))
+        covered = [coverage(person, f) for f in PEOPLE_FRACTIONS]
+        if person is not None:
+            below_at_half.append(below)
+            jumps_by_person[person], covered_by_person[person] = jumps, covered
+        count = sum(1 for r in rows if r["predictor"] == name and r["fraction"] == 0.5 and person in (None, r["person"]))
+        lines.append(f"| {person or '**all reaches**'} | {count} | {' / '.join(f'{e:.3f}' for e in mine)} | "
+                     f"{' / '.join(f'{e:.3f}' for e in best)} | {best_rule} | {'yes' if below else 'no'} | "
+                     f"{' / '.join(f'{100 * c:.0f}' for c in covered)} % | {100 * jumps:.1f} % |")
+    over_people = {f: float(np.median([median(name, person, f) for person in people])) for f in PEOPLE_FRACTIONS}
+    rule_over_people = {f: min(float(np.median([median(rule, person, f) for person in people])) for rule in rules)
+                        for f in PEOPLE_FRACTIONS}
+    yes = lambda ok: "yes" if ok else "no"
+    low = min(min(c) for c in covered_by_person.values())
+    high = max(max(c) for c in covered_by_person.values())
+    worst_jumps = max(jumps_by_person, key=jumps_by_person.get)
+    lines += ["", "| target (leave-one-person-out) | measured | met |", "|---|---|---|",
+              "| endpoint below every simple rule at 25–90 % of MT (median over people) | "
+              + "; ".join(f"{int(100 * f)} %: {over_people[f]:.3f} vs {rule_over_people[f]:.3f}" for f in PEOPLE_FRACTIONS)
+              + f" D | {yes(all(over_people[f] < rule_over_people[f] for f in PEOPLE_FRACTIONS))} |",
+              f"| below every simple rule at 50 % of MT for ≥ 80 % of people | {sum(below_at_half)} of {len(people)} | "
+              f"{yes(sum(below_at_half) >= 0.8 * len(people))} |",
+              f"| a new person's first reach: the 95 % region holds the endpoint in 80–98 % (every person, 25–90 % of MT) | "
+              f"{100 * low:.0f}–{100 * high:.0f} % | {yes(0.8 <= low and high <= 0.98)} |",
+              f"| after 25 % of MT, ≤ 1 % of updates move the goal by > 0.1 D (every person) | at most "
+              f"{100 * jumps_by_person[worst_jumps]:.1f} % ({worst_jumps}) | {yes(jumps_by_person[worst_jumps] <= 0.01)} |"]
+    return "\n".join(lines)
+
+
 PUBLISHED_PX = {0.5: 83, 0.75: 48, 0.9: 39}
 """Kinematic template matching's published errors on mouse movements of 100–800 px (Pasqual & Wobbrock 2014), px."""
 
@@ -282,9 +375,11 @@ def figure(summary, path: Path, title: str):
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--source", choices=("cursory", "arms", "simulated"), default="cursory",
-                        help="cursory: mouse movements; arms: motion-capture arm reaches (--arms); simulated: the model's own")
+    parser.add_argument("--source", choices=("cursory", "arms", "people", "simulated"), default="cursory",
+                        help="cursory: mouse movements; arms: motion-capture arm reaches (--arms); people: the eleven arm "
+                             "people (--arms, --ue-adl), each scored leave-one-person-out; simulated: the model's own")
     parser.add_argument("--arms", type=Path, default=ARMS, help="a TAT-HUM 3-D data folder (trajectory_data/, trial_data/)")
+    parser.add_argument("--ue-adl", type=Path, default=UE_ADL, help="a folder of people's Vicon Nexus exports (--source people)")
     parser.add_argument("--split", choices=("development", "held_out"), default="development",
                         help="cursory split; held_out only to report a claimed improvement")
     parser.add_argument("--limit", type=int, default=None, help="at most this many movements")
@@ -304,9 +399,16 @@ def main(argv=None):
     from comanip.recordings.cursory_data import SCALE
 
     scale = args.scale or SCALE
-    models = args.models or ("arm,human_cartesian" if args.source == "arms" else "planar,human,people")
-    kind = "arm" if args.source == "arms" else "mouse"
-    if args.source == "arms":
+    models = args.models or {"arms": "arm,human_cartesian", "people": "arm"}.get(args.source, "planar,human,people")
+    kind = "arm" if args.source in ("arms", "people") else "mouse"
+    person_of = {}
+    if args.source == "people":
+        if args.split != "development":
+            sys.exit("the arm people's held-out people are not in these folders: they are scored elsewhere")
+        movements, person_of, people_for, library_for = leave_one_person_out(args.arms, args.ue_adl, args.limit, log)
+        title = (f"{len(set(person_of.values()))} arm people (TAT-HUM's, UE_ADL's), development split, streamed as a "
+                 "tracker delivers them, each scored with the people model and templates of the other people only")
+    elif args.source == "arms":
         if args.split != "development":
             sys.exit("the arm reaches' held-out split is not in this folder: it is scored elsewhere")
         trials = load_tathum(args.arms)
@@ -326,16 +428,18 @@ def main(argv=None):
         if args.limit:
             recordings = recordings[:args.limit]
         movements = recordings
-    library = TemplateLibrary(development, step=0.01)
-    if args.source != "simulated" and args.split == "development":
-        # the shipped people models were fitted on this split: score each movement with one fitted on the other half
-        print(f"fitting the {kind} people model on each half of the development split ...", flush=True, file=log)
-        folds = [PeopleModel.fit(development[1 - k::2], kind=kind) for k in (0, 1)]
-        half = {r.name: k % 2 for k, r in enumerate(development)}
-        people_for = lambda r: folds[half[r.name]]
-    else:
-        people_for = lambda r: shipped_people_model(kind)
-    made = predictors([m for m in models.split(",") if m], library, exclude_self=args.split == "development",
+    if args.source != "people":
+        library = TemplateLibrary(development, step=0.01)
+        library_for = lambda r: library
+        if args.source != "simulated" and args.split == "development":
+            # the shipped people models were fitted on this split: score each movement with one fitted on the other half
+            print(f"fitting the {kind} people model on each half of the development split ...", flush=True, file=log)
+            folds = [PeopleModel.fit(development[1 - k::2], kind=kind) for k in (0, 1)]
+            half = {r.name: k % 2 for k, r in enumerate(development)}
+            people_for = lambda r: folds[half[r.name]]
+        else:
+            people_for = lambda r: shipped_people_model(kind)
+    made = predictors([m for m in models.split(",") if m], library_for, exclude_self=args.split == "development",
                       people_for=people_for)
     if args.only:
         made = {k: v for k, v in made.items() if any(o.strip() in k for o in args.only.split(","))}
@@ -351,7 +455,8 @@ def main(argv=None):
         for name in names:
             answers, times, predictor = run_predictor(made[name], recording)
             if isinstance(predictor, _Online):
-                diagnosed.setdefault(name, []).append(diagnostics(predictor.trace, recording))
+                diagnosed.setdefault(name, []).append(diagnostics(predictor.trace, recording)
+                                                      | {"person": person_of.get(recording.name, "")})
                 forecasts.setdefault(name, []).extend(forecast_rows(predictor.trace, recording, name, predictor.estimator))
                 if len(examples.setdefault(name, [])) < FORECAST_EXAMPLES:
                     examples[name].append((recording, predictor.trace))
@@ -368,7 +473,7 @@ def main(argv=None):
                         covered = bool(e @ np.linalg.solve(cov, e) <= chi2.ppf(0.95, len(e)))
                     except np.linalg.LinAlgError:
                         covered = False
-                rows.append({"movement": recording.name, "predictor": name, "fraction": f, "distance_m": D,
+                rows.append({"person": person_of.get(recording.name, ""), "movement": recording.name, "predictor": name, "fraction": f, "distance_m": D,
                              "movement_time_s": recording.movement_time, "error": error, "covered": covered})
         for row in rows[-len(names) * len(FRACTIONS):]:
             row["current_error"] = current[FRACTIONS.index(row["fraction"])] if current else math.nan
@@ -382,6 +487,9 @@ def main(argv=None):
         table += "\n\n" + diagnostics_markdown(diagnosed)
     for name, scored in forecasts.items():
         table += "\n\n" + forecast_markdown(scored, name)
+    if args.source == "people":
+        for name in diagnosed:
+            table += "\n\n" + people_markdown(name, rows, diagnosed[name])
     if args.source == "arms":
         for name in diagnosed:
             table += "\n\n" + aims_markdown(name, summary, lat, diagnosed)
