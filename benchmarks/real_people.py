@@ -6,12 +6,16 @@ split only to report) is observed sample by sample (every 10 ms) from its first 
 error / D = |g_hat - end| / |end - start|. Printed: the median and interquartile range per fraction, how
 often the predictor's 95 % region holds the endpoint (predictors with a covariance), how often it is worse
 than the current position by more than 0.05 D, and the update time. ``--source simulated`` runs the same
-table on reaches sampled from a reaching model's own noise (open loop, as the model's belief assumes).
+table on reaches sampled from a reaching model's own noise (open loop, as the model's belief assumes);
+``--source people`` on the eleven arm people (TAT-HUM's and UE_ADL's, streamed as ``forecast_peers.py`` streams them),
+each person's reaches scored with the people model and the template library fitted on the other people's only, and
+a table person by person with the targets over people (:func:`people_markdown`).
 
     python benchmarks/real_people.py                      # development split, every predictor
     python benchmarks/real_people.py --limit 200          # the first 200 movements of the split
     python benchmarks/real_people.py --split held_out     # the report split: run once per claimed improvement
     python benchmarks/real_people.py --source simulated   # the model's own reaches
+    python benchmarks/real_people.py --source people      # leave-one-person-out over the arm people
 
 Outputs in ``--out`` (default benchmarks/results/real_people_<source>_<split>/): ``errors.csv`` (one row per
 movement, fraction and predictor), ``summary.json``, ``summary.md`` and ``error_by_fraction.png``.
