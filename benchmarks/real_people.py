@@ -36,7 +36,7 @@ from scipy.stats import chi2
 from comanip.estimation.people.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from forecast_peers import people_reaches  # noqa: E402  (beside this script)
+from forecast_peers import leave_one_person_out as fits_without_each, people_reaches  # noqa: E402  (beside this script)
 from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
@@ -160,7 +160,7 @@ def simulated_recordings(model_name: str, count: int, seed: int):
 def leave_one_person_out(tathum: Path, ue_adl: Path, limit: int | None, log):
     """The eleven arm people's reaches (``forecast_peers.people_reaches``) as one list of movements, the person of
     each (by name), and for each movement the people model and the template library fitted on the other people's
-    reaches only (fitted once per person, when first asked)."""
+    reaches only (``forecast_peers.leave_one_person_out``: fitted once per person)."""
     from comanip.estimation.people.people_model import PeopleModel
     from comanip.estimation.people.template_matching import TemplateLibrary
 
@@ -170,19 +170,14 @@ def leave_one_person_out(tathum: Path, ue_adl: Path, limit: int | None, log):
     person_of = {r.name: person for person, recordings in people.items() for r in recordings}
     if len(person_of) != sum(map(len, people.values())):
         sys.exit("two reaches share a name: the people's reaches must be told apart by name")
-    fitted = {}
 
-    def others(recording):
-        person = person_of[recording.name]
-        if person not in fitted:
-            print(f"  fitting the people model and templates without {person} ...", flush=True, file=log)
-            rest = [r for other, recordings in people.items() if other != person for r in recordings]
-            fitted[person] = PeopleModel.fit(rest, kind="arm"), TemplateLibrary(rest, step=0.01)
-        return fitted[person]
+    def fit(rest):
+        print(f"  fitting the people model and templates on {len(rest)} reaches of the other people ...", flush=True, file=log)
+        return PeopleModel.fit(rest, kind="arm"), TemplateLibrary(rest, step=0.01)
 
+    fitted = dict(fits_without_each(people, fit))
     movements = [r for recordings in people.values() for r in recordings]
-    return movements, person_of, lambda r: others(r)[0], lambda r: others(r)[1]
-
+    return movements, person_of, lambda r: fitted[person_of[r.name]][0], lambda r: fitted[person_of[r.name]][1]
 
 def summarise(rows, names):
     """{predictor: {fraction: {median, q25, q75, coverage, worse}}} from the per-movement rows."""

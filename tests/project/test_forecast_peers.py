@@ -1,26 +1,17 @@
 """benchmarks/forecast_peers.py: its learned forecaster reads only the past, is the same for a reach turned, moved and
 scaled, and a person left out is never seen by the fit that scores them."""
 
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
 from comanip.recordings import recording_from_samples
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.project.benchmark_scripts import load_benchmark
 
 
 @pytest.fixture(scope="module")
 def peers():
-    """benchmarks/forecast_peers.py as a module (a script beside the benchmarks, not part of the package)."""
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    spec = importlib.util.spec_from_file_location("benchmarks_forecast_peers", ROOT / "benchmarks" / "forecast_peers.py")
-    module = sys.modules[spec.name] = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """benchmarks/forecast_peers.py as a module."""
+    return load_benchmark("forecast_peers")
 
 
 def reach(name, offset, duration=0.8, start=(0.1, -0.2, 0.3), bend=0.0):

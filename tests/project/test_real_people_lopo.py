@@ -1,26 +1,19 @@
 """benchmarks/real_people.py's leave-one-person-out: a person's reaches never reach the people model or the
 templates that score them, and the person-by-person table says which targets the rows meet."""
 
-import importlib.util
 import sys
-from pathlib import Path
 
 import pytest
 
 from comanip.estimation.people import people_model, template_matching
+from tests.project.benchmark_scripts import load_benchmark
 from tests.project.test_forecast_peers import people_of_reaches
-
-ROOT = Path(__file__).resolve().parents[2]
 
 
 @pytest.fixture(scope="module")
 def real_people():
-    """benchmarks/real_people.py as a module (a script beside the benchmarks, not part of the package)."""
-    sys.path.insert(0, str(ROOT / "benchmarks"))
-    spec = importlib.util.spec_from_file_location("benchmarks_real_people", ROOT / "benchmarks" / "real_people.py")
-    module = sys.modules[spec.name] = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    """benchmarks/real_people.py as a module."""
+    return load_benchmark("real_people")
 
 
 def test_a_person_left_out_is_never_seen_by_what_scores_them(real_people, monkeypatch):

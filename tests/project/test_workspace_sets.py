@@ -1,24 +1,17 @@
 """The sampled workspace sets the solve-time benchmarks read (benchmarks/workspace/): what their script draws from its
 seed, and inside the ranges it promises."""
 
-import importlib.util
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 import comanip
-
-ROOT = Path(__file__).resolve().parents[2]
+from tests.project.benchmark_scripts import load_benchmark
 
 
 def _workspace():
-    """benchmarks/workspace.py as a module (a script beside the benchmarks, not part of the package)."""
-    spec = importlib.util.spec_from_file_location("benchmarks_workspace", ROOT / "benchmarks" / "workspace.py")
-    module = sys.modules[spec.name] = importlib.util.module_from_spec(spec)  # its dataclass looks its module up there
-    spec.loader.exec_module(module)
-    return module
+    """benchmarks/workspace.py as a module."""
+    return load_benchmark("workspace")
 
 
 @pytest.mark.parametrize("preset", ["planar", "human_cartesian", "franka_rest"])

@@ -80,11 +80,6 @@ class OnlineEstimate:
         return self.status in ESTIMATED
 
     @property
-    def estimated_goal(self) -> np.ndarray:
-        """g_hat (d,), m (``goal``)."""
-        return self.goal
-
-    @property
     def reach_distance(self) -> float:
         """D (m): from the reach's start to g_hat."""
         return float(np.linalg.norm(self.start[:len(self.goal)] - self.goal))
