@@ -46,8 +46,8 @@ def test_bad_names_say_what_is_allowed(name, fragment):
     assert "model, recorded, arm or a folder" in str(error.value) and "\n" not in str(error.value)
 
 
-def test_a_folder_not_in_the_tathum_layout_is_refused(tmp_path):
-    with pytest.raises(ValueError, match="TAT-HUM layout: it needs trajectory_data/ and trial_data/"):
+def test_a_folder_of_no_arm_reaches_is_refused(tmp_path):
+    with pytest.raises(ValueError, match=r"neither in the TAT-HUM layout \(trajectory_data/ and trial_data/ inside\) nor"):
         choose_person(str(tmp_path))
 
 
