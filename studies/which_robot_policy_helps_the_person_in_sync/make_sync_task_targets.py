@@ -27,7 +27,8 @@ from comanip.demo import GUIDING_FORCE_N  # noqa: E402
 from comanip.plots.sync_speed_profiles import plot_speed_profiles  # noqa: E402
 from comanip.simulation import PersonParameters, SyncSettings  # noqa: E402
 from comanip.simulation.policy_comparison import CANDIDATE, people_rows, people_table  # noqa: E402
-from comanip.simulation.sync_targets import pairs_table, robots_table, target_rows, targets_table  # noqa: E402
+from comanip.simulation.sync_targets import (REQUIRED, pairs_table, robots_table, target_rows, target_summary,  # noqa: E402
+                                             targets_table)
 from studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison import ARM_REACHES, run_or_load  # noqa: E402
 from studies.which_robot_policy_helps_the_person_in_sync.make_policy_comparison import (  # noqa: E402
     GOALS, add_run_arguments)
@@ -57,6 +58,14 @@ PEOPLE = {
 ARM_FOLDERS = {label: UE_ADL / label.split("-")[0] for label in PEOPLE if label.startswith("ADL")}
 #: The people whose peak force the guiding-force target asks about: the model's people and the slowed arms.
 GUIDING_PEOPLE = tuple(label for label, person in PEOPLE.items() if person.hand_path == "model" or person.pace == SLOWED)
+#: people group -> whether a label of PEOPLE belongs to it (the block's table by group).
+GROUPS = {
+    "the model's person": lambda label: label.startswith("model"),
+    "TAT-HUM's arm": lambda label: label == "arm",
+    f"TAT-HUM's arm ×{SLOWED:g}": lambda label: label == f"arm-x{SLOWED:g}",
+    "UE_ADL at their speed": lambda label: label.startswith("ADL") and "-x" not in label,
+    f"UE_ADL ×{SLOWED:g}": lambda label: label.startswith("ADL") and label.endswith(f"-x{SLOWED:g}"),
+}
 #: The robots the figure shows.
 FIGURE_POLICIES = ("passive", "admittance", "onset-minimum-jerk", "forecast")
 
@@ -102,6 +111,8 @@ def block(results: dict, trials: int, seed: int, wall: float, variant: bool) -> 
             f"its speed (x–y: the person's, z: the robot's) first falls below 5 % of its peak after it; lags and the "
             f"height error as medians over the trials.\n\n"
             f"{targets_table(rows)}\n"
+            f"By people group (pairs meeting each target of those it is asked of):\n\n"
+            f"{_groups_table(rows)}\n"
             f"Per person and goal (bold: the target missed; the guiding force, {low:.0f}–{high:.0f} N, is asked of "
             f"{', '.join(p for p in GUIDING_PEOPLE if p in results)}):\n\n"
             f"{pairs_table(rows)}\n"
@@ -113,6 +124,17 @@ def block(results: dict, trials: int, seed: int, wall: float, variant: bool) -> 
             f"robot, mean ± standard error):\n\n"
             f"{people_table(people_rows(results), policies, goal_error=False)}\n"
             f"![speed profiles](../figures/{figure.name})")
+
+
+def _groups_table(rows: list[dict]) -> str:
+    """Per people group of GROUPS with rows: the pairs meeting each target, as a markdown table."""
+    lines = ["| people | " + " | ".join(what for what, _ in REQUIRED.values()) + " |", "|" + "---|" * (len(REQUIRED) + 1)]
+    for group, member in GROUPS.items():
+        mine = [row for row in rows if member(row["person"])]
+        if mine:
+            cells = ["–" if asked == 0 else f"{met} of {asked}" for met, asked, _ in target_summary(mine).values()]
+            lines.append(f"| {group} | " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
 
 
 def _calibration_text(results: dict) -> str:
