@@ -138,18 +138,49 @@ def _groups_table(rows: list[dict]) -> str:
 
 
 def _calibration_text(results: dict) -> str:
-    """How much the candidate robot had learned of each person by their last trial (carried calibration: it learns
-    from a trial whose hand came to rest within it)."""
-    def learned(trials) -> int:
-        return trials[-1].metrics.get("calibration_reaches", 0) if trials else 0
-
-    parts = [f"{person} {', '.join(str(learned(by_policy.get(CANDIDATE, []))) for by_policy in by_goal.values())}"
-             for person, by_goal in results.items()]
+    """What the candidate robot had learned of each person when its last trial at each goal began (carried
+    calibration: it learns from a trial whose handle came to rest within it): the reaches learned from, per goal,
+    and the range over the goals of its amplitude and spread factors."""
+    parts = []
+    for person, by_goal in results.items():
+        last = [by_policy[CANDIDATE][-1].metrics for by_policy in by_goal.values()]
+        text = f"{person} {', '.join(str(metrics.get('calibration_reaches', 0)) for metrics in last)}"
+        if any(metrics.get("calibration_reaches", 0) for metrics in last):
+            text += " (" + ", ".join(f"{factor} {_range([metrics[f'calibration_{factor}'] for metrics in last])}"
+                                     for factor in ("amplitude", "spread")) + ")"
+        parts.append(text)
     trials = len(next(iter(next(iter(results.values())).values()))[CANDIDATE])
     return (f"Each estimating robot carries what it learned of the person from trial to trial of a goal, in seed order "
-            f"(`SyncSettings.carry_calibration`); it learns from a trial whose handle came to rest within it. The "
-            f"reaches `{CANDIDATE}` had learned from when its last trial began (of {trials - 1}), per goal: "
-            f"{'; '.join(parts)}.")
+            f"(`SyncSettings.carry_calibration`); it learns from a trial whose handle came to rest within it. What "
+            f"`{CANDIDATE}` had learned when its last trial began: the reaches learned from (of {trials - 1}) at each goal "
+            f"and, where any, the range of its amplitude and spread factors over the goals (1: a person not seen yet): "
+            f"{'; '.join(parts)}. Its trials that began knowing nothing of the person against those that began with a "
+            f"learned calibration, by people group (median height error at the person's arrival; mean RMS force "
+            f"beyond holding): {_calibrated_against_not(results)}.")
+
+
+def _calibrated_against_not(results: dict) -> str:
+    """Per people group, the candidate's trials that began with no reach learned against those that began with one or
+    more: their number, median height error at arrival (mm) and mean RMS force change (N)."""
+    parts = []
+    for group, member in GROUPS.items():
+        trials = [trial.metrics for person, by_goal in results.items() if member(person)
+                  for by_policy in by_goal.values() for trial in by_policy[CANDIDATE]]
+        if not trials:
+            continue
+        texts = []
+        for learned in (False, True):
+            mine = [metrics for metrics in trials if bool(metrics.get("calibration_reaches", 0)) == learned]
+            height = np.nanmedian([metrics["height_error_at_arrival_m"] for metrics in mine]) if mine else np.nan
+            force = np.nanmean([metrics["rms_force_change_N"] for metrics in mine]) if mine else np.nan
+            texts.append(f"{len(mine)} trials, {1e3 * height:.0f} mm, {force:.1f} N" if mine else "no trials")
+        parts.append(f"{group}: {texts[0]} against {texts[1]}")
+    return "; ".join(parts)
+
+
+def _range(values: list[float]) -> str:
+    low, high = min(values), max(values)
+    return f"{low:.2g}" if f"{low:.2g}" == f"{high:.2g}" else f"{low:.2g}–{high:.2g}"
 
 
 def _write_csv(rows: list[dict], path: Path) -> None:
