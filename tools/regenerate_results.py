@@ -45,7 +45,7 @@ BLOCKS: dict[str, tuple[str, list[str]]] = {
                       ["studies/which_robot_policy_helps_the_person_in_sync/make_people_comparison.py", "--trials", "10"]),
     "sync-task": ("the paper's synchronisation task: every robot policy with the model's person at four paces and recorded arm reaches (TAT-HUM's and UE_ADL's ten people) at their speed and slower, each robot carrying its calibration of the person, the task's targets met or missed, 10 trials × 4 goals × 26 people (about 70 min in one process; --people, --save and --load split it)",
                   ["studies/which_robot_policy_helps_the_person_in_sync/make_sync_task_targets.py", "--trials", "10"]),
-    "sync-task-variant": ("the same with a person who intends the height too, 5 trials × 4 goals × 26 people (about 40 min)",
+    "sync-task-variant": ("the same with a person who intends the height too, 5 trials × 4 goals × 26 people (about 35 min)",
                           ["studies/which_robot_policy_helps_the_person_in_sync/make_sync_task_targets.py", "--trials", "5", "--variant"]),
     "speed": ("solve times of every preset, warm and cold (several minutes; the machine's load moves them)",
               ["benchmarks/solve_times.py", "--markdown", "--repeats", "20", "--only",
