@@ -13,8 +13,8 @@ and be merged afterwards:
 
 Every policy of :data:`comanip.simulation.policies.POLICIES` meets every person of PEOPLE at every goal of GOALS,
 ``--trials`` trials each (trial k: person seed + k for every policy; a recorded person's seed picks its
-recording of the development split; the continuous and forecast policies' goal estimator uses the person's ONLINE_PRESETS
-entry). Prints, per person and goal, the forecast policy's (CANDIDATE's) mean goal and forecast errors from t_o to MT against constant
+recording of the development split; the continuous and forecast policies' goal estimator uses the person's
+:func:`online_preset`). Prints, per person and goal, the forecast policy's (CANDIDATE's) mean goal and forecast errors from t_o to MT against constant
 velocity's and every policy's RMS force change and the person's work beyond holding (mean ± std over the
 trials), with the verdicts; writes the table's CSV beside this script and docs/figures/policy_comparison_people.png (progress on
 stderr).
@@ -62,9 +62,13 @@ PEOPLE = {
     "arm-x2.5": PersonParameters(hand_path="recorded-arm", pace=2.5),
 }
 
-#: label -> the preset of the continuous and forecast policies' online goal estimator with that person (SyncSettings.online_preset;
-#: absent: the scenario's Cartesian preset): the arm preset, made for a person's hand in 3-D, with the arm reaches.
-ONLINE_PRESETS = {"arm": "arm", "arm-x2.5": "arm"}
+
+
+def online_preset(person: PersonParameters) -> str | None:
+    """The preset of the continuous and forecast policies' online goal estimator with that person
+    (SyncSettings.online_preset; None: the scenario's Cartesian preset): the arm preset, made for a person's hand in
+    3-D, with the arm people (``hand_path="recorded-arm"``)."""
+    return "arm" if person.hand_path == "recorded-arm" else None
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -93,7 +97,7 @@ def main(argv: list[str] | None = None) -> int:
     heavier = [row for row in rows if row.get("force_change_above")]
     more_work = [row for row in rows if row.get("work_above")]
     above_passive = [row for row in rows if "passive" in row.get("work_above", [])]
-    presets_text = "; ".join(f"{label}: `{preset}`" for label, preset in ONLINE_PRESETS.items() if label in results)
+    presets_text = "; ".join(f"{label}: `{online_preset(PEOPLE[label])}`" for label in results if online_preset(PEOPLE[label]))
     block = (f"Measured by `PYTHONPATH=src python -m studies.which_robot_policy_helps_the_person_in_sync.make_people_comparison "
              f"--trials {trials} --seed {seed}{people_option}` ({trials} trials per person, goal and policy, person seeds {seed}–{seed + trials - 1} "
              f"for every policy; goals (m): {goal_text}; people: {', '.join(results)}; the continuous and forecast policies' estimator "
@@ -168,11 +172,14 @@ def _figure(rows: list[dict], policies: list[str], path: Path) -> Path:
     return save_figure(fig, path)
 
 
-def run_or_load(args, people: dict, person_leads_height: bool = False):
+def run_or_load(args, people: dict, person_leads_height: bool = False, arm_folders: dict | None = None,
+                carry_calibration: bool = False):
     """The comparison's results {person: {goal: {policy: trials}}}, its wall time (s), trials and seed, for the
     ``people`` {label: PersonParameters} named by ``args.people`` and the goals of ``args.goals``: loaded from the
-    runs of ``args.load``, or simulated (``person_leads_height``: the variant of the task) and, with ``args.save``,
-    saved there instead (then None)."""
+    runs of ``args.load``, or simulated (``person_leads_height``: the variant of the task; ``carry_calibration``:
+    each estimating robot keeps what it learned of the person from trial to trial, SyncSettings.carry_calibration)
+    and, with ``args.save``, saved there instead (then None). An arm person's reaches come from their
+    ``arm_folders`` entry (label -> folder), else from ``args.arm_reaches``."""
     if args.load:
         runs, wall, trials, seed = load_runs(args.load)
         results = {}
@@ -184,13 +191,15 @@ def run_or_load(args, people: dict, person_leads_height: bool = False):
     unknown = sorted(set(goals) - set(GOALS)) + sorted(set(chosen) - set(people))
     if unknown:
         raise ValueError(f"--goals must name goals of {list(GOALS)} and --people people of {list(people)}, got {unknown}")
-    settings = {label: SyncSettings(goal=GOALS[label], trials=args.trials, seed=args.seed,
+    settings = {label: SyncSettings(goal=GOALS[label], trials=args.trials, seed=args.seed, carry_calibration=carry_calibration,
                                     person_leads_height=person_leads_height) for label in goals}
-    setup = ScenarioSetup(next(iter(settings.values())), arm_reaches=args.arm_reaches)
+    setups: dict[Path, ScenarioSetup] = {}
     began = time.perf_counter()
     results = {}
     for label in chosen:
-        mine = {goal: replace(goal_settings, online_preset=ONLINE_PRESETS.get(label)) for goal, goal_settings in settings.items()}
+        folder = Path((arm_folders or {}).get(label, args.arm_reaches))
+        setup = setups.setdefault(folder, ScenarioSetup(next(iter(settings.values())), arm_reaches=folder))
+        mine = {goal: replace(goal_settings, online_preset=online_preset(people[label])) for goal, goal_settings in settings.items()}
         results.update(compare_with_people(mine, {label: people[label]}, list(POLICIES), setup, progress=True))
     wall = time.perf_counter() - began
     if args.save:

@@ -46,8 +46,8 @@ def test_bad_names_say_what_is_allowed(name, fragment):
     assert "model, recorded, arm or a folder" in str(error.value) and "\n" not in str(error.value)
 
 
-def test_a_folder_not_in_the_tathum_layout_is_refused(tmp_path):
-    with pytest.raises(ValueError, match="TAT-HUM layout: it needs trajectory_data/ and trial_data/"):
+def test_a_folder_of_no_arm_reaches_is_refused(tmp_path):
+    with pytest.raises(ValueError, match=r"neither in the TAT-HUM layout \(trajectory_data/ and trial_data/ inside\) nor"):
         choose_person(str(tmp_path))
 
 
@@ -63,14 +63,16 @@ def test_the_command_lines_person_reaches_the_scenario(tmp_path, monkeypatch):
 
     monkeypatch.setattr(scenario_runs, "run_scenario", run_scenario)
     with pytest.raises(_Chosen) as chosen:
-        main(["simulate", "sync", "--person", "arm-x2.5", "--goal", "near", "--out", str(tmp_path / "out")])
+        main(["simulate", "sync", "--person", "arm-x2.5", "--goal", "near", "--carry-calibration", "--out", str(tmp_path / "out")])
     name, settings_by_goal, arm_reaches = chosen.value.args
     assert name == "sync" and arm_reaches == SHIPPED_ARM_REACHES
     assert settings_by_goal["near"].person == PersonParameters(hand_path="recorded-arm", pace=2.5)
+    assert settings_by_goal["near"].carry_calibration
 
 
 @pytest.mark.parametrize("argv, fragment", [(["sync", "--person", "walker"], "'walker' is neither a name nor a folder"),
-                                            (["handover", "--person", "arm"], "--person applies to the sync scenario only")])
+                                            (["handover", "--person", "arm"], "--person applies to the sync scenario only"),
+                                            (["handover", "--carry-calibration"], "--carry-calibration applies to the sync scenario only")])
 def test_a_bad_person_on_the_command_line_is_one_line_before_any_work(tmp_path, capsys, argv, fragment):
     out = tmp_path / "out"
     assert main(["simulate", *argv, "--out", str(out)]) == 2

@@ -6,8 +6,10 @@ over trials) and figures comparing the policies over the same trials and person 
 person's x–y and the robot's z speed over t / MT), ``--person-leads-height`` makes the person intend the height too
 (default: the paper's task, the height the robot's), and ``--person``
 chooses the person (default: the model's own): ``model``, ``recorded`` (a recorded mouse movement), ``arm`` (a
-recorded arm reach of examples/data/arm_reaches), or a folder of your own arm reaches in the TAT-HUM layout,
-each optionally with ``-xP`` to play it P times slower (``arm-x2.5``) or faster (``model-x0.7``)."""
+recorded arm reach of examples/data/arm_reaches), or a folder of your own arm reaches (the TAT-HUM layout, or
+Vicon Nexus exports: one person's folder or a folder of people's), each optionally with ``-xP`` to play it P times
+slower (``arm-x2.5``) or faster (``model-x0.7``); ``--carry-calibration`` lets the estimating robots keep what they
+learned of the person from trial to trial."""
 
 from __future__ import annotations
 
@@ -36,14 +38,19 @@ def add_parser(subparsers) -> None:
     parser.add_argument("--person-leads-height", action="store_true",
                         help="sync only: the person intends the height too (default: the paper's task, the person "
                              "leads x–y and follows the height the robot leads)")
+    parser.add_argument("--carry-calibration", action="store_true",
+                        help="sync only: the continuous and forecast robots keep what they learned of the person "
+                             "(amplitude, pace, spread) from trial to trial, in seed order (default: every trial's "
+                             "robot meets a person not seen yet)")
     parser.add_argument("--trigger", help="handover only: what releases the robot, goal_distance (default: the handle "
                                           "within T of the known goal) or estimate (within T of the online goal estimate)")
     parser.add_argument("--person", help="sync only: who holds the handle, model (default: the reaching model's "
                                          "person), recorded (a recorded mouse movement, the 'data' extra), arm (a "
                                          "recorded arm reach of examples/data/arm_reaches) or FOLDER (your own arm "
-                                         "reaches, TAT-HUM layout); add -xP to play it P times as long, e.g. "
-                                         "arm-x2.5; the trial with seed s plays recording 37·s mod N of the N "
-                                         "that play as a reach")
+                                         "reaches: TAT-HUM layout, or Vicon Nexus exports, one person's folder such "
+                                         "as ue_adl/ADL003 or a folder of people's); add -xP to play it P times as "
+                                         "long, e.g. arm-x2.5; the trial with seed s plays recording 37·s mod N of "
+                                         "the N that play as a reach")
     add_output_arguments(parser, "out/simulate")
     parser.add_argument("--no-frames", action="store_true", help="skip the rendered frame strip")
     parser.add_argument("--viewer", action="store_true", help="replay the first trial in MuJoCo's viewer (needs a display)")
@@ -107,6 +114,10 @@ def scenario_settings(args) -> ScenarioChoice:
         if args.scenario != "sync":
             raise ValueError(f"--person-leads-height applies to the sync scenario only, got scenario {args.scenario!r}")
         common["person_leads_height"] = True
+    if args.carry_calibration:
+        if args.scenario != "sync":
+            raise ValueError(f"--carry-calibration applies to the sync scenario only, got scenario {args.scenario!r}")
+        common["carry_calibration"] = True
     if args.person is not None:
         if args.scenario != "sync":
             raise ValueError(f"--person applies to the sync scenario only, got scenario {args.scenario!r}")

@@ -9,8 +9,11 @@ A name is one of
   (:class:`~comanip.simulation.recorded_person.RecordedPerson`);
 - ``arm``: the same with a motion-capture arm reach in 3-D, one of the ten shipped in
   ``examples/data/arm_reaches/`` (:data:`SHIPPED_ARM_REACHES`);
-- a folder of the user's own arm reaches in the TAT-HUM layout (:func:`comanip.recordings.load_tathum`:
-  ``trajectory_data/`` and ``trial_data/`` inside), played as ``arm`` plays the shipped ones;
+- a folder of the user's own arm reaches, played as ``arm`` plays the shipped ones (:func:`arm_reach_layout`): in
+  the TAT-HUM layout (:func:`comanip.recordings.load_tathum`: ``trajectory_data/`` and ``trial_data/`` inside), or
+  Vicon Nexus trajectories exports (:func:`comanip.recordings.load_nexus_trajectories`, the fingertip of the arm
+  that reached), one person's folder (``ue_adl/ADL003``: that person alone) or a folder of people's (one
+  sub-folder each);
 
 optionally followed by ``-xP``, P > 0 the person's pace: their whole movement takes P times as long
 (:attr:`PersonParameters.pace`; ``arm-x2.5``: the arm reach played 2.5 times slower, ``model-x0.7``: the model's
@@ -39,8 +42,9 @@ PERSON_NAMES = {"model": "model", "recorded": "recorded", "arm": "recorded-arm"}
 
 _PACED = re.compile(r"^(?P<name>.+)-x(?P<pace>[0-9]*\.?[0-9]+)$")
 
-USAGE = ("model, recorded, arm or a folder of arm reaches in the TAT-HUM layout, each optionally with -xP, "
-         "P > 0 its pace (arm-x2.5: 2.5 times slower)")
+USAGE = ("model, recorded, arm or a folder of arm reaches (TAT-HUM layout, or Vicon Nexus exports: one person's "
+         "folder such as ue_adl/ADL003, or a folder of people's), each optionally with -xP, P > 0 its pace "
+         "(arm-x2.5: 2.5 times slower)")
 """What a person's name may be, for error messages and help texts."""
 
 
@@ -53,7 +57,8 @@ class ChosenPerson:
     parameters: PersonParameters
     """Where their intended hand path comes from and their pace; the arm impedance is the default's."""
     arm_reaches: Path | None
-    """The TAT-HUM data folder of an arm person's reaches (the setup's ``arm_reaches``); None for the others."""
+    """The folder of an arm person's reaches (the setup's ``arm_reaches``; :func:`arm_reach_layout`); None for the
+    others."""
 
 
 def choose_person(name: str) -> ChosenPerson:
@@ -78,10 +83,25 @@ def choose_person(name: str) -> ChosenPerson:
     folder = Path(base)
     if not folder.is_dir():
         raise ValueError(f"the person must be {USAGE}; {base!r} is neither a name nor a folder")
-    if not (folder / "trajectory_data").is_dir() or not (folder / "trial_data").is_dir():
-        raise ValueError(f"the person's folder {base!r} is not in the TAT-HUM layout: it needs trajectory_data/ and "
-                         f"trial_data/ inside (docs/data_formats.md)")
+    arm_reach_layout(folder)
     return ChosenPerson(name, PersonParameters(hand_path="recorded-arm", pace=pace), folder)
+
+
+def arm_reach_layout(folder: str | Path) -> str:
+    """How a folder of arm reaches is laid out: ``"tathum"`` (``trajectory_data/`` and ``trial_data/`` inside) or
+    ``"nexus"`` (Vicon Nexus trajectories exports in it, or in one sub-folder per person); a one-line ValueError
+    saying what a folder needs otherwise. Reads no more than the first line of the CSV files in it (and in its
+    sub-folders)."""
+    from comanip.recordings.nexus_trajectories import nexus_exports
+
+    folder = Path(folder)
+    if (folder / "trajectory_data").is_dir() and (folder / "trial_data").is_dir():
+        return "tathum"
+    if nexus_exports(folder):
+        return "nexus"
+    raise ValueError(f"the arm reaches' folder {str(folder)!r} is neither in the TAT-HUM layout (trajectory_data/ and "
+                     f"trial_data/ inside) nor holds Vicon Nexus trajectories exports (in it or in one sub-folder per "
+                     f"person; docs/data_formats.md)")
 
 
 def shipped_arm_reaches() -> Path:

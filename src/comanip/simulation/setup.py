@@ -1,6 +1,7 @@
 """What a scenario builds once and reuses for every trial: the world, the person's planner, the robot's
 planner or estimator, the settled start, the person's first plan and, for recorded people, the recordings
-(mouse movements of the cursory development split, or motion-capture arm reaches from a TAT-HUM data folder).
+(mouse movements of the cursory development split, or motion-capture arm reaches from a folder of them: TAT-HUM's
+layout or Vicon Nexus exports).
 
 Building the solvers takes seconds; a trial then takes a fraction of its simulated time. One
 :class:`ScenarioSetup` can serve several runs of the same scenario family (e.g. a near and a far goal):
@@ -20,6 +21,7 @@ from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
 from comanip.planning.planner import Planner, SolverOptions
 from comanip.recordings.recording import Recording
+from comanip.simulation.people import arm_reach_layout
 from comanip.simulation.person import PersonParameters, SimulatedPerson, solve_to_convergence
 from comanip.simulation.recorded_person import RECORDING_STRIDE, RecordedPerson, surface_normal, usable_for_reach
 from comanip.simulation.scenario import ScenarioSettings, SettledStart, settle
@@ -29,8 +31,10 @@ from comanip.simulation.world import CoManipulationWorld
 class ScenarioSetup:
     """Shared, lazily built parts of the scenarios for one set of settings (goal and trial count aside).
 
-    arm_reaches: a TAT-HUM data folder of motion-capture arm reaches (:func:`comanip.recordings.load_tathum`),
-    the intended paths of people with ``hand_path="recorded-arm"``; None: no such people.
+    arm_reaches: a folder of motion-capture arm reaches (:func:`comanip.simulation.people.arm_reach_layout`: a
+    TAT-HUM data folder, :func:`comanip.recordings.load_tathum`, or Vicon Nexus exports of one person or of one
+    sub-folder per person, :func:`comanip.recordings.load_nexus_trajectories`, the fingertip of the arm that
+    reached), the intended paths of people with ``hand_path="recorded-arm"``; None: no such people.
     """
 
     def __init__(self, settings: ScenarioSettings, arm_reaches: str | Path | None = None):
@@ -95,12 +99,15 @@ class ScenarioSetup:
     @cached_property
     def arm_recordings(self) -> list[Recording]:
         """The arm reaches of the ``arm_reaches`` folder that play as a reach (:func:`usable_for_reach`), by
-        participant and trial: the intended paths of people with ``hand_path="recorded-arm"``."""
+        participant and trial (TAT-HUM) or by file (Nexus exports): the intended paths of people with
+        ``hand_path="recorded-arm"``."""
         if self.arm_reaches is None:
-            raise ValueError('people with hand_path="recorded-arm" need the setup\'s arm_reaches folder (TAT-HUM layout)')
-        from comanip.recordings import load_tathum
+            raise ValueError('people with hand_path="recorded-arm" need the setup\'s arm_reaches folder (TAT-HUM layout '
+                             'or Vicon Nexus exports)')
+        from comanip.recordings import load_nexus_trajectories, load_tathum
 
-        recordings = [trial.recording() for trial in load_tathum(self.arm_reaches)]
+        load = load_tathum if arm_reach_layout(self.arm_reaches) == "tathum" else load_nexus_trajectories
+        recordings = [trial.recording() for trial in load(self.arm_reaches)]
         usable = [recording for recording in recordings if usable_for_reach(recording)]
         if not usable:
             raise ValueError(f"none of the {len(recordings)} arm reaches in {str(self.arm_reaches)!r} plays as a reach "

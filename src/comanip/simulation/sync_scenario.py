@@ -41,7 +41,7 @@ from comanip.planning.plan import Plan
 from comanip.progress import progress_bar
 from comanip.simulation.rest_trajectory import RestTarget
 from comanip.simulation.measures import trial_measures
-from comanip.simulation.policies import POLICIES, PolicyContext, Prediction, RobotPolicy, check_policy
+from comanip.simulation.policies import POLICIES, ContinuousPolicy, PolicyContext, Prediction, RobotPolicy, check_policy
 from comanip.simulation.policies.protocol import DEFAULT_UPDATE_INTERVAL
 from comanip.simulation.rest_trajectory import RestTrajectory
 from comanip.simulation.scenario import TABLE_CENTRE, ScenarioSettings, SettledStart, TrialRecord, check_workspace, reach_times, run_trial
@@ -77,6 +77,11 @@ class SyncSettings(ScenarioSettings):
     """The reaching model of the continuous policy's online goal estimator, a preset name of
     :mod:`comanip.presets` (e.g. ``"arm"``, a person's arm in 3-D); None: the scenario's model (the Cartesian
     preset)."""
+    carry_calibration: bool = False
+    """True: the estimating robots (``continuous``, ``forecast``) keep what they learned of the person from trial to
+    trial of a run (:mod:`comanip.estimation.calibration.person_calibration`: amplitude, pace and spread), so trial k
+    (seed + k) starts with the calibration learned from trials 0..k-1, in seed order; each run (one person, goal and
+    policy) starts with a person not seen yet. False: every trial's robot meets a person not seen yet."""
 
     def __post_init__(self):
         super().__post_init__()
@@ -85,6 +90,8 @@ class SyncSettings(ScenarioSettings):
         if self.online_preset is not None and self.online_preset not in presets.names():
             raise ValueError(f"online_preset must be one of {presets.names()} or None, got {self.online_preset!r}")
         as_positive("update_interval", self.update_interval, "s")
+        if not isinstance(self.carry_calibration, bool):
+            raise ValueError(f"carry_calibration must be True or False, got {self.carry_calibration!r}")
         object.__setattr__(self, "prior_goal", tuple(check_workspace(
             as_vector("prior_goal", self.prior_goal, 3, "m, robot base frame"), "prior_goal").tolist()))
 
@@ -251,7 +258,9 @@ def policy_context(settings: SyncSettings, setup: ScenarioSetup, start: SettledS
 
 def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progress: bool = True) -> list[SyncTrial]:
     """Run the synchronisation scenario's trials (one per seed) with the settings' policy, with a progress bar
-    unless progress=False. Trial k's person (seed + k) is the same whatever the policy."""
+    unless progress=False. Trial k's person (seed + k) is the same whatever the policy; with
+    ``settings.carry_calibration`` an estimating robot starts trial k knowing what it learned of them in trials
+    0..k-1 (each trial's metrics say what: :func:`calibration_metrics`)."""
     setup = setup or ScenarioSetup(settings)
     start = setup.settled_start(np.zeros(3))
     goal, width = np.asarray(settings.goal), setup.width
@@ -259,17 +268,21 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
     context = policy_context(settings, setup, start)
     trials = []
     person_parameters = replace(settings.person, led_axes=person_axes(settings))
+    calibration = None
     for k in progress_bar(f"sync {settings.policy} to {np.round(goal, 2).tolist()}", settings.trials, "trial", progress,
                            iterable=range(settings.trials)):
         person = setup.person(start, goal, settings.seed + k, first_plan, person_parameters)
-        policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials)))
+        policy = POLICIES[settings.policy](replace(context, warm_start=_successful_estimate(trials), person=calibration))
+        known = calibration_metrics(policy)
         robot = PolicyRobot(setup.world.controller, policy, settings)
         record = run_trial(setup.world, start, person, robot, context.duration)
+        if settings.carry_calibration and isinstance(policy, ContinuousPolicy):
+            calibration = policy.finish_trial()
         prediction = robot.prediction
         estimated = np.full((len(record.t), 3), np.nan) if prediction is None else np.array([prediction.rest(t)[0] for t in record.t])
         metrics, grid, error = sync_metrics(record, robot.goal_estimate, estimated, width, settings.observation_time,
                                             robot.history)
-        metrics["predictions"] = robot.predictions
+        metrics.update(predictions=robot.predictions, **known)
         if prediction is not None and prediction.estimate is not None and prediction.estimate is not context.prior_plan:
             estimate = prediction.estimate
             metrics.update(estimate_success=bool(estimate.success), estimate_status=str(estimate.status),
@@ -277,6 +290,17 @@ def run_sync(settings: SyncSettings, setup: ScenarioSetup | None = None, progres
         trials.append(SyncTrial(record, settings.policy, None if prediction is None else prediction.estimate, estimated,
                                 metrics, grid, error))
     return trials
+
+
+def calibration_metrics(policy: RobotPolicy) -> dict:
+    """What an estimating robot (continuous, forecast) knows of the person as its trial starts: the reaches it has
+    learned from (``calibration_reaches``) and its amplitude, pace and spread factors (1 for a person not seen
+    yet); {} for the other policies."""
+    if not isinstance(policy, ContinuousPolicy):
+        return {}
+    person = policy.estimator.person
+    return {"calibration_reaches": person.reaches, "calibration_amplitude": person.amplitude,
+            "calibration_pace": person.pace, "calibration_spread": person.spread}
 
 
 def _successful_estimate(trials: list[SyncTrial]) -> Plan | None:

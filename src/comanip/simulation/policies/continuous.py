@@ -12,6 +12,7 @@ import dataclasses
 
 import numpy as np
 
+from comanip.estimation import PersonCalibration
 from comanip.estimation.online.online_estimator import OnlineGoalEstimator
 from comanip.estimation.streaming import online_settings
 from comanip.estimation.streaming.online_settings import OnlineSettings
@@ -49,15 +50,23 @@ class ContinuousPolicy:
         self.context = context
         self.update_interval = context.update_interval
         self.settings = robot_estimation(context, settings)
-        self.loop = self.settings.estimation_loop(context.start, prior_goal=context.prior_goal, model=context.online_model)
+        self.loop = self.settings.estimation_loop(context.start, prior_goal=context.prior_goal, model=context.online_model,
+                                                  person=context.person)
         """The loop that paces the robot's observations (:class:`~comanip.estimation.EstimationLoop`): one reach, from
-        the trial's start at t = 0."""
+        the trial's start at t = 0, for the context's person (a person not seen yet when it has none)."""
         self.loop.begin(0.0, context.start[:context.online_model.n])
 
     @property
     def estimator(self) -> OnlineGoalEstimator:
         """The robot's online estimator."""
         return self.loop.estimator
+
+    def finish_trial(self) -> PersonCalibration:
+        """The trial is over: learn the person from its reach (where the hand came to rest away from its start;
+        :meth:`~comanip.estimation.online.online_estimator.OnlineGoalEstimator.finish_reach`) and return what the
+        robot now knows of them, for the next trial's context (``PolicyContext.person``)."""
+        self.estimator.finish_reach()
+        return self.estimator.person
 
     def observe(self, t: float, position: np.ndarray, velocity: np.ndarray, force: np.ndarray) -> None:
         self.loop.add_sample(t, position, velocity)

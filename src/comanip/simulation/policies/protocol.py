@@ -15,7 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from comanip.analysis.speed_profile import speed_metrics
-from comanip.estimation import GoalEstimator, OnlineEstimate
+from comanip.estimation import GoalEstimator, OnlineEstimate, PersonCalibration
 from comanip.model import ReachingModel
 from comanip.planning.plan import Plan
 from comanip.simulation.rest_trajectory import RestTrajectory
@@ -58,6 +58,10 @@ class PolicyContext:
     """The placing height (m) when the scenario knows it (``SyncSettings.known_height``), else None. The robot
     applies it to every prediction (:func:`comanip.simulation.sync_scenario.end_at_height`); a policy may lead to
     it itself."""
+    person: PersonCalibration | None = None
+    """What the robot knows of the person when the trial starts: the calibration the estimating policies
+    (continuous, forecast) apply to their online estimates and learn into from the trial's reach, in place
+    (``finish_trial()``); None: a person not seen yet (:attr:`comanip.simulation.sync_scenario.SyncSettings.carry_calibration`)."""
 
     @cached_property
     def expected_movement_time(self) -> float:
