@@ -126,3 +126,41 @@ def test_reset_sets_a_new_prior_goal_or_keeps_the_one_before(cartesian_planner):
     np.testing.assert_array_equal(estimator.prior_mean, [0.1, 0.0, 0.0])
     with pytest.raises(ValueError, match="prior_goal"):
         estimator.reset(np.zeros(6), prior_goal=[0.1, 0.2])
+
+
+def led_run(planner, reaches, led_axes):
+    """A person at the model's pace horizontally whose height a partner brings to 0.3 of where the model would:
+    the calibration learned over their reaches by an estimator told the height is led (``led_axes``) or not."""
+    person = PersonCalibration()
+    options = OnlineOptions(timing="model", led_axes=led_axes, correction_time=0.3 if led_axes else None)
+    for plan in reaches[:4]:
+        estimator = comanip.OnlineGoalEstimator(planner, np.zeros(6), options=options, person=person)
+        t, x, v = played(plan, 1.0)
+        x, v = x * [1, 1, 0.3], v * [1, 1, 0.3]
+        for k in range(1, len(t)):
+            estimator.update(t[k], x[k], v[k])
+        estimator.finish_reach()
+    return person
+
+
+def test_the_calibration_learns_nothing_from_the_axes_a_partner_leads(cartesian_planner, reaches):
+    led, unled = led_run(cartesian_planner, reaches, (2,)), led_run(cartesian_planner, reaches, ())
+    assert led.reaches == unled.reaches == 4
+    assert abs(led.amplitude - 1.0) < 0.05 < abs(unled.amplitude - 1.0), (led.amplitude, unled.amplitude)
+
+
+def test_a_calibration_on_some_axes_leaves_the_others_as_they_are():
+    person = PersonCalibration()
+    person._amplitudes, person.spread = [np.log(0.5)], 4.0            # a person who stops short, spread out
+    rng = np.random.default_rng(0)
+    root = rng.normal(size=(3, 3))
+    hand, goal, covariance = rng.normal(size=3), rng.normal(size=3), root @ root.T
+    new_goal, new_covariance = person.goal(hand, goal, covariance, axes=[0, 1])
+    assert new_goal[2] == goal[2] and new_covariance[2, 2] == covariance[2, 2]
+    np.testing.assert_allclose(new_goal[:2], hand[:2] + person.amplitude * (goal[:2] - hand[:2]))
+    factor = person.spread * person.amplitude**2
+    np.testing.assert_allclose(new_covariance[:2, :2], factor * covariance[:2, :2])
+    assert np.linalg.eigvalsh(new_covariance).min() > 0
+    everywhere = person.goal(hand, goal, covariance)
+    np.testing.assert_allclose(everywhere[1], factor * covariance)
+    np.testing.assert_allclose(person.goal(hand, goal, covariance, axes=[0, 1, 2])[1], everywhere[1])

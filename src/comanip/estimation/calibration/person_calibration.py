@@ -30,6 +30,7 @@ Shapes: d task dimensions, K estimates.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -243,12 +244,33 @@ class PersonCalibration:
         seen, weight = min(max(seen, SPREAD_RANGE[0]), SPREAD_RANGE[1]), self.settings.prior_reaches
         return math.exp((weight * math.log(new_person) + self.reaches * math.log(seen)) / (weight + self.reaches))
 
-    def goal(self, hand: np.ndarray, goal: np.ndarray, covariance: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(goal (d,) m, covariance (d, d) m²) of an estimate for this person, the hand at ``hand`` (d,) m."""
+    def goal(self, hand: np.ndarray, goal: np.ndarray, covariance: np.ndarray,
+             axes: Sequence[int] | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """(goal (d,) m, covariance (d, d) m²) of an estimate for this person, the hand at ``hand`` (d,) m.
+
+        ``axes``: the axes the person leads (what they were learned from); the others are left as they are.
+        None: every axis."""
         a, factor = self.amplitude, self.spread * self.amplitude**2
-        return (goal if a == 1.0 else hand + a * (goal - hand)), (covariance if factor == 1.0 else factor * covariance)
+        if a != 1.0:
+            axes = list(range(goal.size)) if axes is None else list(axes)
+            goal = goal.copy()
+            goal[axes] = hand[axes] + a * (goal[axes] - hand[axes])
+        return goal, scaled_on_axes(covariance, factor, axes)
 
     def stop(self, t_now: float, stop_s: float) -> float:
         """The stop time (s) of an estimate made at ``t_now`` (s) that said ``stop_s`` (s)."""
         pace = self.pace
         return stop_s if pace == 1.0 else t_now + pace * max(stop_s - t_now, 0.0)
+
+
+def scaled_on_axes(covariance: np.ndarray, factor: float, axes: Sequence[int] | None) -> np.ndarray:
+    """``covariance`` (..., d, d) with its variances along ``axes`` times ``factor`` and their covariances with the
+    other axes times √factor (D P D, D diagonal: √factor on ``axes``, 1 elsewhere; positive semidefinite as P is).
+    None: every axis (factor · P)."""
+    if factor == 1.0:
+        return covariance
+    if axes is None:
+        return factor * covariance
+    scale = np.ones(covariance.shape[-1])
+    scale[list(axes)] = math.sqrt(factor)
+    return covariance * scale[:, None] * scale[None, :]

@@ -62,7 +62,8 @@ from comanip.estimation.model_reaches.model_families import FamilyCache, default
 from comanip.estimation.online.online_estimate import OnlineEstimate
 from comanip.estimation.online.online_options import OnlineOptions
 from comanip.estimation.model_reaches.reach_timing import timed_plan
-from comanip.estimation.calibration.person_calibration import FORECAST_LEADS, FinishedReach, PersonCalibration, ReachFactors
+from comanip.estimation.calibration.person_calibration import (FORECAST_LEADS, FinishedReach, PersonCalibration, ReachFactors,
+                                                               scaled_on_axes)
 from comanip.model import ReachingModel
 from comanip.estimation.estimate_status import EstimateStatus
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S, MAX_HUMAN_REACH_M
@@ -124,6 +125,8 @@ class OnlineGoalEstimator:
         self.family = families.family(width, o.family_distances, o.family_size, o.family_tolerance)
         if any(a >= n for a in self.options.led_axes):
             raise ValueError(f"options.led_axes must be axes 0..{n - 1} of the hand position, got {self.options.led_axes!r}")
+        self._person_axes = [a for a in range(n) if a not in self.options.led_axes]
+        """The axes the person leads: what the calibration learns from and applies to (a partner leads the others)."""
         self.explanations = (list(explanations) if explanations is not None
                              else default_explanations(self.model, self.options, self.family))
         self._at_rest_first = bool(self.explanations) and isinstance(self.explanations[0], HandAtRest)
@@ -183,8 +186,12 @@ class OnlineGoalEstimator:
         end_s = float(hand.t[np.flatnonzero(speed >= 0.05 * speed.max())[-1]])
         t, hands, goals, covariances, stops = (np.array(column) for column in zip(*history))
         ahead, ahead_covariances = (np.array(column) for column in zip(*forecasts))
-        return self.person.learn(FinishedReach(self.start_position, end, onset, end_s, t, hands, goals, covariances, stops,
-                                               ahead, ahead_covariances, hand.t.copy(), hand.position.copy()))
+        axes = self._person_axes                 # a partner's axes say nothing of the person
+        block = np.ix_(axes, axes)
+        return self.person.learn(FinishedReach(self.start_position[axes], end[axes], onset, end_s, t, hands[:, axes],
+                                               goals[:, axes], covariances[:, block[0], block[1]], stops,
+                                               ahead[..., axes], ahead_covariances[..., block[0], block[1]],
+                                               hand.t.copy(), hand.position[:, axes].copy()))
 
     def forget_person(self) -> None:
         """Forget what was learned of the person: the next reaches are a new person's."""
@@ -397,7 +404,7 @@ class OnlineGoalEstimator:
         goal, covariance = np.array(explained.goal, dtype=float), np.array(explained.covariance, dtype=float)
         if status != EstimateStatus.UNINFORMATIVE:
             self._history.append((self._last_time, observed[:n].copy(), goal, covariance, math.nan if stop is None else stop))
-            goal, covariance = self.person.goal(observed[:n], goal, covariance)
+            goal, covariance = self.person.goal(observed[:n], goal, covariance, self._person_axes)
             stop = None if stop is None else self.person.stop(self._last_time, stop)
         unsmoothed = goal, covariance
         if self._smoother is not None:
@@ -417,7 +424,8 @@ class OnlineGoalEstimator:
                 ahead = forecast.at(self._last_time + np.array(FORECAST_LEADS))
                 self._forecasts.append((ahead.position, ahead.covariance))
             if self.person.forecast_spread != 1.0:
-                forecast = dataclasses.replace(forecast, cov=self.person.forecast_spread * forecast.cov)
+                forecast = dataclasses.replace(forecast, cov=scaled_on_axes(forecast.cov, self.person.forecast_spread,
+                                                                            self._person_axes))
             path = within_horizon(forecast, self.options.forecast_horizon)
         return OnlineEstimate(goal=goal, goal_covariance=covariance, status=status,
                               message="; ".join([*reasons, explained.message]), t_obs=self._last_time, path=path,

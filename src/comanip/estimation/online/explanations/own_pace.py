@@ -41,7 +41,6 @@ from comanip.estimation.observation import observation_covariance
 from comanip.estimation.online.observation_whitening import ObservationWhitening
 from comanip.estimation.online.online_options import OnlineOptions
 from comanip.model import ReachingModel
-from comanip.estimation.estimate_status import EstimateStatus
 from comanip.optim import Status
 from comanip.plausibility import MAX_HUMAN_HAND_SPEED_M_S
 
