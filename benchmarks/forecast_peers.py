@@ -150,6 +150,33 @@ def leave_one_person_out(people: dict[str, list], fit):
         yield person, fit([r for other, recordings in people.items() if other != person for r in recordings])
 
 
+def people_models(people: dict[str, list], cache: Path | None = None, log=sys.stderr) -> dict:
+    """{person: the ``arm`` people model (:class:`~comanip.estimation.people.people_model.PeopleModel`) fitted on every
+    other person's reaches} (:func:`leave_one_person_out`). ``cache``: a folder where each fit is kept as
+    ``<reaches>-<digest>.npz``, the count and a digest of the names of the reaches it was fitted on, and read back by
+    the next run on the same reaches (a fit takes about a minute)."""
+    import hashlib
+
+    from comanip.estimation.people.people_model import PeopleModel
+
+    def fit(recordings):
+        names = sorted(r.name for r in recordings)
+        path = None
+        if cache is not None:
+            digest = hashlib.sha256("\n".join(names).encode()).hexdigest()[:12]
+            path = cache / f"{len(names)}-{digest}.npz"
+            if path.is_file():
+                return PeopleModel.load(path)
+        print(f"  fitting the people model on {len(recordings)} reaches of the other people ...", flush=True, file=log)
+        model = PeopleModel.fit(recordings, kind="arm")
+        if path is not None:
+            cache.mkdir(parents=True, exist_ok=True)
+            model.save(path)
+        return model
+
+    return dict(leave_one_person_out(people, fit))
+
+
 def comanip_paths(recording, people_model, ks) -> dict[int, np.ndarray]:
     """{k: where comanip's forecast puts the hand at +LEADS s from sample k (len(LEADS), d) m}, the online estimator
     (``arm`` preset, ``people_model``) fed every sample up to the largest k; a k without a forecast is left out."""

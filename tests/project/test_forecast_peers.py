@@ -96,3 +96,24 @@ def test_the_tables_give_each_person_and_the_medians(peers):
     assert table[0.5]["all reaches"][peers.LEARNED] == pytest.approx([0.3, 0.31, 0.32])
     text = peers.markdown(table, [*peers.KINEMATIC, peers.LEARNED], {"A": 3, "B": 3})
     assert "| A | 3 | 0.200 / 0.210 / 0.220 |" in text and "for 0 of 2 people" in text
+
+
+def test_the_kept_people_models_are_read_back_only_for_the_reaches_they_were_fitted_on(peers, tmp_path, monkeypatch):
+    from comanip.estimation.people.people_model import PeopleModel
+
+    people = people_of_reaches()
+    fitted = peers.people_models(people, tmp_path)
+    assert len(list(tmp_path.glob("*.npz"))) == len(people)
+    probe = people["A"][1]
+    original_fit, refitted = PeopleModel.fit, []
+    monkeypatch.setattr(PeopleModel, "fit", lambda recordings, kind: refitted.append({r.name for r in recordings})
+                        or original_fit(recordings, kind=kind))
+    again = peers.people_models(people, tmp_path)
+    assert refitted == []                                              # every fit read back
+    seen = (probe.t[:60], probe.position[:60], probe.velocity[:60], probe.position[0])
+    for person in people:
+        assert np.array_equal(again[person].predict(*seen).goal, fitted[person].predict(*seen).goal)
+    fewer = {**people, "B": people["B"][:2]}                          # B has one reach less: A's and C's fits change
+    peers.people_models(fewer, tmp_path)
+    assert sorted(map(sorted, refitted)) == sorted(sorted({r.name for p, rs in fewer.items() if p != left for r in rs})
+                                                   for left in ("A", "C"))
