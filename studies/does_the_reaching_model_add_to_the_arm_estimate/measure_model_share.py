@@ -47,7 +47,7 @@ PHASE = np.linspace(0.0, 1.0, 201)
 
 def people_shape(recordings) -> tuple[ReachProfile, float]:
     """The recordings' mean progress along their line, r(phi) from onset to end, and their median movement time (s)."""
-    fractions, rates, times = [], [], []
+    fractions, rates = [], []
     for r in recordings:
         inside = (r.t >= r.onset) & (r.t <= r.end_time)
         t, p, v = r.t[inside], r.position[inside], r.velocity[inside]

@@ -6,7 +6,6 @@ every symbol the page names exists in the package."""
 
 import ast
 import re
-from pathlib import Path
 
 from comanip.caching.module_imports import PACKAGE, import_graph, module_files
 import pytest
