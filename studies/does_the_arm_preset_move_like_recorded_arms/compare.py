@@ -13,7 +13,12 @@ closed-loop executions at their end; Fitts' law of the plans on the validation g
 normalised in time (by MT, from the onset) and amplitude (by the peak), the model over the people's
 10–90 % band.
 
+``--people``: the same timing person by person on the eleven recorded arm people (TAT-HUM's and UE_ADL's ten,
+read as benchmarks/forecast_peers.py reads them), each against the preset's closed loop over that person's median
+distance: does the timing the preset was fitted to (one person at 0.22 m) carry to people it was not fitted on?
+
     PYTHONPATH=src python -m studies.does_the_arm_preset_move_like_recorded_arms.compare [--preset arm] [--figure PATH]
+    PYTHONPATH=src python -m studies.does_the_arm_preset_move_like_recorded_arms.compare --people [--trials 8]
 """
 
 from __future__ import annotations
@@ -35,7 +40,12 @@ PHASE = np.linspace(0.0, 1.0, 51)
 
 def people(folder: Path) -> dict:
     trials = load_tathum(folder)
-    recordings = [trial.recording() for trial in trials]
+    return recorded_metrics(trials, [trial.recording() for trial in trials])
+
+
+def recorded_metrics(trials, recordings) -> dict:
+    """The people's quantities (module docstring) of ``recordings``, the preprocessed ``trials`` (their labels name
+    each reach's target)."""
     asymmetry, profiles, peaks = [], [], []
     for r in recordings:
         speed = np.linalg.norm(r.velocity, axis=1)
@@ -70,6 +80,15 @@ def timing(t: np.ndarray, speed: np.ndarray) -> dict:
             "profile": np.interp(metrics.onset + PHASE * metrics.movement_time, t, speed) / metrics.peak_speed}
 
 
+def closed_loop(model, distance: float, trials: int) -> tuple[dict, list]:
+    """(the timing (:func:`timing`) of their mean, the executions) of ``trials`` closed-loop executions of the
+    preset's reach over ``distance`` (m)."""
+    planner = comanip.Planner(model)
+    start, goal, rng = np.zeros(model.state_size), np.array([distance, 0.0, 0.0]), np.random.default_rng(0)
+    runs = [execute_receding_horizon(planner, start, goal, model.width, steps=2 * model.H, rng=rng) for _ in range(trials)]
+    return timing(runs[0].t, np.linalg.norm(np.mean([run.ee_velocity for run in runs], axis=0), axis=1)), runs
+
+
 def model_reach(model, distance: float, trials: int) -> dict:
     planner = comanip.Planner(model)
     start = np.zeros(model.state_size)
@@ -78,13 +97,46 @@ def model_reach(model, distance: float, trials: int) -> dict:
     planned = timing(plan.t, plan.ee_speed)
     at_mt = int(np.searchsorted(plan.t, speed_metrics(plan.t, plan.ee_speed).movement_time))
     planned["endpoint_sd"] = float(np.sqrt(np.trace(plan.ee_cov[at_mt]) / model.d))
-    rng = np.random.default_rng(0)
-    runs = [execute_receding_horizon(planner, start, goal, model.width, steps=2 * model.H, rng=rng) for _ in range(trials)]
-    closed = timing(runs[0].t, np.linalg.norm(np.mean([run.ee_velocity for run in runs], axis=0), axis=1))
+    closed, runs = closed_loop(model, distance, trials)
     closed["endpoint_sd"] = float(np.sqrt(np.mean(np.var([run.ee[-1] for run in runs], axis=0))))
     grid = [(D, w, speed_metrics(*(lambda p: (p.t, p.ee_speed))(planner.solve(start, [D, 0.0, 0.0], w))).movement_time)
             for D in (0.15, 0.3, 0.45) for w in (0.005, 0.01, 0.02, 0.04)]
     return {"plan": planned, "closed": closed, "fitts": fit_fitts(*map(np.array, zip(*grid)))}
+
+
+def by_person(preset: str, trials: int) -> None:
+    """The --people table (module docstring), with the share of people whose median MT the preset's is within
+    10 % of and whose IQR of t_peak / MT holds the preset's."""
+    from comanip.recordings import load_nexus_trajectories
+    from comanip.recordings.motion_capture import STREAM_LEAD_S
+    tathum, ue_adl = ARMS, ARMS.parents[1] / "ue_adl"
+    people_trials = {}
+    for person, trial in ([(f"TAT-HUM {t.label['participant']}", t) for t in load_tathum(tathum)]
+                          + [(t.label["participant"], t) for t in load_nexus_trajectories(ue_adl)]):
+        recording = trial.recording()
+        if recording.onset >= STREAM_LEAD_S:            # the reaches the other arm-people blocks score
+            people_trials.setdefault(person, []).append((trial, recording))
+    model = comanip.presets.load(preset)
+    print(f"The `{preset}` preset's closed loop ({trials} executions) over each recorded arm person's median distance, "
+          "against the person's reaches: median [IQR]\n")
+    print("| person | reaches | distance (m) | MT (s): people; preset | t_peak / MT: people; preset | "
+          "peak speed (m/s): people; preset |\n|---|---|---|---|---|---|")
+    within, inside = 0, 0
+    q = lambda x: f"{np.median(x):.3g} [{np.percentile(x, 25):.3g}–{np.percentile(x, 75):.3g}]"
+    for person, pairs in people_trials.items():
+        recorded = recorded_metrics(*zip(*pairs))
+        D = float(np.median(recorded["distance"]))
+        closed, _ = closed_loop(model, D, trials)
+        mt = float(np.median(recorded["movement_time"]))
+        low, high = np.percentile(recorded["asymmetry"], [25, 75])
+        within += abs(closed["movement_time"] / mt - 1) <= 0.1
+        inside += low <= closed["asymmetry"] <= high
+        print(f"| {person} | {recorded['count']} | {D:.3f} | {q(recorded['movement_time'])}; {closed['movement_time']:.3f} | "
+              f"{q(recorded['asymmetry'])}; {closed['asymmetry']:.3f} | {q(recorded['peak_speed'])}; "
+              f"{closed['peak_speed']:.3f} |")
+    count = len(people_trials)
+    print(f"\nThe preset's MT within 10 % of the person's median for {within} of {count} people; its t_peak / MT inside "
+          f"the person's IQR for {inside} of {count}.")
 
 
 def main(argv=None):
@@ -93,7 +145,10 @@ def main(argv=None):
     parser.add_argument("--preset", default="arm")
     parser.add_argument("--trials", type=int, default=32, help="closed-loop executions averaged")
     parser.add_argument("--figure", type=Path, default=None)
+    parser.add_argument("--people", action="store_true", help="person by person on the eleven arm people (module docstring)")
     args = parser.parse_args(argv)
+    if args.people:
+        return by_person(args.preset, args.trials)
     recorded = people(args.arms)
     model = comanip.presets.load(args.preset)
     D = float(np.median(recorded["distance"]))
