@@ -107,7 +107,9 @@ def holds(error: np.ndarray, covariance: np.ndarray) -> bool:
 
 
 def scored_reach(estimator, recording) -> dict:
-    """Stream ``recording`` then REST_S at rest into ``estimator``; the scores (module docstring)."""
+    """Stream ``recording`` then REST_S at rest into ``estimator``; the scores (module docstring), with constant
+    velocity's error at +LEAD_S s from the same samples beside the forecast's."""
+    from comanip.estimation.forecast.path_baselines import constant_velocity
     D, end = recording.distance, recording.end
     until = {f: recording.seen_until(f) for f in FRACTIONS}
     scores = {}
@@ -127,8 +129,11 @@ def scored_reach(estimator, recording) -> dict:
                 scores[f"covered {f:g}"] = holds(e, estimate.goal_covariance)
                 if f in FORECASTS_FROM and estimate.forecast is not None:
                     ahead = estimate.forecast.at([recording.t[k] + LEAD_S])
-                    e = ahead.position[0] - recording.position_at(recording.t[k] + LEAD_S)
+                    there = recording.position_at(recording.t[k] + LEAD_S)
+                    e = ahead.position[0] - there
                     scores[f"forecast error {f:g}"] = float(np.linalg.norm(e)) / D
+                    extrapolated = constant_velocity(recording.position[k], recording.velocity[k], [LEAD_S])[0]
+                    scores[f"constant velocity error {f:g}"] = float(np.linalg.norm(extrapolated - there)) / D
                     scores[f"forecast covered {f:g}"] = holds(e, ahead.covariance[0])
     return scores
 
@@ -194,16 +199,22 @@ def people_markdown(rows) -> str:
     lines = [f"Person by person, each with the people model fitted on the other people: the 95 % regions' coverage, "
              f"the endpoint's pooled over {' / '.join(f'{100 * f:g}' for f in FRACTIONS)} % of MT and the forecast's at "
              f"+{LEAD_S:g} s pooled over {' / '.join(f'{100 * f:g}' for f in FORECASTS_FROM)} % of MT, on the first "
-             f"reach and from the {LATER}th reach on (calibrated; not calibrated), and the endpoint's median error / D "
-             f"at 50 % of MT from the {LATER}th reach on", "",
-             "| person | reaches | endpoint, 1st reach | endpoint, later | forecast, later | error / D at 50 %, later |",
-             "|---|---|---|---|---|---|"]
+             f"reach and from the {LATER}th reach on (calibrated; not calibrated), and from the {LATER}th reach on the "
+             f"endpoint's median error / D at 50 % of MT and the forecast's at +{LEAD_S:g} s (pooled over "
+             f"{' / '.join(f'{100 * f:g}' for f in FORECASTS_FROM)} % of MT; constant velocity's from the same samples)", "",
+             "| person | reaches | endpoint, 1st reach | endpoint, later | forecast, later | error / D at 50 %, later | "
+             f"forecast error / D, later: calibrated; not; constant velocity |",
+             "|---|---|---|---|---|---|---|"]
     endpoint_keys = [f"covered {f:g}" for f in FRACTIONS]
     forecast_keys = [f"forecast covered {f:g}" for f in FORECASTS_FROM]
 
     def pooled(chosen, keys):
         values = [r[key] for r in chosen for key in keys if key in r]
         return 100 * float(np.mean(values)) if values else float("nan")
+
+    def pooled_median(chosen, name):
+        values = [r[f"{name} {f:g}"] for r in chosen for f in FORECASTS_FROM if f"{name} {f:g}" in r]
+        return float(np.median(values)) if values else float("nan")
 
     later_shares, first = {}, []
     for person in people:
@@ -214,7 +225,10 @@ def people_markdown(rows) -> str:
         cells = [f"{pooled([r for r in mine[MODES[0]] if r['reach'] == 1], endpoint_keys):.0f} %",
                  "; ".join(f"{pooled(later[mode], endpoint_keys):.0f}" for mode in MODES) + " %",
                  "; ".join(f"{pooled(later[mode], forecast_keys):.0f}" for mode in MODES) + " %",
-                 "; ".join(f"{np.nanmedian([r.get('error 0.5', np.nan) for r in later[mode]]):.3f}" for mode in MODES)]
+                 "; ".join(f"{np.nanmedian([r.get('error 0.5', np.nan) for r in later[mode]]):.3f}" for mode in MODES),
+                 "; ".join(f"{pooled_median(later[mode], key):.3f}"
+                           for mode, key in ((MODES[0], "forecast error"), (MODES[1], "forecast error"),
+                                             (MODES[0], "constant velocity error")))]
         lines.append(f"| {person} | {len(mine[MODES[0]])} | " + " | ".join(cells) + " |")
     inside = lambda value, band: band[0] <= value <= band[1]
     first_share = 100 * float(np.mean(first))
