@@ -36,7 +36,7 @@ from scipy.stats import chi2
 from comanip.estimation.people.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from forecast_peers import leave_one_person_out as fits_without_each, people_reaches  # noqa: E402  (beside this script)
+from forecast_peers import leave_one_person_out as fits_without_each, people_models, people_reaches  # noqa: E402  (beside this script)
 from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
@@ -157,11 +157,11 @@ def simulated_recordings(model_name: str, count: int, seed: int):
     return recordings
 
 
-def leave_one_person_out(tathum: Path, ue_adl: Path, limit: int | None, log):
+def leave_one_person_out(tathum: Path, ue_adl: Path, limit: int | None, log, fits: Path | None = None):
     """The eleven arm people's reaches (``forecast_peers.people_reaches``) as one list of movements, the person of
     each (by name), and for each movement the people model and the template library fitted on the other people's
-    reaches only (``forecast_peers.leave_one_person_out``: fitted once per person)."""
-    from comanip.estimation.people.people_model import PeopleModel
+    reaches only (``forecast_peers.leave_one_person_out``: fitted once per person; the people models kept in
+    ``fits``, a folder, where given: ``forecast_peers.people_models``)."""
     from comanip.estimation.people.template_matching import TemplateLibrary
 
     people = people_reaches(tathum, ue_adl, limit)
@@ -171,13 +171,10 @@ def leave_one_person_out(tathum: Path, ue_adl: Path, limit: int | None, log):
     if len(person_of) != sum(map(len, people.values())):
         sys.exit("two reaches share a name: the people's reaches must be told apart by name")
 
-    def fit(rest):
-        print(f"  fitting the people model and templates on {len(rest)} reaches of the other people ...", flush=True, file=log)
-        return PeopleModel.fit(rest, kind="arm"), TemplateLibrary(rest, step=0.01)
-
-    fitted = dict(fits_without_each(people, fit))
+    models = people_models(people, fits, log)
+    libraries = dict(fits_without_each(people, lambda rest: TemplateLibrary(rest, step=0.01)))
     movements = [r for recordings in people.values() for r in recordings]
-    return movements, person_of, lambda r: fitted[person_of[r.name]][0], lambda r: fitted[person_of[r.name]][1]
+    return movements, person_of, lambda r: models[person_of[r.name]], lambda r: libraries[person_of[r.name]]
 
 def summarise(rows, names):
     """{predictor: {fraction: {median, q25, q75, coverage, worse}}} from the per-movement rows."""
@@ -379,6 +376,8 @@ def main(argv=None):
                              "people (--arms, --ue-adl), each scored leave-one-person-out; simulated: the model's own")
     parser.add_argument("--arms", type=Path, default=ARMS, help="a TAT-HUM 3-D data folder (trajectory_data/, trial_data/)")
     parser.add_argument("--ue-adl", type=Path, default=UE_ADL, help="a folder of people's Vicon Nexus exports (--source people)")
+    parser.add_argument("--fits", type=Path, default=None,
+                        help="--source people: a folder to keep the leave-one-person-out people models in for the next run")
     parser.add_argument("--split", choices=("development", "held_out"), default="development",
                         help="cursory split; held_out only to report a claimed improvement")
     parser.add_argument("--limit", type=int, default=None, help="at most this many movements")
@@ -404,7 +403,7 @@ def main(argv=None):
     if args.source == "people":
         if args.split != "development":
             sys.exit("the arm people's held-out people are not in these folders: they are scored elsewhere")
-        movements, person_of, people_for, library_for = leave_one_person_out(args.arms, args.ue_adl, args.limit, log)
+        movements, person_of, people_for, library_for = leave_one_person_out(args.arms, args.ue_adl, args.limit, log, args.fits)
         title = (f"{len(set(person_of.values()))} arm people (TAT-HUM's, UE_ADL's), development split, streamed as a "
                  "tracker delivers them, each scored with the people model and templates of the other people only")
     elif args.source == "arms":
