@@ -187,10 +187,9 @@ class OnlineGoalEstimator:
         t, hands, goals, covariances, stops = (np.array(column) for column in zip(*history))
         ahead, ahead_covariances = (np.array(column) for column in zip(*forecasts))
         axes = self._person_axes                 # a partner's axes say nothing of the person
-        block = np.ix_(axes, axes)
         return self.person.learn(FinishedReach(self.start_position[axes], end[axes], onset, end_s, t, hands[:, axes],
-                                               goals[:, axes], covariances[:, block[0], block[1]], stops,
-                                               ahead[..., axes], ahead_covariances[..., block[0], block[1]],
+                                               goals[:, axes], covariances[..., axes, :][..., axes], stops,
+                                               ahead[..., axes], ahead_covariances[..., axes, :][..., axes],
                                                hand.t.copy(), hand.position[:, axes].copy()))
 
     def forget_person(self) -> None:
@@ -424,8 +423,9 @@ class OnlineGoalEstimator:
                 ahead = forecast.at(self._last_time + np.array(FORECAST_LEADS))
                 self._forecasts.append((ahead.position, ahead.covariance))
             if self.person.forecast_spread != 1.0:
-                forecast = dataclasses.replace(forecast, cov=scaled_on_axes(forecast.cov, self.person.forecast_spread,
-                                                                            self._person_axes))
+                blocks = forecast.cov.shape[-1] // n             # the person's axes in every state block
+                axes = [block * n + a for block in range(blocks) for a in self._person_axes]
+                forecast = dataclasses.replace(forecast, cov=scaled_on_axes(forecast.cov, self.person.forecast_spread, axes))
             path = within_horizon(forecast, self.options.forecast_horizon)
         return OnlineEstimate(goal=goal, goal_covariance=covariance, status=status,
                               message="; ".join([*reasons, explained.message]), t_obs=self._last_time, path=path,
