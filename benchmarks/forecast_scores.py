@@ -23,6 +23,17 @@ GIVEN_THE_END = ("the forecast given the recorded endpoint and stop", "minimum j
 """What a perfect goal and stop would give each shape: not predictors, the ceiling of each."""
 
 
+def holds(error: np.ndarray, covariance: np.ndarray) -> bool:
+    """Whether the 95 % region of ``covariance`` (d, d) m² around an estimate holds a truth ``error`` (d,) m from it;
+    a singular covariance's region (a point, or a flat ellipsoid) holds it only where the error lies in its span."""
+    try:
+        return bool(error @ np.linalg.solve(covariance, error) <= chi2.ppf(0.95, len(error)))
+    except np.linalg.LinAlgError:
+        flat = np.linalg.lstsq(covariance, error, rcond=None)[0]
+        inside = np.allclose(covariance @ flat, error, atol=1e-12)
+        return bool(inside and error @ flat <= chi2.ppf(0.95, len(error)))
+
+
 def truth(recording, k: int) -> np.ndarray:
     """Where the recorded hand is at +LEADS s from its sample k (held at its endpoint after the end): (len(LEADS), d) m."""
     return np.array([recording.position_at(recording.t[k] + s) for s in LEADS])
@@ -66,12 +77,7 @@ def forecast_rows(trace, recording, name: str, estimator) -> list[dict]:
         for forecaster, path in paths.items():
             for i, s in enumerate(lead):
                 error = path[i] - recorded[i]
-                covered = None
-                if forecaster == name:
-                    try:
-                        covered = bool(error @ np.linalg.solve(predicted.covariance[i], error) <= chi2.ppf(0.95, len(error)))
-                    except np.linalg.LinAlgError:
-                        covered = False
+                covered = holds(error, predicted.covariance[i]) if forecaster == name else None
                 rows.append({"movement": recording.name, "forecaster": forecaster, "from": start, "lead_s": float(s),
                              "error": float(np.linalg.norm(error)) / D, "covered": covered})
     return rows

@@ -37,10 +37,10 @@ import warnings
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import chi2
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from forecast_peers import TATHUM, UE_ADL, people_models, people_reaches  # noqa: E402  (beside this script)
+from forecast_scores import holds  # noqa: E402
 
 FRACTIONS = (0.25, 0.5, 0.75, 0.9)
 LEAD_S = 0.2
@@ -93,17 +93,6 @@ def model_people(count: int, people: int, rng) -> list[list]:
                                                  np.r_[rest, states[:, :model.n]], step=0.01 * pace))
         out.append(person)
     return out
-
-
-def holds(error: np.ndarray, covariance: np.ndarray) -> bool:
-    """Whether the 95 % region of ``covariance`` (d, d) m² around an estimate holds a truth ``error`` (d,) m from it;
-    a singular covariance's region (a point, or a flat ellipsoid) holds it only where the error lies in its span."""
-    try:
-        return bool(error @ np.linalg.solve(covariance, error) <= chi2.ppf(0.95, len(error)))
-    except np.linalg.LinAlgError:
-        flat = np.linalg.lstsq(covariance, error, rcond=None)[0]
-        inside = np.allclose(covariance @ flat, error, atol=1e-12)
-        return bool(inside and error @ flat <= chi2.ppf(0.95, len(error)))
 
 
 def scored_reach(estimator, recording) -> dict:

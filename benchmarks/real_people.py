@@ -31,13 +31,12 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.stats import chi2
 
 from comanip.estimation.people.endpoint_baselines import EndpointPrediction, PrefixPredictor
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from forecast_peers import leave_one_person_out as fits_without_each, people_models, people_reaches  # noqa: E402  (beside this script)
-from forecast_scores import forecast_figure, forecast_markdown, forecast_rows  # noqa: E402
+from forecast_scores import forecast_figure, forecast_markdown, forecast_rows, holds  # noqa: E402
 
 FRACTIONS = (0.1, 0.25, 0.5, 0.75, 0.9)
 ARMS = Path(__file__).resolve().parents[2] / "shared" / "data" / "arm_reaches" / "tathum" / "data_3d"
@@ -464,13 +463,7 @@ def main(argv=None):
             if name == "current position":
                 current = errors
             for f, (goal, cov), error in zip(FRACTIONS, answers, errors):
-                covered = None
-                if cov is not None:
-                    e = goal - recording.end
-                    try:
-                        covered = bool(e @ np.linalg.solve(cov, e) <= chi2.ppf(0.95, len(e)))
-                    except np.linalg.LinAlgError:
-                        covered = False
+                covered = None if cov is None else holds(goal - recording.end, cov)
                 rows.append({"person": person_of.get(recording.name, ""), "movement": recording.name, "predictor": name, "fraction": f, "distance_m": D,
                              "movement_time_s": recording.movement_time, "error": error, "covered": covered})
         for row in rows[-len(names) * len(FRACTIONS):]:
