@@ -59,10 +59,10 @@ LEARNED = "learned (trees on the last 0.2 s)"
 COMANIP = "OnlineGoalEstimator (arm)"
 
 
-def people_reaches(tathum: Path | None, ue_adl: Path | None, limit: int | None = None) -> dict[str, list]:
-    """{person: streamed recordings (:class:`~comanip.recordings.Recording`)} of TAT-HUM's and UE_ADL's people (a
-    folder None or missing: none of its people), the reaches whose hand rests for the stream's lead before their
-    onset; ``limit``: at most that many reaches per person."""
+def people_trials(tathum: Path | None, ue_adl: Path | None, limit: int | None = None) -> dict[str, list]:
+    """{person: trials (:class:`~comanip.recordings.TrackedSamples`)} of TAT-HUM's and UE_ADL's people (a folder None
+    or missing: none of its people), the reaches whose hand rests for the stream's lead before their onset;
+    ``limit``: at most that many reaches per person."""
     from comanip.recordings import load_nexus_trajectories, load_tathum
     from comanip.recordings.motion_capture import STREAM_LEAD_S
 
@@ -74,8 +74,14 @@ def people_reaches(tathum: Path | None, ue_adl: Path | None, limit: int | None =
     people: dict[str, list] = {}
     for person, trial in trials:
         if trial.recording().onset >= STREAM_LEAD_S and (limit is None or len(people.get(person, [])) < limit):
-            people.setdefault(person, []).append(trial.streamed_recording())
+            people.setdefault(person, []).append(trial)
     return people
+
+
+def people_reaches(tathum: Path | None, ue_adl: Path | None, limit: int | None = None) -> dict[str, list]:
+    """{person: streamed recordings (:class:`~comanip.recordings.Recording`)} of :func:`people_trials`."""
+    return {person: [trial.streamed_recording() for trial in trials]
+            for person, trials in people_trials(tathum, ue_adl, limit).items()}
 
 
 def _at(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarray:

@@ -24,6 +24,7 @@ distance: does the timing the preset was fitted to (one person at 0.22 m) carry 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -107,15 +108,9 @@ def model_reach(model, distance: float, trials: int) -> dict:
 def by_person(preset: str, trials: int) -> None:
     """The --people table (module docstring), with the share of people whose median MT the preset's is within
     10 % of and whose IQR of t_peak / MT holds the preset's."""
-    from comanip.recordings import load_nexus_trajectories
-    from comanip.recordings.motion_capture import STREAM_LEAD_S
-    tathum, ue_adl = ARMS, ARMS.parents[1] / "ue_adl"
-    people_trials = {}
-    for person, trial in ([(f"TAT-HUM {t.label['participant']}", t) for t in load_tathum(tathum)]
-                          + [(t.label["participant"], t) for t in load_nexus_trajectories(ue_adl)]):
-        recording = trial.recording()
-        if recording.onset >= STREAM_LEAD_S:            # the reaches the other arm-people blocks score
-            people_trials.setdefault(person, []).append((trial, recording))
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+    from forecast_peers import TATHUM, UE_ADL, people_trials  # noqa: E402  (the reaches the arm-people blocks score)
+    people = people_trials(TATHUM, UE_ADL)
     model = comanip.presets.load(preset)
     print(f"The `{preset}` preset's closed loop ({trials} executions) over each recorded arm person's median distance, "
           "against the person's reaches: median [IQR]\n")
@@ -123,8 +118,8 @@ def by_person(preset: str, trials: int) -> None:
           "peak speed (m/s): people; preset |\n|---|---|---|---|---|---|")
     within, inside = 0, 0
     q = lambda x: f"{np.median(x):.3g} [{np.percentile(x, 25):.3g}–{np.percentile(x, 75):.3g}]"
-    for person, pairs in people_trials.items():
-        recorded = recorded_metrics(*zip(*pairs))
+    for person, reaches in people.items():
+        recorded = recorded_metrics(reaches, [trial.recording() for trial in reaches])
         D = float(np.median(recorded["distance"]))
         closed, _ = closed_loop(model, D, trials)
         mt = float(np.median(recorded["movement_time"]))
@@ -134,7 +129,7 @@ def by_person(preset: str, trials: int) -> None:
         print(f"| {person} | {recorded['count']} | {D:.3f} | {q(recorded['movement_time'])}; {closed['movement_time']:.3f} | "
               f"{q(recorded['asymmetry'])}; {closed['asymmetry']:.3f} | {q(recorded['peak_speed'])}; "
               f"{closed['peak_speed']:.3f} |")
-    count = len(people_trials)
+    count = len(people)
     print(f"\nThe preset's MT within 10 % of the person's median for {within} of {count} people; its t_peak / MT inside "
           f"the person's IQR for {inside} of {count}.")
 
