@@ -85,11 +85,16 @@ def smoothed(times: np.ndarray, goals: np.ndarray, time_constant: float) -> np.n
     return out
 
 
+def free_rate_name(rate: float, time_constant: float) -> str:
+    """The name of the estimator's rule with free rate ``rate`` (1/s) and ``time_constant`` (s)."""
+    return f"free up to {rate:g} D/s, the excess averaged over {1000 * time_constant:g} ms"
+
+
 def rules() -> dict:
     """{name: rule(recording, times, goals, covariances) -> smoothed goals} of every rule tried."""
     out = {f"average, {1000 * tau:g} ms": (lambda r, times, goals, covariances, tau=tau: smoothed(times, goals, tau))
            for tau in TIME_CONSTANTS_S}
-    out.update({f"free up to {rate:g} D/s, the excess averaged over {1000 * tau:g} ms":
+    out.update({free_rate_name(rate, tau):
                 (lambda r, times, goals, covariances, rate=rate, tau=tau: free_rate_smoothed(r, times, goals, covariances, rate, tau))
                 for rate, tau in FREE_RATES})
     return out
@@ -158,7 +163,7 @@ def people_markdown(table: dict, counts: dict) -> str:
     default rule, and the targets."""
     people = list(counts)
     default = GoalSmoothing()
-    default_name = f"free up to {default.free_rate:g} D/s, the excess averaged over {1000 * default.time_constant:g} ms"
+    default_name = free_rate_name(default.free_rate, default.time_constant)
     lines = [f"The people model's goal smoothed over time on {len(people)} arm people ({sum(counts.values())} reaches, "
              "each person's scored with the people model fitted on the other people only): error / D at "
              f"{' / '.join(f'{100 * f:g}' for f in FRACTIONS)} % of MT (the median over people of each person's median) "
