@@ -214,6 +214,31 @@ def test_a_saved_people_model_loads_to_the_same_predictions_without_pickle(peopl
         PeopleModel.load(tmp_path / "other.npz")
 
 
+def test_a_people_model_reads_the_features_it_names_keeps_them_when_saved_and_refuses_others_before_fitting(people, tmp_path):
+    from comanip.estimation.people.people_model import FEATURES, UNNAMED_FEATURES, PeopleModel
+    named = ("speed_over_peak", "tau_s", "straightness")
+    model = PeopleModel.fit(people[:12], kind="mouse", features=named)
+    assert model.features == named and list(model.columns) == [FEATURES.index(name) for name in named]
+    back = PeopleModel.load(model.save(tmp_path / "named.npz"))
+    assert back.features == named
+    r = people[20]
+    for k in (8, len(r.t)):
+        np.testing.assert_array_equal(back.predict(r.t[:k], r.position[:k], r.velocity[:k], r.position[0]).goal,
+                                      model.predict(r.t[:k], r.position[:k], r.velocity[:k], r.position[0]).goal)
+    # a file that does not name its features reads those models of its kind read before files named them
+    with np.load(tmp_path / "named.npz") as data:
+        arrays = {name: data[name] for name in data.files if name != "features"}
+    np.savez(tmp_path / "unnamed.npz", **{**arrays, "kind": np.array("arm")})
+    assert PeopleModel.load(tmp_path / "unnamed.npz").features == UNNAMED_FEATURES["arm"]
+    # trees that read more features than the model names are refused
+    with pytest.raises(ValueError, match="the trees read feature 2"):
+        replace(model, features=named[:2])
+    for kind, features, message in (("arm", ("tau_s",), "without units"), ("mouse", ("speed",), "distinct movement features"),
+                                    ("mouse", ("tau_s", "tau_s"), "distinct movement features"), ("mouse", (), "distinct")):
+        with pytest.raises(ValueError, match=message):
+            PeopleModel.fit(people[:12], kind=kind, features=features)
+
+
 def test_an_arm_people_model_ships_reads_only_the_features_without_units_and_a_mouse_one_is_refused_for_an_arm():
     from comanip.estimation.people.people_model import SCALE_FREE, shipped_people_model
     arm = shipped_people_model("arm")

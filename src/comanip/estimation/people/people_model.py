@@ -23,10 +23,15 @@ while the path so far is short, never below the distance the hand can still cove
 (``STOPPING_TIME``).
 
 A model is fitted per **kind** of movement (:data:`KINDS`): people move a mouse and an arm differently, and a
-model fitted on one is not applied to the other. An arm model uses only the features without units
-(:data:`SCALE_FREE`): fitted on reaches of one length and pace, it predicts in units of the path so far and
-of the time since the onset, so it carries over to other distances and paces as far as people's profiles
-keep their shape.
+model fitted on one is not applied to the other. An arm model uses only features without units
+(:data:`ARM_FEATURES`, of :data:`SCALE_FREE`): fitted on reaches of one length and pace, it predicts in units of
+the path so far and of the time since the onset, so it carries over to other distances and paces as far as
+people's profiles keep their shape. Of the features without units it leaves out the straightness and the
+acceleration: fitted on other people without them, its goal moves less from one sample to the next and is as
+near. Both read the tracker as much as the hand: the straightness sets the displacement against a path
+integrated from velocities derived over a window (so a short reach's looks less straight than a long one's of
+the same shape, and a noisy tracker's path is longer), and the acceleration is a difference of two successive
+speeds. A model reads the features it names (:attr:`PeopleModel.features`), saved with it.
 
 Models are saved as plain arrays (``.npz``: every tree's nodes, :class:`TreeEnsemble`) and loaded without
 scikit-learn (:meth:`PeopleModel.load`). Two ship with comanip (``comanip/data/people_endpoint_<kind>.npz``):
@@ -57,8 +62,15 @@ FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak",
 SCALE_FREE = ("speed_over_peak", "acceleration_scaled", "since_peak_over_tau", "path_at_peak_over_path", "straightness",
               "direction_cosine", "peak_speed_tau_over_path")
 """The features without units (neither m nor s): what an ``arm`` model uses."""
-KINDS = {"mouse": FEATURES, "arm": SCALE_FREE}
-"""Kinds of movement a people model is fitted to, and the features each uses."""
+ARM_FEATURES = ("speed_over_peak", "since_peak_over_tau", "path_at_peak_over_path", "direction_cosine",
+                "peak_speed_tau_over_path")
+"""The features an ``arm`` model is fitted on: :data:`SCALE_FREE` but the straightness and the acceleration (module
+docstring), chosen leave-one-person-out on recorded arm people
+(``studies/which_movement_features_carry_across_people``)."""
+KINDS = {"mouse": FEATURES, "arm": ARM_FEATURES}
+"""Kinds of movement a people model is fitted to, and the features a model of each is fitted on."""
+UNNAMED_FEATURES = {"mouse": FEATURES, "arm": SCALE_FREE}
+"""The features a model of each kind read when its file did not name them (saved before models named theirs)."""
 DIRECTION_SPEED = 0.1
 """The direction of motion u is the velocity's while the speed is above this fraction of its peak so far..."""
 DIRECTION_WINDOW = 0.05
@@ -80,6 +92,19 @@ MAX_SHARE = 0.999
 """The largest share of the path still to go a prediction is taken at (a = 999 path lengths)."""
 _MIN_PATH = 1e-4
 _MIN_RECENT = 2e-3
+
+
+def checked_features(kind: str, features=None) -> tuple[str, ...]:
+    """The names of the features a model of ``kind`` reads: ``features`` (names of :data:`FEATURES`, distinct;
+    for an arm, of :data:`SCALE_FREE`) or, for None, the kind's (:data:`KINDS`); a one-line ValueError otherwise."""
+    if kind not in KINDS:
+        raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
+    named = KINDS[kind] if features is None else tuple(str(name) for name in features)
+    if not named or len(set(named)) < len(named) or not set(named) <= set(FEATURES):
+        raise ValueError(f"features must name distinct movement features of {FEATURES}, got {named!r}")
+    if kind == "arm" and not set(named) <= set(SCALE_FREE):
+        raise ValueError(f"an arm model reads features without units only (of {SCALE_FREE}), got {named!r}")
+    return named
 
 
 def movement_features(t: np.ndarray, position: np.ndarray, velocity: np.ndarray, start: np.ndarray):
@@ -127,7 +152,7 @@ class PeopleModel:
     coverage_factor: float
     """Multiplies the predicted squared error so the 95 % region holds 95 % of the fitting samples' endpoints."""
     kind: str = "mouse"
-    """The kind of movement it was fitted to, a key of :data:`KINDS` (which features it reads)."""
+    """The kind of movement it was fitted to, a key of :data:`KINDS`."""
     trained_on: str = ""
     """What the model was fitted on."""
     remaining: "TreeEnsemble | None" = None
@@ -135,40 +160,50 @@ class PeopleModel:
     along_target: str = "share"
     """What ``along`` predicts, a key of :data:`ALONG_TARGETS`: ``share`` (s) or, in models saved before it
     existed, ``over path`` (a itself)."""
+    features: tuple[str, ...] | None = None
+    """Names (of :data:`FEATURES`, in the order its trees read them) of the features the model reads; None: those
+    of its kind (:data:`KINDS`)."""
 
     def __post_init__(self):
-        object.__setattr__(self, "_trees", StackedTrees([e for e in (self.along, self.spread, self.remaining) if e is not None]))
         if self.kind not in KINDS:
             raise ValueError(f"kind must be one of {sorted(KINDS)}, got {self.kind!r}")
         if self.along_target not in ALONG_TARGETS:
             raise ValueError(f"along_target must be one of {sorted(ALONG_TARGETS)}, got {self.along_target!r}")
+        object.__setattr__(self, "features", checked_features(self.kind, self.features))
+        read = max((int(e.feature[~e.leaf].max(initial=0)) for e in (self.along, self.spread, self.remaining) if e is not None))
+        if read >= len(self.features):
+            raise ValueError(f"the trees read feature {read}, but the model names {len(self.features)} features")
+        object.__setattr__(self, "_trees", StackedTrees([e for e in (self.along, self.spread, self.remaining) if e is not None]))
 
     @property
     def columns(self) -> np.ndarray:
         """Indices into :data:`FEATURES` of the features this model reads."""
-        return np.array([FEATURES.index(name) for name in KINDS[self.kind]])
+        return np.array([FEATURES.index(name) for name in self.features])
 
     @classmethod
-    def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None) -> "PeopleModel":
+    def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None,
+            features=None) -> "PeopleModel":
         """Fit on recordings (:class:`comanip.recordings.Recording`) of one ``kind`` of movement, every sample
         from each one's onset to its end: the spread regressor on two-fold out-of-sample errors of the along
         regressor, and the coverage factor on those errors over the spread each fold's spread regressor predicts
         for the other fold (a spread fitted on the very errors it is scored on predicts them too well), then
         the along, spread and remaining-time regressors on all samples. ``progress``: called with a line of
-        text per stage. Needs scikit-learn."""
+        text per stage. ``features``: names of :data:`FEATURES` to fit on (default: the kind's, :data:`KINDS`).
+        Needs scikit-learn."""
         from threadpoolctl import ThreadpoolController
         if kind not in KINDS:
             raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
         if len(recordings) < 4:
             raise ValueError(f"PeopleModel.fit needs at least 4 recordings (two folds of two), got {len(recordings)}")
+        features = checked_features(kind, features)
         with ThreadpoolController().limit(limits=1, user_api="openmp"):   # reproducible, no spinning threads
-            return cls._fit(recordings, kind, trained_on, seed, progress or (lambda line: None))
+            return cls._fit(recordings, kind, features, trained_on, seed, progress or (lambda line: None))
 
     @classmethod
-    def _fit(cls, recordings, kind: str, trained_on: str, seed: int, say) -> "PeopleModel":
+    def _fit(cls, recordings, kind: str, features: tuple, trained_on: str, seed: int, say) -> "PeopleModel":
         from sklearn.ensemble import HistGradientBoostingRegressor
         X, along, across, remaining, owner = _samples(recordings)
-        X = X[:, [FEATURES.index(name) for name in KINDS[kind]]]
+        X = X[:, [FEATURES.index(name) for name in features]]
         fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
         predicted = np.zeros(len(X))
         for k in (0, 1):
@@ -191,7 +226,7 @@ class PeopleModel:
         remaining_regressor = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
             X, np.log(remaining + REMAINING_FLOOR))
         return cls(TreeEnsemble.of(along_regressor), TreeEnsemble.of(spread), factor, kind, trained_on,
-                   TreeEnsemble.of(remaining_regressor))
+                   TreeEnsemble.of(remaining_regressor), features=features)
 
     def predict(self, t, position, velocity, start) -> EndpointPrediction | None:
         """The endpoint (d,) m and its covariance (d, d) m² from the movement so far (:func:`movement_features`'
@@ -226,7 +261,7 @@ class PeopleModel:
                   for field, value in getattr(self, name).arrays().items()}
         with open(path, "wb") as stream:
             np.savez_compressed(stream, coverage_factor=self.coverage_factor, kind=self.kind, trained_on=self.trained_on,
-                                along_target=self.along_target, **arrays)
+                                along_target=self.along_target, features=np.array(self.features), **arrays)
         return path
 
     @classmethod
@@ -239,8 +274,10 @@ class PeopleModel:
                 if along is None or spread is None:
                     raise KeyError("along or spread regressor")
                 target = str(data["along_target"]) if "along_target" in data else "over path"
-                return cls(along, spread, float(data["coverage_factor"]), str(data["kind"]), str(data["trained_on"]), remaining,
-                           target)
+                kind = str(data["kind"])
+                features = tuple(str(name) for name in data["features"]) if "features" in data else UNNAMED_FEATURES.get(kind)
+                return cls(along, spread, float(data["coverage_factor"]), kind, str(data["trained_on"]), remaining,
+                           target, features)
         except (OSError, KeyError, ValueError) as error:
             raise ValueError(f"{str(path)!r} is not a people model written by PeopleModel.save ({error})") from None
 
