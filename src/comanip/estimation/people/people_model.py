@@ -26,12 +26,11 @@ A model is fitted per **kind** of movement (:data:`KINDS`): people move a mouse 
 model fitted on one is not applied to the other. An arm model uses only features without units
 (:data:`ARM_FEATURES`, of :data:`SCALE_FREE`): fitted on reaches of one length and pace, it predicts in units of
 the path so far and of the time since the onset, so it carries over to other distances and paces as far as
-people's profiles keep their shape. Of the features without units it leaves out the straightness and the
-acceleration: fitted on other people without them, its goal moves less from one sample to the next and is as
-near. Both read the tracker as much as the hand: the straightness sets the displacement against a path
-integrated from velocities derived over a window (so a short reach's looks less straight than a long one's of
-the same shape, and a noisy tracker's path is longer), and the acceleration is a difference of two successive
-speeds. A model reads the features it names (:attr:`PeopleModel.features`), saved with it.
+people's profiles keep their shape. Of the features without units it leaves out the straightness: fitted on
+other people without it, its goal moves less from one sample to the next and is as near. The straightness reads
+the tracker as much as the hand: it sets the displacement against a path integrated from velocities derived
+over a window, so a short reach's looks less straight than a long one's of the same shape, and a noisy tracker's
+path is longer. A model reads the features it names (:attr:`PeopleModel.features`), saved with it.
 
 Models are saved as plain arrays (``.npz``: every tree's nodes, :class:`TreeEnsemble`) and loaded without
 scikit-learn (:meth:`PeopleModel.load`). Two ship with comanip (``comanip/data/people_endpoint_<kind>.npz``):
@@ -62,11 +61,9 @@ FEATURES = ("tau_s", "path_m", "speed_m_s", "peak_speed_m_s", "speed_over_peak",
 SCALE_FREE = ("speed_over_peak", "acceleration_scaled", "since_peak_over_tau", "path_at_peak_over_path", "straightness",
               "direction_cosine", "peak_speed_tau_over_path")
 """The features without units (neither m nor s): what an ``arm`` model uses."""
-ARM_FEATURES = ("speed_over_peak", "since_peak_over_tau", "path_at_peak_over_path", "direction_cosine",
-                "peak_speed_tau_over_path")
-"""The features an ``arm`` model is fitted on: :data:`SCALE_FREE` but the straightness and the acceleration (module
-docstring), chosen leave-one-person-out on recorded arm people
-(``studies/which_movement_features_carry_across_people``)."""
+ARM_FEATURES = tuple(name for name in SCALE_FREE if name != "straightness")
+"""The features an ``arm`` model is fitted on: :data:`SCALE_FREE` but the straightness (module docstring), chosen
+leave-one-person-out on recorded arm people (``studies/which_movement_features_carry_across_people``)."""
 KINDS = {"mouse": FEATURES, "arm": ARM_FEATURES}
 """Kinds of movement a people model is fitted to, and the features a model of each is fitted on."""
 UNNAMED_FEATURES = {"mouse": FEATURES, "arm": SCALE_FREE}
