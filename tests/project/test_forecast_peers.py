@@ -98,8 +98,8 @@ def test_the_tables_give_each_person_and_the_medians(peers):
     assert "| A | 3 | 0.200 / 0.210 / 0.220 |" in text and "for 0 of 2 people" in text
 
 
-def test_the_kept_people_models_are_read_back_only_for_the_reaches_they_were_fitted_on(peers, tmp_path, monkeypatch):
-    from comanip.estimation.people.people_model import PeopleModel
+def test_the_kept_people_models_are_read_back_only_for_the_reaches_and_features_they_were_fitted_on(peers, tmp_path, monkeypatch):
+    from comanip.estimation.people.people_model import ARM_FEATURES, KINDS, PeopleModel
 
     people = people_of_reaches()
     fitted = peers.people_models(people, tmp_path)
@@ -117,3 +117,7 @@ def test_the_kept_people_models_are_read_back_only_for_the_reaches_they_were_fit
     peers.people_models(fewer, tmp_path)
     assert sorted(map(sorted, refitted)) == sorted(sorted({r.name for p, rs in fewer.items() if p != left for r in rs})
                                                    for left in ("A", "C"))
+    refitted.clear()                                                   # other features: every fit changes
+    monkeypatch.setitem(KINDS, "arm", ARM_FEATURES[:-1])
+    peers.people_models(fewer, tmp_path)
+    assert len(refitted) == len(fewer)
