@@ -18,8 +18,9 @@ second after it left the start and its net speed over that time below half ``RES
 :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of its peak for ``REST_TIME``) is at its
 endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (errors and their predicted
-spread both out of sample), and
-while the path so far is short, never below the distance the hand can still cover at its speed
+spread both out of sample), one factor for each phase of the movement (:data:`PHASE_BINS`: bins of the predicted
+share still to go, s, each holding as many fitting samples), so that the region holds as often near the end as
+early on; and while the path so far is short, never below the distance the hand can still cover at its speed
 (``STOPPING_TIME``).
 
 A model is fitted per **kind** of movement (:data:`KINDS`): people move a mouse and an arm differently, and a
@@ -66,6 +67,10 @@ ARM_FEATURES = tuple(name for name in SCALE_FREE if name != "straightness")
 leave-one-person-out on recorded arm people (``studies/which_movement_features_carry_across_people``)."""
 KINDS = {"mouse": FEATURES, "arm": ARM_FEATURES}
 """Kinds of movement a people model is fitted to, and the features a model of each is fitted on."""
+PHASE_BINS = {"mouse": 1, "arm": 5}
+"""How many phases of the movement (bins of the predicted share still to go) a model of each kind calibrates its
+95 % region on, each with its own coverage factor; the arm's chosen leave-one-person-out on recorded arm people
+(``studies/does_a_region_per_phase_hold_for_new_people``)."""
 UNNAMED_FEATURES = {"mouse": FEATURES, "arm": SCALE_FREE}
 """The features a model of each kind read when its file did not name them (saved before models named theirs)."""
 DIRECTION_SPEED = 0.1
@@ -147,7 +152,8 @@ class PeopleModel:
     spread: "TreeEnsemble"
     """Regressor of log(|error|² / L²) from the features."""
     coverage_factor: float
-    """Multiplies the predicted squared error so the 95 % region holds 95 % of the fitting samples' endpoints."""
+    """Multiplies the predicted squared error so the 95 % region holds 95 % of the fitting samples' endpoints (of
+    every phase; where ``phase_factors`` are given, they replace it)."""
     kind: str = "mouse"
     """The kind of movement it was fitted to, a key of :data:`KINDS`."""
     trained_on: str = ""
@@ -160,6 +166,11 @@ class PeopleModel:
     features: tuple[str, ...] | None = None
     """Names (of :data:`FEATURES`, in the order its trees read them) of the features the model reads; None: those
     of its kind (:data:`KINDS`)."""
+    phase_edges: tuple[float, ...] = ()
+    """Bounds of the phases (P - 1 increasing values of the predicted share still to go s, in (-1, 1))."""
+    phase_factors: tuple[float, ...] = ()
+    """The coverage factor of each phase (P values > 0, from the phase nearest the end, lowest s, on); empty: the
+    one ``coverage_factor``."""
 
     def __post_init__(self):
         if self.kind not in KINDS:
@@ -167,6 +178,15 @@ class PeopleModel:
         if self.along_target not in ALONG_TARGETS:
             raise ValueError(f"along_target must be one of {sorted(ALONG_TARGETS)}, got {self.along_target!r}")
         object.__setattr__(self, "features", checked_features(self.kind, self.features))
+        edges, factors = tuple(float(e) for e in self.phase_edges), tuple(float(f) for f in self.phase_factors)
+        if factors and (len(edges) != len(factors) - 1 or np.any(np.diff(edges) <= 0)
+                        or not all(math.isfinite(f) and f > 0 for f in factors)):
+            raise ValueError(f"phase_factors must be P > 0 factors and phase_edges P - 1 increasing shares, got "
+                             f"{factors!r} and {edges!r}")
+        if edges and not factors:
+            raise ValueError(f"phase_edges need phase_factors, got edges {edges!r} alone")
+        object.__setattr__(self, "phase_edges", edges)
+        object.__setattr__(self, "phase_factors", factors)
         read = max((int(e.feature[~e.leaf].max(initial=0)) for e in (self.along, self.spread, self.remaining) if e is not None))
         if read >= len(self.features):
             raise ValueError(f"the trees read feature {read}, but the model names {len(self.features)} features")
@@ -179,13 +199,14 @@ class PeopleModel:
 
     @classmethod
     def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None,
-            features=None) -> "PeopleModel":
+            features=None, phases: int | None = None) -> "PeopleModel":
         """Fit on recordings (:class:`comanip.recordings.Recording`) of one ``kind`` of movement, every sample
         from each one's onset to its end: the spread regressor on two-fold out-of-sample errors of the along
         regressor, and the coverage factor on those errors over the spread each fold's spread regressor predicts
         for the other fold (a spread fitted on the very errors it is scored on predicts them too well), then
         the along, spread and remaining-time regressors on all samples. ``progress``: called with a line of
         text per stage. ``features``: names of :data:`FEATURES` to fit on (default: the kind's, :data:`KINDS`).
+        ``phases``: how many phases get their own coverage factor (≥ 1; default: the kind's, :data:`PHASE_BINS`).
         Needs scikit-learn."""
         from threadpoolctl import ThreadpoolController
         if kind not in KINDS:
@@ -193,20 +214,23 @@ class PeopleModel:
         if len(recordings) < 4:
             raise ValueError(f"PeopleModel.fit needs at least 4 recordings (two folds of two), got {len(recordings)}")
         features = checked_features(kind, features)
+        phases = PHASE_BINS[kind] if phases is None else phases
+        if isinstance(phases, bool) or not isinstance(phases, (int, np.integer)) or phases < 1:
+            raise ValueError(f"phases must be a whole number ≥ 1, got {phases!r}")
         with ThreadpoolController().limit(limits=1, user_api="openmp"):   # reproducible, no spinning threads
-            return cls._fit(recordings, kind, features, trained_on, seed, progress or (lambda line: None))
+            return cls._fit(recordings, kind, features, int(phases), trained_on, seed, progress or (lambda line: None))
 
     @classmethod
-    def _fit(cls, recordings, kind: str, features: tuple, trained_on: str, seed: int, say) -> "PeopleModel":
+    def _fit(cls, recordings, kind: str, features: tuple, phases: int, trained_on: str, seed: int, say) -> "PeopleModel":
         from sklearn.ensemble import HistGradientBoostingRegressor
         X, along, across, remaining, owner = _samples(recordings)
         X = X[:, [FEATURES.index(name) for name in features]]
         fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
-        predicted = np.zeros(len(X))
+        share = np.zeros(len(X))
         for k in (0, 1):
             say(f"along regressor, fold {k + 1} of 2 ({int((fold != k).sum())} samples)")
-            predicted[fold == k] = beyond_over_path(_along_regressor(X[fold != k], share_to_go(along[fold != k]),
-                                                                     seed).predict(X[fold == k]))
+            share[fold == k] = _along_regressor(X[fold != k], share_to_go(along[fold != k]), seed).predict(X[fold == k])
+        predicted = beyond_over_path(share)
         squared = (np.maximum(predicted, 0.0) - along) ** 2 + across**2
         log_squared = np.log(squared + 1e-6)
         spread_out_of_sample = np.zeros(len(X))
@@ -214,7 +238,11 @@ class PeopleModel:
             say(f"spread regressor, fold {k + 1} of 2")
             spread_out_of_sample[fold == k] = _spread_regressor(X[fold != k], log_squared[fold != k], seed).predict(X[fold == k])
         d = recordings[0].position.shape[1]
-        factor = float(np.quantile(squared / np.exp(spread_out_of_sample), 0.95) / chi2.ppf(0.95, d) * d)
+        ratio = squared / np.exp(spread_out_of_sample) / chi2.ppf(0.95, d) * d
+        factor = float(np.quantile(ratio, 0.95))
+        edges = np.unique(np.quantile(share, np.arange(1, phases) / phases)) if phases > 1 else np.zeros(0)
+        phase = np.searchsorted(edges, share)
+        factors = tuple(float(np.quantile(ratio[phase == i], 0.95)) for i in range(len(edges) + 1)) if len(edges) else ()
         say("spread regressor, all samples")
         spread = _spread_regressor(X, log_squared, seed)
         say("along regressor, all samples")
@@ -223,7 +251,7 @@ class PeopleModel:
         remaining_regressor = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
             X, np.log(remaining + REMAINING_FLOOR))
         return cls(TreeEnsemble.of(along_regressor), TreeEnsemble.of(spread), factor, kind, trained_on,
-                   TreeEnsemble.of(remaining_regressor), features=features)
+                   TreeEnsemble.of(remaining_regressor), features=features, phase_edges=tuple(edges), phase_factors=factors)
 
     def predict(self, t, position, velocity, start) -> EndpointPrediction | None:
         """The endpoint (d,) m and its covariance (d, d) m² from the movement so far (:func:`movement_features`'
@@ -244,12 +272,19 @@ class PeopleModel:
         predicted = self._trees(x)
         along, log_squared = float(ALONG_TARGETS[self.along_target](predicted[0])), float(predicted[1])
         goal = position[-1] + path * max(along, 0.0) * u
-        variance = self.coverage_factor * path**2 * math.exp(log_squared) / len(u)
+        variance = self.factor_at(float(predicted[0])) * path**2 * math.exp(log_squared) / len(u)
         if path < STOPPING_TIME * speed[-1]:
             variance = max(variance, (STOPPING_TIME * speed[-1]) ** 2)
         end_time = None if self.remaining is None else \
             float(t[-1]) + features[0] * max(math.exp(predicted[2]) - REMAINING_FLOOR, 0.0)
         return EndpointPrediction(goal, variance * np.eye(len(u)), end_time)
+
+    def factor_at(self, share: float) -> float:
+        """The coverage factor of the phase at the along regressor's prediction ``share`` (s, or for an ``over path``
+        model a)."""
+        if not self.phase_factors:
+            return self.coverage_factor
+        return self.phase_factors[int(np.searchsorted(self.phase_edges, share))]
 
     def save(self, path: str | Path) -> Path:
         """Write the model to ``path`` as plain arrays (``.npz``); :meth:`load` reads it back."""
@@ -258,7 +293,8 @@ class PeopleModel:
                   for field, value in getattr(self, name).arrays().items()}
         with open(path, "wb") as stream:
             np.savez_compressed(stream, coverage_factor=self.coverage_factor, kind=self.kind, trained_on=self.trained_on,
-                                along_target=self.along_target, features=np.array(self.features), **arrays)
+                                along_target=self.along_target, features=np.array(self.features),
+                                phase_edges=np.array(self.phase_edges), phase_factors=np.array(self.phase_factors), **arrays)
         return path
 
     @classmethod
@@ -273,8 +309,9 @@ class PeopleModel:
                 target = str(data["along_target"]) if "along_target" in data else "over path"
                 kind = str(data["kind"])
                 features = tuple(str(name) for name in data["features"]) if "features" in data else UNNAMED_FEATURES.get(kind)
+                phases = {name: tuple(data[name]) if name in data else () for name in ("phase_edges", "phase_factors")}
                 return cls(along, spread, float(data["coverage_factor"]), kind, str(data["trained_on"]), remaining,
-                           target, features)
+                           target, features, **phases)
         except (OSError, KeyError, ValueError) as error:
             raise ValueError(f"{str(path)!r} is not a people model written by PeopleModel.save ({error})") from None
 
