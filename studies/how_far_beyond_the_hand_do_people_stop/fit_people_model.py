@@ -36,7 +36,9 @@ def main(argv=None):
     out = args.out or Path(str(resources.files("comanip") / "data" / f"people_endpoint_{args.kind}.npz"))
     print(f"fitting on {len(recordings)} movements ...", flush=True)
     model = PeopleModel.fit(recordings, kind=args.kind, trained_on=source, progress=lambda line: print(f"  {line}", flush=True))
-    print(f"coverage factor {model.coverage_factor:.3f}; wrote {model.save(out)}")
+    phases = ", ".join(f"{factor:.3f}" for factor in model.phase_factors) or "one phase"
+    print(f"features {', '.join(model.features)}; coverage factor {model.coverage_factor:.3f} (per phase: {phases}); "
+          f"wrote {model.save(out)}")
 
 
 if __name__ == "__main__":
