@@ -84,6 +84,28 @@ def people_reaches(tathum: Path | None, ue_adl: Path | None, limit: int | None =
             for person, trials in people_trials(tathum, ue_adl, limit).items()}
 
 
+def add_people_arguments(parser: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """``--tathum`` and ``--ue-adl``, the folders the arm people are read from, on ``parser``."""
+    parser.add_argument("--tathum", type=Path, default=TATHUM, help="a TAT-HUM 3-D data folder (default: %(default)s)")
+    parser.add_argument("--ue-adl", type=Path, default=UE_ADL, help="a folder of people's Nexus exports (default: %(default)s)")
+    return parser
+
+
+def people_of(args, parser: argparse.ArgumentParser, limit: int | None = None) -> dict[str, list]:
+    """:func:`people_reaches` of the folders ``args`` name (:func:`add_people_arguments`); the parser's one-line error
+    when they hold fewer than two people (leave-one-person-out needs two)."""
+    people = people_reaches(args.tathum, args.ue_adl, limit)
+    if len(people) < 2:
+        parser.error(f"leave-one-person-out needs at least two people; {args.tathum} and {args.ue_adl} hold {len(people)}")
+    return people
+
+
+def people_from_command_line(description: str, argv=None) -> dict[str, list]:
+    """:func:`people_of` the folders a command line of :func:`add_people_arguments` alone names."""
+    parser = add_people_arguments(argparse.ArgumentParser(description=description))
+    return people_of(parser.parse_args(argv), parser)
+
+
 def _at(t: np.ndarray, values: np.ndarray, times: np.ndarray) -> np.ndarray:
     """``values`` (K, d) interpolated linearly at ``times`` (M,) within t (K,), held at the ends: (M, d)."""
     return np.column_stack([np.interp(times, t, column) for column in values.T])
@@ -266,9 +288,7 @@ def markdown(table, forecasters, counts) -> str:
 
 
 def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--tathum", type=Path, default=TATHUM, help="a TAT-HUM 3-D data folder (default: %(default)s)")
-    parser.add_argument("--ue-adl", type=Path, default=UE_ADL, help="a folder of people's Nexus exports (default: %(default)s)")
+    parser = add_people_arguments(argparse.ArgumentParser(description=__doc__.split("\n\n")[0]))
     parser.add_argument("--limit", type=int, default=None, help="at most this many reaches per person")
     parser.add_argument("--every", type=int, default=1, help="train the learned forecaster on every N-th sample (default: %(default)s)")
     parser.add_argument("--max-iter", type=int, default=200, help="boosting iterations per tree ensemble (default: %(default)s)")
@@ -280,9 +300,7 @@ def main(argv=None):
         parser.error("--limit, --every and --max-iter must be whole numbers ≥ 1")
     log = sys.stderr if args.markdown else sys.stdout
     begin = time.perf_counter()
-    people = people_reaches(args.tathum, args.ue_adl, args.limit)
-    if len(people) < 2:
-        parser.error(f"leave-one-person-out needs at least two people; {args.tathum} and {args.ue_adl} hold {len(people)}")
+    people = people_of(args, parser, args.limit)
     counts = {person: len(recordings) for person, recordings in people.items()}
     print(f"{len(people)} people, {sum(counts.values())} reaches read in {time.perf_counter() - begin:.0f} s", file=log, flush=True)
     from comanip.estimation.people.people_model import PeopleModel

@@ -19,7 +19,6 @@ Printed as a markdown block (progress on stderr).
 
 from __future__ import annotations
 
-import argparse
 import sys
 import warnings
 from pathlib import Path
@@ -94,16 +93,10 @@ def band_chance(reaches: int, rate: float = 0.95) -> float:
 
 def main(argv=None) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-    from forecast_peers import TATHUM, UE_ADL, leave_one_person_out, people_reaches  # noqa: E402  (the benchmarks' folds)
+    from forecast_peers import leave_one_person_out, people_from_command_line  # noqa: E402  (the benchmarks' folds)
 
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--tathum", type=Path, default=TATHUM, help="a TAT-HUM 3-D data folder (default: %(default)s)")
-    parser.add_argument("--ue-adl", type=Path, default=UE_ADL, help="a folder of people's Nexus exports (default: %(default)s)")
-    args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    people = people_reaches(args.tathum, args.ue_adl)
-    if len(people) < 2:
-        sys.exit(f"leave-one-person-out needs at least two people; {args.tathum} and {args.ue_adl} hold {len(people)}")
+    people = people_from_command_line(__doc__.split("\n\n")[0], argv)
     table: dict = {}
     for P in PHASES:
         print(f"P = {P} ...", file=sys.stderr, flush=True)

@@ -203,18 +203,14 @@ def people_markdown(table: dict, counts: dict) -> str:
 
 def over_people(argv) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-    from forecast_peers import TATHUM, UE_ADL, people_models, people_reaches  # noqa: E402  (the benchmarks' folds)
+    from forecast_peers import add_people_arguments, people_models, people_of  # noqa: E402  (the benchmarks' folds)
 
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser = add_people_arguments(argparse.ArgumentParser(description=__doc__.split("\n\n")[0]))
     parser.add_argument("--people", action="store_true", required=True)
-    parser.add_argument("--tathum", type=Path, default=TATHUM, help="a TAT-HUM 3-D data folder (default: %(default)s)")
-    parser.add_argument("--ue-adl", type=Path, default=UE_ADL, help="a folder of people's Nexus exports (default: %(default)s)")
     parser.add_argument("--fits", type=Path, default=None, help="a folder to keep the people models in for the next run")
     args = parser.parse_args(argv)
     warnings.simplefilter("ignore")
-    people = people_reaches(args.tathum, args.ue_adl)
-    if len(people) < 2:
-        sys.exit(f"leave-one-person-out needs at least two people; {args.tathum} and {args.ue_adl} hold {len(people)}")
+    people = people_of(args, parser)
     models = people_models(people, args.fits, sys.stderr)
     table: dict = {}
     for i, (person, recordings) in enumerate(people.items()):
