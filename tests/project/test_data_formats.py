@@ -213,6 +213,18 @@ def test_arm_reach_library_arrays_are_the_saved_ones(tmp_path):
             assert saved[name].shape == shape, name
 
 
+def test_people_model_arrays_are_the_saved_ones(tmp_path):
+    from comanip.estimation.people.people_model import shipped_people_model
+
+    def expanded(name: str) -> list[str]:                 # {a,b}_{x,y} names every a_x, a_y, b_x, b_y
+        parts = [part.split(",") for part in re.split(r"\{([^}]*)\}", name)]
+        return ["".join(choice) for choice in itertools.product(*parts)]
+
+    documented = [full for row in table("People model (npz)") for name in ticked(row[0]) for full in expanded(name)]
+    with np.load(shipped_people_model("arm").save(tmp_path / "people.npz")) as saved:
+        assert sorted(documented) == sorted(saved.files)
+
+
 # ---- outputs --------------------------------------------------------------------------------------------------
 
 def test_every_command_has_its_row_of_files_and_the_manifest_keys(tmp_path):
