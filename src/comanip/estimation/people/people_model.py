@@ -209,11 +209,9 @@ class PeopleModel:
         ``phases``: how many phases get their own coverage factor (≥ 1; default: the kind's, :data:`PHASE_BINS`).
         Needs scikit-learn."""
         from threadpoolctl import ThreadpoolController
-        if kind not in KINDS:
-            raise ValueError(f"kind must be one of {sorted(KINDS)}, got {kind!r}")
+        features = checked_features(kind, features)
         if len(recordings) < 4:
             raise ValueError(f"PeopleModel.fit needs at least 4 recordings (two folds of two), got {len(recordings)}")
-        features = checked_features(kind, features)
         phases = PHASE_BINS[kind] if phases is None else phases
         if isinstance(phases, bool) or not isinstance(phases, (int, np.integer)) or phases < 1:
             raise ValueError(f"phases must be a whole number ≥ 1, got {phases!r}")
@@ -242,7 +240,8 @@ class PeopleModel:
         factor = float(np.quantile(ratio, 0.95))
         edges = np.unique(np.quantile(share, np.arange(1, phases) / phases)) if phases > 1 else np.zeros(0)
         phase = np.searchsorted(edges, share)
-        factors = tuple(float(np.quantile(ratio[phase == i], 0.95)) for i in range(len(edges) + 1)) if len(edges) else ()
+        factors = tuple(float(np.quantile(ratio[phase == i], 0.95)) if np.any(phase == i) else factor   # a phase of ties
+                        for i in range(len(edges) + 1)) if len(edges) else ()
         say("spread regressor, all samples")
         spread = _spread_regressor(X, log_squared, seed)
         say("along regressor, all samples")
