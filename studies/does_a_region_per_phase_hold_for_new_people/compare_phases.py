@@ -36,10 +36,9 @@ BAND = (0.80, 0.98)
 """The band a new person's coverage should lie in, at each fraction."""
 
 
-def coverage(recordings, model: PeopleModel) -> np.ndarray:
-    """Whether the 95 % region holds the recorded endpoint: (reaches, fractions) booleans."""
-    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-    from forecast_scores import holds  # noqa: E402  (the benchmarks' check of a region)
+def coverage(recordings, model: PeopleModel, holds) -> np.ndarray:
+    """Whether the 95 % region holds the recorded endpoint, by ``holds(error, covariance)``: (reaches, fractions)
+    booleans."""
     out = np.zeros((len(recordings), len(FRACTIONS)), dtype=bool)
     for i, r in enumerate(recordings):
         for j, f in enumerate(FRACTIONS):
@@ -94,6 +93,7 @@ def band_chance(reaches: int, rate: float = 0.95) -> float:
 def main(argv=None) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
     from forecast_peers import leave_one_person_out, people_from_command_line  # noqa: E402  (the benchmarks' folds)
+    from forecast_scores import holds  # noqa: E402  (the benchmarks' check of a region)
 
     warnings.simplefilter("ignore")
     people = people_from_command_line(__doc__.split("\n\n")[0], argv)
@@ -101,7 +101,7 @@ def main(argv=None) -> None:
     for P in PHASES:
         print(f"P = {P} ...", file=sys.stderr, flush=True)
         for person, model in leave_one_person_out(people, lambda recordings: PeopleModel.fit(recordings, kind="arm", phases=P)):
-            table.setdefault(P, {})[person] = coverage(people[person], model).mean(axis=0)
+            table.setdefault(P, {})[person] = coverage(people[person], model, holds).mean(axis=0)
             print(f"  {person}: {np.round(100 * table[P][person])}", file=sys.stderr, flush=True)
     print(markdown(table, {person: len(recordings) for person, recordings in people.items()}))
 

@@ -28,8 +28,8 @@ import numpy as np
 from comanip.estimation.calibration.goal_smoothing import GoalSmoothing
 from comanip.estimation.people.people_model import ARM_FEATURES, SCALE_FREE, PeopleModel
 
-from studies.what_does_a_smoother_arm_goal_cost.measure_smoothing import (FRACTIONS, JUMP, free_rate_smoothed,
-                                                                          people_goals, scored)
+from studies.what_does_a_smoother_arm_goal_cost.measure_smoothing import (FRACTIONS, JUMP, UNSMOOTHED, free_rate_name,
+                                                                          people_goals, rules, scored)
 
 FEATURE_SETS = {
     "every feature without units": SCALE_FREE,
@@ -42,20 +42,12 @@ COST = 0.005
 """Error / D a chosen set may have above the lowest, at each fraction of the movement time (median over people)."""
 
 
-def unsmoothed(recording, times, goals, covariances):
-    return goals
-
-
-def default_smoothed(recording, times, goals, covariances):
-    rule = GoalSmoothing()
-    return free_rate_smoothed(recording, times, goals, covariances, rule.free_rate, rule.time_constant)
-
-
 def person_scores(recordings, model: PeopleModel) -> dict:
     """{"error": (fractions,) median error / D, "jumps": share unsmoothed, "smoothed jumps": with the default rule}."""
     traces = [people_goals(recording, model) for recording in recordings]
+    default, tried = GoalSmoothing(), rules()
     out = {}
-    for name, rule in (("", unsmoothed), ("smoothed ", default_smoothed)):
+    for name, rule in (("", tried[UNSMOOTHED]), ("smoothed ", tried[free_rate_name(default.free_rate, default.time_constant)])):
         each = [scored(recording, trace, rule) for recording, trace in zip(recordings, traces)]
         if not name:
             out["error"] = np.median([[errors[f] for f in FRACTIONS] for errors, _ in each], axis=0)

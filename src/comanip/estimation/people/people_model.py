@@ -30,7 +30,7 @@ the path so far and of the time since the onset, so it carries over to other dis
 people's profiles keep their shape. Of the features without units it leaves out the straightness: fitted on
 other people without it, its goal moves less from one sample to the next and is as near. The straightness reads
 the tracker as much as the hand: it sets the displacement against a path integrated from velocities derived
-over a window, so a short reach's looks less straight than a long one's of the same shape, and a noisy tracker's
+over a window, so a short reach's differs from a long one's of the same shape, and a noisy tracker's
 path is longer. A model reads the features it names (:attr:`PeopleModel.features`), saved with it.
 
 Models are saved as plain arrays (``.npz``: every tree's nodes, :class:`TreeEnsemble`) and loaded without
