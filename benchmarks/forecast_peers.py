@@ -182,17 +182,17 @@ def people_models(people: dict[str, list], cache: Path | None = None, log=sys.st
     """{person: the ``arm`` people model (:class:`~comanip.estimation.people.people_model.PeopleModel`) fitted on every
     other person's reaches} (:func:`leave_one_person_out`). ``cache``: a folder where each fit is kept as
     ``<reaches>-<digest>.npz``, the count and a digest of the names of the reaches it was fitted on and of the features
-    an arm model reads, and read back by the next run on the same reaches and features (a fit takes seconds to a
-    minute)."""
+    an arm model reads and of how its fit weighs them, and read back by the next run on the same reaches, features and
+    weighting (a fit takes seconds to a minute)."""
     import hashlib
 
-    from comanip.estimation.people.people_model import KINDS, PeopleModel
+    from comanip.estimation.people.people_model import KINDS, WEIGHTING, PeopleModel
 
     def fit(recordings):
         names = sorted(r.name for r in recordings)
         path = None
         if cache is not None:
-            digest = hashlib.sha256("\n".join([*names, *KINDS["arm"]]).encode()).hexdigest()[:12]
+            digest = hashlib.sha256("\n".join([*names, *KINDS["arm"], WEIGHTING["arm"]]).encode()).hexdigest()[:12]
             path = cache / f"{len(names)}-{digest}.npz"
             if path.is_file():
                 return PeopleModel.load(path)

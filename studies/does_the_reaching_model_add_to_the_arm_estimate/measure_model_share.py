@@ -33,7 +33,7 @@ import numpy as np
 import comanip
 from comanip.estimation.people.endpoint_baselines import MOVING_SPEED
 from comanip.estimation.model_reaches.paced_model import PACE_STD, PacedModel
-from comanip.estimation.people.people_model import (FEATURES, KINDS, PeopleModel, _along_regressor, beyond_over_path,
+from comanip.estimation.people.people_model import (FEATURES, KINDS, WEIGHTING, PeopleModel, _along_regressor, beyond_over_path,
                                              movement_features, share_to_go)
 from comanip.estimation.model_reaches.profile_fit import detected_onset
 from comanip.estimation.model_reaches.reach_profile import ReachProfile
@@ -130,12 +130,13 @@ def main(argv=None) -> None:
         train = [k for k in range(len(recordings)) if k % 2 != parity]
         people = PeopleModel.fit([recordings[k] for k in train], kind="arm")
         shape, movement_time = people_shape([recordings[k] for k in train])
-        X, y = [], []
+        X, y, weights = [], [], []
         for k in train:
             for prefix, (features, u, path, _, extra) in traces[k].items():
                 X.append(np.r_[features, extra])
                 y.append(float((recordings[k].end - recordings[k].position[prefix - 1]) @ u) / path)
-        with_model = _along_regressor(np.array(X), share_to_go(np.array(y)), 0)
+                weights.append(1.0 / len(traces[k]) if WEIGHTING["arm"] == "reach" else 1.0)   # as the people model's fit
+        with_model = _along_regressor(np.array(X), share_to_go(np.array(y)), 0, np.array(weights) * len(weights) / sum(weights))
         for k in range(parity, len(recordings), 2):
             r = recordings[k]
             speed = np.linalg.norm(r.velocity, axis=1)

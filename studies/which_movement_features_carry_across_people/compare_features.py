@@ -56,21 +56,28 @@ def person_scores(recordings, model: PeopleModel) -> dict:
 
 
 def chosen_set(table: dict) -> str:
-    """The set (a key of ``table``: {set: {person: person_scores}}) chosen as the module docstring says."""
+    """The choice (a key of ``table``: {choice: {person: person_scores}}) made as the module docstring says: of the
+    choices whose error is within ``COST`` D of the lowest at every fraction, the one whose most jumping person jumps
+    least."""
     error = {name: np.median([s["error"] for s in people.values()], axis=0) for name, people in table.items()}
     lowest = np.min(list(error.values()), axis=0)
     near = [name for name in table if np.all(error[name] <= lowest + COST)]
     return min(near, key=lambda name: max(s["jumps"] for s in table[name].values()))
 
 
-def markdown(table: dict, counts: dict) -> str:
+def markdown(table: dict, counts: dict, compared: str = "sets of features", shipped: str | None = None) -> str:
+    """The block: ``table`` ({choice: {person: person_scores}}), ``counts`` ({person: reaches}); ``compared``: what the
+    choices are (the first column's heading); ``shipped``: the choice an arm people model makes (default: the
+    feature set it reads)."""
     people = list(counts)
+    if shipped is None:
+        shipped = next((name for name, features in FEATURE_SETS.items() if features == ARM_FEATURES), "none of these")
     lines = [f"The people model's goal on {len(people)} arm people ({sum(counts.values())} reaches, each person's scored "
-             "with the people model fitted on the other people only) for each set of features it reads: error / D at "
+             f"with the people model fitted on the other people only) for each of its {compared}: error / D at "
              f"{' / '.join(f'{100 * f:g}' for f in FRACTIONS)} % of MT (median over people of each person's median) and "
              f"the share of updates after 25 % of MT moving the goal by more than {JUMP:g} D, unsmoothed and with the "
              "estimator's goal smoothing", "",
-             "| features | error / D | jumps: median over people | jumps: most (person) | smoothed jumps: median | smoothed jumps: most (person) |",
+             f"| {compared} | error / D | jumps: median over people | jumps: most (person) | smoothed jumps: median | smoothed jumps: most (person) |",
              "|---|---|---|---|---|---|"]
     for name, scores in table.items():
         error = np.median([scores[p]["error"] for p in people], axis=0)
@@ -85,10 +92,8 @@ def markdown(table: dict, counts: dict) -> str:
         lines.append(f"| {p} | {counts[p]} | " + " | ".join(
             f"{table[name][p]['error'][FRACTIONS.index(0.5)]:.3f}; {100 * table[name][p]['jumps']:.1f} % "
             f"({100 * table[name][p]['smoothed jumps']:.1f} %)" for name in table) + " |")
-    chosen = chosen_set(table)
-    arm = next((name for name, features in FEATURE_SETS.items() if features == ARM_FEATURES), "none of these")
-    lines += ["", f"Chosen (of the sets within {COST:g} D of the lowest error at every fraction, the one whose most "
-              f"jumping person jumps least): {chosen}. The arm people model reads: {arm}."]
+    lines += ["", f"Chosen (of the {compared} within {COST:g} D of the lowest error at every fraction, the one whose most "
+              f"jumping person jumps least): {chosen_set(table)}. An arm people model's: {shipped}."]
     return "\n".join(lines)
 
 

@@ -358,3 +358,33 @@ def test_a_region_calibrated_per_phase_holds_nearer_95_percent_near_the_end_of_r
     end = rates["per phase"][0]
     assert 0.90 <= end <= 0.98 and abs(end - 0.95) < abs(rates["pooled"][0] - 0.95), rates
     assert min(rates["per phase"]) >= 0.85, rates
+
+
+@given(st.lists(st.floats(-5.0, 5.0, allow_nan=False), min_size=1, max_size=30), st.floats(0.0, 1.0),
+       st.lists(st.integers(1, 4), min_size=30, max_size=30))
+def test_a_weighted_quantile_is_the_quantile_of_the_values_repeated_as_often_as_they_weigh(values, q, repeats):
+    from comanip.estimation.people.people_model import weighted_quantile
+    values, repeats = np.array(values), np.array(repeats[:len(values)])
+    assert weighted_quantile(values, q, np.ones(len(values))) == np.quantile(values, q, method="inverted_cdf")
+    assert weighted_quantile(values, q, repeats.astype(float)) == np.quantile(np.repeat(values, repeats), q, method="inverted_cdf")
+
+
+def test_recordings_weighed_by_their_samples_fit_as_every_sample_alike_and_bad_weights_are_refused(people):
+    from comanip.estimation.people.people_model import PeopleModel, _samples
+    recordings = people[:12]
+    counts = np.bincount(_samples(recordings)[-1], minlength=len(recordings))
+    assert counts.max() > 1.5 * counts.min()                # the weightings differ on these recordings
+    by_sample, as_samples, by_reach = (PeopleModel.fit(recordings, kind="mouse", weights=weights)
+                                       for weights in ("sample", 0.37 * counts, "reach"))
+    goals = {model: [] for model in (by_sample, as_samples, by_reach)}
+    for r in people[20:26]:
+        for k in range(8, len(r.t), 5):
+            for model, said in goals.items():
+                said.append(model.predict(r.t[:k], r.position[:k], r.velocity[:k], r.position[0]).goal)
+    same = np.median(np.linalg.norm(np.subtract(goals[as_samples], goals[by_sample]), axis=1))
+    other = np.median(np.linalg.norm(np.subtract(goals[by_reach], goals[by_sample]), axis=1))
+    assert same < 0.5 * other, (same, other)           # the trees differ a little: weighted leaves take weighted quantiles
+    for weights, message in (("person", "'sample', 'reach'"), (np.ones(3), "one per recording"),
+                             (-np.ones(12), "≥ 0"), (np.zeros(12), "not all 0"), (np.r_[np.nan, np.ones(11)], "finite")):
+        with pytest.raises(ValueError, match=message):
+            PeopleModel.fit(recordings, kind="mouse", weights=weights)

@@ -18,7 +18,8 @@ second after it left the start and its net speed over that time below half ``RES
 :mod:`comanip.estimation.hand_rest`, or its speed below ``REST_FRACTION`` of its peak for ``REST_TIME``) is at its
 endpoint. Its covariance is isotropic: the predicted squared error times a
 factor that makes the 95 % region hold 95 % of the fitting samples' endpoints (errors and their predicted
-spread both out of sample), one factor for each phase of the movement (:data:`PHASE_BINS`: bins of the predicted
+spread both out of sample; the samples weighted as the fit weighs them, :data:`WEIGHTING`: for an arm, every reach
+alike, whatever its tracker's rate and its duration), one factor for each phase of the movement (:data:`PHASE_BINS`: bins of the predicted
 share still to go, s, each holding as many fitting samples), so that the region holds as often near the end as
 early on; and while the path so far is short, never below the distance the hand can still cover at its speed
 (``STOPPING_TIME``).
@@ -71,6 +72,11 @@ PHASE_BINS = {"mouse": 1, "arm": 5}
 """How many phases of the movement (bins of the predicted share still to go) a model of each kind calibrates its
 95 % region on, each with its own coverage factor; the arm's chosen leave-one-person-out on recorded arm people
 (``studies/does_a_region_per_phase_hold_for_new_people``)."""
+WEIGHTING = {"mouse": "sample", "arm": "reach"}
+"""How a fit of each kind weighs its recordings' samples: ``"sample"``, every sample alike (a recording at a higher
+rate, or of a longer movement, counts more), or ``"reach"``, every recording alike (its samples share a weight of
+one); the arm's chosen leave-one-person-out on recorded arm people, whose trackers and paces differ
+(``studies/should_every_reach_weigh_alike``)."""
 UNNAMED_FEATURES = {"mouse": FEATURES, "arm": SCALE_FREE}
 """The features a model of each kind read when its file did not name them (saved before models named theirs)."""
 DIRECTION_SPEED = 0.1
@@ -199,7 +205,7 @@ class PeopleModel:
 
     @classmethod
     def fit(cls, recordings, kind: str = "mouse", trained_on: str = "", seed: int = 0, progress=None,
-            features=None, phases: int | None = None) -> "PeopleModel":
+            features=None, phases: int | None = None, weights=None) -> "PeopleModel":
         """Fit on recordings (:class:`comanip.recordings.Recording`) of one ``kind`` of movement, every sample
         from each one's onset to its end: the spread regressor on two-fold out-of-sample errors of the along
         regressor, and the coverage factor on those errors over the spread each fold's spread regressor predicts
@@ -207,7 +213,10 @@ class PeopleModel:
         the along, spread and remaining-time regressors on all samples. ``progress``: called with a line of
         text per stage. ``features``: names of :data:`FEATURES` to fit on (default: the kind's, :data:`KINDS`).
         ``phases``: how many phases get their own coverage factor (≥ 1; default: the kind's, :data:`PHASE_BINS`).
-        Needs scikit-learn."""
+        ``weights``: ``"sample"`` (every sample counts alike), ``"reach"`` (every recording counts alike, its weight
+        shared among its samples), how much each recording counts (len(recordings),), ≥ 0, shared among its samples
+        (e.g. one over a person's count of recordings, so that every person counts alike), or None: the kind's
+        (:data:`WEIGHTING`). Needs scikit-learn."""
         from threadpoolctl import ThreadpoolController
         features = checked_features(kind, features)
         if len(recordings) < 4:
@@ -215,40 +224,62 @@ class PeopleModel:
         phases = PHASE_BINS[kind] if phases is None else phases
         if isinstance(phases, bool) or not isinstance(phases, (int, np.integer)) or phases < 1:
             raise ValueError(f"phases must be a whole number ≥ 1, got {phases!r}")
+        weights = WEIGHTING[kind] if weights is None else weights
+        if isinstance(weights, str):
+            if weights not in ("sample", "reach"):
+                raise ValueError(f"weights must be 'sample', 'reach' or one number per recording, got {weights!r}")
+            weights = None if weights == "sample" else np.ones(len(recordings))
+        else:
+            weights = np.asarray(weights, dtype=float)
+            if weights.shape != (len(recordings),) or not np.all(np.isfinite(weights)) or np.any(weights < 0) or not weights.any():
+                raise ValueError(f"weights must be {len(recordings)} finite numbers ≥ 0 (one per recording), not all 0, "
+                                 f"got shape {weights.shape}")
         with ThreadpoolController().limit(limits=1, user_api="openmp"):   # reproducible, no spinning threads
-            return cls._fit(recordings, kind, features, int(phases), trained_on, seed, progress or (lambda line: None))
+            return cls._fit(recordings, kind, features, int(phases), weights, trained_on, seed, progress or (lambda line: None))
 
     @classmethod
-    def _fit(cls, recordings, kind: str, features: tuple, phases: int, trained_on: str, seed: int, say) -> "PeopleModel":
+    def _fit(cls, recordings, kind: str, features: tuple, phases: int, weights, trained_on: str, seed: int,
+             say) -> "PeopleModel":
         from sklearn.ensemble import HistGradientBoostingRegressor
         X, along, across, remaining, owner = _samples(recordings)
         X = X[:, [FEATURES.index(name) for name in features]]
+        w = None
+        if weights is not None:
+            counts = np.bincount(owner, minlength=len(recordings))
+            if not weights[counts > 0].any():
+                raise ValueError("weights give no weight to any recording that moves")
+            w = weights[owner] / counts[owner] * len(X) / weights[counts > 0].sum()   # mean 1 over the samples
+
+        def part(mask):
+            return None if w is None else w[mask]
         fold = np.random.default_rng(seed).permutation(len(recordings))[owner] % 2
         share = np.zeros(len(X))
         for k in (0, 1):
             say(f"along regressor, fold {k + 1} of 2 ({int((fold != k).sum())} samples)")
-            share[fold == k] = _along_regressor(X[fold != k], share_to_go(along[fold != k]), seed).predict(X[fold == k])
+            share[fold == k] = _along_regressor(X[fold != k], share_to_go(along[fold != k]), seed,
+                                                part(fold != k)).predict(X[fold == k])
         predicted = beyond_over_path(share)
         squared = (np.maximum(predicted, 0.0) - along) ** 2 + across**2
         log_squared = np.log(squared + 1e-6)
         spread_out_of_sample = np.zeros(len(X))
         for k in (0, 1):
             say(f"spread regressor, fold {k + 1} of 2")
-            spread_out_of_sample[fold == k] = _spread_regressor(X[fold != k], log_squared[fold != k], seed).predict(X[fold == k])
+            spread_out_of_sample[fold == k] = _spread_regressor(X[fold != k], log_squared[fold != k], seed,
+                                                                part(fold != k)).predict(X[fold == k])
         d = recordings[0].position.shape[1]
         ratio = squared / np.exp(spread_out_of_sample) / chi2.ppf(0.95, d) * d
-        factor = float(np.quantile(ratio, 0.95))
-        edges = np.unique(np.quantile(share, np.arange(1, phases) / phases)) if phases > 1 else np.zeros(0)
+        factor = weighted_quantile(ratio, 0.95, w)
+        edges = np.unique(weighted_quantile(share, np.arange(1, phases) / phases, w)) if phases > 1 else np.zeros(0)
         phase = np.searchsorted(edges, share)
-        factors = tuple(float(np.quantile(ratio[phase == i], 0.95)) if np.any(phase == i) else factor   # a phase of ties
+        factors = tuple(weighted_quantile(ratio[phase == i], 0.95, part(phase == i)) if np.any(phase == i) else factor   # ties
                         for i in range(len(edges) + 1)) if len(edges) else ()
         say("spread regressor, all samples")
-        spread = _spread_regressor(X, log_squared, seed)
+        spread = _spread_regressor(X, log_squared, seed, w)
         say("along regressor, all samples")
-        along_regressor = _along_regressor(X, share_to_go(along), seed)
+        along_regressor = _along_regressor(X, share_to_go(along), seed, w)
         say("remaining-time regressor")
         remaining_regressor = HistGradientBoostingRegressor(max_iter=100, learning_rate=0.1, random_state=seed).fit(
-            X, np.log(remaining + REMAINING_FLOOR))
+            X, np.log(remaining + REMAINING_FLOOR), sample_weight=w)
         return cls(TreeEnsemble.of(along_regressor), TreeEnsemble.of(spread), factor, kind, trained_on,
                    TreeEnsemble.of(remaining_regressor), features=features, phase_edges=tuple(edges), phase_factors=factors)
 
@@ -413,15 +444,30 @@ ALONG_TARGETS = {"share": beyond_over_path, "over path": lambda beyond: beyond}
 over the path so far."""
 
 
-def _spread_regressor(X, log_squared, seed: int):
+def weighted_quantile(values: np.ndarray, q, weights: np.ndarray | None = None):
+    """The ``q`` quantile(s) (a float or an array in [0, 1]) of ``values`` (N,), each counting its ``weights`` (N,):
+    the smallest value whose share of the weight at or below it reaches q (with equal weights, numpy's
+    ``inverted_cdf`` quantile); for weights None, numpy's default (linear) quantile."""
+    if weights is None:
+        picked = np.quantile(values, q)
+        return float(picked) if np.ndim(picked) == 0 else picked
+    order = np.argsort(values, kind="stable")
+    cumulative = np.cumsum(weights[order])
+    at = np.searchsorted(cumulative, np.asarray(q) * cumulative[-1] * (1 - 1e-12), side="left")
+    picked = values[order][np.minimum(at, len(values) - 1)]
+    return float(picked) if np.ndim(picked) == 0 else picked
+
+
+def _spread_regressor(X, log_squared, seed: int, weights=None):
     from sklearn.ensemble import HistGradientBoostingRegressor
-    return HistGradientBoostingRegressor(max_iter=120, learning_rate=0.06, random_state=seed).fit(X, log_squared)
+    return HistGradientBoostingRegressor(max_iter=120, learning_rate=0.06, random_state=seed).fit(X, log_squared,
+                                                                                                  sample_weight=weights)
 
 
-def _along_regressor(X, share, seed: int):
+def _along_regressor(X, share, seed: int, weights=None):
     from sklearn.ensemble import HistGradientBoostingRegressor
     return HistGradientBoostingRegressor(max_iter=250, learning_rate=0.06, loss="quantile", quantile=QUANTILE,
-                                         random_state=seed).fit(X, share)
+                                         random_state=seed).fit(X, share, sample_weight=weights)
 
 
 def _samples(recordings):
