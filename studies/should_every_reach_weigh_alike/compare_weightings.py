@@ -10,7 +10,7 @@ unsmoothed goal's error / D at 25 / 50 / 75 / 90 % of the movement time and the 
 it that move the goal by more than 0.1 D, unsmoothed and with the estimator's goal smoothing (as
 ``studies/which_movement_features_carry_across_people`` scores its sets of features).
 
-The weighting chosen is made by that study's rule (:func:`chosen_set`): of the weightings whose error (median over
+The weighting chosen is made by that study's rule (``compare_features.chosen_set``): of the weightings whose error (median over
 people) is within ``COST`` D of the lowest at every fraction, the one whose most jumping person jumps least,
 unsmoothed.
 
@@ -29,7 +29,7 @@ import numpy as np
 
 from comanip.estimation.people.people_model import WEIGHTING, PeopleModel
 
-from studies.which_movement_features_carry_across_people.compare_features import chosen_set, markdown, person_scores
+from studies.which_movement_features_carry_across_people.compare_features import markdown, person_scores
 
 WEIGHTINGS = {
     "every sample alike": "sample",
