@@ -284,10 +284,19 @@ def people_markdown(name: str, rows, diagnosed) -> str:
                   and person in (None, r["person"])]
         return float(np.median(errors)) if errors else math.nan
 
-    def coverage(person, f):
-        held = [r["covered"] for r in rows if r["predictor"] == name and r["fraction"] == f and r["covered"] is not None
+    def held(person, f):
+        return [r["covered"] for r in rows if r["predictor"] == name and r["fraction"] == f and r["covered"] is not None
                 and person in (None, r["person"])]
-        return float(np.mean(held)) if held else math.nan
+
+    def coverage(person, f):
+        return float(np.mean(held(person, f))) if held(person, f) else math.nan
+
+    def consistent(person, f):
+        """Whether the count of reaches held at ``f`` is consistent with a region that holds 95 % of the time
+        (two-sided binomial test at 5 %)."""
+        from scipy.stats import binomtest
+        each = held(person, f)
+        return bool(each) and binomtest(int(sum(each)), len(each), 0.95).pvalue >= 0.05
 
     lines = [f"`{name}` person by person, each scored with the people model and templates of the other people only: "
              "median error / D at 25 / 50 / 75 / 90 % of MT, the best simple rule's (its name at 50 %), the 95 % region's "
@@ -325,6 +334,10 @@ def people_markdown(name: str, rows, diagnosed) -> str:
               f"{yes(sum(below_at_half) >= 0.8 * len(people))} |",
               f"| a new person's first reach: the 95 % region holds the endpoint in 80–98 % (every person, 25–90 % of MT) | "
               f"{100 * low:.0f}–{100 * high:.0f} % | {yes(0.8 <= low and high <= 0.98)} |",
+              f"| the same judged by a binomial test: person-fractions whose count held is consistent with 95 % (two-sided, "
+              f"5 %) | {sum(consistent(p, f) for p in people for f in PEOPLE_FRACTIONS)} of "
+              f"{len(people) * len(PEOPLE_FRACTIONS)} | "
+              f"{yes(all(consistent(p, f) for p in people for f in PEOPLE_FRACTIONS))} |",
               f"| after 25 % of MT, ≤ 1 % of updates move the goal by > 0.1 D (every person) | at most "
               f"{100 * jumps_by_person[worst_jumps]:.1f} % ({worst_jumps}) | {yes(jumps_by_person[worst_jumps] <= 0.01)} |"]
     return "\n".join(lines)

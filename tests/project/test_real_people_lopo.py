@@ -50,3 +50,7 @@ def test_the_person_table_says_who_the_estimator_beats(real_people):
     assert "| 1 of 2 | no |" in text                                    # 50 % of the people, not 80 %
     assert "at most 5.0 % (Q) | no |" in text
     assert "100–100 % | no |" in text                                  # every region holds: too wide, not 80–98 %
+    # one reach a person, each held: consistent with a region that holds 95 % of the time; 100 reaches all held are not
+    assert f"| {2 * len(real_people.PEOPLE_FRACTIONS)} of {2 * len(real_people.PEOPLE_FRACTIONS)} | yes |" in text
+    many = real_people.people_markdown(name, 100 * rows_of(errors, real_people.FRACTIONS), diagnosed)
+    assert f"| 0 of {2 * len(real_people.PEOPLE_FRACTIONS)} | no |" in many
