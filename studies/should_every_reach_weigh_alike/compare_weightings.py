@@ -29,7 +29,7 @@ import numpy as np
 
 from comanip.estimation.people.people_model import WEIGHTING, PeopleModel
 
-from studies.which_movement_features_carry_across_people.compare_features import markdown, person_scores
+from studies.which_movement_features_carry_across_people.compare_features import markdown, scored_people
 
 WEIGHTINGS = {
     "every sample alike": "sample",
@@ -51,19 +51,14 @@ def fit_weights(weighting: str, owners: list[str]):
 
 def main(argv=None) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
-    from forecast_peers import people_from_command_line  # noqa: E402  (the benchmarks' people)
+    from forecast_peers import leave_one_person_out, people_from_command_line  # noqa: E402  (the benchmarks' folds)
 
     warnings.simplefilter("ignore")
     people = people_from_command_line(__doc__.split("\n\n")[0], argv)
-    table: dict = {}
-    for name, weighting in WEIGHTINGS.items():
-        print(f"{name} ...", file=sys.stderr, flush=True)
-        for person in people:
-            others = [(other, r) for other, recordings in people.items() if other != person for r in recordings]
-            model = PeopleModel.fit([r for _, r in others], kind="arm",
-                                    weights=fit_weights(weighting, [other for other, _ in others]))
-            table.setdefault(name, {})[person] = scores = person_scores(people[person], model)
-            print(f"  {person}: {np.round(scores['error'], 3)}, jumps {scores['jumps']:.1%}", file=sys.stderr, flush=True)
+    owner = {r.name: person for person, recordings in people.items() for r in recordings}
+    table = {name: scored_people(people, leave_one_person_out(people, lambda recordings: PeopleModel.fit(
+        recordings, kind="arm", weights=fit_weights(weighting, [owner[r.name] for r in recordings]))), name)
+        for name, weighting in WEIGHTINGS.items()}
     shipped = next(name for name, weighting in WEIGHTINGS.items() if weighting == WEIGHTING["arm"])
     print(markdown(table, {person: len(recordings) for person, recordings in people.items()}, "weightings", shipped))
 

@@ -97,20 +97,26 @@ def markdown(table: dict, counts: dict, compared: str = "sets of features", ship
     return "\n".join(lines)
 
 
+def scored_people(people: dict, fits, label: str) -> dict:
+    """{person: person_scores} of each (person, model) of ``fits`` on ``people[person]`` ({person: recordings}),
+    with progress on stderr under ``label``."""
+    print(f"{label} ...", file=sys.stderr, flush=True)
+    scores = {}
+    for person, model in fits:
+        scores[person] = person_scores(people[person], model)
+        print(f"  {person}: {np.round(scores[person]['error'], 3)}, jumps {scores[person]['jumps']:.1%}", file=sys.stderr, flush=True)
+    return scores
+
+
 def main(argv=None) -> None:
     sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
     from forecast_peers import leave_one_person_out, people_from_command_line  # noqa: E402  (the benchmarks' folds)
 
     warnings.simplefilter("ignore")
     people = people_from_command_line(__doc__.split("\n\n")[0], argv)
-    table: dict = {}
-    for name, features in FEATURE_SETS.items():
-        print(f"{name} ({', '.join(features)}) ...", file=sys.stderr, flush=True)
-        fits = leave_one_person_out(people, lambda recordings: PeopleModel.fit(recordings, kind="arm", features=features))
-        for person, model in fits:
-            table.setdefault(name, {})[person] = person_scores(people[person], model)
-            print(f"  {person}: {np.round(table[name][person]['error'], 3)}, jumps {table[name][person]['jumps']:.1%}",
-                  file=sys.stderr, flush=True)
+    table = {name: scored_people(people, leave_one_person_out(
+        people, lambda recordings: PeopleModel.fit(recordings, kind="arm", features=features)), f"{name} ({', '.join(features)})")
+        for name, features in FEATURE_SETS.items()}
     print(markdown(table, {person: len(recordings) for person, recordings in people.items()}))
 
 
